@@ -1,0 +1,42 @@
+// Anything that can be evaluated as a BRDF: an analytic material, a measured database file
+// (RGL, MERL), an interpolated capture. The simulated scatterometer captures any BrdfSource,
+// and `brdf eval` prints one.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "brdf/core/geometry.h"
+#include "brdf/core/models.h"
+
+namespace brdf {
+
+class BrdfSource {
+ public:
+  virtual ~BrdfSource() = default;
+
+  // f_r in 1/sr, linear Rec.709 RGB, not multiplied by cosθ. `wi` points to the light, `wo`
+  // to the viewer, both unit vectors in the local frame (z = normal). Zero below the horizon.
+  virtual Rgb Eval(const Vec3& wi, const Vec3& wo) const = 0;
+
+  // Short name for metadata and messages ("gold", "paper_white_rgb.bsdf").
+  virtual std::string Name() const = 0;
+};
+
+class AnalyticBrdf final : public BrdfSource {
+ public:
+  explicit AnalyticBrdf(Material material) : material_(std::move(material)) {}
+  Rgb Eval(const Vec3& wi, const Vec3& wo) const override { return material_.Evaluate(wi, wo); }
+  std::string Name() const override { return material_.name; }
+  const Material& material() const { return material_; }
+
+ private:
+  Material material_;
+};
+
+// Opens any evaluable file by its content and extension. Material JSON files are
+// supported here; measured formats register as their readers land.
+// Throws FormatError / IoError naming the file.
+std::unique_ptr<BrdfSource> OpenBrdfSource(const std::string& path);
+
+}  // namespace brdf

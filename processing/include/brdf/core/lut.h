@@ -1,0 +1,46 @@
+// The exported asset in memory: K slices of the specular-frame LUT of DESIGN §5.
+//
+// Slice k holds f(θin,k, ω_out) sampled at texel centres (φd = i·1°, i = 0…360; θd = j·1°,
+// j = 0…180) of the specular frame S(θin,k); column 360 repeats column 0. Values are f_r in
+// 1/sr, linear RGB. Storage is float RGB, index ((k·181 + j)·361 + i)·3 + c.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <string>
+#include <vector>
+
+namespace brdf {
+
+struct Lut {
+  static constexpr int kWidth = 361;   // Nφ
+  static constexpr int kHeight = 181;  // Nθ
+  static constexpr double kTexelDeg = 1.0;
+
+  std::vector<double> theta_in_deg;  // K values, k·Δin
+  std::vector<float> texels;         // K × 181 × 361 × 3
+
+  int slices() const { return static_cast<int>(theta_in_deg.size()); }
+  // Δin in degrees (theta_in_deg[1] - theta_in_deg[0]; 0 for a single slice).
+  double DeltaInDeg() const;
+
+  void Resize(std::size_t k) {
+    theta_in_deg.resize(k);
+    texels.assign(k * kHeight * kWidth * 3, 0.0f);
+  }
+  std::size_t Index(int k, int j, int i) const {
+    return ((static_cast<std::size_t>(k) * kHeight + j) * kWidth + i) * 3;
+  }
+  float* Texel(int k, int j, int i) { return &texels[Index(k, j, i)]; }
+  const float* Texel(int k, int j, int i) const { return &texels[Index(k, j, i)]; }
+
+  // Samples the LUT exactly as a GPU samples the 3D texture: normalised coordinates
+  // u = (φd/1° + 0.5)/361, v = (θd/1° + 0.5)/181, w = (θin/Δin + 0.5)/K, trilinear filtering,
+  // clamp-to-edge addressing.
+  std::array<float, 3> SampleTrilinear(double u, double v, double w) const;
+  // The same lookup from angles (degrees): ω_out given by (θout, φout), light at (θin, 0).
+  std::array<float, 3> SampleAngles(double theta_in_deg, double theta_out_deg,
+                                    double phi_out_deg) const;
+};
+
+}  // namespace brdf

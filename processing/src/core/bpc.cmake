@@ -1,0 +1,1 @@
+# .bpc reader and writer: target_sources(brdf_core PRIVATE ...) added by that part.

@@ -1,0 +1,66 @@
+#include "brdf/core/lut.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "brdf/core/geometry.h"
+
+namespace brdf {
+namespace {
+
+// Texel-space position of a normalised coordinate, GPU style: x = u·N − 0.5, clamped so
+// that both taps stay inside [0, N − 1] (clamp-to-edge).
+struct Taps {
+  int i0, i1;
+  float t;
+};
+
+Taps LinearTaps(double u, int n) {
+  const double x = u * n - 0.5;
+  const double fl = std::floor(x);
+  int i0 = static_cast<int>(fl);
+  float t = static_cast<float>(x - fl);
+  int i1 = i0 + 1;
+  i0 = std::clamp(i0, 0, n - 1);
+  i1 = std::clamp(i1, 0, n - 1);
+  return {i0, i1, t};
+}
+
+}  // namespace
+
+double Lut::DeltaInDeg() const {
+  return theta_in_deg.size() >= 2 ? theta_in_deg[1] - theta_in_deg[0] : 0.0;
+}
+
+std::array<float, 3> Lut::SampleTrilinear(double u, double v, double w) const {
+  std::array<float, 3> out{};
+  if (texels.empty()) return out;
+  const Taps tu = LinearTaps(u, kWidth), tv = LinearTaps(v, kHeight), tw = LinearTaps(w, slices());
+  for (int c = 0; c < 3; ++c) {
+    auto bilinear = [&](int k) {
+      const float a = texels[Index(k, tv.i0, tu.i0) + c], b = texels[Index(k, tv.i0, tu.i1) + c];
+      const float d = texels[Index(k, tv.i1, tu.i0) + c], e = texels[Index(k, tv.i1, tu.i1) + c];
+      const float top = a + (b - a) * tu.t, bottom = d + (e - d) * tu.t;
+      return top + (bottom - top) * tv.t;
+    };
+    const float s0 = bilinear(tw.i0), s1 = bilinear(tw.i1);
+    out[c] = s0 + (s1 - s0) * tw.t;
+  }
+  return out;
+}
+
+std::array<float, 3> Lut::SampleAngles(double theta_in, double theta_out_deg,
+                                       double phi_out_deg) const {
+  const Vec3 w_out = SphericalDirectionDeg(theta_out_deg, phi_out_deg);
+  const Vec3 w_d = SpecularFrame::FromThetaInDeg(theta_in).ToSpecular(w_out);
+  const double theta_d = RadToDeg(ThetaOf(w_d));
+  const double phi_d = RadToDeg(PhiOf(w_d));
+  const double delta = DeltaInDeg();
+  const double k = delta > 0 ? (theta_in - theta_in_deg.front()) / delta : 0.0;
+  const double u = (phi_d / kTexelDeg + 0.5) / kWidth;
+  const double v = (theta_d / kTexelDeg + 0.5) / kHeight;
+  const double w = (k + 0.5) / slices();
+  return SampleTrilinear(u, v, w);
+}
+
+}  // namespace brdf

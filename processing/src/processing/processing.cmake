@@ -1,0 +1,1 @@
+# brdf_processing target: defined here once resampling lands.

@@ -1,0 +1,1 @@
+# Further command sources: target_sources(brdf PRIVATE ...) and their libraries.

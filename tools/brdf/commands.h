@@ -1,0 +1,48 @@
+// The `brdf` subcommands. main.cpp parses the command line with CLI11 into these option
+// structs; each Run* function lives in its own translation unit, writes results to stdout,
+// progress to stderr, and returns the process exit code. Errors thrown as brdf::Error are
+// turned into one line on stderr by main.cpp.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace brdf::cli {
+
+struct InfoOptions {
+  std::string file;
+  bool json = false;
+};
+int RunInfo(const InfoOptions& options);
+
+struct EvalOptions {
+  std::string file;
+  double theta_in_deg = 0, phi_in_deg = 0;
+  double theta_out_deg = 0, phi_out_deg = 0;
+};
+int RunEval(const EvalOptions& options);
+
+struct MaterialsOptions {
+  bool json = false;
+};
+int RunMaterials(const MaterialsOptions& options);
+
+struct CaptureOptions {
+  std::string device = "sim";
+  std::string material;  // library name or file
+  std::string sample;    // sample name recorded in the metadata
+  std::string out;       // .bpc path
+  std::vector<double> theta_in_deg = {0, 20, 40, 60};
+  double theta_out_max_deg = 75;
+  double theta_out_step_deg = 1;
+  double phi_out_step_deg = 1;
+  double noise = 1.0;  // 0 = noise-free and unsaturated; 1 = the reference instrument's noise
+  std::uint64_t seed = 1;
+  std::string operator_notes;
+  bool resume = false;
+  bool quiet = false;
+};
+int RunCapture(const CaptureOptions& options);
+
+}  // namespace brdf::cli

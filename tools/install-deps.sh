@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# Installs every Debian 12 package brdf-toolchain needs to build, test, benchmark and render.
+# Idempotent: packages already present are skipped, so a second run does nothing.
+# Nothing is downloaded from outside Debian's archive (the npm package used by the KTX2 test
+# is installed separately by tools/install-npm-deps.sh from the npm registry).
+set -euo pipefail
+
+packages=(
+  build-essential cmake ninja-build pkg-config git
+  libceres-dev libeigen3-dev
+  libopenimageio-dev openimageio-tools libopenexr-dev
+  libvtk9-dev
+  libusb-1.0-0-dev libhidapi-dev
+  libcli11-dev nlohmann-json3-dev libfmt-dev libspdlog-dev libtbb-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  umockdev libumockdev-dev
+  xvfb xauth
+  clang libclang-rt-14-dev
+  python3 python3-numpy python3-scipy
+  nodejs
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed'; then
+    missing+=("$p")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages already installed"
+  exit 0
+fi
+
+echo "install-deps: installing ${#missing[@]} package(s): ${missing[*]}"
+sudo_cmd=()
+if [ "$(id -u)" -ne 0 ]; then
+  sudo_cmd=(sudo)
+fi
+export DEBIAN_FRONTEND=noninteractive
+"${sudo_cmd[@]}" apt-get update -q
+"${sudo_cmd[@]}" apt-get install -y -q --no-install-recommends "${missing[@]}"
