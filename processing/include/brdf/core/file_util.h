@@ -1,0 +1,92 @@
+// File helpers shared by every reader and writer.
+//
+// Files written whole (conversions, exports, rewrites) go to a temporary name in the same
+// folder and are renamed over the final name only when complete, so a crash or a full disk
+// never leaves a half-written file under the final name. Reads are bounded: a file larger
+// than the caller's limit is refused before anything is allocated.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace brdf {
+
+// A temporary sibling of `final_path` ("dir/.name.tmp-<pid>-<n>"); removed by the destructor
+// unless Commit() renamed it into place.
+class AtomicOutputPath {
+ public:
+  explicit AtomicOutputPath(std::string final_path);
+  AtomicOutputPath(const AtomicOutputPath&) = delete;
+  AtomicOutputPath& operator=(const AtomicOutputPath&) = delete;
+  ~AtomicOutputPath();
+
+  const std::string& temp_path() const { return temp_path_; }
+  const std::string& final_path() const { return final_path_; }
+  // fsyncs the temporary file and renames it to the final path. Throws IoError.
+  void Commit();
+
+ private:
+  std::string final_path_, temp_path_;
+  bool committed_ = false;
+};
+
+// Writes `bytes` to `path` atomically (temporary sibling, fsync, rename). Throws IoError.
+void WriteFileAtomically(const std::string& path, std::string_view bytes);
+
+// Reads a whole file; throws IoError if it cannot be read and FormatError if it is larger
+// than `max_bytes` (checked before allocating).
+std::vector<std::uint8_t> ReadFileBytes(const std::string& path, std::uint64_t max_bytes);
+std::string ReadFileText(const std::string& path, std::uint64_t max_bytes);
+
+// Little-endian cursor over a byte buffer that knows the file name and its position, so every
+// read past the end or unexpected value becomes a FormatError naming both.
+class ByteReader {
+ public:
+  ByteReader(const std::uint8_t* data, std::size_t size, std::string file,
+             std::uint64_t base_offset = 0)
+      : data_(data), size_(size), file_(std::move(file)), base_(base_offset) {}
+
+  std::uint64_t offset() const { return base_ + pos_; }  // absolute file offset
+  std::size_t remaining() const { return size_ - pos_; }
+  const std::string& file() const { return file_; }
+  void Seek(std::size_t pos);  // relative to the buffer start; throws past the end
+  void Skip(std::size_t n);
+
+  std::uint8_t U8(std::string_view what);
+  std::uint16_t U16(std::string_view what);
+  std::uint32_t U32(std::string_view what);
+  std::uint64_t U64(std::string_view what);
+  std::int32_t I32(std::string_view what);
+  float F32(std::string_view what);
+  double F64(std::string_view what);
+  // Pointer to the next n bytes, advancing past them.
+  const std::uint8_t* Bytes(std::size_t n, std::string_view what);
+  std::string String(std::size_t n, std::string_view what);
+
+  // Throws FormatError "<file>: byte <offset>: expected <expected>, got <got>".
+  [[noreturn]] void Fail(std::string_view expected, std::string_view got) const;
+
+ private:
+  void Need(std::size_t n, std::string_view what) const;
+  const std::uint8_t* data_;
+  std::size_t size_;
+  std::size_t pos_ = 0;
+  std::string file_;
+  std::uint64_t base_;
+};
+
+// Little-endian appenders for writers.
+void AppendU16(std::string& out, std::uint16_t v);
+void AppendU32(std::string& out, std::uint32_t v);
+void AppendU64(std::string& out, std::uint64_t v);
+void AppendF32(std::string& out, float v);
+
+// CRC-32 (IEEE 802.3, reflected polynomial 0xEDB88320, as zlib's crc32). `crc` continues a
+// running checksum; start with 0.
+std::uint32_t Crc32(const void* data, std::size_t size, std::uint32_t crc = 0);
+
+}  // namespace brdf

@@ -1,0 +1,216 @@
+#include "brdf/core/file_util.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <array>
+#include <atomic>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+
+#include "brdf/core/error.h"
+
+namespace brdf {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+std::string ErrnoText() { return std::strerror(errno); }
+
+void SyncPath(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY);
+  if (fd < 0) return;
+  ::fsync(fd);
+  ::close(fd);
+}
+
+}  // namespace
+
+AtomicOutputPath::AtomicOutputPath(std::string final_path) : final_path_(std::move(final_path)) {
+  static std::atomic<unsigned> counter{0};
+  const fs::path p(final_path_);
+  const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  temp_path_ = (dir / ("." + p.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
+                       std::to_string(counter++)))
+                   .string();
+}
+
+AtomicOutputPath::~AtomicOutputPath() {
+  if (!committed_) ::unlink(temp_path_.c_str());
+}
+
+void AtomicOutputPath::Commit() {
+  SyncPath(temp_path_);
+  if (std::rename(temp_path_.c_str(), final_path_.c_str()) != 0)
+    throw IoError(final_path_ + ": cannot rename temporary file " + temp_path_ + " into place: " +
+                  ErrnoText());
+  committed_ = true;
+  const fs::path p(final_path_);
+  SyncPath(p.has_parent_path() ? p.parent_path().string() : std::string("."));
+}
+
+void WriteFileAtomically(const std::string& path, std::string_view bytes) {
+  AtomicOutputPath out(path);
+  std::FILE* f = std::fopen(out.temp_path().c_str(), "wb");
+  if (f == nullptr) throw IoError(path + ": cannot create file: " + ErrnoText());
+  const std::size_t written = std::fwrite(bytes.data(), 1, bytes.size(), f);
+  const bool ok = written == bytes.size() && std::fflush(f) == 0;
+  const std::string why = ok ? std::string() : ErrnoText();
+  std::fclose(f);
+  if (!ok) throw IoError(path + ": write failed: " + why);
+  out.Commit();
+}
+
+std::vector<std::uint8_t> ReadFileBytes(const std::string& path, std::uint64_t max_bytes) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (f == nullptr) throw IoError(path + ": cannot open: " + ErrnoText());
+  struct Closer {
+    std::FILE* f;
+    ~Closer() { std::fclose(f); }
+  } closer{f};
+  if (std::fseek(f, 0, SEEK_END) != 0) throw IoError(path + ": cannot seek: " + ErrnoText());
+  const long size = std::ftell(f);
+  if (size < 0) throw IoError(path + ": cannot tell size: " + ErrnoText());
+  if (static_cast<std::uint64_t>(size) > max_bytes)
+    throw FormatError(path, "file size", "at most " + std::to_string(max_bytes) + " bytes",
+                      std::to_string(size) + " bytes");
+  std::rewind(f);
+  std::vector<std::uint8_t> data(static_cast<std::size_t>(size));
+  if (!data.empty() && std::fread(data.data(), 1, data.size(), f) != data.size())
+    throw IoError(path + ": read failed: " + ErrnoText());
+  return data;
+}
+
+std::string ReadFileText(const std::string& path, std::uint64_t max_bytes) {
+  const auto bytes = ReadFileBytes(path, max_bytes);
+  return std::string(bytes.begin(), bytes.end());
+}
+
+void ByteReader::Need(std::size_t n, std::string_view what) const {
+  if (n > size_ - pos_)
+    throw FormatError(file_, BytePosition(offset()),
+                      std::to_string(n) + " more bytes for " + std::string(what),
+                      "end of data after " + std::to_string(size_ - pos_) + " bytes");
+}
+
+void ByteReader::Seek(std::size_t pos) {
+  if (pos > size_)
+    throw FormatError(file_, BytePosition(base_ + pos), "an offset inside the data",
+                      "offset past the end (" + std::to_string(base_ + size_) + " bytes)");
+  pos_ = pos;
+}
+
+void ByteReader::Skip(std::size_t n) {
+  Need(n, "skipped bytes");
+  pos_ += n;
+}
+
+const std::uint8_t* ByteReader::Bytes(std::size_t n, std::string_view what) {
+  Need(n, what);
+  const std::uint8_t* p = data_ + pos_;
+  pos_ += n;
+  return p;
+}
+
+std::uint8_t ByteReader::U8(std::string_view what) { return *Bytes(1, what); }
+
+std::uint16_t ByteReader::U16(std::string_view what) {
+  const std::uint8_t* p = Bytes(2, what);
+  return static_cast<std::uint16_t>(p[0] | (p[1] << 8));
+}
+
+std::uint32_t ByteReader::U32(std::string_view what) {
+  const std::uint8_t* p = Bytes(4, what);
+  return static_cast<std::uint32_t>(p[0]) | (static_cast<std::uint32_t>(p[1]) << 8) |
+         (static_cast<std::uint32_t>(p[2]) << 16) | (static_cast<std::uint32_t>(p[3]) << 24);
+}
+
+std::uint64_t ByteReader::U64(std::string_view what) {
+  const std::uint64_t lo = U32(what);
+  const std::uint64_t hi = U32(what);
+  return lo | (hi << 32);
+}
+
+std::int32_t ByteReader::I32(std::string_view what) { return static_cast<std::int32_t>(U32(what)); }
+
+float ByteReader::F32(std::string_view what) {
+  const std::uint32_t bits = U32(what);
+  float v;
+  std::memcpy(&v, &bits, sizeof v);
+  return v;
+}
+
+double ByteReader::F64(std::string_view what) {
+  const std::uint64_t bits = U64(what);
+  double v;
+  std::memcpy(&v, &bits, sizeof v);
+  return v;
+}
+
+std::string ByteReader::String(std::size_t n, std::string_view what) {
+  const std::uint8_t* p = Bytes(n, what);
+  return std::string(reinterpret_cast<const char*>(p), n);
+}
+
+void ByteReader::Fail(std::string_view expected, std::string_view got) const {
+  throw FormatError(file_, BytePosition(offset()), std::string(expected), std::string(got));
+}
+
+void AppendU16(std::string& out, std::uint16_t v) {
+  out.push_back(static_cast<char>(v & 0xff));
+  out.push_back(static_cast<char>(v >> 8));
+}
+
+void AppendU32(std::string& out, std::uint32_t v) {
+  for (int i = 0; i < 4; ++i) out.push_back(static_cast<char>((v >> (8 * i)) & 0xff));
+}
+
+void AppendU64(std::string& out, std::uint64_t v) {
+  AppendU32(out, static_cast<std::uint32_t>(v));
+  AppendU32(out, static_cast<std::uint32_t>(v >> 32));
+}
+
+void AppendF32(std::string& out, float v) {
+  std::uint32_t bits;
+  std::memcpy(&bits, &v, sizeof bits);
+  AppendU32(out, bits);
+}
+
+namespace {
+
+// Slicing-by-4 tables: a capture of 110 k samples is ~5 MB, so the CRC is on the read path.
+struct Crc32Tables {
+  std::array<std::array<std::uint32_t, 256>, 4> t{};
+  Crc32Tables() {
+    for (std::uint32_t i = 0; i < 256; ++i) {
+      std::uint32_t c = i;
+      for (int k = 0; k < 8; ++k) c = (c & 1u) ? 0xEDB88320u ^ (c >> 1) : c >> 1;
+      t[0][i] = c;
+    }
+    for (std::uint32_t i = 0; i < 256; ++i)
+      for (int s = 1; s < 4; ++s) t[s][i] = (t[s - 1][i] >> 8) ^ t[0][t[s - 1][i] & 0xff];
+  }
+};
+
+}  // namespace
+
+std::uint32_t Crc32(const void* data, std::size_t size, std::uint32_t crc) {
+  static const Crc32Tables tables;
+  const auto& t = tables.t;
+  const auto* p = static_cast<const std::uint8_t*>(data);
+  crc = ~crc;
+  while (size >= 4) {
+    crc ^= static_cast<std::uint32_t>(p[0]) | (static_cast<std::uint32_t>(p[1]) << 8) |
+           (static_cast<std::uint32_t>(p[2]) << 16) | (static_cast<std::uint32_t>(p[3]) << 24);
+    crc = t[3][crc & 0xff] ^ t[2][(crc >> 8) & 0xff] ^ t[1][(crc >> 16) & 0xff] ^ t[0][crc >> 24];
+    p += 4;
+    size -= 4;
+  }
+  while (size-- > 0) crc = t[0][(crc ^ *p++) & 0xff] ^ (crc >> 8);
+  return ~crc;
+}
+
+}  // namespace brdf
