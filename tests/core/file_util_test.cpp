@@ -28,8 +28,9 @@ TEST(ByteReader, ReadsLittleEndianAndReportsOffsetsPastEnd) {
     r.U32("the count");
     FAIL();
   } catch (const FormatError& e) {
-    EXPECT_EQ(std::string(e.what()),
-              "x.bin: byte 104: expected 4 more bytes for the count, got end of data after 1 bytes");
+    EXPECT_EQ(
+        std::string(e.what()),
+        "x.bin: byte 104: expected 4 more bytes for the count, got end of data after 1 bytes");
   }
 }
 

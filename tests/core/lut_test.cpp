@@ -40,7 +40,8 @@ TEST(LutSampling, AnglesAddressTheSpecularFrameTexel) {
   const Lut lut = RampLut();
   // The direction at (θd, φd) = (12°, 90°) in the specular frame of θin = 40° must land on
   // texel (i, j, k) = (90, 12, 2).
-  const Vec3 w_out = SpecularFrame::FromThetaInDeg(40.0).FromSpecular(SphericalDirectionDeg(12, 90));
+  const Vec3 w_out =
+      SpecularFrame::FromThetaInDeg(40.0).FromSpecular(SphericalDirectionDeg(12, 90));
   const double theta_out = RadToDeg(ThetaOf(w_out)), phi_out = RadToDeg(PhiOf(w_out));
   EXPECT_NEAR(lut.SampleAngles(40.0, theta_out, phi_out)[0], 90 + 12000 + 2e6, 0.5);
 }

@@ -107,8 +107,7 @@ TEST(Models, GgxMatchesTheTanSquaredFormOfDesign) {
         Vec3 h = l + v;
         h = h * (1.0 / std::sqrt(Dot(h, h)));
         const double ch = h.z, th2 = (1 - ch * ch) / (ch * ch);
-        const double d = alpha * alpha /
-                         (kPi * std::pow(ch, 4) * std::pow(alpha * alpha + th2, 2));
+        const double d = alpha * alpha / (kPi * std::pow(ch, 4) * std::pow(alpha * alpha + th2, 2));
         auto g1 = [&](double c) {
           const double t2 = (1 - c * c) / (c * c);
           return 2.0 / (1.0 + std::sqrt(1.0 + alpha * alpha * t2));

@@ -51,8 +51,7 @@ int main(int argc, char** argv) {
   std::string eval_in, eval_out;
   auto* eval_cmd = app.add_subcommand(
       "eval", "Print f_r (1/sr, linear RGB) of a BRDF source for one pair of directions");
-  eval_cmd->add_option("file", eval.file, "Material file (.json) or other BRDF source")
-      ->required();
+  eval_cmd->add_option("file", eval.file, "Material file (.json) or other BRDF source")->required();
   eval_cmd->add_option("--in", eval_in, "Light direction THETA,PHI in degrees")
       ->required()
       ->check(AnglePairValidator());

@@ -45,8 +45,8 @@ AtomicOutputPath::~AtomicOutputPath() {
 void AtomicOutputPath::Commit() {
   SyncPath(temp_path_);
   if (std::rename(temp_path_.c_str(), final_path_.c_str()) != 0)
-    throw IoError(final_path_ + ": cannot rename temporary file " + temp_path_ + " into place: " +
-                  ErrnoText());
+    throw IoError(final_path_ + ": cannot rename temporary file " + temp_path_ +
+                  " into place: " + ErrnoText());
   committed_ = true;
   const fs::path p(final_path_);
   SyncPath(p.has_parent_path() ? p.parent_path().string() : std::string("."));

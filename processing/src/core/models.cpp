@@ -54,8 +54,7 @@ Rgb ReadRgb(const nlohmann::json& object, std::string_view key, const std::strin
                       "nothing (the member is missing)");
   Rgb out{};
   auto read_number = [&](const nlohmann::json& v, const std::string& where) {
-    if (!v.is_number())
-      throw FormatError(file, where, "a finite number", Abbreviate(v));
+    if (!v.is_number()) throw FormatError(file, where, "a finite number", Abbreviate(v));
     const double d = v.get<double>();
     if (!std::isfinite(d)) throw FormatError(file, where, "a finite number", Abbreviate(v));
     return d;
@@ -85,8 +84,8 @@ std::string_view ModelName(Model model) { return InfoOf(model).name; }
 Model ModelFromName(std::string_view name) {
   for (const auto& info : kModels)
     if (info.name == name) return info.model;
-  throw InvalidArgument("unknown BRDF model '" + std::string(name) + "' (known: " +
-                        KnownModelNames() + ")");
+  throw InvalidArgument("unknown BRDF model '" + std::string(name) +
+                        "' (known: " + KnownModelNames() + ")");
 }
 
 Material ParseMaterialJson(std::string_view json_text, const std::string& file) {
@@ -102,15 +101,14 @@ Material ParseMaterialJson(std::string_view json_text, const std::string& file) 
                       std::string(doc.type_name()));
   const auto model_it = doc.find("model");
   if (model_it == doc.end() || !model_it->is_string())
-    throw FormatError(file, "member 'model'", "one of " + KnownModelNames(),
-                      model_it == doc.end() ? "nothing (the member is missing)"
-                                            : Abbreviate(*model_it));
+    throw FormatError(
+        file, "member 'model'", "one of " + KnownModelNames(),
+        model_it == doc.end() ? "nothing (the member is missing)" : Abbreviate(*model_it));
   Material m;
   try {
     m.model = ModelFromName(model_it->get<std::string>());
   } catch (const InvalidArgument&) {
-    throw FormatError(file, "member 'model'", "one of " + KnownModelNames(),
-                      Abbreviate(*model_it));
+    throw FormatError(file, "member 'model'", "one of " + KnownModelNames(), Abbreviate(*model_it));
   }
   const ModelInfo& info = InfoOf(m.model);
   m.kd = ReadRgb(doc, info.kd, file);
@@ -146,7 +144,8 @@ Material LoadMaterialFile(const std::string& path) {
   Material m = ParseMaterialJson(text.str(), path);
   if (m.name.empty()) {
     std::string stem = path;
-    if (auto slash = stem.find_last_of('/'); slash != std::string::npos) stem = stem.substr(slash + 1);
+    if (auto slash = stem.find_last_of('/'); slash != std::string::npos)
+      stem = stem.substr(slash + 1);
     if (auto dot = stem.rfind('.'); dot != std::string::npos) stem = stem.substr(0, dot);
     m.name = stem;
   }

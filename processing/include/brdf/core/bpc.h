@@ -24,7 +24,7 @@ struct BpcProblem {
 };
 
 struct BpcReadResult {
-  Measurement measurement;          // every intact slice, in file order
+  Measurement measurement;           // every intact slice, in file order
   std::vector<BpcProblem> problems;  // empty for an intact, finished file
   bool finished = false;             // the end chunk (capture end metadata) is present
   std::uint64_t valid_bytes = 0;     // length of the longest intact prefix; a resume truncates here

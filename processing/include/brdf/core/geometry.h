@@ -21,8 +21,12 @@ template <class T>
 struct Vec3T {
   T x{}, y{}, z{};
 
-  friend Vec3T operator+(const Vec3T& a, const Vec3T& b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
-  friend Vec3T operator-(const Vec3T& a, const Vec3T& b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+  friend Vec3T operator+(const Vec3T& a, const Vec3T& b) {
+    return {a.x + b.x, a.y + b.y, a.z + b.z};
+  }
+  friend Vec3T operator-(const Vec3T& a, const Vec3T& b) {
+    return {a.x - b.x, a.y - b.y, a.z - b.z};
+  }
   friend Vec3T operator*(const Vec3T& a, const T& s) { return {a.x * s, a.y * s, a.z * s}; }
   friend Vec3T operator*(const T& s, const Vec3T& a) { return {a.x * s, a.y * s, a.z * s}; }
 };

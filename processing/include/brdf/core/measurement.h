@@ -71,7 +71,7 @@ struct SliceStats {
   double theta_out_min_deg = 0, theta_out_max_deg = 0;
   double phi_out_min_deg = 0, phi_out_max_deg = 0;
   std::array<double, 3> min{}, max{}, mean{};  // over samples without kFlagInvalid
-  std::array<std::size_t, 4> flag_counts{};    // saturated, below noise floor, interpolated, invalid
+  std::array<std::size_t, 4> flag_counts{};  // saturated, below noise floor, interpolated, invalid
 };
 SliceStats ComputeSliceStats(const Slice& slice);
 

@@ -1,0 +1,30 @@
+#!/usr/bin/env bash
+# The main job on the built-in defaults: installs the Debian packages, builds the toolchain,
+# captures every material of the virtual sample library with the simulated scatterometer and
+# converts the captures into engine-ready lookup textures.
+# Usage: tools/run-demo.sh [OUT_DIR]   (default: out/demo)
+set -euo pipefail
+root="$(cd "$(dirname "$0")/.." && pwd)"
+out="${1:-$root/out/demo}"
+build="$root/build/release"
+
+"$root/tools/install-deps.sh"
+cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
+  -DBRDF_BUILD_TESTS=OFF -DBRDF_BUILD_BENCH=OFF >/dev/null
+cmake --build "$build" -j "$(nproc)" --target brdf
+brdf="$build/tools/brdf"
+
+mkdir -p "$out/captures"
+echo "== capturing the virtual sample library with the simulated scatterometer -> $out/captures"
+"$brdf" materials
+for material in $("$brdf" materials --json | /usr/bin/python3 -c 'import json,sys; print(" ".join(m["name"] for m in json.load(sys.stdin)))'); do
+  "$brdf" capture --device sim --material "$material" --sample "$material" \
+    --out "$out/captures/$material.bpc" --seed 1
+done
+if "$brdf" convert --help >/dev/null 2>&1; then
+  echo "== converting captures to RGB9E5 lookup textures -> $out/luts"
+  "$brdf" convert "$out/captures" --out "$out/luts"
+  "$brdf" atlas "$out/captures" --out "$out/atlas/library"
+fi
+echo "== done: $(ls "$out/captures" | wc -l) captures in $out/captures"
+"$brdf" info "$out/captures/gold.bpc"
