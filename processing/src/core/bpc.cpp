@@ -440,6 +440,13 @@ class BpcParser {
     if (const std::uint32_t crc = Crc32(payload, n); crc != h.payload_crc)
       FailHeader(pos + kChunkHeaderSize, "header JSON CRC-32 " + Hex32(h.payload_crc), Hex32(crc));
     const Json j = ParseJsonPayload(payload, n, file_, pos + kChunkHeaderSize, "header");
+    // The preamble's version is outside any CRC; the JSON repeats it, so a damaged version
+    // field is caught rather than silently accepted.
+    const Json want_version = {major, minor};
+    if (const auto v = j.find("version"); v == j.end() || *v != want_version)
+      FailHeader(8, "the format version of the header JSON",
+                 "preamble version " + std::to_string(major) + "." + std::to_string(minor) +
+                     " but header JSON 'version' " + (v == j.end() ? "missing" : v->dump()));
     const auto md = j.find("metadata");
     if (md == j.end())
       throw FormatError(file_, BytePosition(pos + kChunkHeaderSize) + " (header JSON)",
