@@ -372,8 +372,11 @@ class BpcParser {
         // it is reported like damage so the slices before it stay readable.
         try {
           const Json j = ParseJsonPayload(payload, n, file_, pos + kChunkHeaderSize, "end");
-          if (const auto it = j.find("metadata"); it != j.end())
-            end_metadata_ = MetadataFromJson(*it, file_, pos + kChunkHeaderSize, "end chunk");
+          const auto it = j.find("metadata");
+          if (it == j.end())
+            throw FormatError(file_, BytePosition(pos + kChunkHeaderSize), "a 'metadata' member",
+                              "none");
+          end_metadata_ = MetadataFromJson(*it, file_, pos + kChunkHeaderSize, "end chunk");
           result_.finished = true;
         } catch (const FormatError& e) {
           AddProblem(BpcProblemKind::kCorrupt, pos, end - pos, -1, e.expected(), e.got());
