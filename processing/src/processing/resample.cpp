@@ -17,6 +17,8 @@ namespace brdf::processing {
 namespace {
 
 constexpr double kThetaInTolDeg = 1e-3;
+// Texels 1° from the nadir are 0.017 away from the axis; rounding puts the nadir ~1e-16 away.
+constexpr double kNadirRadius2 = 1e-18;
 
 std::string Num(double v) {
   char buf[32];
@@ -46,21 +48,21 @@ std::vector<std::size_t> UniformThetaInOrder(const Measurement& m, double* delta
                           "(DESIGN §5), got θin = " +
                           list + "°: " + why);
   };
+  for (std::size_t k = 1; k < order.size(); ++k)
+    if (m.slices[order[k]].theta_in_deg - m.slices[order[k - 1]].theta_in_deg <= kThetaInTolDeg)
+      fail("duplicate incidence angle " + Num(m.slices[order[k]].theta_in_deg) + "° (slices " +
+           std::to_string(order[k - 1]) + " and " + std::to_string(order[k]) + ")");
   const double first = m.slices[order.front()].theta_in_deg;
   if (std::fabs(first) > kThetaInTolDeg) fail("the first is not 0°");
   *delta_in = 0.0;
   if (order.size() == 1) return order;
   const double delta =
       (m.slices[order.back()].theta_in_deg - first) / static_cast<double>(order.size() - 1);
-  if (delta <= kThetaInTolDeg) fail("duplicate incidence angles");
   for (std::size_t k = 0; k < order.size(); ++k) {
     const double expected = static_cast<double>(k) * delta;
     if (std::fabs(m.slices[order[k]].theta_in_deg - expected) > kThetaInTolDeg)
-      fail(k > 0 && std::fabs(m.slices[order[k]].theta_in_deg -
-                              m.slices[order[k - 1]].theta_in_deg) <= kThetaInTolDeg
-               ? "duplicate incidence angles"
-               : "the steps are not uniform (expected " + Num(expected) + "° as slice " +
-                     std::to_string(k) + ")");
+      fail("the steps are not uniform (expected " + Num(expected) + "° as number " +
+           std::to_string(k + 1) + " in ascending order)");
   }
   *delta_in = delta;
   return order;
@@ -123,7 +125,7 @@ Lut BuildLut(const Measurement& measurement, const ExtrapolationParams& params,
     sin_p[static_cast<std::size_t>(i)] = std::sin(DegToRad(i * Lut::kTexelDeg));
     cos_p[static_cast<std::size_t>(i)] = std::cos(DegToRad(i * Lut::kTexelDeg));
   }
-  // Rows 0 and 180 are single directions; sin(π) is not exactly 0 in floating point.
+  // Rows 0 and 180 are single directions each (sin(π) is not exactly 0 in floating point).
   sin_t[0] = 0.0;
   sin_t[kH - 1] = 0.0;
 
@@ -141,7 +143,10 @@ Lut BuildLut(const Measurement& measurement, const ExtrapolationParams& params,
       const double phi_out = RadToDeg(PhiOf(w_out));
       Rgb v;
       if (w_out.z <= 0.0) {  // at or below the horizon: the 90° value at this φout
-        v = slice.Horizon(phi_out);
+        // Straight down (the nadir) every φout meets, and rounding noise would pick one at
+        // random: like the pole of a measurement, the nadir takes the mean over all φout.
+        const bool nadir = w_out.x * w_out.x + w_out.y * w_out.y < kNadirRadius2;
+        v = nadir ? slice.HorizonMean() : slice.Horizon(phi_out);
         for (double& c : v) c *= factor_90;
       } else {
         const double theta_out = RadToDeg(ThetaOf(w_out));

@@ -392,11 +392,22 @@ SliceInterpolator::SliceInterpolator(const Slice& slice, std::size_t slice_index
 
 void SliceInterpolator::PrepareHorizon(double theta_b_deg) {
   theta_b_deg_ = theta_b_deg;
-  if (grid_) return;
+  horizon_mean_ = {0, 0, 0};
+  if (grid_) {
+    // f(θb, φ) is piecewise linear between the lattice columns: its circular mean is the mean
+    // of the column values.
+    for (int i = 0; i < grid_->n_phi; ++i) {
+      const Rgb v = grid_->At(theta_b_deg, grid_->phi0 + i * grid_->d_phi);
+      for (int c = 0; c < 3; ++c) horizon_mean_[c] += v[c] / grid_->n_phi;
+    }
+    return;
+  }
   ring_.resize(kRingSize);
   for (int n = 0; n < kRingSize; ++n) {
     const double phi = n * (360.0 / kRingSize);
-    ring_[static_cast<std::size_t>(n)] = scattered_->At(SphericalDirectionDeg(theta_b_deg, phi));
+    const Rgb v = scattered_->At(SphericalDirectionDeg(theta_b_deg, phi));
+    ring_[static_cast<std::size_t>(n)] = v;
+    for (int c = 0; c < 3; ++c) horizon_mean_[c] += v[c] / kRingSize;
   }
 }
 

@@ -114,6 +114,8 @@ class SliceInterpolator {
   void PrepareHorizon(double theta_b_deg);
   // f at (θb, φ): exact on the regular grid; from a 0.1° ring table for the scattered method.
   Rgb Horizon(double phi_deg) const;
+  // Mean of f(θb, φ) over the full circle of φ: the value for the nadir, where all φ meet.
+  const Rgb& HorizonMean() const { return horizon_mean_; }
 
   const SliceResampleReport& report() const { return report_; }
 
@@ -122,6 +124,7 @@ class SliceInterpolator {
   std::unique_ptr<ScatteredInterpolator> scattered_;
   double theta_b_deg_ = 0;
   std::vector<Rgb> ring_;  // scattered only: f(θb, n·360°/ring_.size())
+  Rgb horizon_mean_{};
   SliceResampleReport report_;
 };
 
