@@ -129,6 +129,25 @@ Lut BuildLut(const Measurement& measurement, const ExtrapolationParams& params,
   sin_t[0] = 0.0;
   sin_t[kH - 1] = 0.0;
 
+  // The texel's value from its outgoing direction (ω_out, θout, φout) per DESIGN §5 and §6.
+  const auto texel_value = [&](const internal::SliceInterpolator& slice, const Vec3& w_out,
+                               double theta_out, double phi_out) {
+    Rgb v;
+    if (w_out.z <= 0.0) {  // at or below the horizon: the 90° value at this φout
+      // Straight down (the nadir) every φout meets, and rounding noise would pick one at
+      // random: like the pole of a measurement, the nadir takes the mean over all φout.
+      const bool nadir = w_out.x * w_out.x + w_out.y * w_out.y < kNadirRadius2;
+      v = nadir ? slice.HorizonMean() : slice.Horizon(phi_out);
+      for (double& c : v) c *= factor_90;
+    } else if (theta_out <= theta_b) {
+      v = slice.At(theta_out, phi_out, w_out);
+    } else {
+      const double f = ExtrapolationFactor(theta_out, theta_b, params);
+      v = slice.Horizon(phi_out);
+      for (double& c : v) c *= f;
+    }
+    return v;
+  };
   const auto do_row = [&](int row) {
     const int k = row / kH, j = row % kH;
     const internal::SliceInterpolator& slice = *slices[static_cast<std::size_t>(k)];
@@ -136,30 +155,22 @@ Lut BuildLut(const Measurement& measurement, const ExtrapolationParams& params,
         SpecularFrame::FromThetaInDeg(lut.theta_in_deg[static_cast<std::size_t>(k)]);
     const double st = sin_t[static_cast<std::size_t>(j)], ct = cos_t[static_cast<std::size_t>(j)];
     float* out = lut.Texel(k, j, 0);
-    for (int i = 0; i < kCols; ++i) {
+    const auto store = [out](int i, const Rgb& v) {
+      for (int c = 0; c < 3; ++c) out[i * 3 + c] = static_cast<float>(v[static_cast<std::size_t>(c)]);
+    };
+    // S(θin) keeps the xz-plane, so columns i and 360 − i are mirror images (y → −y): the same
+    // θout and φout → 360° − φout. The angles are computed once per mirror pair.
+    for (int i = 0; i <= kCols / 2; ++i) {
       const Vec3 w_d{st * cos_p[static_cast<std::size_t>(i)],
                      st * sin_p[static_cast<std::size_t>(i)], ct};
       const Vec3 w_out = frame.FromSpecular(w_d);
       const double phi_out = RadToDeg(PhiOf(w_out));
-      Rgb v;
-      if (w_out.z <= 0.0) {  // at or below the horizon: the 90° value at this φout
-        // Straight down (the nadir) every φout meets, and rounding noise would pick one at
-        // random: like the pole of a measurement, the nadir takes the mean over all φout.
-        const bool nadir = w_out.x * w_out.x + w_out.y * w_out.y < kNadirRadius2;
-        v = nadir ? slice.HorizonMean() : slice.Horizon(phi_out);
-        for (double& c : v) c *= factor_90;
-      } else {
-        const double theta_out = RadToDeg(ThetaOf(w_out));
-        if (theta_out <= theta_b) {
-          v = slice.At(theta_out, phi_out, w_out);
-        } else {
-          const double f = ExtrapolationFactor(theta_out, theta_b, params);
-          v = slice.Horizon(phi_out);
-          for (double& c : v) c *= f;
-        }
-      }
-      for (int c = 0; c < 3; ++c)
-        out[i * 3 + c] = static_cast<float>(v[static_cast<std::size_t>(c)]);
+      const double theta_out = w_out.z > 0.0 ? RadToDeg(ThetaOf(w_out)) : 90.0;
+      store(i, texel_value(slice, w_out, theta_out, phi_out));
+      if (i == 0 || i == kCols / 2) continue;
+      const Vec3 w_mirror{w_out.x, -w_out.y, w_out.z};
+      const double phi_mirror = phi_out > 0.0 ? 360.0 - phi_out : 0.0;
+      store(kCols - i, texel_value(slice, w_mirror, theta_out, phi_mirror));
     }
     for (int c = 0; c < 3; ++c) out[kCols * 3 + c] = out[c];
   };

@@ -1,6 +1,7 @@
 #include "slice_interpolator.h"
 
 #include <algorithm>
+#include <bit>
 #include <cstdio>
 #include <limits>
 #include <string>
@@ -26,21 +27,44 @@ std::string SliceName(const Slice& slice, std::size_t index) {
   return "slice " + std::to_string(index) + " (θin = " + Num(slice.theta_in_deg) + "°)";
 }
 
-// Sorted values → minimum distance between consecutive clusters (values closer than the
-// tolerance form one cluster). Returns +inf for fewer than two clusters.
-double MinClusterGap(std::vector<double>& v, double* first, double* last) {
-  std::sort(v.begin(), v.end());
-  double gap = std::numeric_limits<double>::infinity();
-  double start = v.front();
-  *first = v.front();
-  for (double x : v) {
-    if (x - start > kAngleTolDeg) {
-      gap = std::min(gap, x - start);
-      start = x;
+// Distinct values (within kAngleTolDeg) of angles in [0°, range]: how many, the first and
+// last cluster and the smallest distance between neighbouring clusters. A bitmap of half-
+// tolerance bins makes this linear in the number of values (a sort of every sample's angle
+// was a tenth of the whole resampling time).
+struct Clusters {
+  int count = 0;
+  double first = 0, last = 0;
+  double min_gap = std::numeric_limits<double>::infinity();
+};
+
+// `angle(point)` returns the angle to cluster, or a negative value to skip the point.
+template <class AngleOf>
+Clusters FindClusters(const std::vector<Point>& points, double range_deg, AngleOf angle) {
+  constexpr double kBin = kAngleTolDeg / 2;
+  const std::size_t n_bins = static_cast<std::size_t>(range_deg / kBin) + 2;
+  std::vector<std::uint64_t> bits((n_bins + 63) / 64, 0);
+  for (const Point& p : points) {
+    const double v = angle(p);
+    if (v < 0.0) continue;
+    const auto b = std::min(static_cast<std::size_t>(v * (1.0 / kBin) + 0.5), n_bins - 1);
+    bits[b >> 6] |= std::uint64_t{1} << (b & 63);
+  }
+  Clusters c;
+  std::ptrdiff_t prev = -1000, start = -1;
+  for (std::size_t w = 0; w < bits.size(); ++w) {
+    for (std::uint64_t word = bits[w]; word != 0; word &= word - 1) {
+      const auto b = static_cast<std::ptrdiff_t>(w * 64 + static_cast<std::size_t>(std::countr_zero(word)));
+      if (b - prev > 2) {  // more than kAngleTolDeg after the previous value: a new cluster
+        if (start >= 0) c.min_gap = std::min(c.min_gap, static_cast<double>(b - start) * kBin);
+        else c.first = static_cast<double>(b) * kBin;
+        start = b;
+        ++c.count;
+      }
+      prev = b;
     }
   }
-  *last = start;
-  return gap;
+  c.last = static_cast<double>(start) * kBin;
+  return c;
 }
 
 }  // namespace
@@ -81,11 +105,11 @@ CleanSlice CleanSliceSamples(const Slice& slice, std::size_t slice_index) {
       theta = -theta;
       phi += 180.0;
     }
-    phi = WrapDeg360(phi - slice.phi_in_deg);
+    phi -= slice.phi_in_deg;
+    if (!(phi >= 0.0 && phi < 360.0)) phi = WrapDeg360(phi);  // fmod only when needed
     Point p;
     p.theta_deg = theta;
     p.phi_deg = phi;
-    p.dir = SphericalDirectionDeg(theta, phi);
     p.value = {s.rgb[0], s.rgb[1], s.rgb[2]};
     out.max_theta_deg = std::max(out.max_theta_deg, theta);
     out.points.push_back(p);
@@ -102,8 +126,11 @@ ScatteredInterpolator::ScatteredInterpolator(const std::vector<Point>& points, i
   k_ = static_cast<int>(std::min<std::size_t>(static_cast<std::size_t>(neighbours), n));
   double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
   double max_theta = 0;
-  for (const Point& p : points) {
-    const double c[3] = {p.dir.x, p.dir.y, p.dir.z};
+  std::vector<Vec3> dirs(n);
+  for (std::size_t i = 0; i < n; ++i) dirs[i] = SphericalDirectionDeg(points[i].theta_deg, points[i].phi_deg);
+  for (std::size_t i = 0; i < n; ++i) {
+    const Point& p = points[i];
+    const double c[3] = {dirs[i].x, dirs[i].y, dirs[i].z};
     for (int a = 0; a < 3; ++a) {
       lo[a] = std::min(lo[a], c[a]);
       hi[a] = std::max(hi[a], c[a]);
@@ -138,7 +165,7 @@ ScatteredInterpolator::ScatteredInterpolator(const std::vector<Point>& points, i
   cell_start_.assign(cells + 1, 0);
   std::vector<std::size_t> cell_index(n);
   for (std::size_t i = 0; i < n; ++i) {
-    cell_index[i] = cell_of(points[i].dir);
+    cell_index[i] = cell_of(dirs[i]);
     ++cell_start_[cell_index[i] + 1];
   }
   for (std::size_t c = 0; c < cells; ++c) cell_start_[c + 1] += cell_start_[c];
@@ -147,7 +174,7 @@ ScatteredInterpolator::ScatteredInterpolator(const std::vector<Point>& points, i
   val_.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     const std::uint32_t at = fill[cell_index[i]]++;
-    pos_[at] = points[i].dir;
+    pos_[at] = dirs[i];
     val_[at] = points[i].value;
   }
 }
@@ -277,20 +304,23 @@ std::optional<RegularGrid> DetectRegularGrid(const std::vector<Point>& points,
                                              std::vector<std::size_t>& holes) {
   holes.clear();
   if (points.size() < 8) return std::nullopt;
-  std::vector<double> thetas, phis;
-  thetas.reserve(points.size());
-  phis.reserve(points.size());
+  double theta_max = 0, phi_min = 360.0;
+  std::size_t off_pole = 0;
   for (const Point& p : points) {
-    thetas.push_back(p.theta_deg);
-    if (p.theta_deg > kAngleTolDeg) phis.push_back(p.phi_deg);
+    theta_max = std::max(theta_max, p.theta_deg);
+    if (p.theta_deg > kAngleTolDeg) {
+      phi_min = std::min(phi_min, p.phi_deg);
+      ++off_pole;
+    }
   }
-  double first = 0, last = 0;
-  const double d_theta = MinClusterGap(thetas, &first, &last);
-  if (!(d_theta >= kMinStepDeg) || phis.empty()) return std::nullopt;
-  const double theta_max = last;
-  double phi_first = 0, phi_last = 0;
-  double d_phi_min = MinClusterGap(phis, &phi_first, &phi_last);
-  const double wrap_gap = phi_first + 360.0 - phi_last;
+  const Clusters rows = FindClusters(points, 90.0, [](const Point& p) { return p.theta_deg; });
+  const double d_theta = rows.min_gap;
+  if (!(d_theta >= kMinStepDeg) || off_pole == 0) return std::nullopt;
+  const Clusters columns = FindClusters(points, 360.0, [](const Point& p) {
+    return p.theta_deg > kAngleTolDeg ? p.phi_deg : -1.0;  // the pole has no azimuth
+  });
+  double d_phi_min = columns.min_gap;
+  const double wrap_gap = columns.first + 360.0 - columns.last;
   if (wrap_gap > kAngleTolDeg) d_phi_min = std::min(d_phi_min, wrap_gap);
   if (!(d_phi_min >= kMinStepDeg)) return std::nullopt;
   const int n_phi = static_cast<int>(std::lround(360.0 / d_phi_min));
@@ -299,16 +329,18 @@ std::optional<RegularGrid> DetectRegularGrid(const std::vector<Point>& points,
   const auto n_theta = static_cast<int>(n_theta_l);
   // At least half of the non-pole nodes must be measured, which also bounds the allocation.
   const std::size_t nodes = static_cast<std::size_t>(n_theta - 1) * static_cast<std::size_t>(n_phi);
-  if (nodes > 2 * phis.size()) return std::nullopt;
+  if (nodes > 2 * off_pole) return std::nullopt;
 
   RegularGrid g;
   g.n_theta = n_theta;
   g.n_phi = n_phi;
-  g.d_theta = d_theta;
-  g.d_phi = 360.0 / n_phi;
-  g.phi0 = phi_first;
-  // Snap the steps to the lattice they describe (float32 angles carry ~1e-5° of noise).
+  // Snap the steps to the lattice they describe (float32 angles carry ~1e-5° of noise); the
+  // smallest φ is a lattice column (a sample near 360° is one near 0°, checked below).
   g.d_theta = theta_max / (n_theta - 1);
+  g.d_phi = 360.0 / n_phi;
+  g.phi0 = phi_min;
+  g.inv_d_theta = 1.0 / g.d_theta;
+  g.inv_d_phi = 1.0 / g.d_phi;
   const std::size_t total = static_cast<std::size_t>(n_theta) * static_cast<std::size_t>(n_phi);
   g.values.assign(total * 3, 0.0);
   std::vector<std::uint32_t> count(total, 0);
@@ -320,14 +352,14 @@ std::optional<RegularGrid> DetectRegularGrid(const std::vector<Point>& points,
       ++pole_count;
       continue;
     }
-    const double tj = p.theta_deg / g.d_theta;
-    const long j = std::lround(tj);
+    // Both quotients are > −1 (θ > 0, φ ≥ φ0 − tolerance), so truncating x + 0.5 rounds.
+    const auto j = static_cast<long>(p.theta_deg * g.inv_d_theta + 0.5);
     if (j < 1 || j >= n_theta || std::fabs(p.theta_deg - j * g.d_theta) > kAngleTolDeg)
       return std::nullopt;
-    double u = (p.phi_deg - g.phi0) / g.d_phi;
-    long i = std::lround(u);
+    const double u = (p.phi_deg - g.phi0) * g.inv_d_phi;
+    auto i = static_cast<long>(u + 0.5);
     if (std::fabs(p.phi_deg - g.phi0 - i * g.d_phi) > kAngleTolDeg) return std::nullopt;
-    i = ((i % n_phi) + n_phi) % n_phi;
+    if (i >= n_phi) i -= n_phi;  // φ just below 360° is the column at φ0
     const std::size_t node = static_cast<std::size_t>(j) * n_phi + static_cast<std::size_t>(i);
     for (int c = 0; c < 3; ++c) g.values[node * 3 + c] += p.value[c];
     ++count[node];
@@ -411,8 +443,7 @@ void SliceInterpolator::PrepareHorizon(double theta_b_deg) {
   }
 }
 
-Rgb SliceInterpolator::Horizon(double phi_deg) const {
-  if (grid_) return grid_->At(theta_b_deg_, phi_deg);
+Rgb SliceInterpolator::RingAt(double phi_deg) const {
   double u = phi_deg * (kRingSize / 360.0);
   u -= std::floor(u / kRingSize) * kRingSize;
   int i0 = static_cast<int>(u);

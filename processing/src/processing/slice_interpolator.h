@@ -20,7 +20,6 @@ namespace brdf::processing::internal {
 
 // One valid sample after normalisation: θ ∈ [0°, 90°], φ ∈ [0°, 360°) relative to φin.
 struct Point {
-  Vec3 dir;
   double theta_deg = 0, phi_deg = 0;
   Rgb value{};
 };
@@ -61,11 +60,12 @@ class ScatteredInterpolator {
 struct RegularGrid {
   int n_theta = 0, n_phi = 0;
   double d_theta = 1, d_phi = 1, phi0 = 0;
+  double inv_d_theta = 1, inv_d_phi = 1;
   std::vector<double> values;  // (j·Nφ + i)·3 + c
 
   // Bilinear in (θ, φ); φ wraps across the seam; θ beyond the last row clamps to it.
   Rgb At(double theta_deg, double phi_deg) const {
-    double tj = theta_deg / d_theta;
+    double tj = theta_deg * inv_d_theta;
     int j0;
     double ft;
     if (tj >= n_theta - 1) {
@@ -76,8 +76,9 @@ struct RegularGrid {
       j0 = static_cast<int>(tj);
       ft = tj - j0;
     }
-    double u = (phi_deg - phi0) / d_phi;
-    u -= std::floor(u / n_phi) * n_phi;
+    double u = (phi_deg - phi0) * inv_d_phi;
+    if (u < 0.0) u += n_phi;  // φ ∈ [0°, 360°) and φ0 within one step of 0°: one wrap is enough
+    if (!(u >= 0.0 && u < n_phi)) u -= std::floor(u / n_phi) * n_phi;
     int i0 = static_cast<int>(u);
     if (i0 >= n_phi) i0 = 0;  // u rounded up to exactly Nφ
     const double fu = u - i0;
@@ -113,13 +114,15 @@ class SliceInterpolator {
   // Precomputes what Horizon needs; call once θb of the whole measurement is known.
   void PrepareHorizon(double theta_b_deg);
   // f at (θb, φ): exact on the regular grid; from a 0.1° ring table for the scattered method.
-  Rgb Horizon(double phi_deg) const;
+  Rgb Horizon(double phi_deg) const { return grid_ ? grid_->At(theta_b_deg_, phi_deg) : RingAt(phi_deg); }
   // Mean of f(θb, φ) over the full circle of φ: the value for the nadir, where all φ meet.
   const Rgb& HorizonMean() const { return horizon_mean_; }
 
   const SliceResampleReport& report() const { return report_; }
 
  private:
+  Rgb RingAt(double phi_deg) const;
+
   std::optional<RegularGrid> grid_;
   std::unique_ptr<ScatteredInterpolator> scattered_;
   double theta_b_deg_ = 0;
