@@ -84,8 +84,8 @@ void Run(benchmark::State& state, const brdf::Measurement& meas, bool parallel) 
     benchmark::DoNotOptimize(lut.texels.data());
   }
   state.counters["samples"] = static_cast<double>(meas.SampleCount());
-  state.counters["texels/s"] = benchmark::Counter(4.0 * 361 * 181 * static_cast<double>(state.iterations()),
-                                                  benchmark::Counter::kIsRate);
+  state.counters["texels/s"] = benchmark::Counter(
+      4.0 * 361 * 181 * static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 
 void BM_ResampleGridSingleThread(benchmark::State& state) { Run(state, GridCapture(), false); }

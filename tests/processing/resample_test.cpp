@@ -219,6 +219,51 @@ TEST(ResampleScattered, LambertianBlindSpotIsFilledExactly) {
       }
 }
 
+TEST(ResampleScattered, IrregularStepsUseTheScatteredMethod) {
+  // θout steps that grow towards grazing are no lattice: the scattered method takes over and
+  // still reproduces a constant exactly.
+  Measurement meas;
+  const Material m = test::Lambertian();
+  for (double ti : kThetaIn) {
+    Slice slice;
+    slice.theta_in_deg = ti;
+    for (double to : {0.0, 1.0, 3.0, 6.0, 10.0, 15.0, 21.0, 28.0, 36.0, 45.0, 55.0, 66.0, 72.0})
+      for (int po = 0; po < 360; po += 2)
+        slice.samples.push_back(
+            test::MakeSample(ti, to, po, test::EvalMaterial(m, ti, test::FromAngles(to, po))));
+    meas.slices.push_back(std::move(slice));
+  }
+  ResampleReport report;
+  const Lut lut = BuildLut(meas, {0.2, 0.3}, {}, &report);
+  EXPECT_EQ(report.theta_b_deg, 72.0);
+  for (const auto& s : report.slices) EXPECT_EQ(s.method, InterpolationMethod::kScattered);
+  const Comparison c = CompareWithMaterial(lut, m, 72.0, {0.2, 0.3});
+  EXPECT_EQ(c.bad_texels, 0u);
+  EXPECT_LT(test::Percentile(c.in_range, 1.0), 1e-6);
+  EXPECT_LT(test::Percentile(c.band, 1.0), 1e-6);
+  EXPECT_LT(test::Percentile(c.below, 1.0), 1e-6);
+}
+
+TEST(ResampleScattered, SparseCaptureStillFillsEveryTexel) {
+  for (std::size_t n : {1u, 2u, 5u, 40u}) {
+    const Measurement meas = test::ScatteredCapture(test::LafortuneN20(), n, 100 + n);
+    const Lut lut = BuildLut(meas, {0.2, 0.3});
+    double lo = 1e300, hi = -1e300;
+    for (const Slice& s : meas.slices)
+      for (const Sample& x : s.samples)
+        for (float v : x.rgb) {
+          lo = std::min<double>(lo, v);
+          hi = std::max<double>(hi, v);
+        }
+    for (float v : lut.texels) {
+      ASSERT_TRUE(std::isfinite(v) && v > 0.0f) << n << " samples per slice";
+      // Interpolation never leaves the data's range; extrapolation scales it by p ≤ 1 here.
+      ASSERT_LE(v, hi * (1 + 1e-6)) << n;
+      ASSERT_GE(v, 0.2 * lo * (1 - 1e-6)) << n;
+    }
+  }
+}
+
 // A capture whose value depends on φout only, jagged from one degree to the next and scaled
 // per slice, so every texel's expected value is known exactly: bilinear on the 1° lattice is
 // linear in φ between nodes, constant in θ, and the pole row is the mean of all pole samples.

@@ -156,7 +156,8 @@ Lut BuildLut(const Measurement& measurement, const ExtrapolationParams& params,
     const double st = sin_t[static_cast<std::size_t>(j)], ct = cos_t[static_cast<std::size_t>(j)];
     float* out = lut.Texel(k, j, 0);
     const auto store = [out](int i, const Rgb& v) {
-      for (int c = 0; c < 3; ++c) out[i * 3 + c] = static_cast<float>(v[static_cast<std::size_t>(c)]);
+      for (int c = 0; c < 3; ++c)
+        out[i * 3 + c] = static_cast<float>(v[static_cast<std::size_t>(c)]);
     };
     // S(θin) keeps the xz-plane, so columns i and 360 − i are mirror images (y → −y): the same
     // θout and φout → 360° − φout. The angles are computed once per mirror pair.

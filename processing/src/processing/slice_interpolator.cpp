@@ -53,10 +53,13 @@ Clusters FindClusters(const std::vector<Point>& points, double range_deg, AngleO
   std::ptrdiff_t prev = -1000, start = -1;
   for (std::size_t w = 0; w < bits.size(); ++w) {
     for (std::uint64_t word = bits[w]; word != 0; word &= word - 1) {
-      const auto b = static_cast<std::ptrdiff_t>(w * 64 + static_cast<std::size_t>(std::countr_zero(word)));
+      const auto b =
+          static_cast<std::ptrdiff_t>(w * 64 + static_cast<std::size_t>(std::countr_zero(word)));
       if (b - prev > 2) {  // more than kAngleTolDeg after the previous value: a new cluster
-        if (start >= 0) c.min_gap = std::min(c.min_gap, static_cast<double>(b - start) * kBin);
-        else c.first = static_cast<double>(b) * kBin;
+        if (start >= 0)
+          c.min_gap = std::min(c.min_gap, static_cast<double>(b - start) * kBin);
+        else
+          c.first = static_cast<double>(b) * kBin;
         start = b;
         ++c.count;
       }
@@ -127,7 +130,8 @@ ScatteredInterpolator::ScatteredInterpolator(const std::vector<Point>& points, i
   double lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
   double max_theta = 0;
   std::vector<Vec3> dirs(n);
-  for (std::size_t i = 0; i < n; ++i) dirs[i] = SphericalDirectionDeg(points[i].theta_deg, points[i].phi_deg);
+  for (std::size_t i = 0; i < n; ++i)
+    dirs[i] = SphericalDirectionDeg(points[i].theta_deg, points[i].phi_deg);
   for (std::size_t i = 0; i < n; ++i) {
     const Point& p = points[i];
     const double c[3] = {dirs[i].x, dirs[i].y, dirs[i].z};

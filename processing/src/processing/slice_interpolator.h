@@ -114,7 +114,9 @@ class SliceInterpolator {
   // Precomputes what Horizon needs; call once θb of the whole measurement is known.
   void PrepareHorizon(double theta_b_deg);
   // f at (θb, φ): exact on the regular grid; from a 0.1° ring table for the scattered method.
-  Rgb Horizon(double phi_deg) const { return grid_ ? grid_->At(theta_b_deg_, phi_deg) : RingAt(phi_deg); }
+  Rgb Horizon(double phi_deg) const {
+    return grid_ ? grid_->At(theta_b_deg_, phi_deg) : RingAt(phi_deg);
+  }
   // Mean of f(θb, φ) over the full circle of φ: the value for the nadir, where all φ meet.
   const Rgb& HorizonMean() const { return horizon_mean_; }
 

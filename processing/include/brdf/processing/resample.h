@@ -7,7 +7,8 @@
 // brdf/core/geometry.h), with the light at (θin,k, φin = 0). Per texel:
 //   θout ≤ θb        interpolated from the slice's samples at (θout, φout);
 //   θb < θout ≤ 90°  DESIGN §6 extrapolation of the interpolated value at (θb, φout);
-//   θout > 90°       the value at θout = 90° with the same φout (edge extension).
+//   θout > 90°       the value at θout = 90° with the same φout (edge extension); at the
+//                    nadir, where every φout meets, the mean of those values over φout.
 // θb is the largest θout among the valid samples of the whole measurement. Column 360 is a
 // copy of column 0, so the seam filters without wrap addressing.
 //
