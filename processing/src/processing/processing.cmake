@@ -1,1 +1,14 @@
-# brdf_processing target: defined here once resampling lands.
+# brdf::processing: resampling to the LUT grid (DESIGN §5), grazing extrapolation (DESIGN §6)
+# and the interpolated-capture BrdfSource. Fitting (Ceres) joins this target later.
+add_library(brdf_processing
+  ${CMAKE_CURRENT_LIST_DIR}/extrapolation.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/slice_interpolator.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/resample.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/measurement_brdf.cpp
+)
+add_library(brdf::processing ALIAS brdf_processing)
+target_include_directories(brdf_processing PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include
+                                           PRIVATE ${CMAKE_CURRENT_LIST_DIR})
+target_link_libraries(brdf_processing
+  PUBLIC brdf::core
+  PRIVATE brdf::warnings TBB::tbb nlohmann_json::nlohmann_json)
