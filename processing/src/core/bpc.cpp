@@ -5,6 +5,7 @@
 #include <unistd.h>
 
 #include <array>
+#include <bit>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -77,12 +78,6 @@ float LoadF32(const std::uint8_t* p) {
   float v;
   std::memcpy(&v, &bits, sizeof v);
   return v;
-}
-
-void AppendF64(std::string& out, double v) {
-  std::uint64_t bits;
-  std::memcpy(&bits, &v, sizeof bits);
-  AppendU64(out, bits);
 }
 
 Json MetadataToJson(const Metadata& m) {
@@ -199,32 +194,46 @@ std::string EncodeChunk(const char* tag, std::uint32_t slice_index, const std::s
   return out;
 }
 
-std::string EncodeSlicePayload(const Slice& slice) {
-  const std::uint32_t record_size = slice.has_sigma ? kRecordSizeSigma : kRecordSizeNoSigma;
-  std::string out;
-  out.reserve(kSliceHeaderSize + slice.samples.size() * record_size);
-  AppendF64(out, slice.theta_in_deg);
-  AppendF64(out, slice.phi_in_deg);
-  AppendU64(out, slice.samples.size());
-  AppendU32(out, (slice.has_sigma ? kSliceFlagHasSigma : 0u) |
-                     (slice.complete ? 0u : kSliceFlagIncomplete));
-  AppendU32(out, record_size);
-  for (const Sample& s : slice.samples) {
-    AppendF32(out, s.theta_in_deg);
-    AppendF32(out, s.phi_in_deg);
-    AppendF32(out, s.theta_out_deg);
-    AppendF32(out, s.phi_out_deg);
-    for (float v : s.rgb) AppendF32(out, v);
-    out.push_back(static_cast<char>(s.flags));
-    out.append(3, '\0');
-    if (slice.has_sigma)
-      for (float v : s.sigma) AppendF32(out, v);
-  }
-  return out;
+void StoreU32(char* p, std::uint32_t v) {
+  for (int i = 0; i < 4; ++i) p[i] = static_cast<char>((v >> (8 * i)) & 0xff);
 }
+void StoreU64(char* p, std::uint64_t v) {
+  StoreU32(p, static_cast<std::uint32_t>(v));
+  StoreU32(p + 4, static_cast<std::uint32_t>(v >> 32));
+}
+void StoreF32(char* p, float v) { StoreU32(p, std::bit_cast<std::uint32_t>(v)); }
 
+// Built in place in one buffer (a reference slice is 1.2 MB): header fields, then records,
+// then the two CRCs.
 std::string EncodeSliceChunk(const Slice& slice, int index) {
-  return EncodeChunk(kTagSlice, static_cast<std::uint32_t>(index), EncodeSlicePayload(slice));
+  const std::uint32_t record_size = slice.has_sigma ? kRecordSizeSigma : kRecordSizeNoSigma;
+  const std::size_t payload_size = kSliceHeaderSize + slice.samples.size() * record_size;
+  std::string out(kChunkHeaderSize + payload_size, '\0');  // reserved bytes stay 0
+  char* p = out.data() + kChunkHeaderSize;
+  StoreU64(p, std::bit_cast<std::uint64_t>(slice.theta_in_deg));
+  StoreU64(p + 8, std::bit_cast<std::uint64_t>(slice.phi_in_deg));
+  StoreU64(p + 16, slice.samples.size());
+  StoreU32(p + 24, (slice.has_sigma ? kSliceFlagHasSigma : 0u) |
+                       (slice.complete ? 0u : kSliceFlagIncomplete));
+  StoreU32(p + 28, record_size);
+  char* r = p + kSliceHeaderSize;
+  for (const Sample& s : slice.samples) {
+    StoreF32(r, s.theta_in_deg);
+    StoreF32(r + 4, s.phi_in_deg);
+    StoreF32(r + 8, s.theta_out_deg);
+    StoreF32(r + 12, s.phi_out_deg);
+    for (int c = 0; c < 3; ++c) StoreF32(r + 16 + 4 * c, s.rgb[c]);
+    r[28] = static_cast<char>(s.flags);
+    if (slice.has_sigma)
+      for (int c = 0; c < 3; ++c) StoreF32(r + 32 + 4 * c, s.sigma[c]);
+    r += record_size;
+  }
+  std::memcpy(out.data(), kTagSlice, 4);
+  StoreU32(out.data() + 4, static_cast<std::uint32_t>(index));
+  StoreU64(out.data() + 8, payload_size);
+  StoreU32(out.data() + 16, Crc32(p, payload_size));
+  StoreU32(out.data() + 20, Crc32(out.data(), 20));
+  return out;
 }
 
 std::string EncodePreambleAndHeader(const Metadata& metadata) {
