@@ -216,8 +216,13 @@ Measurement ParseCsv(std::string_view text_in, const std::string& file) {
     if (s.phi_out_deg >= 360.0f) s.phi_out_deg = 0.0f;
     for (int c = 0; c < 3; ++c) s.rgb[c] = static_cast<float>(number(kR + c));
     if (has_sigma) {
-      for (int c = 0; c < 3; ++c)
-        s.sigma[c] = static_cast<float>(in_range(kSigmaR + c, 0, 3.4e38, false));
+      for (int c = 0; c < 3; ++c) {
+        const double v = number(kSigmaR + c);
+        if (v < 0)
+          lines.Fail(std::string("a non-negative ") + kColumnNames[kSigmaR + c],
+                     text::Printable(fields[index[kSigmaR + c]]));
+        s.sigma[c] = static_cast<float>(v);
+      }
     }
     if (index[kFlags] >= 0) {
       const std::string_view f = fields[index[kFlags]];

@@ -136,7 +136,7 @@ LightToolsBsdf ParseLightToolsBsdf(std::string_view text_in, const std::string& 
       const std::string_view k = t.text;
       if (text::EqualsIgnoreCase(k, "AOI")) {
         once(&aoi, t);
-        block.aoi_deg = ts.NextInRange("AOI (degrees)", 0.0, std::nextafter(90.0, 0.0));
+        block.aoi_deg = ts.NextInRange("AOI (degrees)", 0.0, 90.0, true);
       } else if (text::EqualsIgnoreCase(k, "POI")) {
         once(&poi, t);
         block.poi_deg = ts.NextInRange("POI (degrees)", -360.0, 360.0);

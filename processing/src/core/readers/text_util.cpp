@@ -184,12 +184,13 @@ double TokenStream::NextDouble(std::string_view what) {
   return ParseFiniteDouble(t.text, file_, t.line, what);
 }
 
-double TokenStream::NextInRange(std::string_view what, double min, double max) {
+double TokenStream::NextInRange(std::string_view what, double min, double max, bool max_open) {
   const Token t = Next(what);
   const double v = ParseFiniteDouble(t.text, file_, t.line, what);
-  if (v < min || v > max) {
+  if (v < min || v > max || (max_open && v == max)) {
     FailAt(t.line,
-           std::string(what) + " in [" + FormatShortest(min) + ", " + FormatShortest(max) + "]",
+           std::string(what) + " in [" + FormatShortest(min) + ", " + FormatShortest(max) +
+               (max_open ? ")" : "]"),
            Printable(t.text));
   }
   return v;

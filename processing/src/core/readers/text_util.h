@@ -71,8 +71,8 @@ class TokenStream {
   std::string RestOfLine(std::string_view what);
 
   double NextDouble(std::string_view what);
-  // A finite number within [min, max].
-  double NextInRange(std::string_view what, double min, double max);
+  // A finite number within [min, max], or [min, max) when `max_open`.
+  double NextInRange(std::string_view what, double min, double max, bool max_open = false);
   // A non-negative integer count in [min_count, max_count] that also fits in what is left
   // of the file at `bytes_per_item` bytes per item (an item needs at least a digit and a
   // separator, so 2 for one number).

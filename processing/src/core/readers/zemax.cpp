@@ -17,12 +17,12 @@ namespace {
 constexpr std::size_t kMaxAngles = 100000;
 
 void ReadAngleList(text::TokenStream& ts, std::string_view name, double min, double max,
-                   std::vector<double>* out) {
+                   std::vector<double>* out, bool max_open = false) {
   const std::size_t n = ts.NextCount(std::string(name) + " count", 1, kMaxAngles, 2);
   out->clear();
   out->reserve(n);
   for (std::size_t i = 0; i < n; ++i) {
-    const double v = ts.NextInRange(std::string(name) + " angle (degrees)", min, max);
+    const double v = ts.NextInRange(std::string(name) + " angle (degrees)", min, max, max_open);
     if (!out->empty() && !(v > out->back()))
       ts.Fail(std::string(name) + " angles in strictly ascending order",
               text::FormatShortest(v) + " after " + text::FormatShortest(out->back()));
@@ -138,8 +138,7 @@ ZemaxBsdf ParseZemaxBsdf(std::string_view text_in, const std::string& file) {
       ReadAngleList(ts, "SampleRotation", -360.0, 360.0, &z.sample_rotation_deg);
     } else if (text::EqualsIgnoreCase(k, "AngleOfIncidence")) {
       once(&have_aoi, t);
-      ReadAngleList(ts, "AngleOfIncidence", 0.0, std::nextafter(90.0, 0.0),
-                    &z.angle_of_incidence_deg);
+      ReadAngleList(ts, "AngleOfIncidence", 0.0, 90.0, &z.angle_of_incidence_deg, true);
     } else if (text::EqualsIgnoreCase(k, "ScatterAzimuth")) {
       once(&have_azimuth, t);
       azimuth_line = t.line;
