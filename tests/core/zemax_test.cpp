@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
@@ -268,6 +269,21 @@ TEST(ZemaxReader, ErrorsNameFileLineExpectedAndFound) {
     EXPECT_EQ(std::string(e.what()),
               "t.bsdf: line 16: expected a BSDF value (a finite number), got 'nan'");
   }
+}
+
+TEST(ZemaxReader, RefusesFilesLargerThanItsCapBeforeReading) {
+  // A sparse 65 MiB file: refused from its size alone, nothing is allocated or read.
+  const std::filesystem::path p = std::filesystem::temp_directory_path() / "brdf_zemax_huge.bsdf";
+  { std::ofstream(p.string()).put('#'); }
+  std::filesystem::resize_file(p, 65ull << 20);
+  try {
+    ReadZemaxBsdf(p.string());
+    FAIL();
+  } catch (const FormatError& e) {
+    EXPECT_EQ(e.file(), p.string());
+    EXPECT_EQ(e.expected(), "at most 67108864 bytes");
+  }
+  std::filesystem::remove(p);
 }
 
 }  // namespace

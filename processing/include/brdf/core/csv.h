@@ -35,6 +35,7 @@ namespace brdf {
 // line (and the column) for a missing or unknown header column, a row with the wrong number of
 // fields, a non-numeric, non-finite or out-of-range value, or a file without data rows.
 Measurement ParseCsv(std::string_view text, const std::string& file);
+// Reads a file of at most 128 MiB (about 1.5 M rows; larger ones are refused before reading).
 Measurement ReadCsv(const std::string& path);
 
 // The CSV text of a measurement (metadata as comments, sigma columns when any slice has sigma).

@@ -49,6 +49,7 @@ struct GonioTable {
 // a row with the wrong number of fields, a non-finite or negative value, an angle outside
 // [0°, 90°) (incidence) or [−90°, 90°] (measurement), duplicate rows.
 GonioTable ParseGonioTable(std::string_view text, const std::string& file);
+// Reads a file of at most 32 MiB (larger ones are refused before reading).
 GonioTable ReadGonioTable(const std::string& path);
 
 // One slice per incidence (ascending θin), samples in file order with f_r in linear Rec.709

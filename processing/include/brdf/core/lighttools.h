@@ -64,6 +64,7 @@ struct LightToolsBsdf {
 // NaN/inf or negative values, a TristimulusValue that does not fit SpectralContent,
 // truncation, text after DataEnd.
 LightToolsBsdf ParseLightToolsBsdf(std::string_view text, const std::string& file);
+// Reads a file of at most 128 MiB (larger ones are refused before reading).
 LightToolsBsdf ReadLightToolsBsdf(const std::string& path);
 
 // The file text (values with 9 significant digits: below float resolution) and an atomic

@@ -73,6 +73,7 @@ struct ZemaxBsdf {
 // ascending (AngleOfIncidence in [0, 90), ScatterAzimuth in [0, 360] — [0, 180] for
 // PlaneSymmetrical — and ScatterRadial in [0, 180]), NaN/inf or negative values, truncation.
 ZemaxBsdf ParseZemaxBsdf(std::string_view text, const std::string& file);
+// Reads a file of at most 64 MiB (larger ones are refused before reading).
 ZemaxBsdf ReadZemaxBsdf(const std::string& path);
 
 // The file-format text of `bsdf` (writes TIS lines only where they are not NaN). Used by the

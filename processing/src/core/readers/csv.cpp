@@ -260,7 +260,7 @@ Measurement ParseCsv(std::string_view text_in, const std::string& file) {
 }
 
 Measurement ReadCsv(const std::string& path) {
-  return ParseCsv(text::ReadTextFile(path, 256ull << 20), path);
+  return ParseCsv(text::ReadTextFile(path, text::kMaxCsvBytes), path);
 }
 
 std::string FormatCsv(const Measurement& m) {

@@ -176,7 +176,7 @@ GonioTable ParseGonioTable(std::string_view text, const std::string& file) {
 }
 
 GonioTable ReadGonioTable(const std::string& path) {
-  return ParseGonioTable(text::ReadTextFile(path), path);
+  return ParseGonioTable(text::ReadTextFile(path, text::kMaxGonioBytes), path);
 }
 
 Measurement GonioToMeasurement(const GonioTable& table, const std::string& file) {

@@ -208,7 +208,7 @@ LightToolsBsdf ParseLightToolsBsdf(std::string_view text_in, const std::string& 
 }
 
 LightToolsBsdf ReadLightToolsBsdf(const std::string& path) {
-  return ParseLightToolsBsdf(text::ReadTextFile(path), path);
+  return ParseLightToolsBsdf(text::ReadTextFile(path, text::kMaxLightToolsBytes), path);
 }
 
 std::string FormatLightToolsBsdf(const LightToolsBsdf& lt) {

@@ -17,8 +17,15 @@
 
 namespace brdf::text {
 
-// Largest text file any of these readers accepts (checked before reading).
-inline constexpr std::uint64_t kMaxTextFileBytes = 512ull << 20;
+// Largest files the readers accept (checked before reading). Parsed data takes up to about
+// four times the text size (8-byte doubles from 2-byte "0 " tokens, 44-byte samples from
+// 14-byte CSV rows), so these caps also bound memory. Real files are far smaller: the shared
+// Zemax file is 28 KB, a 110 k-row capture CSV 8 MB, a MiniDiff-sized LightTools export 4 MB.
+inline constexpr std::uint64_t kMaxZemaxBytes = 64ull << 20;
+inline constexpr std::uint64_t kMaxLightToolsBytes = 128ull << 20;
+inline constexpr std::uint64_t kMaxCsvBytes = 128ull << 20;
+inline constexpr std::uint64_t kMaxGonioBytes = 32ull << 20;
+inline constexpr std::uint64_t kMaxTextFileBytes = kMaxLightToolsBytes;
 
 // Reads a whole text file with the size cap above. Throws IoError / FormatError.
 std::string ReadTextFile(const std::string& path, std::uint64_t max_bytes = kMaxTextFileBytes);

@@ -233,7 +233,7 @@ ZemaxBsdf ParseZemaxBsdf(std::string_view text_in, const std::string& file) {
 }
 
 ZemaxBsdf ReadZemaxBsdf(const std::string& path) {
-  return ParseZemaxBsdf(text::ReadTextFile(path), path);
+  return ParseZemaxBsdf(text::ReadTextFile(path, text::kMaxZemaxBytes), path);
 }
 
 std::string FormatZemaxBsdf(const ZemaxBsdf& z) {
