@@ -48,12 +48,15 @@ Frame Driver::NextFrame(std::string_view waiting_for) {
                           (last_damage_.empty() ? "" : " (damaged frame: " + last_damage_ + ")"));
       have_device_sequence_ = true;
       device_sequence_ = r.frame.sequence;
+      last_damage_.clear();
       return std::move(r.frame);
     }
     if (r.status == DecodeStatus::kInvalid) {
       // Noise between frames is skipped; a damaged frame is remembered: if it was a real frame
-      // the next sequence number jumps and the loss is reported with this reason.
-      if (r.corrupt) last_damage_ = r.reason;
+      // the next sequence number jumps and the loss is reported with this reason. The first
+      // damage after the last good frame is kept: what follows it is usually the damaged
+      // frame's own payload being searched for a frame start.
+      if (r.corrupt && last_damage_.empty()) last_damage_ = r.reason;
       continue;
     }
     const std::size_t n = transport_.Read(buffer, options_.timeout_ms);

@@ -113,7 +113,7 @@ class Driver {
   std::uint8_t host_sequence_ = 0;
   bool have_device_sequence_ = false;
   std::uint8_t device_sequence_ = 0;
-  std::string last_damage_;  // the last damaged frame seen, to explain a loss or a timeout
+  std::string last_damage_;  // first damaged frame since the last good one, to explain a loss
   bool connected_ = false;
   InstrumentInfo info_;
   ExposureSetting exposure_;
