@@ -51,8 +51,7 @@ int main(int argc, char** argv) {
   std::string eval_in, eval_out;
   auto* eval_cmd = app.add_subcommand(
       "eval", "Print f_r (1/sr, linear RGB) of a BRDF source for one pair of directions");
-  eval_cmd->add_option("file", eval.file, "Material file (.json) or other BRDF source")
-      ->required();
+  eval_cmd->add_option("file", eval.file, "Material file (.json) or other BRDF source")->required();
   eval_cmd->add_option("--in", eval_in, "Light direction THETA,PHI in degrees")
       ->required()
       ->check(AnglePairValidator());
@@ -64,6 +63,16 @@ int main(int argc, char** argv) {
     ParseAnglePair(eval_out, &eval.theta_out_deg, &eval.phi_out_deg);
     exit_code = brdf::cli::RunEval(eval);
   });
+
+  // brdf info
+  brdf::cli::InfoOptions info;
+  auto* info_cmd = app.add_subcommand(
+      "info",
+      "Describe a file: a .bpc capture (slices, samples, ranges, statistics, flags, "
+      "metadata, damage) or a material .json (model and parameters)");
+  info_cmd->add_option("file", info.file, "File to describe (.bpc, .json)")->required();
+  info_cmd->add_flag("--json", info.json, "Print JSON instead of text");
+  info_cmd->callback([&] { exit_code = brdf::cli::RunInfo(info); });
 
   // brdf materials
   brdf::cli::MaterialsOptions materials;
