@@ -13,8 +13,7 @@ void LoopbackTransport::Write(std::span<const std::uint8_t> bytes) {
 std::size_t LoopbackTransport::Read(std::span<std::uint8_t> buffer, int /*timeout_ms*/) {
   const std::size_t n = firmware_.Transmit(buffer);
   if (n == 0 && !firmware_.link_up())
-    throw DeviceError(Description() + ": the instrument disconnected (read failed after " +
-                      std::to_string(firmware_.frames_sent()) + " frames)");
+    throw DeviceError(Description() + ": the instrument disconnected (read failed)");
   return n;
 }
 
