@@ -145,10 +145,14 @@ void SimulatedFirmware::Receive(std::span<const std::uint8_t> bytes) {
 }
 
 std::size_t SimulatedFirmware::Transmit(std::span<std::uint8_t> out) {
-  while (output_.empty() && streaming_ && link_up_ && !stalled_) ProduceStreamFrame();
-  const std::size_t n = std::min(out.size(), output_.size());
-  std::copy_n(output_.begin(), n, out.begin());
-  output_.erase(output_.begin(), output_.begin() + static_cast<std::ptrdiff_t>(n));
+  if (output_start_ == output_.size()) {
+    output_.clear();
+    output_start_ = 0;
+    while (output_.empty() && streaming_ && link_up_ && !stalled_) ProduceStreamFrame();
+  }
+  const std::size_t n = std::min(out.size(), output_.size() - output_start_);
+  std::copy_n(output_.begin() + static_cast<std::ptrdiff_t>(output_start_), n, out.begin());
+  output_start_ += n;
   return n;
 }
 

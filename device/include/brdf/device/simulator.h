@@ -32,7 +32,6 @@
 
 #include <array>
 #include <cstdint>
-#include <deque>
 #include <memory>
 #include <random>
 #include <span>
@@ -146,7 +145,8 @@ class SimulatedFirmware {
   GeometryInfo geometry_;
   std::shared_ptr<const BrdfSource> white_;
   FrameReader input_;
-  std::deque<std::uint8_t> output_;
+  std::vector<std::uint8_t> output_;  // bytes waiting for the host, from output_start_ on
+  std::size_t output_start_ = 0;
   std::uint64_t frames_sent_ = 0;
   std::uint8_t sequence_ = 0;
   bool link_up_ = true;
