@@ -97,6 +97,12 @@ const InstrumentInfo& Driver::Connect() {
   Send(MessageType::kGetGeometry, {});
   info_.geometry =
       DecodeGeometry(Expect(MessageType::kGetGeometry, MessageType::kGeometry).payload);
+  const std::size_t per_slice = std::size_t{info_.geometry.rows} * info_.geometry.columns;
+  if (per_slice == 0 || per_slice > kMaxSamplesPerSlice)
+    throw DeviceError(transport_.Description() + ": geometry of " +
+                      std::to_string(info_.geometry.rows) + " × " +
+                      std::to_string(info_.geometry.columns) +
+                      " samples per slice is outside 1 … " + std::to_string(kMaxSamplesPerSlice));
   connected_ = true;
   have_dark_ = false;
   whites_.clear();

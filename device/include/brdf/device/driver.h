@@ -37,6 +37,10 @@
 
 namespace brdf::device {
 
+// Largest slice the driver accepts from an instrument (a slice is held in memory while it
+// streams): 2^22 samples, room for 0.1° steps over the whole hemisphere.
+inline constexpr std::size_t kMaxSamplesPerSlice = std::size_t{1} << 22;
+
 struct InstrumentInfo {
   IdentityInfo identity;
   GeometryInfo geometry;

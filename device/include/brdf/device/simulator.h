@@ -21,13 +21,14 @@
 // is scaled too because a float32 reading of D_c + (a tiny signal) cannot hold the tiny signal
 // to float precision; an ideal detector has no bias.
 //
-// Exposure is auto-ranged per θout row (default): the firmware takes the row's brightest
-// sample from a probe and sets t so it reaches `autorange_target_fraction` of the range above
-// dark, within [min_exposure_ms, max_exposure_ms]. A peak too bright even at the shortest
-// exposure clips, and the sample carries clip bits per channel. Noise is drawn from a seeded
-// generator restarted for every measurement from (seed, what is measured, θin), so a slice is
-// reproduced exactly whatever was measured before it (a resumed capture matches an
-// uninterrupted one).
+// Exposure is auto-ranged per θout row (default): the firmware finds the row's brightest
+// sample with a probe exposure (simulated as the noise-free maximum of the row) and sets t so
+// it reaches `autorange_target_fraction` of the range above dark, within
+// [min_exposure_ms, max_exposure_ms]. The white reference is always ranged this way. A peak too
+// bright even at the shortest exposure clips, and the sample carries clip bits per channel. Noise
+// is drawn from a seeded generator restarted for every measurement from (seed, what is measured,
+// θin), so a slice is reproduced exactly whatever was measured before it (a resumed capture matches
+// an uninterrupted one).
 #pragma once
 
 #include <array>
@@ -98,7 +99,8 @@ struct SimulatorConfig {
 // One raw reading that clipped, for tests only: real firmware reports clipping through the
 // clip bits of its messages and nothing else.
 struct ClipRecord {
-  float theta_in_deg = 0;  // NaN-free; white readings use row = column = 0xFFFF
+  float theta_in_deg = 0;
+  // θout row and φout column of the sample; 0xFFFF for both in a white reference reading.
   std::uint16_t row = 0, column = 0;
   std::uint8_t channels = 0;  // bit c: channel c clipped
 };
