@@ -149,6 +149,20 @@ TEST_F(CaptureCli, ResumeRefusesDifferentSettings) {
   EXPECT_NE(other_sample.err.find("holds sample 'g'"), std::string::npos) << other_sample.err;
 }
 
+TEST_F(CaptureCli, ResumeOfAFileWithoutAReadableHeaderSuggestsStartingOver) {
+  const std::string out = Path("junk.bpc");
+  {
+    std::FILE* f = std::fopen(out.c_str(), "wb");
+    std::fputs("not a capture", f);
+    std::fclose(f);
+  }
+  const ToolRun r = Run("capture --material gold --sample g --out " + out + kCoarse + " --resume");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("byte 0"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--force"), std::string::npos) << r.err;
+  EXPECT_EQ(ReadFileText(out, 100), "not a capture");
+}
+
 TEST_F(CaptureCli, RefusesToOverwriteAnExistingFileWithoutForce) {
   const std::string out = Path("x.bpc");
   {

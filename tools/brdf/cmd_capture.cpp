@@ -174,7 +174,12 @@ int RunCapture(const CaptureOptions& o) {
                           " already exists: use --resume to continue an interrupted "
                           "capture or --force to overwrite it");
   if (o.resume && exists) {
-    existing = ReadBpc(o.out);
+    try {
+      existing = ReadBpc(o.out);
+    } catch (const FormatError& e) {
+      throw FormatError(e.file(), e.position(), e.expected(), e.got(),
+                        "nothing in it can be resumed; start over with --force");
+    }
     const Metadata& old = existing->measurement.metadata;
     if (existing->finished) {
       if (!o.quiet)
