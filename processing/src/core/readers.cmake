@@ -1,1 +1,5 @@
 # Importers of third-party formats: target_sources(brdf_core PRIVATE ...) added by that part.
+target_sources(brdf_core PRIVATE
+  src/core/readers/rgl_tensor.cpp
+  src/core/readers/rgl_brdf.cpp
+)
