@@ -238,6 +238,46 @@ def compare(driver, path, n, seed, rtol, tiny_fraction):
     return worst <= rtol and abs_small <= rtol
 
 
+def write_tensor_file(path, fields):
+    """Writes [(name, numpy array)] as a version 1.0 tensor file (data 8-byte aligned)."""
+    codes = {np.dtype(v).newbyteorder('<'): k for k, v in DTYPES.items()}
+    header = 18 + sum(2 + len(n) + 2 + 1 + 8 + 8 * a.ndim for n, a in fields)
+    offset, blocks, head = (header + 7) // 8 * 8, [], b''
+    for name, a in fields:
+        a = np.ascontiguousarray(a, a.dtype.newbyteorder('<'))
+        head += struct.pack('<H', len(name)) + name.encode()
+        head += struct.pack('<HBQ', a.ndim, codes[a.dtype], offset)
+        head += b''.join(struct.pack('<Q', d) for d in a.shape)
+        blocks.append((offset, a.tobytes()))
+        offset = (offset + a.nbytes + 7) // 8 * 8
+    out = bytearray(b'tensor_file\0\x01\x00' + struct.pack('<I', len(fields)) + head)
+    for off, data in blocks:
+        out += bytes(off - len(out)) + data
+    open(path, 'wb').write(bytes(out))
+
+
+def synthetic_file(path, seed, anisotropic, jacobian):
+    """A random but smooth material: exercises what the real files do not (several phi_i
+    slices, jacobian = 0, non-square tables, negative RGB)."""
+    rng = np.random.default_rng(seed)
+    phi = np.array([-np.pi, -1.0, 0.5, np.pi], np.float32) if anisotropic else \
+        np.array([0.0], np.float32)
+    theta = np.array([0.0, 0.3, 0.8, 1.2, np.pi / 2], np.float32)
+    p, t, vy, vx, ny, nx = len(phi), len(theta), 17, 23, 9, 12
+    x = np.linspace(0, 1, vx)[None, None, None, :]
+    y = np.linspace(0, 1, vy)[None, None, :, None]
+    a = rng.uniform(0.5, 3.0, (p, t, 1, 1))
+    vndf = (np.exp(-a * x * 3) * (1.2 + np.cos(2 * np.pi * (y - rng.uniform(0, 1, (p, t, 1, 1)))))
+            * x).astype(np.float32)
+    rgb = rng.uniform(-0.05, 1.0, (p, t, 3, ny, nx)).astype(np.float32)
+    ndf = rng.uniform(0.1, 5.0, (2, 31)).astype(np.float32)
+    sigma = rng.uniform(0.2, 1.0, (2, 31)).astype(np.float32)
+    write_tensor_file(path, [
+        ('description', np.frombuffer(b'oracle synthetic', np.uint8)),
+        ('phi_i', phi), ('theta_i', theta), ('sigma', sigma), ('ndf', ndf), ('vndf', vndf),
+        ('rgb', rgb), ('jacobian', np.array([jacobian], np.uint8))])
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     ap.add_argument('--driver', required=True)
@@ -247,13 +287,18 @@ def main():
         'irid_flake_paint1_fine_rgb.bsdf', 'ilm_solo_m_68_rgb.bsdf', 'cc_ibiza_sunset_rgb.bsdf'])
     ap.add_argument('--extra', nargs='*', default=[], help='further .bsdf files (any path)')
     ap.add_argument('--pairs', type=int, default=3000)
-    ap.add_argument('--rtol', type=float, default=1e-4)
+    ap.add_argument('--rtol', type=float, default=1e-6)
     ap.add_argument('--tiny', type=float, default=1e-6)
     args = ap.parse_args()
     ok = True
     paths = [os.path.join(args.data_dir, f) for f in args.files] + args.extra
-    for i, path in enumerate(paths):
-        ok &= compare(args.driver, path, args.pairs, 1234 + i, args.rtol, args.tiny)
+    with tempfile.TemporaryDirectory() as tmp:
+        for name, aniso, jac in [('synthetic_anisotropic.bsdf', True, 1),
+                                 ('synthetic_jacobian0.bsdf', False, 0)]:
+            paths.append(os.path.join(tmp, name))
+            synthetic_file(paths[-1], len(paths), aniso, jac)
+        for i, path in enumerate(paths):
+            ok &= compare(args.driver, path, args.pairs, 1234 + i, args.rtol, args.tiny)
     if not ok:
         print('FAILED: C++ and the NumPy oracle differ by more than rtol %.1e' % args.rtol)
         return 1

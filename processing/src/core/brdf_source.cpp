@@ -1,6 +1,7 @@
 #include "brdf/core/brdf_source.h"
 
 #include "brdf/core/error.h"
+#include "brdf/core/rgl.h"
 
 namespace brdf {
 
@@ -8,7 +9,8 @@ std::unique_ptr<BrdfSource> OpenBrdfSource(const std::string& path) {
   const auto dot = path.rfind('.');
   const std::string ext = dot == std::string::npos ? "" : path.substr(dot);
   if (ext == ".json") return std::make_unique<AnalyticBrdf>(LoadMaterialFile(path));
-  throw FormatError(path, "file name", "an evaluable BRDF file (.json material)",
+  if (ext == ".bsdf") return std::make_unique<RglBrdf>(RglBrdf::Load(path));
+  throw FormatError(path, "file name", "an evaluable BRDF file (.json material, .bsdf RGL)",
                     "extension '" + ext + "'");
 }
 

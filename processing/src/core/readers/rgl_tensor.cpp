@@ -164,13 +164,18 @@ TensorFile TensorFile::Parse(std::vector<std::uint8_t> bytes, std::string file) 
           what + " data no larger than the file (" + std::to_string(file_size) + " bytes)",
           "shape " + f.ShapeString() + " of " + TensorDtypeName(f.dtype));
     f.data_bytes = elements * item;
-    if (f.data_offset > file_size || f.data_bytes > file_size - f.data_offset)
-      throw FormatError(
-          out.file_, BytePosition(offset_at),
-          what + " data inside the file (" + std::to_string(file_size) + " bytes)",
-          std::to_string(f.data_bytes) + " bytes at offset " + std::to_string(f.data_offset));
     names.insert(f.name);
     out.fields_.push_back(std::move(f));
+  }
+  // Data ranges are checked once the whole header has been read, so a file cut inside its
+  // header is reported there rather than at the first field whose data went missing.
+  for (const TensorField& f : out.fields_) {
+    if (f.data_offset > file_size || f.data_bytes > file_size - f.data_offset)
+      throw FormatError(
+          out.file_, BytePosition(f.header_offset + 2 + f.name.size() + 2 + 1),
+          "field " + Quoted(f.name) + " data inside the file (" + std::to_string(file_size) +
+              " bytes)",
+          std::to_string(f.data_bytes) + " bytes at offset " + std::to_string(f.data_offset));
   }
   return out;
 }
