@@ -1,5 +1,5 @@
 // RGL and MERL readers: load time per file and evaluation throughput.
-//   build/bench/bench_rgl --benchmark_filter=Rgl
+//   build/bench/bench_rgl --benchmark_filter=Rgl   (or Merl, Sha256)
 // Evaluation target (issue 4): at least 5 M RGL evaluations per second per core.
 #include <benchmark/benchmark.h>
 
@@ -8,8 +8,15 @@
 #include <string>
 #include <vector>
 
+#include <filesystem>
+
+#include "brdf/core/brdf_source.h"
+#include "brdf/core/file_util.h"
 #include "brdf/core/geometry.h"
+#include "brdf/core/merl.h"
+#include "brdf/core/models.h"
 #include "brdf/core/rgl.h"
+#include "brdf/core/sha256.h"
 
 namespace brdf {
 namespace {
@@ -77,6 +84,59 @@ void BM_RglVirtualCapture(benchmark::State& state) {
   state.SetItemsProcessed(state.iterations() * 4 * static_cast<std::int64_t>(outs.size()));
 }
 BENCHMARK(BM_RglVirtualCapture)->Unit(benchmark::kMillisecond);
+
+// MERL: a synthetic file (no genuine one ships) written once from a GGX material.
+const std::string& MerlFile() {
+  static const std::string path = [] {
+    const std::string p =
+        (std::filesystem::temp_directory_path() / "bench_rgl_synthetic.binary").string();
+    Material m;
+    m.model = Model::kGgx;
+    m.kd = {0.1, 0.2, 0.3};
+    m.ks = {0.04, 0.04, 0.04};
+    m.shape = {0.2, 0.2, 0.2};
+    WriteMerlBinary(p, AnalyticBrdf(m));
+    return p;
+  }();
+  return path;
+}
+
+void BM_MerlLoad(benchmark::State& state) {
+  const std::string& path = MerlFile();
+  for (auto _ : state) benchmark::DoNotOptimize(MerlBrdf::Load(path));
+  state.SetBytesProcessed(state.iterations() * static_cast<std::int64_t>(kMerlFileBytes));
+}
+BENCHMARK(BM_MerlLoad)->Unit(benchmark::kMillisecond);
+
+void BM_MerlEval(benchmark::State& state) {
+  const MerlBrdf brdf = MerlBrdf::Load(MerlFile());
+  const std::vector<Pair> pairs = RandomPairs(1 << 14);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const Pair& p = pairs[i++ & (pairs.size() - 1)];
+    benchmark::DoNotOptimize(brdf.Eval(p.wi, p.wo));
+  }
+  state.SetItemsProcessed(state.iterations());
+}
+BENCHMARK(BM_MerlEval);
+
+void BM_MerlWrite(benchmark::State& state) {
+  Material m;
+  m.model = Model::kGgx;
+  m.kd = {0.1, 0.2, 0.3};
+  m.ks = {0.04, 0.04, 0.04};
+  m.shape = {0.2, 0.2, 0.2};
+  const AnalyticBrdf source(m);
+  for (auto _ : state) benchmark::DoNotOptimize(EncodeMerlBinary(source));
+}
+BENCHMARK(BM_MerlWrite)->Unit(benchmark::kMillisecond);
+
+void BM_Sha256(benchmark::State& state) {
+  const std::string data(1 << 24, 'x');
+  for (auto _ : state) benchmark::DoNotOptimize(Sha256Hex(data));
+  state.SetBytesProcessed(state.iterations() * static_cast<std::int64_t>(data.size()));
+}
+BENCHMARK(BM_Sha256)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 }  // namespace brdf

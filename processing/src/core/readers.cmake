@@ -3,3 +3,7 @@ target_sources(brdf_core PRIVATE
   src/core/readers/rgl_tensor.cpp
   src/core/readers/rgl_brdf.cpp
 )
+target_sources(brdf_core PRIVATE
+  src/core/readers/merl.cpp
+  src/core/sha256.cpp
+)
