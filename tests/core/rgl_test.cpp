@@ -611,6 +611,7 @@ TEST(RglBrokenFiles, EachFailsWithAClearFormatError) {
       {"negative_vndf.bsdf", "a finite density >= 0, got -1"},
       {"zero_vndf.bsdf", "positive total mass"},
       {"zero_sigma.bsdf", "projected area > 0"},
+      {"absurd_ndf.bsdf", "expected a magnitude of at most 1e30, got 3.00000001e+38"},
       {"theta_not_increasing.bsdf", "values increasing strictly"},
       {"bad_utf8_description.bsdf", "expected UTF-8 text, got invalid UTF-8"},
       {"bad_utf8_field_name.bsdf", "a UTF-8 field name"},

@@ -25,6 +25,7 @@
 #include <optional>
 #include <span>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "brdf/core/brdf_source.h"
@@ -108,6 +109,8 @@ struct MerlDigest {
 // BRDF_MERL_SHA256_TABLE environment variable; InvalidArgument when neither is given.
 // Throws IoError / FormatError naming the line.
 std::vector<MerlDigest> ReadMerlDigestTable(const std::string& path = "");
+// The same parse of a table's text; `file` names it in messages.
+std::vector<MerlDigest> ParseMerlDigestTable(std::string_view text, const std::string& file);
 
 // The MERL material whose published digest matches the file's SHA-256 and size, or nullopt
 // for a file that is not one of the published ones (e.g. a synthetic file). The table is read

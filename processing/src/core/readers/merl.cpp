@@ -172,13 +172,16 @@ std::vector<MerlDigest> ReadMerlDigestTable(const std::string& path) {
           "(../shared/brdf-data/reference/merl_binary_sha256.tsv)");
     table = env;
   }
-  const std::string text = ReadFileText(table, 1u << 20);
+  return ParseMerlDigestTable(ReadFileText(table, 1u << 20), table);
+}
+
+std::vector<MerlDigest> ParseMerlDigestTable(std::string_view text, const std::string& table) {
   std::vector<MerlDigest> out;
   std::size_t start = 0;
   for (std::uint64_t line_no = 1; start < text.size(); ++line_no) {
     std::size_t end = text.find('\n', start);
     if (end == std::string::npos) end = text.size();
-    std::string line = text.substr(start, end - start);
+    std::string line(text.substr(start, end - start));
     start = end + 1;
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.empty() || line[0] == '#') continue;

@@ -21,6 +21,9 @@ namespace {
 
 // Table dimensions are stored as int; real files use at most a few hundred.
 constexpr std::uint64_t kMaxDimension = 1u << 16;
+// Largest magnitude accepted in any table (real files stay below 1e5). With it, every
+// product the evaluator forms (rgb · ndf / 4σ, σ ≥ the smallest float) stays finite in double.
+constexpr double kMaxMagnitude = 1e30;
 
 std::string Quoted(std::string_view s) { return "'" + std::string(s) + "'"; }
 
@@ -266,11 +269,13 @@ class FieldChecker {
   std::vector<float> Values(const TensorField& f, Pred ok, std::string_view requirement) const {
     std::vector<float> v = tf_.Float32(f);
     for (std::size_t k = 0; k < v.size(); ++k) {
-      if (!std::isfinite(v[k]) || !ok(v[k]))
+      const bool absurd = std::isfinite(v[k]) && std::abs(v[k]) > kMaxMagnitude;
+      if (!std::isfinite(v[k]) || absurd || !ok(v[k]))
         throw FormatError(tf_.file(),
                           BytePosition(f.data_offset + 4 * k) + " (field " + Quoted(f.name) +
                               " element " + IndexString(f.shape, k) + ")",
-                          std::string(requirement), FormatValue(v[k]));
+                          absurd ? "a magnitude of at most 1e30" : std::string(requirement),
+                          FormatValue(v[k]));
     }
     return v;
   }

@@ -115,6 +115,7 @@ def broken_files():
     files['inf_rgb.bsdf'] = with_value(b'rgb', 5, math.inf)
     files['negative_vndf.bsdf'] = with_value(b'vndf', 3, -1.0)
     files['zero_sigma.bsdf'] = with_value(b'sigma', 2, 0.0)
+    files['absurd_ndf.bsdf'] = with_value(b'ndf', 1, 3e38)
     files['theta_not_increasing.bsdf'] = with_value(b'theta_i', 1, 0.0)
     fs = base_fields()
     field(fs, b'vndf')['data'] = f32([0.0] * 50)
