@@ -3,8 +3,13 @@
 // Everything that depends only on the file is computed once here: each incidence slice's VNDF
 // is normalised and its conditional (along u(θ)) and marginal (along u(φ)) CDFs are tabulated,
 // and the RGB table is interleaved per texel so one evaluation touches a few cache lines. Eval
-// then costs two acos, two atan2, the warp inversion on a 2×2 cell blended over (at most four)
-// incidence slices, and three bilinear lookups.
+// then costs two acos, one atan2 (two for anisotropic files), the warp inversion on a 2×2 cell
+// blended over (at most four) incidence slices, and three bilinear lookups.
+//
+// The warp tables are double where the reference loader keeps float. Measured against the
+// float64 NumPy oracle, float tables move f_r by up to ~5e-5 relative at moderate angles and
+// ~5e-4 at grazing half vectors (θm > 80°, where X = C / row_total divides small sums): the
+// size of the reference's own rounding. With double tables the two agree to ~1e-11.
 #include <algorithm>
 #include <array>
 #include <cmath>
