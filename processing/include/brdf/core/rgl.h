@@ -133,7 +133,7 @@ struct RglInfo {
 };
 
 // An RGL material as a BrdfSource. Thread-safe to evaluate (immutable after loading); about
-// 1.5 × the file size in memory. Eval allocates nothing.
+// 3 × the file size in memory (the warp tables are kept in double). Eval allocates nothing.
 class RglBrdf final : public BrdfSource {
  public:
   // Reads and checks a file. Throws IoError / FormatError naming the file, byte offset (or
