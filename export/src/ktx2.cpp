@@ -68,12 +68,6 @@ KeyValues WithStandardKeys(const KeyValues& key_values) {
   return all;
 }
 
-std::string TruncatedForMessage(std::string s) {
-  for (char& c : s)
-    if (static_cast<unsigned char>(c) < 0x20) c = '?';
-  return s.size() > 40 ? s.substr(0, 37) + "..." : s;
-}
-
 // Checks one field read at the reader's current position minus 4.
 void Expect32(ByteReader& r, std::uint32_t expected, std::string_view what,
               std::string_view meaning = {}) {
@@ -225,13 +219,14 @@ void WriteKtx2(const std::string& path, const Lut& lut, const TextureMetadata& m
 
 LoadedTexture ParseKtx2(const std::uint8_t* data, std::size_t size, const std::string& file) {
   ByteReader r(data, size, file);
-  const std::uint8_t* id = r.Bytes(std::min<std::size_t>(size, 12), "KTX2 identifier");
-  if (size < 12 || std::memcmp(id, kIdentifier.data(), 12) != 0)
-    throw FormatError(file, BytePosition(0), "the KTX 2.0 identifier «KTX 20»\\r\\n\\x1A\\n",
-                      size < 4 ? "a file of " + std::to_string(size) + " bytes"
-                               : "\"" + TruncatedForMessage(std::string(
-                                            reinterpret_cast<const char*>(data), std::min<std::size_t>(size, 12))) +
-                                     "\"");
+  if (size < 12 || std::memcmp(data, kIdentifier.data(), 12) != 0) {
+    std::string got = size < 12 ? fmt::format("a file of {} bytes", size) : std::string("bytes");
+    for (std::size_t i = 0; i < std::min<std::size_t>(size, 12); ++i) got += fmt::format(" {:02x}", data[i]);
+    throw FormatError(file, BytePosition(0),
+                      "the KTX 2.0 identifier ab 4b 54 58 20 32 30 bb 0d 0a 1a 0a («KTX 20»\\r\\n\\x1A\\n)",
+                      got);
+  }
+  r.Skip(12);
   Expect32(r, kVkFormatE5b9g9r9UfloatPack32, "vkFormat", "VK_FORMAT_E5B9G9R9_UFLOAT_PACK32");
   Expect32(r, 4, "typeSize");
   LoadedTexture t;
