@@ -1,6 +1,7 @@
 #include "brdf/exporter/rgb9e5.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 
 namespace brdf::exporter {
@@ -30,20 +31,26 @@ const ScaleTable kScales;
 std::uint32_t EncodeRgb9e5(float r, float g, float b) {
   const float rc = ClampChannel(r), gc = ClampChannel(g), bc = ClampChannel(b);
   const float max_c = std::max(rc, std::max(gc, bc));
-  if (max_c == 0.0f) return 0;  // exp_shared_p = 0, all mantissas 0
-  // floor(log2(max_c)) is the float's unbiased exponent; ilogb is exact (also for float
-  // denormals), where log2 rounding could misplace a value just below a power of two.
-  const int floor_log2 = std::ilogb(max_c);
-  int exp_shared = std::max(-kB - 1, floor_log2) + 1 + kB;
-  // Dividing by a power of two is exact in double and the scaled value has at most 24
-  // significant bits below 2^10, so adding 0.5 is exact too: floor(x + 0.5) is the spec's
-  // round-half-up without any double rounding.
-  const auto scaled = [](float c, int e) {
-    return static_cast<std::uint32_t>(std::floor(std::ldexp(double{c}, kB + kN - e) + 0.5));
+  // Integer arithmetic on the float's fields keeps every step exact. A clamped channel is
+  // +0 or a positive float c = sig · 2^(e − 150) with a 24-bit significand sig and biased
+  // exponent e ≥ 1; floor(log2(c)) = e − 127. A float denormal (e = 0, c < 2^−126) is far
+  // below the format's smallest step 2^−24 and encodes as 0 at any exponent.
+  const int max_e = static_cast<int>(std::bit_cast<std::uint32_t>(max_c) >> 23);
+  if (max_e == 0) return 0;
+  int exp_shared = std::max(max_e - 127, -kB - 1) + 1 + kB;
+  // floor(c / 2^(exp_shared − B − N) + 0.5) = (sig + 2^(s−1)) >> s with
+  // s = 126 + exp_shared − e (≥ 15 here); for s > 24 the quotient is below ½ and rounds to 0.
+  const auto mantissa = [](float c, int exp) -> std::uint32_t {
+    const std::uint32_t bits = std::bit_cast<std::uint32_t>(c);
+    const int e = static_cast<int>(bits >> 23);
+    const int s = 126 + exp - e;
+    if (e == 0 || s > 24) return 0;
+    const std::uint32_t sig = (bits & 0x7fffffu) | 0x800000u;
+    return (sig + (1u << (s - 1))) >> s;
   };
-  if (scaled(max_c, exp_shared) == (1u << kN)) ++exp_shared;  // round-up correction
-  return scaled(rc, exp_shared) | (scaled(gc, exp_shared) << 9) | (scaled(bc, exp_shared) << 18) |
-         (static_cast<std::uint32_t>(exp_shared) << 27);
+  if (mantissa(max_c, exp_shared) == (1u << kN)) ++exp_shared;  // round-up correction
+  return mantissa(rc, exp_shared) | (mantissa(gc, exp_shared) << 9) |
+         (mantissa(bc, exp_shared) << 18) | (static_cast<std::uint32_t>(exp_shared) << 27);
 }
 
 std::array<float, 3> DecodeRgb9e5(std::uint32_t packed) {
