@@ -8,7 +8,8 @@ std::string BrdfToolVersion() { return BRDF_VERSION_STRING; }
 std::string BrdfToolWriter() { return std::string("brdf-toolchain ") + BRDF_VERSION_STRING; }
 
 GridLayout SquareishGrid(int count) {
-  if (count < 1) throw InvalidArgument("grid layout: need at least one cell, got " + std::to_string(count));
+  if (count < 1)
+    throw InvalidArgument("grid layout: need at least one cell, got " + std::to_string(count));
   int columns = 1;
   while (columns * columns < count) ++columns;  // smallest C with C² ≥ count: ceil(√count)
   const int rows = (count + columns - 1) / columns;
@@ -17,7 +18,8 @@ GridLayout SquareishGrid(int count) {
 
 std::string TexelCentreFormula() {
   return "u = (phi_d/1deg + 0.5)/361, v = (theta_d/1deg + 0.5)/181, "
-         "w = ((theta_in - theta_in_0)/delta_in + 0.5)/K; clamp-to-edge, trilinear; texel (i, j, k) "
+         "w = ((theta_in - theta_in_0)/delta_in + 0.5)/K; clamp-to-edge, trilinear; texel (i, j, "
+         "k) "
          "holds f at exactly phi_d = i deg, theta_d = j deg, theta_in = theta_in_0 + k*delta_in "
          "(texel centres); column 360 repeats column 0; row 0 is theta_d = 0 (top)";
 }

@@ -27,7 +27,8 @@ TextureMetadata FullMeta() {
 TEST(Sidecar, BitwiseReferenceCrcHasTheStandardCheckValue) {
   // The CRC-32 check value of "123456789" is 0xCBF43926 (IEEE 802.3 / zlib).
   const std::string s = "123456789";
-  EXPECT_EQ(test::BitwiseCrc32(reinterpret_cast<const std::uint8_t*>(s.data()), s.size()), 0xCBF43926u);
+  EXPECT_EQ(test::BitwiseCrc32(reinterpret_cast<const std::uint8_t*>(s.data()), s.size()),
+            0xCBF43926u);
 }
 
 TEST(Sidecar, HoldsEveryFieldDesignSection7Names) {
@@ -49,7 +50,8 @@ TEST(Sidecar, HoldsEveryFieldDesignSection7Names) {
   EXPECT_EQ(j["extrapolation"]["l"], 0.3);
   EXPECT_EQ(j["extrapolation"]["theta_b_deg"], 75.0);
   EXPECT_EQ(j["fitted_models"][0]["model"], "lambert");
-  EXPECT_TRUE(std::regex_match(j["tool"]["version"].get<std::string>(), std::regex(R"(\d+\.\d+\.\d+)")));
+  EXPECT_TRUE(
+      std::regex_match(j["tool"]["version"].get<std::string>(), std::regex(R"(\d+\.\d+\.\d+)")));
   EXPECT_EQ(j["payload"]["bytes"], 361u * 181u * 4u * 4u);
   EXPECT_EQ(j["payload"]["checksum"]["algorithm"], "crc32");
   EXPECT_EQ(j["files"].size(), 4u);
@@ -106,7 +108,8 @@ TEST(Sidecar, ParserNamesTheBadMember) {
     ParseSidecarJson(j.dump(), "felt.json");
     FAIL() << "accepted";
   } catch (const FormatError& e) {
-    EXPECT_NE(std::string(e.what()).find("felt.json: member 'theta_in_deg'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("felt.json: member 'theta_in_deg'"), std::string::npos)
+        << e.what();
   }
   try {
     ParseSidecarJson("{\"kind\": ", "broken.json");

@@ -13,9 +13,9 @@ namespace brdf::exporter {
 
 // Grazing extrapolation parameters of DESIGN §6 used to fill θout between θb and 90°.
 struct ExtrapolationInfo {
-  double p = 1.0;            // value factor at 90° (1 = clamping)
-  double l = 0.5;            // Bézier control abscissa in [0, 1] (0.5 = linear ramp)
-  double theta_b_deg = 75;   // the last measured θout of the data
+  double p = 1.0;           // value factor at 90° (1 = clamping)
+  double l = 0.5;           // Bézier control abscissa in [0, 1] (0.5 = linear ramp)
+  double theta_b_deg = 75;  // the last measured θout of the data
 };
 
 struct TextureMetadata {
