@@ -132,7 +132,7 @@ LoadedTexture ParseDds(const std::uint8_t* data, std::size_t size, const std::st
       throw FormatError(file, BytePosition(at), "dwMipMapCount 1 (one level)",
                         std::to_string(mips));
   }
-  r.Skip(44);  // dwReserved1
+  r.Bytes(44, "DDS_HEADER.dwReserved1");
   expect(32, "DDS_PIXELFORMAT.dwSize");
   {
     const std::uint64_t at = r.offset();
@@ -147,7 +147,7 @@ LoadedTexture ParseDds(const std::uint8_t* data, std::size_t size, const std::st
                         "FourCC \"DX10\" (a DDS_HEADER_DXT10 extension header)",
                         FourCcText(four_cc));
   }
-  r.Skip(20);  // bit count and masks
+  r.Bytes(20, "DDS_PIXELFORMAT bit count and masks");
   r.U32("dwCaps");
   {
     const std::uint64_t at = r.offset();
@@ -156,7 +156,7 @@ LoadedTexture ParseDds(const std::uint8_t* data, std::size_t size, const std::st
       throw FormatError(file, BytePosition(at), "dwCaps2 with DDSCAPS2_VOLUME (0x200000)",
                         fmt::format("0x{:08x}", caps2));
   }
-  r.Skip(12);  // dwCaps3, dwCaps4, dwReserved2
+  r.Bytes(12, "dwCaps3, dwCaps4 and dwReserved2");
   {
     const std::uint64_t at = r.offset();
     const std::uint32_t dxgi = r.U32("DDS_HEADER_DXT10.dxgiFormat");
