@@ -171,7 +171,7 @@ std::string AtlasManifestJson(const Atlas& atlas, const std::vector<std::string>
        "image_slice_columns (row-major, ascending theta_in, top-left first)"},
       {"delta_in_deg",
        atlas.theta_in_deg.size() >= 2 ? atlas.theta_in_deg[1] - atlas.theta_in_deg[0] : 0.0}};
-  ordered_json convention = detail::TexelConventionJson();
+  ordered_json convention = detail::TexelConventionJson(atlas.theta_in_deg);
   convention["atlas_cell"] =
       "u = (x0 + phi_d/1deg + 0.5)/texture_width, v = (y0 + theta_d/1deg + 0.5)/texture_height, "
       "w as for one LUT; clamp u to [(x0 + 0.5)/texture_width, (x0 + 360.5)/texture_width] and v "

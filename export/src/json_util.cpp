@@ -27,8 +27,11 @@ ordered_json GridJson(const PackedVolume& payload, const std::vector<double>& th
                        "with the same phi_out"}};
 }
 
-ordered_json TexelConventionJson() {
-  return ordered_json{{"centre_exact", TexelCentreFormula()}, {"published", PublishedFormula()}};
+ordered_json TexelConventionJson(const std::vector<double>& theta_in_deg) {
+  const double delta = theta_in_deg.size() >= 2 ? theta_in_deg[1] - theta_in_deg[0] : 0.0;
+  return ordered_json{{"centre_exact", TexelCentreFormula()},
+                      {"published", PublishedFormula()},
+                      {"glsl", ShaderSnippetGlsl(delta, static_cast<int>(theta_in_deg.size()))}};
 }
 
 std::string Hex32(std::uint32_t v) { return fmt::format("0x{:08x}", v); }

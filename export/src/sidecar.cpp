@@ -22,7 +22,7 @@ std::string SidecarJson(const PackedVolume& payload, const std::vector<double>& 
   j["theta_in_deg"] = theta_in_deg;
   j["grid"] = detail::GridJson(payload, theta_in_deg);
   j["values"] = "f_r in 1/sr, linear Rec.709 RGB, not multiplied by cos(theta)";
-  j["texel_convention"] = detail::TexelConventionJson();
+  j["texel_convention"] = detail::TexelConventionJson(theta_in_deg);
   if (metadata.extrapolation) {
     const ExtrapolationInfo& e = *metadata.extrapolation;
     j["extrapolation"] = {
