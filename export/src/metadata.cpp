@@ -33,6 +33,17 @@ std::string PublishedFormula() {
          "term: addresses texel edges, off by half a texel from the centre-exact formula)";
 }
 
+namespace {
+
+// A GLSL float literal ("20.0", "2.5"): GLSL ES has no implicit int → float conversion.
+std::string GlslFloat(double v) {
+  std::string s = fmt::format("{:g}", v);
+  if (s.find_first_of(".e") == std::string::npos) s += ".0";
+  return s;
+}
+
+}  // namespace
+
 std::string ShaderSnippetGlsl(double delta_in_deg, int slices) {
   return fmt::format(
       "// uniform sampler3D lut: RGB9E5, linear filtering, CLAMP_TO_EDGE on s, t and r\n"
@@ -42,12 +53,13 @@ std::string ShaderSnippetGlsl(double delta_in_deg, int slices) {
       "  float phi_d = degrees(atan(w_d.y, w_d.x));\n"
       "  if (phi_d < 0.0) phi_d += 360.0;\n"
       "  vec3 uvw = vec3((phi_d + 0.5) / 361.0, (theta_d + 0.5) / 181.0,\n"
-      "                  (theta_in_deg / {:g} + 0.5) / {}.0);\n"
+      "                  (theta_in_deg / {} + 0.5) / {}.0);\n"
       "  // published form, half a texel off: vec3(phi_d / 360.0, theta_d / 180.0, "
-      "theta_in_deg / {:g})\n"
+      "theta_in_deg / {})\n"
       "  return texture(lut, uvw).rgb;  // f_r in 1/sr, not multiplied by cos(theta)\n"
       "}}\n",
-      delta_in_deg > 0 ? delta_in_deg : 1.0, slices, delta_in_deg * std::max(slices - 1, 1));
+      GlslFloat(delta_in_deg > 0 ? delta_in_deg : 1.0), slices,
+      GlslFloat(delta_in_deg > 0 ? delta_in_deg * std::max(slices - 1, 1) : 1.0));
 }
 
 }  // namespace brdf::exporter
