@@ -64,25 +64,26 @@ Lut LutFromComposite(const FloatImage& image, std::vector<double> theta_in_deg) 
   return lut;
 }
 
-void WriteExr(const std::string& path, const FloatImage& image, ExrPixelType type,
+void WriteExr(const std::string& path, const FloatImage& image, const ExrOptions& options,
               const StringAttributes& attributes) {
   if (image.width < 1 || image.height < 1 ||
       image.rgb.size() != static_cast<std::size_t>(image.width) * image.height * 3)
     throw InvalidArgument(fmt::format("EXR: inconsistent image {} × {} with {} floats", image.width,
                                       image.height, image.rgb.size()));
-  OIIO::ImageSpec spec(image.width, image.height, 3,
-                       type == ExrPixelType::kHalf ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
+  OIIO::ImageSpec spec(
+      image.width, image.height, 3,
+      options.type == ExrPixelType::kHalf ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
   spec.channelnames = {"R", "G", "B"};
-  spec.attribute("compression", "zip");
+  spec.attribute("compression", options.compression == ExrCompression::kZip ? "zip" : "none");
   spec.attribute("Software", BrdfToolWriter());
   for (const auto& [name, value] : attributes) spec.attribute(name, value);
   WriteImageAtomically(path, "exr", spec, OIIO::TypeDesc::FLOAT, image.rgb.data());
 }
 
 void WriteExrComposite(const std::string& path, const Lut& lut, const PackedVolume& packed,
-                       const TextureMetadata& metadata, ExrPixelType type) {
+                       const TextureMetadata& metadata, const ExrOptions& options) {
   const GridLayout grid = SquareishGrid(lut.slices());
-  WriteExr(path, CompositeImage(lut), type,
+  WriteExr(path, CompositeImage(lut), options,
            {{"brdf:sidecar", SidecarJson(packed, lut.theta_in_deg, metadata)},
             {"brdf:theta_in_deg", FormatThetaList(lut.theta_in_deg)},
             {"brdf:layout", fmt::format("{} x {} slices of 361 x 181, row-major, ascending "
@@ -93,8 +94,8 @@ void WriteExrComposite(const std::string& path, const Lut& lut, const PackedVolu
 }
 
 void WriteExrComposite(const std::string& path, const Lut& lut, const TextureMetadata& metadata,
-                       ExrPixelType type) {
-  WriteExrComposite(path, lut, PackLut(lut), metadata, type);
+                       const ExrOptions& options) {
+  WriteExrComposite(path, lut, PackLut(lut), metadata, options);
 }
 
 std::vector<unsigned char> ToneMapForPng(const FloatImage& image) {

@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 
 #include <OpenImageIO/imageio.h>
 #include <nlohmann/json.hpp>
@@ -129,6 +130,17 @@ TEST(Exr, HalfPrecisionStoresHalfsWithinTheirRounding) {
     const float tolerance = std::max(std::abs(v) * std::ldexp(1.0f, -11), std::ldexp(1.0f, -25));
     ASSERT_NEAR(back.texels[n], v, tolerance) << n;
   }
+}
+
+TEST(Exr, UncompressedFilesHoldTheSameValues) {
+  const std::string dir = test::TestDir("exr_raw");
+  const Lut lut = test::AnalyticLut(test::Lafortune20(), {0, 20, 40, 60});
+  WriteExrComposite(dir + "/zip.exr", lut, Meta());
+  WriteExrComposite(dir + "/raw.exr", lut, Meta(), {ExrPixelType::kFloat, ExrCompression::kNone});
+  EXPECT_EQ(ReadExr(dir + "/raw.exr").image.rgb, ReadExr(dir + "/zip.exr").image.rgb);
+  // Uncompressed float RGB: at least 722·362·3·4 bytes of pixels.
+  EXPECT_GE(std::filesystem::file_size(dir + "/raw.exr"), 722u * 362u * 12u);
+  EXPECT_LT(std::filesystem::file_size(dir + "/zip.exr"), 722u * 362u * 12u);
 }
 
 TEST(Png, ToneMappedCompositeIs722By362EightBitRgb) {
