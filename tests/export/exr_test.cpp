@@ -173,5 +173,27 @@ TEST(Png, ToneMapSendsThe99thPercentileToWhiteAndZeroToBlack) {
   for (int p = 1; p <= 100; ++p) EXPECT_GE(out[3 * p], out[3 * (p - 1)]);  // monotone
 }
 
+TEST(Png, ToneMapFollowsTheDocumentedFormulaAcrossTheRange) {
+  // Two grey pixels: g and 1. L99 is the larger (index round(0.99 · 1) = 1), so s = 1 and
+  // pixel 0 becomes round(255 · sRGB(2g / (1 + g))), computed here in double.
+  int exact = 0, total = 0;
+  for (int n = 1; n <= 20000; ++n) {
+    const double g = n / 20000.0;
+    FloatImage image;
+    image.width = 2;
+    image.height = 1;
+    image.rgb = {static_cast<float>(g), static_cast<float>(g), static_cast<float>(g), 1, 1, 1};
+    const double mapped = 2 * g / (1 + g);
+    const double srgb =
+        mapped <= 0.0031308 ? 12.92 * mapped : 1.055 * std::pow(mapped, 1 / 2.4) - 0.055;
+    const long want = std::lround(255 * srgb);
+    const int got = ToneMapForPng(image)[0];
+    ASSERT_LE(std::abs(got - want), 1) << g;  // float vs double at a rounding boundary
+    exact += got == want;
+    ++total;
+  }
+  EXPECT_GE(exact, total - total / 1000);
+}
+
 }  // namespace
 }  // namespace brdf::exporter
