@@ -20,6 +20,12 @@ packages=(
   nodejs
 )
 
+# Debian's npm is a separate package; a Node.js that already ships npm (e.g. NodeSource's)
+# conflicts with it, so npm is only requested when no npm command exists.
+if ! command -v npm >/dev/null 2>&1; then
+  packages+=(npm)
+fi
+
 missing=()
 for p in "${packages[@]}"; do
   if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed'; then
