@@ -16,9 +16,12 @@
 #include <vector>
 
 #include "brdf/core/bpc.h"
+#include "brdf/core/brdf_source.h"
 #include "brdf/core/file_util.h"
 #include "brdf/core/geometry.h"
+#include "brdf/core/merl.h"
 #include "brdf/core/models.h"
+#include "brdf/core/rgl.h"
 #include "tool_runner.h"
 
 namespace brdf {
@@ -215,6 +218,81 @@ TEST_F(ImportCommand, GoniometerTableGivesReflectanceFactorOverPi) {
     }
   }
   EXPECT_EQ(samples, expected.size());
+}
+
+// A virtual capture at the reference geometry of DESIGN §1 (θin 0/20/40/60°, θout 0–75°,
+// φout 0–359°, 1° steps): every grid point once, f_r equal to the source's own evaluation
+// (the reader's Eval, tested on its own in rgl_test / merl_test) as float, flagged invalid
+// exactly where `unmeasured` says so.
+template <typename Unmeasured>
+void ExpectReferenceCapture(const Measurement& m, const BrdfSource& source, Unmeasured unmeasured,
+                            std::size_t* flagged) {
+  ASSERT_EQ(m.ThetaInDeg(), (std::vector<double>{0, 20, 40, 60}));
+  *flagged = 0;
+  for (const Slice& s : m.slices) {
+    ASSERT_EQ(s.samples.size(), 76u * 360u);
+    EXPECT_FALSE(s.has_sigma);
+    std::vector<bool> seen(76 * 360, false);
+    const Vec3 wi = SphericalDirectionDeg(s.theta_in_deg, 0);
+    for (const Sample& x : s.samples) {
+      const int t = static_cast<int>(x.theta_out_deg), p = static_cast<int>(x.phi_out_deg);
+      ASSERT_TRUE(t == x.theta_out_deg && p == x.phi_out_deg && t >= 0 && t <= 75 && p >= 0 &&
+                  p < 360)
+          << x.theta_out_deg << " " << x.phi_out_deg;
+      ASSERT_FALSE(seen[t * 360 + p]) << "twice: " << t << " " << p;
+      seen[t * 360 + p] = true;
+      const Vec3 wo = SphericalDirectionDeg(t, p);
+      const Rgb f = source.Eval(wi, wo);
+      for (int c = 0; c < 3; ++c)
+        ASSERT_EQ(x.rgb[c], static_cast<float>(f[c])) << s.theta_in_deg << " " << t << " " << p;
+      const bool invalid = unmeasured(wi, wo);
+      ASSERT_EQ(x.flags, invalid ? kFlagInvalid : 0) << s.theta_in_deg << " " << t << " " << p;
+      *flagged += invalid;
+    }
+  }
+}
+
+TEST_F(ImportCommand, RglMaterialBecomesANoiseFreeCaptureAtTheReferenceGeometry) {
+  const std::string file = std::string(BRDF_SHARED_DATA_DIR) + "/rgl/vch_silk_blue_rgb.bsdf";
+  const ToolRun run = Run("import " + Quote(file) + " --out " + Quote(dir_ / "silk.bpc"));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("rgl"), std::string::npos) << run.out;
+  const BpcReadResult back = ReadIntact(dir_ / "silk.bpc");
+  EXPECT_EQ(back.measurement.metadata.extra.at("source_format"), "rgl");
+  std::size_t flagged = 1;
+  ExpectReferenceCapture(
+      back.measurement, RglBrdf::Load(file), [](const Vec3&, const Vec3&) { return false; },
+      &flagged);
+  EXPECT_EQ(flagged, 0u);
+}
+
+// The grey Ward material with a hole: no value (NaN) where the view direction leans far
+// towards −x, which EncodeMerlBinary stores as "not measured" bins.
+class WardWithHole final : public BrdfSource {
+ public:
+  Rgb Eval(const Vec3& wi, const Vec3& wo) const override {
+    if (wo.x < -0.5) return {std::nan(""), std::nan(""), std::nan("")};
+    return GreyWard().Evaluate(wi, wo);
+  }
+  std::string Name() const override { return "ward with a hole"; }
+};
+
+TEST_F(ImportCommand, MerlTableBecomesANoiseFreeCaptureWithUnmeasuredBinsFlagged) {
+  // A MERL table written by the MERL writer under a name whose extension says nothing:
+  // --format decides.
+  const fs::path file = dir_ / "ward_table.dat";
+  WriteMerlBinary(file.string(), WardWithHole());
+  const ToolRun run =
+      Run("import " + Quote(file) + " --format merl --out " + Quote(dir_ / "ward.bpc"));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const MerlBrdf merl = MerlBrdf::Load(file.string());
+  std::size_t flagged = 0;
+  ExpectReferenceCapture(
+      ReadIntact(dir_ / "ward.bpc").measurement, merl,
+      [&](const Vec3& wi, const Vec3& wo) { return !merl.IsMeasured(wi, wo); }, &flagged);
+  EXPECT_GT(flagged, 100u);  // the hole reaches the grid: the flag check above is not idle
+  EXPECT_NE(run.out.find(std::to_string(flagged) + " flagged invalid"), std::string::npos)
+      << run.out;
 }
 
 // The shared Zemax file, read with a plain line scan (not the reader under test).

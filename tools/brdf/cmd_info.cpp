@@ -283,9 +283,8 @@ Json DescribeImported(const std::string& path) {
     case ImportFormat::kMerl:
     case ImportFormat::kAuto:
       j["advice"] =
-          "an evaluable BRDF, not a point cloud: 'brdf capture --device sim "
-          "--material " +
-          path + "' captures it";
+          "an evaluable BRDF, not a point cloud: 'brdf eval' evaluates it, 'brdf import " + path +
+          " --out FILE.bpc' captures it noise-free at the reference geometry";
       break;
   }
   return j;

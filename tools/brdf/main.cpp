@@ -149,13 +149,12 @@ int main(int argc, char** argv) {
   auto* import_cmd = app.add_subcommand(
       "import",
       "Bring a third-party measurement into the toolchain as a .bpc capture: Zemax or "
-      "LightTools (MiniDiff) BSDF text, CSV point cloud, spectral goniometer table");
+      "LightTools (MiniDiff) BSDF text, CSV point cloud, spectral goniometer table; RGL .bsdf "
+      "and MERL .binary BRDFs become a noise-free virtual capture at the reference geometry");
   import_cmd->add_option("file", import.file, "Measurement file to read")->required();
   import_cmd->add_option("--out", import.out, "Output .bpc file (written atomically)")->required();
   import_cmd
-      ->add_option("--format", import.format,
-                   "Input format; auto detects it from the content (rgl and merl are evaluable "
-                   "BRDFs: capture them with 'brdf capture --device sim --material FILE')")
+      ->add_option("--format", import.format, "Input format; auto detects it from the content")
       ->check(CLI::IsMember({"auto", "rgl", "zemax", "lighttools", "merl", "csv", "gonio"},
                             CLI::ignore_case))
       ->capture_default_str();
