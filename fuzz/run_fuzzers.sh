@@ -8,7 +8,7 @@
 set -euo pipefail
 src="$(cd "${1:-$(dirname "$0")/..}" && pwd)"
 work="${2:-$src/build/fuzz-run}"
-seconds="${3:-20}"
+seconds="${3:-15}"
 cc="${BRDF_FUZZ_CC:-clang}"
 cxx="${BRDF_FUZZ_CXX:-clang++}"
 mkdir -p "$work"

@@ -51,4 +51,16 @@ std::string LowerExtension(const std::string& path) {
   return ext;
 }
 
+void CheckOutputPath(const std::string& out, const std::string& input, const char* extension,
+                     bool force, const char* option) {
+  if (LowerExtension(out) != extension)
+    throw InvalidArgument(std::string(option) + ": expected a file name ending in " + extension +
+                          ", got '" + out + "'");
+  std::error_code ec;
+  if (fs::equivalent(out, input, ec))
+    throw InvalidArgument(std::string(option) + ": '" + out + "' is the input file itself");
+  if (fs::exists(out, ec) && !force)
+    throw InvalidArgument(out + " already exists: use --force to overwrite it");
+}
+
 }  // namespace brdf::cli

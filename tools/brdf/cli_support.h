@@ -20,4 +20,11 @@ std::string ResolveMaterial(const std::string& name_or_file);
 // Lower-case extension including the dot (".bpc"), or "" when there is none.
 std::string LowerExtension(const std::string& path);
 
+// Checks an output path before any work is done: it must end in `extension` (".bpc"), must
+// not be the input file itself, and must not exist unless `force` (a .bpc or .csv in the way
+// may be a measurement nobody can repeat). `option` names the option in messages ("--out").
+// Throws InvalidArgument.
+void CheckOutputPath(const std::string& out, const std::string& input, const char* extension,
+                     bool force, const char* option = "--out");
+
 }  // namespace brdf::cli

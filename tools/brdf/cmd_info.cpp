@@ -10,10 +10,15 @@
 #include <vector>
 
 #include "brdf/core/bpc.h"
+#include "brdf/core/csv.h"
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
+#include "brdf/core/gonio.h"
+#include "brdf/core/importers.h"
+#include "brdf/core/lighttools.h"
 #include "brdf/core/measurement.h"
 #include "brdf/core/models.h"
+#include "brdf/core/zemax.h"
 #include "cli_support.h"
 #include "commands.h"
 
@@ -149,6 +154,148 @@ Json DescribeMaterial(const std::string& path) {
   return j;
 }
 
+// Third-party measurement files (brdf/core/importers.h), described as `brdf import` would
+// store them plus what only the source format holds (header, Zemax TIS lines). .bsdf is shared
+// by RGL and Zemax (and LightTools exports), .csv by point clouds and goniometer tables, so
+// the format is decided by content with DetectImportFormat.
+
+// Adds the slices, statistics and metadata of `m` under the same keys DescribeBpc uses.
+void AddPointCloudJson(const Measurement& m, Json* j) {
+  std::array<std::size_t, 4> totals{};
+  Json slices = Json::array();
+  for (std::size_t i = 0; i < m.slices.size(); ++i) {
+    const Slice& slice = m.slices[i];
+    const SliceStats st = ComputeSliceStats(slice);
+    Json s;
+    s["index"] = i;
+    s["theta_in_deg"] = st.theta_in_deg;
+    s["phi_in_deg"] = slice.phi_in_deg;
+    s["samples"] = st.samples;
+    s["complete"] = st.complete;
+    s["has_sigma"] = slice.has_sigma;
+    s["theta_out_deg"] = {Number(st.theta_out_min_deg), Number(st.theta_out_max_deg)};
+    s["phi_out_deg"] = {Number(st.phi_out_min_deg), Number(st.phi_out_max_deg)};
+    s["rgb_min"] = Triple(st.min);
+    s["rgb_max"] = Triple(st.max);
+    s["rgb_mean"] = Triple(st.mean);
+    Json flags;
+    for (int b = 0; b < 4; ++b) {
+      flags[kFlagNames[b]] = st.flag_counts[b];
+      totals[b] += st.flag_counts[b];
+    }
+    s["flag_counts"] = flags;
+    slices.push_back(s);
+  }
+  (*j)["theta_in_deg"] = m.ThetaInDeg();
+  (*j)["sample_count"] = m.SampleCount();
+  (*j)["slices"] = slices;
+  Json flags;
+  for (int b = 0; b < 4; ++b) flags[kFlagNames[b]] = totals[b];
+  (*j)["flag_counts"] = flags;
+  (*j)["metadata"] = MetadataJson(m.metadata);
+}
+
+// The integrated scatter next to the file's TIS lines, per channel, rotation and incidence
+// (IntegrateZemaxTis: "integrated" is the whole-hemisphere estimate, "covered" the part the
+// table covers, a lower bound).
+Json ZemaxTisJson(const ZemaxBsdf& z) {
+  static constexpr const char* kXyzNames[3] = {"X", "Y", "Z"};
+  Json rows = Json::array();
+  for (std::size_t c = 0; c < z.channels(); ++c) {
+    for (const ZemaxTis& t : IntegrateZemaxTis(z, c)) {
+      Json r;
+      r["channel"] = z.xyz ? kXyzNames[c] : "Monochrome";
+      r["sample_rotation_deg"] = t.sample_rotation_deg;
+      r["angle_of_incidence_deg"] = t.angle_of_incidence_deg;
+      r["file_tis"] = Number(t.file_tis);
+      r["integrated_tis"] = Number(t.filled_tis);
+      r["covered_tis"] = Number(t.covered_tis);
+      r["integrated_over_file"] = std::isfinite(t.file_tis) && t.file_tis > 0
+                                      ? Number(t.filled_tis / t.file_tis)
+                                      : Json(nullptr);
+      rows.push_back(r);
+    }
+  }
+  return rows;
+}
+
+Json DescribeImported(const std::string& path) {
+  ImportFormat format;
+  try {
+    format = DetectImportFormat(path);
+  } catch (const FormatError& e) {
+    // The detector's hint names `brdf import --format`, which info does not have.
+    throw FormatError(e.file(), e.position(), e.expected(), e.got());
+  }
+  Json j;
+  j["file"] = path;
+  j["format"] = ImportFormatName(format);
+  j["file_bytes"] = std::filesystem::file_size(path);
+  switch (format) {
+    case ImportFormat::kZemax: {
+      const ZemaxBsdf z = ReadZemaxBsdf(path);
+      Json h;
+      h["source"] = z.source;
+      h["symmetry"] = z.plane_symmetric ? "PlaneSymmetrical" : "Asymmetrical";
+      h["spectral_content"] = z.xyz ? "XYZ" : "Monochrome";
+      h["scatter_type"] = z.btdf ? "BTDF" : "BRDF";
+      h["sample_rotation_deg"] = z.sample_rotation_deg;
+      h["angle_of_incidence_deg"] = z.angle_of_incidence_deg;
+      h["scatter_azimuth_deg"] = z.scatter_azimuth_deg;
+      h["scatter_radial_deg"] = z.scatter_radial_deg;
+      j["header"] = h;
+      // A BTDF table is described as `brdf import --allow-btdf` stores it.
+      AddPointCloudJson(ZemaxToMeasurement(z, path, ZemaxImportOptions{true}), &j);
+      j["tis"] = ZemaxTisJson(z);
+      if (z.btdf)
+        j["advice"] = "ScatterType BTDF (line " + std::to_string(z.scatter_type_line) +
+                      "): transmission data; the slices are shown mirrored into the reflection "
+                      "hemisphere, as 'brdf import --allow-btdf' stores them";
+      break;
+    }
+    case ImportFormat::kLightTools: {
+      const LightToolsBsdf lt = ReadLightToolsBsdf(path);
+      Json h;
+      h["symmetry"] = lt.plane_symmetric ? "PlaneSymmetrical" : "Asymmetrical";
+      h["spectral_content"] = lt.spectral == LightToolsSpectral::kXyz   ? "XYZ"
+                              : lt.spectral == LightToolsSpectral::kRgb ? "RGB"
+                                                                        : "Monochrome";
+      h["scatter_azimuth_deg"] = lt.scatter_azimuth_deg;
+      h["scatter_radial_deg"] = lt.scatter_radial_deg;
+      h["blocks"] = lt.blocks.size();
+      j["header"] = h;
+      AddPointCloudJson(LightToolsToMeasurement(lt, path, LightToolsImportOptions{true}), &j);
+      break;
+    }
+    case ImportFormat::kGonio: {
+      const GonioTable table = ReadGonioTable(path);
+      Json h;
+      h["wavelengths_nm"] = table.wavelengths_nm;
+      h["rows"] = table.rows.size();
+      j["header"] = h;
+      AddPointCloudJson(GonioToMeasurement(table, path), &j);
+      break;
+    }
+    case ImportFormat::kCsv:
+      AddPointCloudJson(ReadCsv(path), &j);
+      break;
+    case ImportFormat::kRgl:
+    case ImportFormat::kMerl:
+    case ImportFormat::kAuto:
+      j["advice"] =
+          "an evaluable BRDF, not a point cloud: 'brdf eval' evaluates it, 'brdf import " + path +
+          " --out FILE.bpc' captures it noise-free at the reference geometry";
+      break;
+  }
+  return j;
+}
+
+bool IsImportedFormat(const Json& j) {
+  const std::string f = j["format"].get<std::string>();
+  return f == "zemax" || f == "lighttools" || f == "csv" || f == "gonio" || f == "rgl" ||
+         f == "merl";
+}
+
 // Describers by extension. Other formats (.ktx2, .dds, export sidecars) add a row here; a
 // .json is a material file when it has a "model" member.
 struct Describer {
@@ -156,8 +303,8 @@ struct Describer {
   Json (*describe)(const std::string& path);
 };
 constexpr Describer kDescribers[] = {
-    {".bpc", DescribeBpc},
-    {".json", DescribeMaterial},
+    {".bpc", DescribeBpc},      {".json", DescribeMaterial},   {".bsdf", DescribeImported},
+    {".csv", DescribeImported}, {".binary", DescribeImported},
 };
 
 std::string Fixed(const Json& v, const char* format = "%.6g") {
@@ -229,6 +376,91 @@ void PrintMaterialText(const Json& j) {
     std::printf("  not physical: %s\n", p.get<std::string>().c_str());
 }
 
+const char* FormatTitle(const std::string& format) {
+  if (format == "zemax") return "Zemax BSDF table";
+  if (format == "lighttools") return "LightTools BSDF table";
+  if (format == "csv") return "CSV point cloud";
+  if (format == "gonio") return "goniometer table";
+  if (format == "rgl") return "RGL .bsdf material";
+  return "MERL .binary material";
+}
+
+// Multi-line metadata (a Zemax file's comment block) on one indented line.
+std::string OneLine(std::string text) {
+  for (std::size_t pos = 0; (pos = text.find('\n', pos)) != std::string::npos;)
+    text.replace(pos, 1, " / ");
+  return text;
+}
+
+void PrintImportedText(const Json& j) {
+  const std::string format = j["format"].get<std::string>();
+  std::printf("%s: %s, %s bytes\n", j["file"].get<std::string>().c_str(), FormatTitle(format),
+              std::to_string(j["file_bytes"].get<std::uint64_t>()).c_str());
+  if (j.contains("header")) {
+    for (const auto& [key, value] : j["header"].items()) {
+      std::string text;
+      if (value.is_string()) {
+        text = value.get<std::string>();
+      } else if (value.is_array()) {
+        text = std::to_string(value.size()) + ":";
+        for (const auto& v : value) text += " " + Fixed(v, "%g");
+      } else {
+        text = value.dump();
+      }
+      if (!text.empty()) std::printf("  %-22s %s\n", key.c_str(), text.c_str());
+    }
+  }
+  if (j.contains("slices")) {
+    for (const auto& [key, value] : j["metadata"].items())
+      if (value.is_string() && !value.get<std::string>().empty())
+        std::printf("  %-22s %s\n", key.c_str(), OneLine(value.get<std::string>()).c_str());
+    for (const auto& [key, value] : j["metadata"]["extra"].items())
+      std::printf("  %-22s %s\n", ("extra." + key).c_str(),
+                  OneLine(value.get<std::string>()).c_str());
+    std::string thetas;
+    for (const auto& t : j["theta_in_deg"]) thetas += (thetas.empty() ? "" : ", ") + Fixed(t, "%g");
+    std::printf("slices: %zu (theta_in %s deg), samples: %s\n", j["slices"].size(), thetas.c_str(),
+                std::to_string(j["sample_count"].get<std::uint64_t>()).c_str());
+    for (const Json& s : j["slices"]) {
+      const std::uint64_t invalid = s["flag_counts"]["invalid"].get<std::uint64_t>();
+      const std::string invalid_text =
+          invalid > 0 ? " (" + std::to_string(invalid) + " invalid)" : std::string();
+      std::printf(
+          "  slice %d: theta_in %s deg, phi_in %s deg, %s samples%s%s, theta_out %s..%s "
+          "deg\n",
+          s["index"].get<int>(), Fixed(s["theta_in_deg"], "%g").c_str(),
+          Fixed(s["phi_in_deg"], "%g").c_str(),
+          std::to_string(s["samples"].get<std::uint64_t>()).c_str(), invalid_text.c_str(),
+          s["complete"].get<bool>() ? "" : ", INCOMPLETE",
+          Fixed(s["theta_out_deg"][0], "%g").c_str(), Fixed(s["theta_out_deg"][1], "%g").c_str());
+      std::printf("    f_r (1/sr, r g b)  min %s  max %s  mean %s\n",
+                  TripleText(s["rgb_min"]).c_str(), TripleText(s["rgb_max"]).c_str(),
+                  TripleText(s["rgb_mean"]).c_str());
+    }
+  }
+  if (j.contains("tis")) {
+    std::printf(
+        "integrated scatter per incidence (TIS = integral of f_r cos(theta) over the "
+        "hemisphere):\n");
+    std::printf("  %-10s %8s %6s %10s %12s %10s %8s\n", "channel", "rotation", "AOI", "file TIS",
+                "integrated", "covered", "int/file");
+    for (const Json& r : j["tis"]) {
+      const Json& ratio = r["integrated_over_file"];
+      const std::string deviation =
+          ratio.is_null() ? "-" : Fixed(Json((ratio.get<double>() - 1) * 100), "%+.1f%%");
+      std::printf("  %-10s %8s %6s %10s %12s %10s %8s\n", r["channel"].get<std::string>().c_str(),
+                  Fixed(r["sample_rotation_deg"], "%g").c_str(),
+                  Fixed(r["angle_of_incidence_deg"], "%g").c_str(),
+                  Fixed(r["file_tis"], "%.5f").c_str(), Fixed(r["integrated_tis"], "%.5f").c_str(),
+                  Fixed(r["covered_tis"], "%.5f").c_str(), deviation.c_str());
+    }
+    std::printf(
+        "  (integrated: the table's zeros past the horizon and beyond its last radial "
+        "angle edge-filled; covered: the table alone, a lower bound)\n");
+  }
+  if (j.contains("advice")) std::printf("note: %s\n", j["advice"].get<std::string>().c_str());
+}
+
 }  // namespace
 
 int RunInfo(const InfoOptions& options) {
@@ -240,6 +472,8 @@ int RunInfo(const InfoOptions& options) {
       std::printf("%s\n", j.dump(2, ' ', false, Json::error_handler_t::replace).c_str());
     } else if (j["format"] == "bpc") {
       PrintBpcText(j);
+    } else if (IsImportedFormat(j)) {
+      PrintImportedText(j);
     } else {
       PrintMaterialText(j);
     }

@@ -1,4 +1,5 @@
 # Further command sources: target_sources(brdf PRIVATE ...) and their libraries.
+target_sources(brdf PRIVATE brdf/cmd_import.cpp brdf/cmd_export_csv.cpp)
 target_sources(brdf PRIVATE brdf/cmd_info.cpp)
 target_sources(brdf PRIVATE brdf/cmd_capture.cpp)
 target_link_libraries(brdf PRIVATE brdf::device)

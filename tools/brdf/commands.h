@@ -28,6 +28,26 @@ struct MaterialsOptions {
 };
 int RunMaterials(const MaterialsOptions& options);
 
+// `brdf import`: a third-party measurement file (Zemax or LightTools BSDF, CSV point cloud,
+// goniometer table; RGL and MERL once their virtual capture is wired) as a .bpc capture.
+struct ImportOptions {
+  std::string file;
+  std::string out;              // .bpc path, written atomically
+  std::string format = "auto";  // auto, rgl, zemax, lighttools, merl, csv, gonio
+  std::string sample;           // sample name for the metadata; empty: the reader's (file name)
+  bool allow_btdf = false;      // accept transmission tables, mirrored (brdf/core/zemax.h)
+  bool force = false;           // overwrite an existing --out
+};
+int RunImport(const ImportOptions& options);
+
+// `brdf export-csv`: a .bpc capture as a CSV point cloud (brdf/core/csv.h).
+struct ExportCsvOptions {
+  std::string file;  // .bpc
+  std::string out;   // .csv path, written atomically
+  bool force = false;
+};
+int RunExportCsv(const ExportCsvOptions& options);
+
 struct CaptureOptions {
   std::string device = "sim";
   std::string material;  // library name or file

@@ -129,8 +129,11 @@ int main(int argc, char** argv) {
   auto* info_cmd = app.add_subcommand(
       "info",
       "Describe a file: a .bpc capture (slices, samples, ranges, statistics, flags, "
-      "metadata, damage) or a material .json (model and parameters)");
-  info_cmd->add_option("file", info.file, "File to describe (.bpc, .json)")->required();
+      "metadata, damage), a material .json (model and parameters) or a third-party "
+      "measurement (Zemax or LightTools .bsdf with the integrated TIS per incidence, CSV "
+      "point cloud, goniometer table)");
+  info_cmd->add_option("file", info.file, "File to describe (.bpc, .json, .bsdf, .csv, .binary)")
+      ->required();
   info_cmd->add_flag("--json", info.json, "Print JSON instead of text");
   info_cmd->callback([&] { exit_code = brdf::cli::RunInfo(info); });
 
@@ -140,6 +143,41 @@ int main(int argc, char** argv) {
       app.add_subcommand("materials", "List the virtual sample library of the simulator");
   materials_cmd->add_flag("--json", materials.json, "Print JSON instead of a table");
   materials_cmd->callback([&] { exit_code = brdf::cli::RunMaterials(materials); });
+
+  // brdf import
+  brdf::cli::ImportOptions import;
+  auto* import_cmd = app.add_subcommand(
+      "import",
+      "Bring a third-party measurement into the toolchain as a .bpc capture: Zemax or "
+      "LightTools (MiniDiff) BSDF text, CSV point cloud, spectral goniometer table; RGL .bsdf "
+      "and MERL .binary BRDFs become a noise-free virtual capture at the reference geometry");
+  import_cmd->add_option("file", import.file, "Measurement file to read")->required();
+  import_cmd->add_option("--out", import.out, "Output .bpc file (written atomically)")->required();
+  import_cmd
+      ->add_option("--format", import.format, "Input format; auto detects it from the content")
+      ->check(CLI::IsMember({"auto", "rgl", "zemax", "lighttools", "merl", "csv", "gonio"},
+                            CLI::ignore_case))
+      ->capture_default_str();
+  import_cmd->add_option("--sample", import.sample,
+                         "Sample name recorded in the file (default: the input's path)");
+  import_cmd->add_flag("--allow-btdf", import.allow_btdf,
+                       "Accept transmission (BTDF) tables, stored mirrored into the reflection "
+                       "hemisphere");
+  import_cmd->add_flag("--force", import.force, "Overwrite --out if it already exists");
+  import_cmd->callback([&] { exit_code = brdf::cli::RunImport(import); });
+
+  // brdf export-csv
+  brdf::cli::ExportCsvOptions export_csv;
+  auto* export_csv_cmd = app.add_subcommand(
+      "export-csv",
+      "Write a .bpc capture as a CSV point cloud "
+      "(theta_in,phi_in,theta_out,phi_out,r,g,b[,sigma_r,sigma_g,sigma_b],flags; degrees, "
+      "f_r in 1/sr); values round-trip bit-exactly through 'brdf import'");
+  export_csv_cmd->add_option("file", export_csv.file, "Capture to export (.bpc)")->required();
+  export_csv_cmd->add_option("--out", export_csv.out, "Output .csv file (written atomically)")
+      ->required();
+  export_csv_cmd->add_flag("--force", export_csv.force, "Overwrite --out if it already exists");
+  export_csv_cmd->callback([&] { exit_code = brdf::cli::RunExportCsv(export_csv); });
 
   try {
     app.parse(argc, argv);
