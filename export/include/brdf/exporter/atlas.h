@@ -1,0 +1,91 @@
+// Atlases: many materials in one texture for deferred renderers (DESIGN §5).
+//
+// Each θin slice of the atlas is a grid of Cm = ceil(√M) × Rm = ceil(M/Cm) cells of 361 × 181
+// texels; material m sits in column m mod Cm, row m div Cm, so its texel (i, j) of slice k is
+// atlas texel (x, y, z) = ((m mod Cm)·361 + i, (m div Cm)·181 + j, k). Unused cells are zero.
+// The 3D texture (KTX2, DDS) is Cm·361 × Rm·181 × K; the EXR arranges the K slice grids exactly
+// like the single-LUT composite (exr.h). All materials must share one θin list: the slice
+// index is the same for every cell.
+//
+// A JSON manifest names every material, its cell (column, row, texel origin), the θin list,
+// the grid sizes and the texel convention, including how a shader addresses a cell:
+//   u = (x0 + φd/1° + 0.5)/(Cm·361), v = (y0 + θd/1° + 0.5)/(Rm·181), w as for one LUT,
+// with u, v clamped to the cell's outer texel centres so filtering never reads a neighbour.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "brdf/core/lut.h"
+#include "brdf/exporter/exr.h"
+#include "brdf/exporter/metadata.h"
+#include "brdf/exporter/packed_volume.h"
+
+namespace brdf::exporter {
+
+struct AtlasLayout {
+  int materials = 0, slices = 0;
+  GridLayout cells;      // Cm × Rm material cells in each slice
+  GridLayout composite;  // C × R slice grids in the flat EXR image
+  int TextureWidth() const { return cells.columns * Lut::kWidth; }
+  int TextureHeight() const { return cells.rows * Lut::kHeight; }
+  int ImageWidth() const { return composite.columns * TextureWidth(); }
+  int ImageHeight() const { return composite.rows * TextureHeight(); }
+};
+// Throws InvalidArgument for materials < 1 or slices < 1.
+AtlasLayout ComputeAtlasLayout(int materials, int slices);
+
+struct AtlasMaterial {
+  std::string name;
+  const Lut* lut = nullptr;  // not owned; must outlive the call
+  std::string source;        // where the LUT came from (for the manifest)
+};
+
+struct Atlas {
+  AtlasLayout layout;
+  std::vector<double> theta_in_deg;
+  std::vector<std::string> names, sources;
+  PackedVolume volume;  // Cm·361 × Rm·181 × K, RGB9E5
+};
+
+// Packs the materials. Throws InvalidArgument if there are none, a LUT is unexportable, names
+// repeat, or θin lists differ ("materials 'gold' (θin 0, 20, 40, 60) and 'felt' (θin 0, 30, 60)
+// have different θin sets; an atlas needs one θin list").
+Atlas BuildAtlas(const std::vector<AtlasMaterial>& materials);
+
+// The flat float image of the atlas (EXR layout above), from the unquantised LUTs.
+FloatImage AtlasImage(const std::vector<AtlasMaterial>& materials);
+
+// The manifest JSON. `files` lists the written file names (no folder).
+std::string AtlasManifestJson(const Atlas& atlas, const std::vector<std::string>& files);
+
+// Writes PREFIX.ktx2, PREFIX.dds, PREFIX.exr and PREFIX.json (the manifest), each atomically,
+// and returns the paths written. The manifest is also embedded in the KTX2 ("brdf.atlas") and
+// the EXR ("brdf:atlas"). Throws InvalidArgument / IoError.
+std::vector<std::string> WriteAtlas(const std::string& prefix,
+                                    const std::vector<AtlasMaterial>& materials,
+                                    ExrPixelType exr_type = ExrPixelType::kFloat);
+
+// Material m's cell of an atlas volume, decoded into a LUT with the given θin list.
+Lut ExtractAtlasCell(const PackedVolume& atlas_volume, const AtlasLayout& layout, int m,
+                     std::vector<double> theta_in_deg);
+
+// What a manifest says, parsed back.
+struct AtlasManifestEntry {
+  std::string name, source;
+  int index = 0, column = 0, row = 0, x0 = 0, y0 = 0;
+};
+struct AtlasManifest {
+  std::vector<double> theta_in_deg;
+  std::vector<AtlasManifestEntry> materials;
+  AtlasLayout layout;
+  int texture_width = 0, texture_height = 0;
+  std::uint64_t payload_bytes = 0;
+  std::uint32_t payload_crc32 = 0;
+};
+// Throws FormatError naming the member.
+AtlasManifest ParseAtlasManifest(std::string_view json_text, const std::string& file = "<manifest>");
+
+}  // namespace brdf::exporter

@@ -1,0 +1,47 @@
+// DirectDraw Surface container for RGB9E5 LUTs and atlases (DESIGN §7).
+//
+// Layout written (Microsoft "DDS" programming guide: DDS_HEADER, DDS_PIXELFORMAT,
+// DDS_HEADER_DXT10), all fields little-endian 32-bit:
+//   "DDS " magic; DDS_HEADER (124 bytes): dwFlags = CAPS | HEIGHT | WIDTH | PITCH | PIXELFORMAT
+//   | MIPMAPCOUNT | DEPTH (0x0082100F), dwHeight, dwWidth, dwPitchOrLinearSize = width · 4,
+//   dwDepth = K, dwMipMapCount = 1, DDS_PIXELFORMAT {dwSize 32, dwFlags DDPF_FOURCC,
+//   dwFourCC "DX10"}, dwCaps = DDSCAPS_TEXTURE (a single-level volume is one surface, so no
+//   DDSCAPS_COMPLEX, as DirectXTex writes it), dwCaps2 = DDSCAPS2_VOLUME;
+//   DDS_HEADER_DXT10 (20 bytes): dxgiFormat 67 (DXGI_FORMAT_R9G9B9E5_SHAREDEXP),
+//   resourceDimension 4 (D3D10_RESOURCE_DIMENSION_TEXTURE3D), miscFlag 0, arraySize 1,
+//   miscFlags2 0; then the texels, byte for byte the same payload as the KTX2 level 0 image
+//   (slice by slice, rows top first), starting at byte 148.
+//
+// DDS has no place for metadata: the θin list travels in the sidecar (sidecar.h) beside it.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "brdf/core/lut.h"
+#include "brdf/exporter/packed_volume.h"
+#include "brdf/exporter/texture_file.h"
+
+namespace brdf::exporter {
+
+inline constexpr std::uint32_t kDxgiFormatR9g9b9e5Sharedexp = 67;
+inline constexpr std::size_t kDdsDataOffset = 4 + 124 + 20;
+
+// The whole file in memory. Throws InvalidArgument for an inconsistent volume.
+std::string EncodeDds(const PackedVolume& volume);
+
+// Writes atomically (temporary sibling renamed into place). Throws InvalidArgument, IoError.
+void WriteDds(const std::string& path, const Lut& lut);
+void WriteDds(const std::string& path, const PackedVolume& volume);
+
+// Reads and validates a DDS file of this format. θin comes from `theta_in_deg` when given
+// (must have depth entries), else k·20° (theta_in_from_metadata = false); ReadTextureFile
+// looks for the sidecar instead. Throws IoError / FormatError ("Unsupported DXGI format: 71
+// (expected 67, DXGI_FORMAT_R9G9B9E5_SHAREDEXP)").
+LoadedTexture ReadDds(const std::string& path, const std::vector<double>& theta_in_deg = {});
+LoadedTexture ParseDds(const std::uint8_t* data, std::size_t size, const std::string& file,
+                       const std::vector<double>& theta_in_deg = {});
+
+}  // namespace brdf::exporter

@@ -1,0 +1,63 @@
+// KTX 2.0 container for RGB9E5 LUTs and atlases (DESIGN §7).
+//
+// Layout written (KTX 2.0 specification, Khronos):
+//   identifier «KTX 20» (12 bytes), header (vkFormat 123 = VK_FORMAT_E5B9G9R9_UFLOAT_PACK32,
+//   typeSize 4, pixelWidth, pixelHeight, pixelDepth = K, layerCount 0, faceCount 1,
+//   levelCount 1, supercompressionScheme 0), index (DFD, key/value data, no supercompression
+//   global data), one level index entry, the Data Format Descriptor, the key/value data, then
+//   the level 0 image (4-byte aligned: lcm(texel block size 4, 4)).
+//
+// Data Format Descriptor: one basic descriptor block (Khronos Data Format Specification 1.3,
+// versionNumber 2), colour model RGBSDA, primaries BT.709, transfer linear, straight alpha,
+// 1×1×1×1 texel block, bytesPlane0 = 4, and six samples, the form the Data Format
+// Specification gives for shared-exponent formats and libktx (KTX-Software) requires for this
+// vkFormat: for each of R, G, B in turn a mantissa sample (bitOffset 0/9/18, 9 bits, no
+// qualifiers, sampleLower 0, sampleUpper 8448) followed by an exponent sample (bitOffset 27,
+// 5 bits, qualifier EXPONENT, sampleLower 15 = bias, sampleUpper 31).
+//
+// Key/value data (sorted by key): "KTXorientation" = "rdi" (row 0 at the top, slices going
+// in), "KTXwriter" = "brdf-toolchain <version>", and the project's metadata: "brdf.sidecar"
+// (the JSON sidecar text, sidecar.h) for a LUT or "brdf.atlas" (the manifest, atlas.h) for an
+// atlas. Values are NUL-terminated UTF-8.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "brdf/core/lut.h"
+#include "brdf/exporter/metadata.h"
+#include "brdf/exporter/packed_volume.h"
+#include "brdf/exporter/texture_file.h"
+
+namespace brdf::exporter {
+
+inline constexpr std::uint32_t kVkFormatE5b9g9r9UfloatPack32 = 123;
+
+using KeyValues = std::vector<std::pair<std::string, std::string>>;
+
+// The whole file in memory. KTXwriter and KTXorientation are added to `key_values`; the
+// pairs are written sorted by key as the specification requires. Keys must be non-empty,
+// unique and free of NUL; throws InvalidArgument otherwise.
+std::string EncodeKtx2(const PackedVolume& volume, const KeyValues& key_values);
+
+// Writes a LUT atomically (temporary sibling renamed into place) with its sidecar JSON
+// embedded as "brdf.sidecar". Throws InvalidArgument for an unexportable LUT, IoError.
+void WriteKtx2(const std::string& path, const Lut& lut, const TextureMetadata& metadata);
+// The same for an already packed LUT (PackLut), so several containers share one encoding.
+void WriteKtx2(const std::string& path, const PackedVolume& volume,
+               const std::vector<double>& theta_in_deg, const TextureMetadata& metadata);
+// Writes any volume with the given key/value pairs (atlases).
+void WriteKtx2(const std::string& path, const PackedVolume& volume, const KeyValues& key_values);
+
+// Reads and validates a KTX2 file written by us or any conforming writer of this format.
+LoadedTexture ReadKtx2(const std::string& path);
+// Parses KTX2 bytes already in memory; `file` names them in errors (also the fuzz entry).
+LoadedTexture ParseKtx2(const std::uint8_t* data, std::size_t size, const std::string& file);
+
+// The 124-byte DFD described above (dfdTotalSize word included), as 31 little-endian words.
+std::vector<std::uint32_t> E5b9g9r9DataFormatDescriptor();
+
+}  // namespace brdf::exporter

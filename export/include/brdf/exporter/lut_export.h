@@ -1,0 +1,45 @@
+// One call that writes every output of one LUT (what `brdf convert` does per input).
+//
+// ExportLut packs the LUT to RGB9E5 once and writes OUT_DIR/<name>.ktx2, .dds, .exr, .png and
+// .json (the sidecar) for the selected formats, each atomically: a file appears under its
+// final name only when complete, so an interrupted batch never leaves a half-written texture.
+// The sidecar lists the files written beside it.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "brdf/core/lut.h"
+#include "brdf/exporter/exr.h"
+#include "brdf/exporter/metadata.h"
+
+namespace brdf::exporter {
+
+struct LutExportFormats {
+  bool ktx2 = true, dds = true, exr = true, png = true, json = true;
+};
+// Parses a comma-separated list such as "ktx2,dds,exr,png,json" (case-sensitive, no
+// duplicates needed, at least one). Throws InvalidArgument naming an unknown entry and the
+// known ones.
+LutExportFormats ParseExportFormats(std::string_view list);
+
+struct LutExportOptions {
+  LutExportFormats formats;
+  ExrPixelType exr_type = ExrPixelType::kFloat;
+};
+
+struct LutExportResult {
+  std::vector<std::string> written;  // paths, in the order ktx2, dds, exr, png, json
+  std::uint64_t payload_bytes = 0;   // RGB9E5 bytes in each of the KTX2 and DDS files
+  std::uint32_t payload_crc32 = 0;   // the sidecar's checksum
+};
+
+// `metadata.name` names the files (must be non-empty and a plain file name);
+// `metadata.companion_files` is filled in here. The folder must exist.
+// Throws InvalidArgument (bad name, unexportable LUT) or IoError.
+LutExportResult ExportLut(const std::string& out_dir, const Lut& lut, TextureMetadata metadata,
+                          const LutExportOptions& options = {});
+
+}  // namespace brdf::exporter

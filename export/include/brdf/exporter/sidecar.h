@@ -1,0 +1,65 @@
+// The JSON sidecar of an exported LUT (DESIGN §7).
+//
+// One small text file beside the textures that says what they hold: the source, the θin list,
+// the grid, both texel conventions (the centre-exact one we address texels with, and the
+// published one that drops the half-texel term), the extrapolation parameters, fitted models
+// (if any), the tool version and a checksum of the texel data. The same JSON text is embedded
+// in the KTX2 key/value data (key "brdf.sidecar") and the EXR header (attribute
+// "brdf:sidecar").
+//
+// Checksum: CRC-32 (IEEE 802.3, reflected polynomial 0xEDB88320, as zlib's crc32) of the
+// RGB9E5 payload bytes exactly as stored in the KTX2 level 0 image and the DDS data: 4 bytes
+// per texel, little-endian words, x fastest then y (rows, top first) then z (slices, θin
+// ascending). The payload size is recorded too (1,045,444 bytes for K = 4).
+//
+// Example (abridged):
+//   { "kind": "brdf-lut-sidecar", "format_version": 1, "name": "gold", "source": "gold.bpc",
+//     "theta_in_deg": [0, 20, 40, 60],
+//     "grid": { "width": 361, "height": 181, "slices": 4, "delta_in_deg": 20, ... },
+//     "texel_convention": { "centre_exact": "u = (phi_d/1deg + 0.5)/361, ...",
+//                           "published": "u = phi_d/(2 pi), ..." },
+//     "extrapolation": { "p": 1, "l": 0.5, "theta_b_deg": 75, ... },
+//     "fitted_models": [], "tool": { "name": "brdf-toolchain", "version": "0.1.0" },
+//     "payload": { "bytes": 1045444, "checksum": { "algorithm": "crc32", "value": "0x…" } },
+//     "files": ["gold.ktx2", "gold.dds"] }
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "brdf/exporter/metadata.h"
+#include "brdf/exporter/packed_volume.h"
+
+namespace brdf::exporter {
+
+// The sidecar JSON text (2-space indent) for a payload and its θin list.
+std::string SidecarJson(const PackedVolume& payload, const std::vector<double>& theta_in_deg,
+                        const TextureMetadata& metadata);
+
+// Writes SidecarJson atomically to `path`. Throws IoError.
+void WriteSidecar(const std::string& path, const PackedVolume& payload,
+                  const std::vector<double>& theta_in_deg, const TextureMetadata& metadata);
+
+// What a sidecar says, parsed back.
+struct SidecarInfo {
+  std::string name, source;
+  std::vector<double> theta_in_deg;
+  int width = 0, height = 0, slices = 0;
+  std::uint64_t payload_bytes = 0;
+  std::uint32_t payload_crc32 = 0;
+  std::optional<ExtrapolationInfo> extrapolation;
+  std::vector<std::string> fitted_models_json;  // each model as compact JSON text
+  std::string tool_version;
+  std::vector<std::string> files;  // companion file names
+};
+
+// Parses a sidecar text; `file` names it in errors. Throws FormatError naming the member and
+// what was expected.
+SidecarInfo ParseSidecarJson(std::string_view json_text, const std::string& file = "<sidecar>");
+// Reads and parses a sidecar file (at most 16 MiB). Throws IoError / FormatError.
+SidecarInfo ReadSidecar(const std::string& path);
+
+}  // namespace brdf::exporter

@@ -1,0 +1,57 @@
+// Reading exported textures back: what the KTX2 and DDS readers return, and one entry point
+// that recognises either container by its content.
+//
+// Used by `brdf eval` / `brdf info` and by the tests. Readers validate every header field the
+// payload depends on and fail with a FormatError naming the file, the byte offset, what was
+// expected and what was found ("gold.ktx2: byte 12: expected vkFormat 123
+// (VK_FORMAT_E5B9G9R9_UFLOAT_PACK32), got 97"). Allocation is bounded by the file size, which
+// is capped at kMaxTextureFileBytes before anything is read.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "brdf/core/lut.h"
+#include "brdf/exporter/packed_volume.h"
+
+namespace brdf::exporter {
+
+// 2 GiB: an atlas of ~250 materials of 4 slices; anything larger is refused unread.
+inline constexpr std::uint64_t kMaxTextureFileBytes = 2ull << 30;
+
+enum class TextureContainer { kKtx2, kDds };
+
+struct LoadedTexture {
+  std::string file;
+  TextureContainer container = TextureContainer::kKtx2;
+  PackedVolume volume;  // the RGB9E5 words exactly as stored
+  // KTX2 key/value pairs in file order, values without their terminating NUL. Empty for DDS.
+  std::vector<std::pair<std::string, std::string>> key_values;
+  // Embedded metadata: the sidecar JSON of a single LUT ("brdf.sidecar") or the manifest of an
+  // atlas ("brdf.atlas"); empty when absent (DDS files, third-party KTX2 files).
+  std::string sidecar_json;
+  std::string atlas_manifest_json;
+  // The θin list (degrees) from the embedded metadata or a sidecar found beside a DDS file;
+  // otherwise k·20° (DESIGN §5's Δin) with theta_in_from_metadata = false.
+  std::vector<double> theta_in_deg;
+  bool theta_in_from_metadata = false;
+  // The decoded LUT when the texture is a single 361 × 181 × K LUT; empty (no slices) for an
+  // atlas.
+  Lut lut;
+
+  bool IsSingleLut() const { return lut.slices() > 0; }
+};
+
+// Reads a .ktx2 or .dds file, recognised by its first bytes (not its extension). For a DDS
+// file, a sidecar "<stem>.json" beside it, if present and of the same size, supplies the θin
+// list and its checksum is verified. Throws IoError / FormatError.
+LoadedTexture ReadTextureFile(const std::string& path);
+
+// Fills theta_in_deg, theta_in_from_metadata and lut from volume and the embedded metadata,
+// and verifies the payload checksum the metadata records. Used by the readers.
+// Throws FormatError naming `loaded.file` on a checksum or size mismatch.
+void FinishLoadedTexture(LoadedTexture& loaded);
+
+}  // namespace brdf::exporter

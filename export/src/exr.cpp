@@ -1,0 +1,169 @@
+#include "brdf/exporter/exr.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <OpenImageIO/imageio.h>
+#include <fmt/format.h>
+
+#include "brdf/core/error.h"
+#include "brdf/core/file_util.h"
+#include "brdf/exporter/atlas.h"
+#include "brdf/exporter/sidecar.h"
+#include "json_util.h"
+
+namespace brdf::exporter {
+namespace {
+
+// Writes through OIIO into the temporary sibling, then renames it into place.
+void WriteImageAtomically(const std::string& path, const char* format, const OIIO::ImageSpec& spec,
+                          OIIO::TypeDesc data_type, const void* data) {
+  AtomicOutputPath out_path(path);
+  auto out = OIIO::ImageOutput::create(format);
+  if (!out)
+    throw IoError(path + ": OpenImageIO has no " + format + " writer: " + OIIO::geterror());
+  if (!out->open(out_path.temp_path(), spec))
+    throw IoError(path + ": cannot create " + format + " file: " + out->geterror());
+  const bool wrote = out->write_image(data_type, data);
+  const std::string write_error = wrote ? std::string() : out->geterror();
+  const bool closed = out->close();
+  if (!wrote) throw IoError(path + ": writing the image failed: " + write_error);
+  if (!closed) throw IoError(path + ": finishing the image failed: " + out->geterror());
+  out.reset();
+  out_path.Commit();
+}
+
+float SrgbEncode(float linear) {
+  return linear <= 0.0031308f ? 12.92f * linear : 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
+}
+
+}  // namespace
+
+FloatImage CompositeImage(const Lut& lut) {
+  ValidateLutForExport(lut);
+  return AtlasImage({AtlasMaterial{"lut", &lut, ""}});
+}
+
+Lut LutFromComposite(const FloatImage& image, std::vector<double> theta_in_deg) {
+  const int k_count = static_cast<int>(theta_in_deg.size());
+  if (k_count < 1) throw InvalidArgument("composite: need at least one θin value");
+  const GridLayout grid = SquareishGrid(k_count);
+  if (image.width != grid.columns * Lut::kWidth || image.height != grid.rows * Lut::kHeight)
+    throw InvalidArgument(fmt::format(
+        "composite: {} slices need a {} × {} image ({} × {} slices), got {} × {}", k_count,
+        grid.columns * Lut::kWidth, grid.rows * Lut::kHeight, grid.columns, grid.rows, image.width,
+        image.height));
+  Lut lut;
+  lut.Resize(theta_in_deg.size());
+  lut.theta_in_deg = std::move(theta_in_deg);
+  for (int k = 0; k < k_count; ++k)
+    for (int j = 0; j < Lut::kHeight; ++j) {
+      const float* src = image.Pixel(grid.CellColumn(k) * Lut::kWidth, grid.CellRow(k) * Lut::kHeight + j);
+      std::copy(src, src + Lut::kWidth * 3, lut.Texel(k, j, 0));
+    }
+  return lut;
+}
+
+void WriteExr(const std::string& path, const FloatImage& image, ExrPixelType type,
+              const StringAttributes& attributes) {
+  if (image.width < 1 || image.height < 1 ||
+      image.rgb.size() != static_cast<std::size_t>(image.width) * image.height * 3)
+    throw InvalidArgument(fmt::format("EXR: inconsistent image {} × {} with {} floats",
+                                      image.width, image.height, image.rgb.size()));
+  OIIO::ImageSpec spec(image.width, image.height, 3,
+                       type == ExrPixelType::kHalf ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
+  spec.channelnames = {"R", "G", "B"};
+  spec.attribute("compression", "zip");
+  spec.attribute("Software", BrdfToolWriter());
+  for (const auto& [name, value] : attributes) spec.attribute(name, value);
+  WriteImageAtomically(path, "exr", spec, OIIO::TypeDesc::FLOAT, image.rgb.data());
+}
+
+void WriteExrComposite(const std::string& path, const Lut& lut, const PackedVolume& packed,
+                       const TextureMetadata& metadata, ExrPixelType type) {
+  const GridLayout grid = SquareishGrid(lut.slices());
+  WriteExr(path, CompositeImage(lut), type,
+           {{"brdf:sidecar", SidecarJson(packed, lut.theta_in_deg, metadata)},
+            {"brdf:theta_in_deg", FormatThetaList(lut.theta_in_deg)},
+            {"brdf:layout", fmt::format("{} x {} slices of 361 x 181, row-major, ascending "
+                                        "theta_in, top-left first",
+                                        grid.columns, grid.rows)},
+            {"brdf:texel_convention", TexelCentreFormula()},
+            {"brdf:payload_crc32", detail::Hex32(packed.Crc32())}});
+}
+
+void WriteExrComposite(const std::string& path, const Lut& lut, const TextureMetadata& metadata,
+                       ExrPixelType type) {
+  WriteExrComposite(path, lut, PackLut(lut), metadata, type);
+}
+
+std::vector<unsigned char> ToneMapForPng(const FloatImage& image) {
+  const std::size_t pixels = static_cast<std::size_t>(image.width) * image.height;
+  std::vector<float> luminance;
+  luminance.reserve(pixels);
+  for (std::size_t p = 0; p < pixels; ++p) {
+    const float* c = &image.rgb[3 * p];
+    const float l = 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2];
+    if (l > 0.0f && std::isfinite(l)) luminance.push_back(l);
+  }
+  float scale = 1.0f;
+  if (!luminance.empty()) {
+    const std::size_t q = static_cast<std::size_t>(std::llround(0.99 * (luminance.size() - 1)));
+    std::nth_element(luminance.begin(), luminance.begin() + q, luminance.end());
+    scale = 1.0f / luminance[q];
+  }
+  std::vector<unsigned char> out(pixels * 3);
+  for (std::size_t i = 0; i < out.size(); ++i) {
+    const float v = image.rgb[i];
+    const float x = v > 0.0f ? v * scale : 0.0f;  // NaN and negatives → black
+    const float mapped = std::isinf(x) ? 1.0f : std::min(1.0f, 2.0f * x / (1.0f + x));
+    out[i] = static_cast<unsigned char>(std::lround(255.0f * SrgbEncode(mapped)));
+  }
+  return out;
+}
+
+void WritePng(const std::string& path, const FloatImage& image) {
+  const std::vector<unsigned char> pixels = ToneMapForPng(image);
+  OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
+  spec.attribute("Software", BrdfToolWriter());
+  WriteImageAtomically(path, "png", spec, OIIO::TypeDesc::UINT8, pixels.data());
+}
+
+void WritePngComposite(const std::string& path, const Lut& lut) {
+  WritePng(path, CompositeImage(lut));
+}
+
+std::string ExrFile::Attribute(const std::string& name) const {
+  for (const auto& [key, value] : attributes)
+    if (key == name) return value;
+  return {};
+}
+
+ExrFile ReadExr(const std::string& path) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) throw IoError(path + ": cannot open image: " + OIIO::geterror());
+  const OIIO::ImageSpec& spec = in->spec();
+  if (spec.nchannels < 3 || spec.channelnames.size() < 3 || spec.channelnames[0] != "R" ||
+      spec.channelnames[1] != "G" || spec.channelnames[2] != "B")
+    throw FormatError(path, "channel list", "channels R, G, B",
+                      fmt::format("{} channels ({})", spec.nchannels,
+                                  fmt::join(spec.channelnames, ", ")));
+  if (spec.width < 1 || spec.height < 1 || spec.depth != 1 ||
+      static_cast<std::uint64_t>(spec.width) * spec.height > (1ull << 30))
+    throw FormatError(path, "data window", "a 2D image of at most 2^30 pixels",
+                      fmt::format("{} × {} × {}", spec.width, spec.height, spec.depth));
+  ExrFile file;
+  file.pixel_type = spec.format == OIIO::TypeDesc::HALF ? ExrPixelType::kHalf : ExrPixelType::kFloat;
+  file.image.width = spec.width;
+  file.image.height = spec.height;
+  file.image.rgb.resize(static_cast<std::size_t>(spec.width) * spec.height * 3);
+  if (!in->read_image(0, 0, 0, 3, OIIO::TypeDesc::FLOAT, file.image.rgb.data()))
+    throw IoError(path + ": reading pixels failed: " + in->geterror());
+  for (const OIIO::ParamValue& p : spec.extra_attribs)
+    if (p.type() == OIIO::TypeDesc::STRING)
+      file.attributes.emplace_back(p.name().string(), p.get_string());
+  in->close();
+  return file;
+}
+
+}  // namespace brdf::exporter

@@ -1,0 +1,140 @@
+#include "json_util.h"
+
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "brdf/core/error.h"
+#include "brdf/exporter/metadata.h"
+
+namespace brdf::exporter::detail {
+
+ordered_json GridJson(const PackedVolume& payload, const std::vector<double>& theta_in_deg) {
+  const double delta = theta_in_deg.size() >= 2 ? theta_in_deg[1] - theta_in_deg[0] : 0.0;
+  return ordered_json{
+      {"frame",
+       "specular frame of theta_in (DESIGN 5): omega_d = S(theta_in) omega_out, "
+       "S = [[-cos, 0, -sin], [0, -1, 0], [-sin, 0, cos]]; phi_in = 0"},
+      {"width", payload.width},
+      {"height", payload.height},
+      {"slices", payload.depth},
+      {"phi_d_deg", {{"first", 0}, {"step", 1}, {"count", 361}}},
+      {"theta_d_deg", {{"first", 0}, {"step", 1}, {"count", 181}}},
+      {"delta_in_deg", delta},
+      {"seam", "column 360 repeats column 0 (phi_d = 360 deg = 0 deg)"},
+      {"below_horizon", "edge extension: theta_out > 90 deg holds the value at theta_out = 90 deg "
+                        "with the same phi_out"}};
+}
+
+ordered_json TexelConventionJson() {
+  return ordered_json{{"centre_exact", TexelCentreFormula()}, {"published", PublishedFormula()}};
+}
+
+std::string Hex32(std::uint32_t v) { return fmt::format("0x{:08x}", v); }
+
+std::uint32_t ParseHex32(const std::string& text, const std::string& file,
+                         const std::string& position) {
+  const bool ok = text.size() == 10 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X') &&
+                  text.find_first_not_of("0123456789abcdefABCDEF", 2) == std::string::npos;
+  if (!ok) throw FormatError(file, position, "a hexadecimal \"0x\" + 8 digits value", "\"" + text + "\"");
+  return static_cast<std::uint32_t>(std::stoul(text.substr(2), nullptr, 16));
+}
+
+ordered_json PayloadJson(const PackedVolume& payload) {
+  return ordered_json{
+      {"encoding",
+       "RGB9E5 per EXT_texture_shared_exponent (N=9, B=15, Emax=31): "
+       "VK_FORMAT_E5B9G9R9_UFLOAT_PACK32 (123), DXGI_FORMAT_R9G9B9E5_SHAREDEXP (67); "
+       "R bits 0-8, G 9-17, B 18-26, exponent 27-31"},
+      {"texel_order", "32-bit little-endian words; x (phi_d) fastest, then y (theta_d rows, top "
+                      "first), then z (theta_in slices, ascending)"},
+      {"bytes", payload.ByteSize()},
+      {"checksum",
+       {{"algorithm", "crc32"},
+        {"definition", "CRC-32 (IEEE 802.3, polynomial 0xEDB88320 reflected, as zlib crc32) of "
+                       "the payload bytes as stored in the KTX2 level 0 image and the DDS data"},
+        {"value", Hex32(payload.Crc32())}}}};
+}
+
+ordered_json ParseEmbeddedJson(const std::string& text, const std::string& what) {
+  try {
+    return ordered_json::parse(text);
+  } catch (const nlohmann::json::exception& e) {
+    throw InvalidArgument(what + " is not valid JSON: " + e.what());
+  }
+}
+
+ordered_json ParseJsonDocument(std::string_view text, const std::string& file) {
+  try {
+    ordered_json j = ordered_json::parse(text);
+    if (!j.is_object()) throw FormatError(file, "top level", "a JSON object", j.type_name());
+    return j;
+  } catch (const nlohmann::json::parse_error& e) {
+    throw FormatError(file, "byte " + std::to_string(e.byte), "valid JSON", e.what());
+  }
+}
+
+JsonFields::JsonFields(const ordered_json& object, std::string file, std::string prefix)
+    : object_(object), file_(std::move(file)), prefix_(std::move(prefix)) {}
+
+void JsonFields::Fail(const char* name, const std::string& expected) const {
+  const std::string got = !object_.contains(name) ? std::string("nothing (member missing)")
+                                                  : object_[name].dump();
+  throw FormatError(file_, "member '" + prefix_ + name + "'", expected,
+                    got.size() > 80 ? got.substr(0, 77) + "..." : got);
+}
+
+const ordered_json& JsonFields::Get(const char* name) const {
+  if (!object_.is_object() || !object_.contains(name)) Fail(name, "a value");
+  return object_[name];
+}
+
+std::string JsonFields::String(const char* name) const {
+  if (!object_.contains(name) || !object_[name].is_string()) Fail(name, "a string");
+  return object_[name].get<std::string>();
+}
+
+double JsonFields::Number(const char* name) const {
+  if (!object_.contains(name) || !object_[name].is_number()) Fail(name, "a number");
+  return object_[name].get<double>();
+}
+
+int JsonFields::Int(const char* name) const {
+  if (!object_.contains(name) || !object_[name].is_number_integer()) Fail(name, "an integer");
+  const auto v = object_[name].get<std::int64_t>();
+  if (v < 0 || v > std::numeric_limits<int>::max()) Fail(name, "a non-negative integer");
+  return static_cast<int>(v);
+}
+
+std::uint64_t JsonFields::UInt64(const char* name) const {
+  if (!object_.contains(name) || !object_[name].is_number_unsigned()) Fail(name, "a non-negative integer");
+  return object_[name].get<std::uint64_t>();
+}
+
+const ordered_json& JsonFields::Object(const char* name) const {
+  if (!object_.contains(name) || !object_[name].is_object()) Fail(name, "an object");
+  return object_[name];
+}
+
+std::vector<double> JsonFields::NumberArray(const char* name) const {
+  if (!object_.contains(name) || !object_[name].is_array()) Fail(name, "an array of numbers");
+  std::vector<double> out;
+  for (const auto& v : object_[name]) {
+    if (!v.is_number() || !std::isfinite(v.get<double>())) Fail(name, "an array of numbers");
+    out.push_back(v.get<double>());
+  }
+  return out;
+}
+
+std::vector<std::string> JsonFields::StringArray(const char* name) const {
+  if (!object_.contains(name) || !object_[name].is_array()) Fail(name, "an array of strings");
+  std::vector<std::string> out;
+  for (const auto& v : object_[name]) {
+    if (!v.is_string()) Fail(name, "an array of strings");
+    out.push_back(v.get<std::string>());
+  }
+  return out;
+}
+
+}  // namespace brdf::exporter::detail

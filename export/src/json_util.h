@@ -1,0 +1,52 @@
+// Private JSON helpers shared by the sidecar, the atlas manifest and the KTX2/EXR metadata.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "brdf/exporter/packed_volume.h"
+
+namespace brdf::exporter::detail {
+
+using nlohmann::ordered_json;
+
+// {"frame": ..., "width": 361, "height": 181, "slices": K, "phi_d_deg": {...}, ...}
+ordered_json GridJson(const PackedVolume& payload, const std::vector<double>& theta_in_deg);
+// {"centre_exact": TexelCentreFormula(), "published": PublishedFormula()}
+ordered_json TexelConventionJson();
+// {"encoding": ..., "texel_order": ..., "bytes": N, "checksum": {"algorithm": "crc32", ...}}
+ordered_json PayloadJson(const PackedVolume& payload);
+// "0x1234abcd"
+std::string Hex32(std::uint32_t v);
+std::uint32_t ParseHex32(const std::string& text, const std::string& file,
+                         const std::string& position);
+
+// Parses caller-supplied JSON (a fitted model); throws InvalidArgument naming `what`.
+ordered_json ParseEmbeddedJson(const std::string& text, const std::string& what);
+// Parses a whole document; throws FormatError with the parser's byte position.
+ordered_json ParseJsonDocument(std::string_view text, const std::string& file);
+
+// Typed member access that throws FormatError(file, "member '<prefix><name>'", ...).
+class JsonFields {
+ public:
+  JsonFields(const ordered_json& object, std::string file, std::string prefix = {});
+  const ordered_json& Get(const char* name) const;
+  std::string String(const char* name) const;
+  double Number(const char* name) const;
+  int Int(const char* name) const;
+  std::uint64_t UInt64(const char* name) const;
+  const ordered_json& Object(const char* name) const;
+  std::vector<double> NumberArray(const char* name) const;
+  std::vector<std::string> StringArray(const char* name) const;
+
+ private:
+  [[noreturn]] void Fail(const char* name, const std::string& expected) const;
+  const ordered_json& object_;
+  std::string file_, prefix_;
+};
+
+}  // namespace brdf::exporter::detail

@@ -1,0 +1,334 @@
+#include "brdf/exporter/ktx2.h"
+
+#include <algorithm>
+#include <array>
+#include <cstring>
+
+#include <fmt/format.h>
+
+#include "brdf/core/error.h"
+#include "brdf/core/file_util.h"
+#include "brdf/exporter/sidecar.h"
+#include "container_util.h"
+
+namespace brdf::exporter {
+namespace {
+
+constexpr std::array<std::uint8_t, 12> kIdentifier = {0xAB, 'K', 'T',  'X',  ' ',  '2',
+                                                      '0',  0xBB, '\r', '\n', 0x1A, '\n'};
+constexpr std::size_t kHeaderEnd = 12 + 9 * 4;        // identifier + header
+constexpr std::size_t kIndexEnd = kHeaderEnd + 32;    // + dfd/kvd/sgd index
+constexpr std::size_t kLevelIndexEnd = kIndexEnd + 24;  // + one level index entry
+
+// Data Format Descriptor field encodings (Khronos Data Format Specification 1.3, basic block).
+constexpr std::uint32_t kDfVersion13 = 2;
+constexpr std::uint32_t kModelRgbsda = 1, kPrimariesBt709 = 1, kTransferLinear = 1;
+constexpr std::uint32_t kQualifierExponent = 0x20;  // KHR_DF_SAMPLE_DATATYPE_EXPONENT
+constexpr std::uint32_t kBasicBlockBytes = 24 + 6 * 16;
+constexpr std::uint32_t kMantissaUpper = 8448;     // as the spec's shared-exponent example
+constexpr std::uint32_t kExponentLower = 15, kExponentUpper = 31;  // bias, maximum
+
+std::uint32_t SampleWord0(std::uint32_t bit_offset, std::uint32_t bit_length,
+                          std::uint32_t channel) {
+  return bit_offset | ((bit_length - 1) << 16) | (channel << 24);
+}
+
+std::size_t Align4(std::size_t n) { return (n + 3) & ~std::size_t{3}; }
+
+void Put32(std::string& out, std::size_t at, std::uint32_t v) {
+  for (int i = 0; i < 4; ++i) out[at + i] = static_cast<char>((v >> (8 * i)) & 0xff);
+}
+void Put64(std::string& out, std::size_t at, std::uint64_t v) {
+  Put32(out, at, static_cast<std::uint32_t>(v));
+  Put32(out, at + 4, static_cast<std::uint32_t>(v >> 32));
+}
+
+KeyValues WithStandardKeys(const KeyValues& key_values) {
+  KeyValues all;
+  all.emplace_back("KTXorientation", "rdi");
+  all.emplace_back("KTXwriter", BrdfToolWriter());
+  for (const auto& kv : key_values) {
+    if (kv.first == "KTXorientation" || kv.first == "KTXwriter") continue;
+    all.push_back(kv);
+  }
+  for (const auto& [key, value] : all)
+    if (key.empty() || key.find('\0') != std::string::npos)
+      throw InvalidArgument("KTX2 key/value data: keys must be non-empty and free of NUL, got \"" +
+                            key + "\"");
+  // Keys sorted by their UTF-8 bytes (KTX 2.0 §3.11); std::string compares bytes as char,
+  // so compare as unsigned to be exact for non-ASCII keys.
+  std::sort(all.begin(), all.end(), [](const auto& a, const auto& b) {
+    return std::lexicographical_compare(
+        a.first.begin(), a.first.end(), b.first.begin(), b.first.end(),
+        [](char x, char y) { return static_cast<unsigned char>(x) < static_cast<unsigned char>(y); });
+  });
+  for (std::size_t i = 1; i < all.size(); ++i)
+    if (all[i].first == all[i - 1].first)
+      throw InvalidArgument("KTX2 key/value data: duplicate key \"" + all[i].first + "\"");
+  return all;
+}
+
+// Checks one field read at the reader's current position minus 4.
+void Expect32(ByteReader& r, std::uint32_t expected, std::string_view what,
+              std::string_view meaning = {}) {
+  const std::uint64_t at = r.offset();
+  const std::uint32_t got = r.U32(what);
+  if (got != expected)
+    throw FormatError(r.file(), BytePosition(at),
+                      fmt::format("{} {}{}", what, expected,
+                                  meaning.empty() ? std::string() : " (" + std::string(meaning) + ")"),
+                      std::to_string(got));
+}
+
+void ValidateDfd(const std::uint8_t* data, std::size_t size, std::uint64_t base,
+                 const std::string& file) {
+  ByteReader r(data, size, file, base);
+  const std::vector<std::uint32_t> expected = E5b9g9r9DataFormatDescriptor();
+  Expect32(r, expected[0], "DFD dfdTotalSize");
+  const std::uint64_t at_block = r.offset();
+  const std::uint32_t w0 = r.U32("DFD vendorId/descriptorType");
+  if (w0 != 0)
+    throw FormatError(file, BytePosition(at_block),
+                      "DFD vendorId 0 (Khronos) and descriptorType 0 (basic format)",
+                      fmt::format("vendorId {}, descriptorType {}", w0 & 0x1ffff, w0 >> 17));
+  const std::uint64_t at_version = r.offset();
+  const std::uint32_t w1 = r.U32("DFD versionNumber/descriptorBlockSize");
+  if ((w1 & 0xffff) != kDfVersion13)
+    throw FormatError(file, BytePosition(at_version), "DFD versionNumber 2 (Data Format 1.3)",
+                      std::to_string(w1 & 0xffff));
+  if ((w1 >> 16) != kBasicBlockBytes)
+    throw FormatError(file, BytePosition(at_version + 2),
+                      "DFD descriptorBlockSize 120 (6 samples: mantissa + exponent per channel)",
+                      std::to_string(w1 >> 16));
+  const std::uint64_t at_model = r.offset();
+  const std::uint32_t w2 = r.U32("DFD colour model");
+  if ((w2 & 0xff) != kModelRgbsda)
+    throw FormatError(file, BytePosition(at_model), "DFD colorModel 1 (RGBSDA)",
+                      std::to_string(w2 & 0xff));
+  if (((w2 >> 16) & 0xff) != kTransferLinear)
+    throw FormatError(file, BytePosition(at_model + 2), "DFD transferFunction 1 (linear)",
+                      std::to_string((w2 >> 16) & 0xff));
+  Expect32(r, 0, "DFD texelBlockDimension word", "1x1x1x1 texel block");
+  Expect32(r, 4, "DFD bytesPlane0-3 word", "bytesPlane0 = 4");
+  Expect32(r, 0, "DFD bytesPlane4-7 word");
+  static constexpr const char* kSampleNames[6] = {"R mantissa", "R exponent", "G mantissa",
+                                                  "G exponent", "B mantissa", "B exponent"};
+  for (int s = 0; s < 6; ++s) {
+    const std::size_t w = 7 + 4 * s;
+    const std::string name = std::string("DFD sample ") + std::to_string(s) + " (" + kSampleNames[s] + ")";
+    const std::uint64_t at = r.offset();
+    const std::uint32_t got = r.U32(name);
+    if (got != expected[w])
+      throw FormatError(file, BytePosition(at),
+                        fmt::format("{}: bitOffset {}, bitLength {} (stored {}), channel 0x{:02x}",
+                                    name, expected[w] & 0xffff, ((expected[w] >> 16) & 0xff) + 1,
+                                    (expected[w] >> 16) & 0xff, expected[w] >> 24),
+                        fmt::format("bitOffset {}, stored bitLength {}, channel 0x{:02x}",
+                                    got & 0xffff, (got >> 16) & 0xff, got >> 24));
+    r.U32("DFD sample position");  // any sample position is acceptable for 1x1 blocks
+    Expect32(r, expected[w + 2], name + " sampleLower");
+    Expect32(r, expected[w + 3], name + " sampleUpper");
+  }
+}
+
+}  // namespace
+
+std::vector<std::uint32_t> E5b9g9r9DataFormatDescriptor() {
+  std::vector<std::uint32_t> d;
+  d.push_back(4 + kBasicBlockBytes);                  // dfdTotalSize
+  d.push_back(0);                                     // vendorId 0, descriptorType 0
+  d.push_back(kDfVersion13 | (kBasicBlockBytes << 16));
+  d.push_back(kModelRgbsda | (kPrimariesBt709 << 8) | (kTransferLinear << 16));  // flags 0
+  d.push_back(0);  // texelBlockDimension0..3 = 0: 1×1×1×1
+  d.push_back(4);  // bytesPlane0 = 4
+  d.push_back(0);  // bytesPlane4..7
+  for (std::uint32_t channel = 0; channel < 3; ++channel) {
+    d.insert(d.end(), {SampleWord0(9 * channel, 9, channel), 0u, 0u, kMantissaUpper});
+    d.insert(d.end(), {SampleWord0(27, 5, channel | kQualifierExponent), 0u, kExponentLower,
+                       kExponentUpper});
+  }
+  return d;
+}
+
+std::string EncodeKtx2(const PackedVolume& volume, const KeyValues& key_values) {
+  if (volume.width < 1 || volume.height < 1 || volume.depth < 1 ||
+      volume.words.size() != static_cast<std::size_t>(volume.width) * volume.height * volume.depth)
+    throw InvalidArgument(fmt::format("KTX2: inconsistent volume {} × {} × {} with {} texels",
+                                      volume.width, volume.height, volume.depth,
+                                      volume.words.size()));
+  const std::vector<std::uint32_t> dfd = E5b9g9r9DataFormatDescriptor();
+  const KeyValues kvs = WithStandardKeys(key_values);
+
+  std::string kvd;
+  for (const auto& [key, value] : kvs) {
+    const std::size_t length = key.size() + 1 + value.size() + 1;  // key\0value\0
+    AppendU32(kvd, static_cast<std::uint32_t>(length));
+    kvd += key;
+    kvd.push_back('\0');
+    kvd += value;
+    kvd.push_back('\0');
+    kvd.resize(Align4(kvd.size()), '\0');  // valuePadding
+  }
+
+  const std::size_t dfd_offset = kLevelIndexEnd;
+  const std::size_t dfd_length = dfd.size() * 4;
+  const std::size_t kvd_offset = dfd_offset + dfd_length;
+  // No supercompression global data, so the level only needs lcm(texel block size, 4) = 4.
+  const std::size_t level_offset = Align4(kvd_offset + kvd.size());
+  const std::size_t level_length = volume.ByteSize();
+
+  std::string out(level_offset, '\0');
+  std::memcpy(out.data(), kIdentifier.data(), kIdentifier.size());
+  const std::uint32_t header[9] = {kVkFormatE5b9g9r9UfloatPack32,
+                                   4,  // typeSize: _PACK32
+                                   static_cast<std::uint32_t>(volume.width),
+                                   static_cast<std::uint32_t>(volume.height),
+                                   static_cast<std::uint32_t>(volume.depth),
+                                   0,   // layerCount: not an array
+                                   1,   // faceCount
+                                   1,   // levelCount
+                                   0};  // supercompressionScheme: none
+  for (int i = 0; i < 9; ++i) Put32(out, 12 + 4 * i, header[i]);
+  Put32(out, kHeaderEnd, static_cast<std::uint32_t>(dfd_offset));
+  Put32(out, kHeaderEnd + 4, static_cast<std::uint32_t>(dfd_length));
+  Put32(out, kHeaderEnd + 8, kvd.empty() ? 0 : static_cast<std::uint32_t>(kvd_offset));
+  Put32(out, kHeaderEnd + 12, static_cast<std::uint32_t>(kvd.size()));
+  Put64(out, kHeaderEnd + 16, 0);  // sgdByteOffset
+  Put64(out, kHeaderEnd + 24, 0);  // sgdByteLength
+  Put64(out, kIndexEnd, level_offset);
+  Put64(out, kIndexEnd + 8, level_length);
+  Put64(out, kIndexEnd + 16, level_length);  // uncompressedByteLength
+  for (std::size_t i = 0; i < dfd.size(); ++i) Put32(out, dfd_offset + 4 * i, dfd[i]);
+  std::memcpy(out.data() + kvd_offset, kvd.data(), kvd.size());
+  out += volume.Bytes();
+  return out;
+}
+
+void WriteKtx2(const std::string& path, const PackedVolume& volume, const KeyValues& key_values) {
+  WriteFileAtomically(path, EncodeKtx2(volume, key_values));
+}
+
+void WriteKtx2(const std::string& path, const PackedVolume& volume,
+               const std::vector<double>& theta_in_deg, const TextureMetadata& metadata) {
+  WriteKtx2(path, volume, KeyValues{{"brdf.sidecar", SidecarJson(volume, theta_in_deg, metadata)}});
+}
+
+void WriteKtx2(const std::string& path, const Lut& lut, const TextureMetadata& metadata) {
+  WriteKtx2(path, PackLut(lut), lut.theta_in_deg, metadata);
+}
+
+LoadedTexture ParseKtx2(const std::uint8_t* data, std::size_t size, const std::string& file) {
+  ByteReader r(data, size, file);
+  if (size < 12 || std::memcmp(data, kIdentifier.data(), 12) != 0) {
+    std::string got = size < 12 ? fmt::format("a file of {} bytes", size) : std::string("bytes");
+    for (std::size_t i = 0; i < std::min<std::size_t>(size, 12); ++i) got += fmt::format(" {:02x}", data[i]);
+    throw FormatError(file, BytePosition(0),
+                      "the KTX 2.0 identifier ab 4b 54 58 20 32 30 bb 0d 0a 1a 0a («KTX 20»\\r\\n\\x1A\\n)",
+                      got);
+  }
+  r.Skip(12);
+  Expect32(r, kVkFormatE5b9g9r9UfloatPack32, "vkFormat", "VK_FORMAT_E5B9G9R9_UFLOAT_PACK32");
+  Expect32(r, 4, "typeSize");
+  LoadedTexture t;
+  t.file = file;
+  t.container = TextureContainer::kKtx2;
+  const auto dimension = [&](const char* what) {
+    const std::uint64_t at = r.offset();
+    const std::uint32_t v = r.U32(what);
+    if (v == 0 || v > (1u << 16))
+      throw FormatError(file, BytePosition(at), std::string(what) + " in 1..65536", std::to_string(v));
+    return static_cast<int>(v);
+  };
+  t.volume.width = dimension("pixelWidth");
+  t.volume.height = dimension("pixelHeight");
+  t.volume.depth = dimension("pixelDepth (a 3D texture: one slice per theta_in)");
+  Expect32(r, 0, "layerCount", "not an array texture");
+  Expect32(r, 1, "faceCount");
+  {
+    const std::uint64_t at = r.offset();
+    const std::uint32_t levels = r.U32("levelCount");
+    if (levels > 1)
+      throw FormatError(file, BytePosition(at), "levelCount 1 (one mip level)", std::to_string(levels));
+  }
+  Expect32(r, 0, "supercompressionScheme", "none");
+  const std::uint32_t dfd_offset = r.U32("dfdByteOffset");
+  const std::uint32_t dfd_length = r.U32("dfdByteLength");
+  const std::uint32_t kvd_offset = r.U32("kvdByteOffset");
+  const std::uint32_t kvd_length = r.U32("kvdByteLength");
+  const std::uint64_t sgd_offset = r.U64("sgdByteOffset");
+  const std::uint64_t sgd_length = r.U64("sgdByteLength");
+  if (sgd_length != 0 || sgd_offset != 0)
+    throw FormatError(file, BytePosition(kHeaderEnd + 16),
+                      "no supercompression global data (offset and length 0)",
+                      fmt::format("offset {}, length {}", sgd_offset, sgd_length));
+  const std::uint64_t level_offset = r.U64("level 0 byteOffset");
+  const std::uint64_t level_length = r.U64("level 0 byteLength");
+  const std::uint64_t level_uncompressed = r.U64("level 0 uncompressedByteLength");
+
+  const auto check_range = [&](std::uint64_t offset, std::uint64_t length, std::uint64_t at,
+                               const char* what) {
+    if (offset > size || length > size - offset)
+      throw FormatError(file, BytePosition(at),
+                        fmt::format("{} inside the file ({} bytes)", what, size),
+                        fmt::format("bytes {}..{}", offset, offset + length));
+  };
+  check_range(dfd_offset, dfd_length, kHeaderEnd, "the Data Format Descriptor");
+  if (dfd_length != 4 + kBasicBlockBytes)
+    throw FormatError(file, BytePosition(kHeaderEnd + 4),
+                      fmt::format("dfdByteLength {} (one basic block of 6 samples)", 4 + kBasicBlockBytes),
+                      std::to_string(dfd_length));
+  ValidateDfd(data + dfd_offset, dfd_length, dfd_offset, file);
+
+  check_range(kvd_offset, kvd_length, kHeaderEnd + 8, "the key/value data");
+  {
+    ByteReader kv(data + kvd_offset, kvd_length, file, kvd_offset);
+    while (kv.remaining() > 0) {
+      const std::uint64_t at = kv.offset();
+      const std::uint32_t length = kv.U32("keyAndValueByteLength");
+      const std::uint8_t* p = kv.Bytes(length, "key and value");
+      const auto* nul = static_cast<const std::uint8_t*>(std::memchr(p, 0, length));
+      if (nul == nullptr || nul == p)
+        throw FormatError(file, BytePosition(at + 4), "a non-empty NUL-terminated key",
+                          "no key terminator in " + std::to_string(length) + " bytes");
+      std::string key(reinterpret_cast<const char*>(p), static_cast<std::size_t>(nul - p));
+      std::string value(reinterpret_cast<const char*>(nul + 1), length - key.size() - 1);
+      if (!value.empty() && value.back() == '\0') value.pop_back();
+      t.key_values.emplace_back(std::move(key), std::move(value));
+      const std::size_t padding = Align4(length) - length;
+      if (padding > 0 && kv.remaining() > 0) kv.Skip(std::min(padding, kv.remaining()));
+    }
+  }
+
+  const std::uint64_t texels = static_cast<std::uint64_t>(t.volume.width) * t.volume.height *
+                               static_cast<std::uint64_t>(t.volume.depth);
+  if (level_length != texels * 4)
+    throw FormatError(file, BytePosition(kIndexEnd + 8),
+                      fmt::format("level 0 byteLength {} ({} × {} × {} texels × 4 bytes)", texels * 4,
+                                  t.volume.width, t.volume.height, t.volume.depth),
+                      std::to_string(level_length));
+  if (level_uncompressed != level_length)
+    throw FormatError(file, BytePosition(kIndexEnd + 16),
+                      fmt::format("uncompressedByteLength {} (no supercompression)", level_length),
+                      std::to_string(level_uncompressed));
+  if (level_offset % 4 != 0)
+    throw FormatError(file, BytePosition(kIndexEnd), "a level byteOffset aligned to 4 bytes",
+                      std::to_string(level_offset));
+  check_range(level_offset, level_length, kIndexEnd, "the level 0 image");
+
+  t.volume.words.resize(texels);
+  detail::CopyLittleEndianWords(data + level_offset, t.volume.words);
+
+  for (const auto& [key, value] : t.key_values) {
+    if (key == "brdf.sidecar") t.sidecar_json = value;
+    if (key == "brdf.atlas") t.atlas_manifest_json = value;
+  }
+  FinishLoadedTexture(t);
+  return t;
+}
+
+LoadedTexture ReadKtx2(const std::string& path) {
+  const std::vector<std::uint8_t> bytes = ReadFileBytes(path, kMaxTextureFileBytes);
+  return ParseKtx2(bytes.data(), bytes.size(), path);
+}
+
+}  // namespace brdf::exporter

@@ -1,0 +1,82 @@
+#include "brdf/exporter/lut_export.h"
+
+#include <filesystem>
+
+#include "brdf/core/error.h"
+#include "brdf/exporter/dds.h"
+#include "brdf/exporter/ktx2.h"
+#include "brdf/exporter/sidecar.h"
+
+namespace brdf::exporter {
+
+LutExportFormats ParseExportFormats(std::string_view list) {
+  LutExportFormats f{false, false, false, false, false};
+  bool any = false;
+  std::size_t start = 0;
+  while (start <= list.size()) {
+    const std::size_t comma = std::min(list.find(',', start), list.size());
+    const std::string_view item = list.substr(start, comma - start);
+    if (item == "ktx2") {
+      f.ktx2 = true;
+    } else if (item == "dds") {
+      f.dds = true;
+    } else if (item == "exr") {
+      f.exr = true;
+    } else if (item == "png") {
+      f.png = true;
+    } else if (item == "json") {
+      f.json = true;
+    } else {
+      throw InvalidArgument("unknown output format '" + std::string(item) +
+                            "' (known: ktx2, dds, exr, png, json)");
+    }
+    any = true;
+    start = comma + 1;
+  }
+  if (!any) throw InvalidArgument("no output format given (known: ktx2, dds, exr, png, json)");
+  return f;
+}
+
+LutExportResult ExportLut(const std::string& out_dir, const Lut& lut, TextureMetadata metadata,
+                          const LutExportOptions& options) {
+  const std::string& name = metadata.name;
+  if (name.empty() || name == "." || name == ".." ||
+      name.find_first_of("/\\") != std::string::npos || name.find('\0') != std::string::npos)
+    throw InvalidArgument("LUT export: the output name must be a plain file name, got '" + name + "'");
+  const PackedVolume packed = PackLut(lut);
+  const LutExportFormats& f = options.formats;
+  metadata.companion_files.clear();
+  if (f.ktx2) metadata.companion_files.push_back(name + ".ktx2");
+  if (f.dds) metadata.companion_files.push_back(name + ".dds");
+  if (f.exr) metadata.companion_files.push_back(name + ".exr");
+  if (f.png) metadata.companion_files.push_back(name + ".png");
+
+  const std::filesystem::path dir(out_dir);
+  const auto path = [&](const char* ext) { return (dir / (name + ext)).string(); };
+  LutExportResult result;
+  result.payload_bytes = packed.ByteSize();
+  result.payload_crc32 = packed.Crc32();
+  if (f.ktx2) {
+    WriteKtx2(path(".ktx2"), packed, lut.theta_in_deg, metadata);
+    result.written.push_back(path(".ktx2"));
+  }
+  if (f.dds) {
+    WriteDds(path(".dds"), packed);
+    result.written.push_back(path(".dds"));
+  }
+  if (f.exr) {
+    WriteExrComposite(path(".exr"), lut, packed, metadata, options.exr_type);
+    result.written.push_back(path(".exr"));
+  }
+  if (f.png) {
+    WritePngComposite(path(".png"), lut);
+    result.written.push_back(path(".png"));
+  }
+  if (f.json) {
+    WriteSidecar(path(".json"), packed, lut.theta_in_deg, metadata);
+    result.written.push_back(path(".json"));
+  }
+  return result;
+}
+
+}  // namespace brdf::exporter

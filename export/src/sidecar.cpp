@@ -1,0 +1,95 @@
+#include "brdf/exporter/sidecar.h"
+
+#include <fmt/format.h>
+
+#include <nlohmann/json.hpp>
+
+#include "brdf/core/error.h"
+#include "brdf/core/file_util.h"
+#include "json_util.h"
+
+namespace brdf::exporter {
+
+using nlohmann::ordered_json;
+
+std::string SidecarJson(const PackedVolume& payload, const std::vector<double>& theta_in_deg,
+                        const TextureMetadata& metadata) {
+  ordered_json j;
+  j["kind"] = "brdf-lut-sidecar";
+  j["format_version"] = 1;
+  j["name"] = metadata.name;
+  j["source"] = metadata.source;
+  j["theta_in_deg"] = theta_in_deg;
+  j["grid"] = detail::GridJson(payload, theta_in_deg);
+  j["values"] = "f_r in 1/sr, linear Rec.709 RGB, not multiplied by cos(theta)";
+  j["texel_convention"] = detail::TexelConventionJson();
+  if (metadata.extrapolation) {
+    const ExtrapolationInfo& e = *metadata.extrapolation;
+    j["extrapolation"] = {
+        {"method", "restricted quadratic Bezier beyond the last measured theta_out (DESIGN 6)"},
+        {"p", e.p},
+        {"l", e.l},
+        {"theta_b_deg", e.theta_b_deg}};
+  } else {
+    j["extrapolation"] = nullptr;
+  }
+  j["fitted_models"] = ordered_json::array();
+  for (const std::string& text : metadata.fitted_models_json)
+    j["fitted_models"].push_back(detail::ParseEmbeddedJson(text, "fitted model"));
+  j["tool"] = {{"name", "brdf-toolchain"},
+               {"version", metadata.tool_version.empty() ? BrdfToolVersion() : metadata.tool_version}};
+  j["payload"] = detail::PayloadJson(payload);
+  j["files"] = metadata.companion_files;
+  return j.dump(2) + "\n";
+}
+
+void WriteSidecar(const std::string& path, const PackedVolume& payload,
+                  const std::vector<double>& theta_in_deg, const TextureMetadata& metadata) {
+  WriteFileAtomically(path, SidecarJson(payload, theta_in_deg, metadata));
+}
+
+SidecarInfo ParseSidecarJson(std::string_view json_text, const std::string& file) {
+  const ordered_json j = detail::ParseJsonDocument(json_text, file);
+  detail::JsonFields f(j, file);
+  if (f.String("kind") != "brdf-lut-sidecar")
+    throw FormatError(file, "member 'kind'", "\"brdf-lut-sidecar\"", j["kind"].dump());
+  SidecarInfo info;
+  info.name = f.String("name");
+  info.source = f.String("source");
+  info.theta_in_deg = f.NumberArray("theta_in_deg");
+  const auto grid = f.Object("grid");
+  detail::JsonFields g(grid, file, "grid.");
+  info.width = g.Int("width");
+  info.height = g.Int("height");
+  info.slices = g.Int("slices");
+  if (static_cast<std::size_t>(info.slices) != info.theta_in_deg.size())
+    throw FormatError(file, "member 'grid.slices'",
+                      fmt::format("the number of theta_in_deg values ({})", info.theta_in_deg.size()),
+                      std::to_string(info.slices));
+  if (j.contains("extrapolation") && !j["extrapolation"].is_null()) {
+    detail::JsonFields e(f.Object("extrapolation"), file, "extrapolation.");
+    info.extrapolation = ExtrapolationInfo{e.Number("p"), e.Number("l"), e.Number("theta_b_deg")};
+  }
+  if (j.contains("fitted_models")) {
+    if (!j["fitted_models"].is_array())
+      throw FormatError(file, "member 'fitted_models'", "an array", j["fitted_models"].type_name());
+    for (const auto& m : j["fitted_models"]) info.fitted_models_json.push_back(m.dump());
+  }
+  detail::JsonFields t(f.Object("tool"), file, "tool.");
+  info.tool_version = t.String("version");
+  detail::JsonFields p(f.Object("payload"), file, "payload.");
+  info.payload_bytes = p.UInt64("bytes");
+  detail::JsonFields c(p.Object("checksum"), file, "payload.checksum.");
+  if (c.String("algorithm") != "crc32")
+    throw FormatError(file, "member 'payload.checksum.algorithm'", "\"crc32\"",
+                      "\"" + c.String("algorithm") + "\"");
+  info.payload_crc32 = detail::ParseHex32(c.String("value"), file, "member 'payload.checksum.value'");
+  if (j.contains("files")) info.files = f.StringArray("files");
+  return info;
+}
+
+SidecarInfo ReadSidecar(const std::string& path) {
+  return ParseSidecarJson(ReadFileText(path, 16u << 20), path);
+}
+
+}  // namespace brdf::exporter

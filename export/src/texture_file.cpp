@@ -1,0 +1,88 @@
+#include "brdf/exporter/texture_file.h"
+
+#include <cstring>
+#include <filesystem>
+
+#include <fmt/format.h>
+
+#include "brdf/core/error.h"
+#include "brdf/core/file_util.h"
+#include "brdf/exporter/atlas.h"
+#include "brdf/exporter/dds.h"
+#include "brdf/exporter/ktx2.h"
+#include "brdf/exporter/sidecar.h"
+
+namespace brdf::exporter {
+namespace {
+
+void CheckRecordedPayload(const LoadedTexture& t, const std::string& what, int width, int height,
+                          int depth, std::uint64_t bytes, std::uint32_t crc) {
+  const PackedVolume& v = t.volume;
+  if (width != v.width || height != v.height || depth != v.depth)
+    throw FormatError(t.file, what, fmt::format("a {} × {} × {} texture as the metadata records", width, height, depth),
+                      fmt::format("{} × {} × {}", v.width, v.height, v.depth));
+  if (bytes != v.ByteSize())
+    throw FormatError(t.file, what, fmt::format("a payload of {} bytes as the metadata records", bytes),
+                      std::to_string(v.ByteSize()) + " bytes");
+  const std::uint32_t actual = v.Crc32();
+  if (actual != crc)
+    throw FormatError(t.file, what,
+                      fmt::format("payload CRC-32 0x{:08x} as the metadata records", crc),
+                      fmt::format("0x{:08x}", actual), "the texel data was changed or damaged");
+}
+
+}  // namespace
+
+void FinishLoadedTexture(LoadedTexture& t) {
+  if (!t.sidecar_json.empty()) {
+    const SidecarInfo info = ParseSidecarJson(t.sidecar_json, t.file + " (embedded sidecar)");
+    CheckRecordedPayload(t, "embedded sidecar", info.width, info.height, info.slices,
+                         info.payload_bytes, info.payload_crc32);
+    t.theta_in_deg = info.theta_in_deg;
+    t.theta_in_from_metadata = true;
+  } else if (!t.atlas_manifest_json.empty()) {
+    const AtlasManifest m = ParseAtlasManifest(t.atlas_manifest_json, t.file + " (embedded manifest)");
+    CheckRecordedPayload(t, "embedded atlas manifest", m.texture_width, m.texture_height,
+                         static_cast<int>(m.theta_in_deg.size()), m.payload_bytes,
+                         m.payload_crc32);
+    t.theta_in_deg = m.theta_in_deg;
+    t.theta_in_from_metadata = true;
+  } else if (t.theta_in_deg.size() != static_cast<std::size_t>(t.volume.depth)) {
+    // No metadata: DESIGN §5's reference spacing, θin,k = k·20°.
+    t.theta_in_deg.clear();
+    for (int k = 0; k < t.volume.depth; ++k) t.theta_in_deg.push_back(20.0 * k);
+    t.theta_in_from_metadata = false;
+  }
+  t.lut = Lut();
+  if (t.volume.width == Lut::kWidth && t.volume.height == Lut::kHeight)
+    t.lut = UnpackLut(t.volume, t.theta_in_deg);
+}
+
+LoadedTexture ReadTextureFile(const std::string& path) {
+  const std::vector<std::uint8_t> bytes = ReadFileBytes(path, kMaxTextureFileBytes);
+  if (bytes.size() >= 12 && bytes[0] == 0xAB && std::memcmp(bytes.data() + 1, "KTX 20", 6) == 0)
+    return ParseKtx2(bytes.data(), bytes.size(), path);
+  if (bytes.size() >= 4 && std::memcmp(bytes.data(), "DDS ", 4) == 0) {
+    LoadedTexture t = ParseDds(bytes.data(), bytes.size(), path);
+    std::filesystem::path sidecar(path);
+    sidecar.replace_extension(".json");
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(sidecar, ec)) {
+      // "<prefix>.json" beside an atlas is its manifest, beside a LUT its sidecar.
+      std::string text = ReadFileText(sidecar.string(), 16u << 20);
+      if (text.find("\"brdf-atlas-manifest\"") != std::string::npos)
+        t.atlas_manifest_json = std::move(text);
+      else
+        t.sidecar_json = std::move(text);
+      FinishLoadedTexture(t);
+    }
+    return t;
+  }
+  std::string head;
+  for (std::size_t i = 0; i < std::min<std::size_t>(bytes.size(), 8); ++i)
+    head += fmt::format("{:02x} ", bytes[i]);
+  throw FormatError(path, BytePosition(0), "a KTX2 («KTX 20») or DDS (\"DDS \") texture",
+                    bytes.empty() ? std::string("an empty file") : "bytes " + head);
+}
+
+}  // namespace brdf::exporter

@@ -1,0 +1,167 @@
+#include "brdf/exporter/atlas.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include <nlohmann/json.hpp>
+
+#include "brdf/core/error.h"
+#include "brdf/core/file_util.h"
+#include "brdf/exporter/dds.h"
+#include "brdf/exporter/ktx2.h"
+#include "brdf/exporter/rgb9e5.h"
+#include "export_test_util.h"
+
+namespace brdf::exporter {
+namespace {
+
+// Five distinct materials sharing θin {0, 20, 40, 60}.
+struct Five {
+  std::vector<Lut> luts;
+  std::vector<AtlasMaterial> materials;
+  Five() {
+    const std::vector<double> theta = {0, 20, 40, 60};
+    luts.push_back(test::AnalyticLut(test::Ggx03(), theta));
+    luts.push_back(test::AnalyticLut(test::Lafortune20(), theta));
+    luts.push_back(test::AnalyticLut(test::Lambert(0.9), theta));
+    luts.push_back(test::PatternLut(theta, 41));
+    luts.push_back(test::PatternLut(theta, 42));
+    const char* names[] = {"ggx", "lafortune", "lambert", "pattern41", "pattern42"};
+    for (int m = 0; m < 5; ++m) materials.push_back({names[m], &luts[m], std::string("src/") + names[m]});
+  }
+};
+
+TEST(Atlas, LayoutFollowsDesignSection5) {
+  const AtlasLayout l = ComputeAtlasLayout(5, 4);
+  EXPECT_EQ(l.cells.columns, 3);  // ceil(√5)
+  EXPECT_EQ(l.cells.rows, 2);     // ceil(5/3)
+  EXPECT_EQ(l.TextureWidth(), 3 * 361);
+  EXPECT_EQ(l.TextureHeight(), 2 * 181);
+  EXPECT_EQ(l.composite.columns, 2);
+  EXPECT_EQ(l.composite.rows, 2);
+  EXPECT_EQ(l.ImageWidth(), 2 * 3 * 361);
+  EXPECT_EQ(l.ImageHeight(), 2 * 2 * 181);
+  const AtlasLayout one = ComputeAtlasLayout(1, 4);
+  EXPECT_EQ(one.TextureWidth(), 361);
+  EXPECT_EQ(one.ImageWidth(), 722);
+  EXPECT_EQ(one.ImageHeight(), 362);
+}
+
+TEST(Atlas, EachCellOfEveryContainerEqualsItsOwnLut) {
+  const Five five;
+  const std::string dir = test::TestDir("atlas_cells");
+  const std::vector<std::string> written = WriteAtlas(dir + "/five", five.materials);
+  EXPECT_EQ(written.size(), 4u);
+  const LoadedTexture ktx2 = ReadKtx2(dir + "/five.ktx2");
+  const LoadedTexture dds = ReadTextureFile(dir + "/five.dds");
+  const ExrFile exr = ReadExr(dir + "/five.exr");
+  ASSERT_EQ(ktx2.volume.width, 3 * 361);
+  ASSERT_EQ(ktx2.volume.height, 2 * 181);
+  ASSERT_EQ(ktx2.volume.depth, 4);
+  EXPECT_FALSE(ktx2.IsSingleLut());
+  EXPECT_TRUE(ktx2.theta_in_from_metadata);
+  EXPECT_TRUE(dds.theta_in_from_metadata);  // from the manifest beside it
+  EXPECT_EQ(dds.volume.words, ktx2.volume.words);
+  ASSERT_EQ(exr.image.width, 2 * 3 * 361);
+  ASSERT_EQ(exr.image.height, 2 * 2 * 181);
+  const int width = 3 * 361, height = 2 * 181;
+  for (int m = 0; m < 5; ++m) {
+    const Lut& lut = five.luts[m];
+    const int x0 = (m % 3) * 361, y0 = (m / 3) * 181;  // column m mod Cm, row m div Cm
+    for (int k = 0; k < 4; ++k) {
+      const int ex = (k % 2) * width, ey = (k / 2) * height;  // slice grid k in the EXR
+      for (int j = 0; j < 181; ++j)
+        for (int i = 0; i < 361; ++i) {
+          const float* t = lut.Texel(k, j, i);
+          const std::size_t at = (static_cast<std::size_t>(k) * height + y0 + j) * width + x0 + i;
+          ASSERT_EQ(ktx2.volume.words[at], EncodeRgb9e5(t[0], t[1], t[2]))
+              << "material " << m << " texel " << i << "," << j << "," << k;
+          const float* e = exr.image.Pixel(ex + x0 + i, ey + y0 + j);
+          for (int c = 0; c < 3; ++c) {
+            if (std::isnan(t[c])) {
+              ASSERT_TRUE(std::isnan(e[c]));
+            } else {
+              ASSERT_EQ(e[c], t[c]) << "material " << m << " EXR " << i << "," << j << "," << k;
+            }
+          }
+        }
+    }
+    // The library's own cell extraction agrees with the layout above.
+    const Lut cell = ExtractAtlasCell(ktx2.volume, ComputeAtlasLayout(5, 4), m, lut.theta_in_deg);
+    EXPECT_EQ(cell.texels, UnpackLut(PackLut(lut), lut.theta_in_deg).texels) << m;
+  }
+}
+
+TEST(Atlas, UnusedCellsAreZero) {
+  const Five five;
+  const Atlas atlas = BuildAtlas(five.materials);
+  // Cell 5 (column 2, row 1) is empty in a 3 × 2 grid of five materials.
+  for (int k = 0; k < 4; ++k)
+    for (int j = 0; j < 181; ++j)
+      for (int i = 0; i < 361; ++i)
+        ASSERT_EQ(atlas.volume.words[atlas.volume.Index(2 * 361 + i, 181 + j, k)], 0u);
+}
+
+TEST(Atlas, ManifestNamesEveryMaterialItsCellAndTheConventions) {
+  const Five five;
+  const std::string dir = test::TestDir("atlas_manifest");
+  WriteAtlas(dir + "/five", five.materials);
+  const auto j = nlohmann::json::parse(ReadFileText(dir + "/five.json", 1 << 20));
+  EXPECT_EQ(j["kind"], "brdf-atlas-manifest");
+  EXPECT_EQ(j["theta_in_deg"], nlohmann::json::array({0, 20, 40, 60}));
+  ASSERT_EQ(j["materials"].size(), 5u);
+  for (int m = 0; m < 5; ++m) {
+    const auto& e = j["materials"][m];
+    EXPECT_EQ(e["name"], five.materials[m].name);
+    EXPECT_EQ(e["source"], five.materials[m].source);
+    EXPECT_EQ(e["cell"]["column"], m % 3);
+    EXPECT_EQ(e["cell"]["row"], m / 3);
+    EXPECT_EQ(e["cell"]["x0"], (m % 3) * 361);
+    EXPECT_EQ(e["cell"]["y0"], (m / 3) * 181);
+  }
+  EXPECT_EQ(j["grid"]["cell_columns"], 3);
+  EXPECT_EQ(j["grid"]["cell_rows"], 2);
+  EXPECT_EQ(j["grid"]["texture_width"], 1083);
+  EXPECT_EQ(j["grid"]["texture_height"], 362);
+  EXPECT_EQ(j["grid"]["texture_depth"], 4);
+  EXPECT_FALSE(j["texel_convention"]["centre_exact"].get<std::string>().empty());
+  EXPECT_FALSE(j["texel_convention"]["published"].get<std::string>().empty());
+  EXPECT_FALSE(j["texel_convention"]["atlas_cell"].get<std::string>().empty());
+  EXPECT_EQ(j["payload"]["bytes"], 1083u * 362u * 4u * 4u);
+  const AtlasManifest parsed = ParseAtlasManifest(j.dump(), "five.json");
+  EXPECT_EQ(parsed.materials[4].name, "pattern42");
+  EXPECT_EQ(parsed.materials[4].x0, 361);
+  EXPECT_EQ(parsed.layout.cells.columns, 3);
+}
+
+TEST(Atlas, RefusesMaterialsWithDifferentThetaSetsNamingThem) {
+  const Lut a = test::AnalyticLut(test::Lambert(0.5), {0, 20, 40, 60});
+  const Lut b = test::AnalyticLut(test::Lambert(0.5), {0, 30, 60});
+  const std::string dir = test::TestDir("atlas_theta");
+  try {
+    WriteAtlas(dir + "/mixed", {{"paper", &a, ""}, {"velvet", &b, ""}});
+    FAIL() << "accepted";
+  } catch (const InvalidArgument& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("'paper'"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("'velvet'"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("0, 30, 60"), std::string::npos) << msg;
+  }
+  EXPECT_TRUE(std::filesystem::is_empty(dir));  // nothing written
+}
+
+TEST(Atlas, RefusesDuplicateNamesAndEmptyLists) {
+  const Lut a = test::PatternLut({0, 20}, 1);
+  EXPECT_THROW(BuildAtlas({{"x", &a, ""}, {"x", &a, ""}}), InvalidArgument);
+  EXPECT_THROW(BuildAtlas({}), InvalidArgument);
+}
+
+TEST(Atlas, SingleMaterialAtlasIsThatLut) {
+  const Lut a = test::AnalyticLut(test::Ggx03(), {0, 20, 40, 60});
+  const Atlas atlas = BuildAtlas({{"only", &a, ""}});
+  EXPECT_EQ(atlas.volume.words, PackLut(a).words);
+}
+
+}  // namespace
+}  // namespace brdf::exporter
