@@ -569,5 +569,68 @@ TEST(Bpc, WriteBpcNeverLeavesAPartialFileOrATemporary) {
   EXPECT_EQ(LoadBpc(path).SampleCount(), 8000u);
 }
 
+// A chunk as docs/formats/bpc.md lays it out, built here independently of the writer.
+std::string SpecChunk(const char tag[4], std::uint32_t index, const std::string& payload) {
+  std::string out(tag, 4);
+  AppendU32(out, index);
+  AppendU64(out, payload.size());
+  AppendU32(out, Crc32(payload.data(), payload.size()));
+  AppendU32(out, Crc32(out.data(), 20));
+  return out + payload;
+}
+
+void ExpectSameResult(const BpcReadResult& a, const BpcReadResult& b) {
+  EXPECT_EQ(a.finished, b.finished);
+  EXPECT_EQ(a.valid_bytes, b.valid_bytes);
+  EXPECT_EQ(a.slice_indices, b.slice_indices);
+  EXPECT_EQ(a.intact_data_after_damage, b.intact_data_after_damage);
+  ASSERT_EQ(a.problems.size(), b.problems.size());
+  for (std::size_t i = 0; i < a.problems.size(); ++i) {
+    EXPECT_EQ(a.problems[i].offset, b.problems[i].offset);
+    EXPECT_EQ(a.problems[i].size, b.problems[i].size);
+    EXPECT_EQ(a.problems[i].slice_index, b.problems[i].slice_index);
+  }
+  ExpectSameMetadata(a.measurement.metadata, b.measurement.metadata);
+  ASSERT_EQ(a.measurement.slices.size(), b.measurement.slices.size());
+  for (std::size_t i = 0; i < a.measurement.slices.size(); ++i)
+    ExpectSameSlice(a.measurement.slices[i], b.measurement.slices[i]);
+}
+
+TEST(Bpc, ReadingFromDiskMatchesParsingInMemory) {
+  // ReadBpc streams intact files and falls back to the tolerant in-memory parser on damage;
+  // both must give the same answer for every kind of file.
+  TempDir dir("stream");
+  Measurement m = TestMeasurement(3, 3000);
+  m.slices[1].samples.clear();  // an empty slice
+  const std::string full = EncodeBpc(m);
+  const std::vector<std::size_t> b = Boundaries(m, full.size());
+  std::vector<std::string> files = {
+      full,
+      full.substr(0, b[3]),          // unfinished
+      full.substr(0, b[0]),          // header only
+      full.substr(0, b[2] + 50000),  // cut inside slice 2
+      full + "x",                    // trailing data
+      // A chunk type from a later minor version between slices 0 and 1: skipped.
+      full.substr(0, b[1]) + SpecChunk("XTRA", 0xffffffffu, std::string(70000, 'q')) +
+          full.substr(b[1]),
+  };
+  std::string flipped = full;
+  flipped[b[2] + 12345] ^= 0x40;
+  files.push_back(flipped);
+  files.push_back(EncodeBpc(Measurement{}));  // no slices at all
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    SCOPED_TRACE("file " + std::to_string(i));
+    const std::string path = dir.File("f" + std::to_string(i) + ".bpc");
+    WriteFileAtomically(path, files[i]);
+    const auto* data = reinterpret_cast<const std::uint8_t*>(files[i].data());
+    ExpectSameResult(ReadBpc(path), ParseBpc(data, files[i].size(), path));
+  }
+  // The unknown chunk really was skipped rather than reported.
+  const BpcReadResult r = ReadBpc(dir.File("f5.bpc"));
+  EXPECT_TRUE(r.problems.empty());
+  EXPECT_TRUE(r.finished);
+  EXPECT_EQ(r.measurement.slices.size(), 3u);
+}
+
 }  // namespace
 }  // namespace brdf

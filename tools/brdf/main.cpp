@@ -64,6 +64,16 @@ int main(int argc, char** argv) {
     exit_code = brdf::cli::RunEval(eval);
   });
 
+  // brdf info
+  brdf::cli::InfoOptions info;
+  auto* info_cmd = app.add_subcommand(
+      "info",
+      "Describe a file: a .bpc capture (slices, samples, ranges, statistics, flags, "
+      "metadata, damage) or a material .json (model and parameters)");
+  info_cmd->add_option("file", info.file, "File to describe (.bpc, .json)")->required();
+  info_cmd->add_flag("--json", info.json, "Print JSON instead of text");
+  info_cmd->callback([&] { exit_code = brdf::cli::RunInfo(info); });
+
   // brdf materials
   brdf::cli::MaterialsOptions materials;
   auto* materials_cmd =

@@ -181,9 +181,10 @@ void AppendF32(std::string& out, float v) {
 
 namespace {
 
-// Slicing-by-4 tables: a capture of 110 k samples is ~5 MB, so the CRC is on the read path.
+// Slicing-by-8 tables: a capture of 110 k samples is ~5 MB and every byte of it is checked on
+// read, so the CRC dominates reading a .bpc (by-8 is about twice as fast as by-4 here).
 struct Crc32Tables {
-  std::array<std::array<std::uint32_t, 256>, 4> t{};
+  std::array<std::array<std::uint32_t, 256>, 8> t{};
   Crc32Tables() {
     for (std::uint32_t i = 0; i < 256; ++i) {
       std::uint32_t c = i;
@@ -191,7 +192,7 @@ struct Crc32Tables {
       t[0][i] = c;
     }
     for (std::uint32_t i = 0; i < 256; ++i)
-      for (int s = 1; s < 4; ++s) t[s][i] = (t[s - 1][i] >> 8) ^ t[0][t[s - 1][i] & 0xff];
+      for (int s = 1; s < 8; ++s) t[s][i] = (t[s - 1][i] >> 8) ^ t[0][t[s - 1][i] & 0xff];
   }
 };
 
@@ -201,13 +202,18 @@ std::uint32_t Crc32(const void* data, std::size_t size, std::uint32_t crc) {
   static const Crc32Tables tables;
   const auto& t = tables.t;
   const auto* p = static_cast<const std::uint8_t*>(data);
+  const auto le32 = [](const std::uint8_t* q) {
+    return static_cast<std::uint32_t>(q[0]) | (static_cast<std::uint32_t>(q[1]) << 8) |
+           (static_cast<std::uint32_t>(q[2]) << 16) | (static_cast<std::uint32_t>(q[3]) << 24);
+  };
   crc = ~crc;
-  while (size >= 4) {
-    crc ^= static_cast<std::uint32_t>(p[0]) | (static_cast<std::uint32_t>(p[1]) << 8) |
-           (static_cast<std::uint32_t>(p[2]) << 16) | (static_cast<std::uint32_t>(p[3]) << 24);
-    crc = t[3][crc & 0xff] ^ t[2][(crc >> 8) & 0xff] ^ t[1][(crc >> 16) & 0xff] ^ t[0][crc >> 24];
-    p += 4;
-    size -= 4;
+  while (size >= 8) {
+    const std::uint32_t lo = crc ^ le32(p);
+    const std::uint32_t hi = le32(p + 4);
+    crc = t[7][lo & 0xff] ^ t[6][(lo >> 8) & 0xff] ^ t[5][(lo >> 16) & 0xff] ^ t[4][lo >> 24] ^
+          t[3][hi & 0xff] ^ t[2][(hi >> 8) & 0xff] ^ t[1][(hi >> 16) & 0xff] ^ t[0][hi >> 24];
+    p += 8;
+    size -= 8;
   }
   while (size-- > 0) crc = t[0][(crc ^ *p++) & 0xff] ^ (crc >> 8);
   return ~crc;

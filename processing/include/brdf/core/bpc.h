@@ -58,9 +58,11 @@ struct BpcReadResult {
                                           // truncating to valid_bytes would discard it
 };
 
-// Reads a .bpc, tolerating damage after the header. Throws FormatError if not even the header
-// is readable (wrong magic, unsupported version, corrupt header chunk), IoError if the file
-// cannot be opened.
+// Reads a .bpc, tolerating damage after the header. An intact file is streamed (the file is
+// never held in memory whole); at the first sign of damage the whole file is read (at most
+// kBpcMaxFileBytes) and parsed by the tolerant reader of docs/formats/bpc.md, "Reading". Throws
+// FormatError if not even the header is readable (wrong magic, unsupported version, corrupt header
+// chunk), IoError if the file cannot be opened.
 BpcReadResult ReadBpc(const std::string& path);
 
 // ReadBpc over bytes already in memory (tests, fuzzing, streams). `file` names the source in
