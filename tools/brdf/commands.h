@@ -20,8 +20,34 @@ struct EvalOptions {
   std::string file;
   double theta_in_deg = 0, phi_in_deg = 0;
   double theta_out_deg = 0, phi_out_deg = 0;
+  std::string extrapolate;  // "P,L" for captures; empty: per-material JSON, else 1,0.5
 };
 int RunEval(const EvalOptions& options);
+
+// std::thread::hardware_concurrency(), at least 1: the default of --jobs.
+int DefaultJobs();
+
+// The export formats `brdf convert` writes unless told otherwise.
+inline constexpr const char* kAllLutFormats = "ktx2,dds,exr,png,json";
+
+struct ConvertOptions {
+  std::vector<std::string> inputs;  // files and folders
+  std::string out;                  // output folder (created if missing)
+  std::string extrapolate;          // "P,L"; empty: per-material JSON, else 1,0.5
+  std::string formats = kAllLutFormats;
+  int jobs = DefaultJobs();
+  bool quiet = false;  // no progress bar
+};
+int RunConvert(const ConvertOptions& options);
+
+struct AtlasOptions {
+  std::vector<std::string> inputs;  // files and folders
+  std::string out;                  // prefix: writes PREFIX.ktx2, .dds, .exr, .json
+  std::string extrapolate;
+  int jobs = DefaultJobs();
+  bool quiet = false;
+};
+int RunAtlas(const AtlasOptions& options);
 
 struct MaterialsOptions {
   bool json = false;
