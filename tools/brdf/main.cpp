@@ -127,7 +127,7 @@ int main(int argc, char** argv) {
       "20, 40, 60).\n"
       "A failing input is reported and skipped; the others are converted. Every file is "
       "written atomically; a failed input leaves none of its outputs. Exit code 0 if all "
-      "inputs converted, 1 if any failed.");
+      "inputs converted, 1 if any failed.\n");
   convert_cmd->callback([&] { exit_code = brdf::cli::RunConvert(convert); });
 
   // brdf atlas

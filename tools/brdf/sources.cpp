@@ -268,66 +268,83 @@ PreparedMeasurement PrepareMeasurement(
 OpenedTexture OpenExportedTexture(const std::string& path) {
   OpenedTexture out;
   const FileKind kind = ClassifyFile(path);
-  if (kind == FileKind::kSidecar) {
+  if (kind == FileKind::kSidecar || kind == FileKind::kAtlasManifest) {
     out.sidecar_path = path;
-    out.sidecar = exporter::ReadSidecar(path);
     const fs::path folder = fs::path(path).parent_path();
+    // What the JSON records about its texture, and where the texture may be.
+    int width = 0, height = 0, depth = 0;
+    std::uint64_t bytes = 0;
+    std::uint32_t crc = 0;
+    std::vector<double> theta_in_deg;
     std::vector<std::string> candidates;
-    for (const char* ext : {".ktx2", ".dds"})
-      for (const std::string& f : out.sidecar->files)
-        if (LowerExtension(f) == ext) candidates.push_back((folder / f).string());
+    if (kind == FileKind::kSidecar) {
+      out.sidecar = exporter::ReadSidecar(path);
+      const exporter::SidecarInfo& s = *out.sidecar;
+      width = s.width, height = s.height, depth = s.slices;
+      bytes = s.payload_bytes, crc = s.payload_crc32, theta_in_deg = s.theta_in_deg;
+      for (const char* ext : {".ktx2", ".dds"})
+        for (const std::string& f : s.files)
+          if (LowerExtension(f) == ext) candidates.push_back((folder / f).string());
+    } else {
+      out.manifest = exporter::ParseAtlasManifest(ReadFileText(path, kMaxJsonBytes), path);
+      const exporter::AtlasManifest& m = *out.manifest;
+      width = m.texture_width, height = m.texture_height;
+      depth = static_cast<int>(m.theta_in_deg.size());
+      bytes = m.payload_bytes, crc = m.payload_crc32, theta_in_deg = m.theta_in_deg;
+      for (const char* ext : {".ktx2", ".dds"})
+        candidates.push_back((folder / (OutputNameOf(path) + ext)).string());
+    }
     std::error_code ec;
     for (const std::string& c : candidates) {
       if (!fs::is_regular_file(c, ec)) continue;
       out.texture_path = c;
       break;
     }
-    if (out.texture_path.empty())
-      throw IoError(path + ": none of the textures this sidecar lists (" +
-                    (candidates.empty() ? std::string("no .ktx2 or .dds") : [&] {
-                      std::string s;
-                      for (const auto& c : candidates) s += (s.empty() ? "" : ", ") + c;
-                      return s;
-                    }()) +
-                    ") exists");
+    if (out.texture_path.empty()) {
+      std::string list;
+      for (const auto& c : candidates) list += (list.empty() ? "" : ", ") + c;
+      throw IoError(path + ": the texture it describes is missing (looked for " +
+                    (list.empty() ? std::string("a .ktx2 or .dds in its file list") : list) + ")");
+    }
     out.texture = exporter::ReadTextureFile(out.texture_path);
     const exporter::PackedVolume& v = out.texture.volume;
-    const exporter::SidecarInfo& s = *out.sidecar;
-    if (v.width != s.width || v.height != s.height || v.depth != s.slices)
-      throw FormatError(path, "member 'grid'",
-                        "the size of " + out.texture_path + " (" + std::to_string(v.width) + " × " +
-                            std::to_string(v.height) + " × " + std::to_string(v.depth) + ")",
-                        std::to_string(s.width) + " × " + std::to_string(s.height) + " × " +
-                            std::to_string(s.slices));
-    const std::uint32_t crc = v.Crc32();
-    if (s.payload_bytes != v.ByteSize() || s.payload_crc32 != crc) {
-      char got[64], want[64];
+    if (v.width != width || v.height != height || v.depth != depth)
+      throw FormatError(
+          path, "grid",
+          "the size of " + out.texture_path + " (" + std::to_string(v.width) + " × " +
+              std::to_string(v.height) + " × " + std::to_string(v.depth) + ")",
+          std::to_string(width) + " × " + std::to_string(height) + " × " + std::to_string(depth));
+    const std::uint32_t actual = v.Crc32();
+    if (bytes != v.ByteSize() || crc != actual) {
+      char want[64], got[64];
       std::snprintf(want, sizeof want, "%llu bytes, CRC-32 0x%08x",
-                    static_cast<unsigned long long>(s.payload_bytes), s.payload_crc32);
-      std::snprintf(got, sizeof got, "%zu bytes, CRC-32 0x%08x", v.ByteSize(), crc);
+                    static_cast<unsigned long long>(bytes), crc);
+      std::snprintf(got, sizeof got, "%zu bytes, CRC-32 0x%08x", v.ByteSize(), actual);
       throw FormatError(out.texture_path, "payload",
-                        std::string("the payload ") + path + " records (" + want + ")", got,
-                        "the texture and its sidecar do not belong together, or one is damaged");
+                        "the payload " + path + " records (" + want + ")", got,
+                        "the texture and its JSON do not belong together, or one is damaged");
     }
     if (!out.texture.theta_in_from_metadata) {
-      out.texture.theta_in_deg = s.theta_in_deg;
+      out.texture.theta_in_deg = theta_in_deg;
       out.texture.theta_in_from_metadata = true;
-      exporter::FinishLoadedTexture(out.texture);  // decode with the sidecar's θin list
+      exporter::FinishLoadedTexture(out.texture);  // decodes the LUT with this θin list
     }
     out.checksum_verified = true;
     return out;
   }
   if (kind != FileKind::kTexture)
     throw InvalidArgument(path +
-                          ": expected a .ktx2 or .dds texture or a LUT sidecar .json, got a " +
-                          FileKindName(kind));
+                          ": expected a .ktx2 or .dds texture, a LUT sidecar or an atlas "
+                          "manifest, got a " +
+                          std::string(FileKindName(kind)));
   out.texture_path = path;
   out.texture = exporter::ReadTextureFile(path);
   if (!out.texture.sidecar_json.empty()) {
-    out.sidecar =
-        exporter::ParseSidecarJson(out.texture.sidecar_json, path + " (embedded sidecar)");
+    out.sidecar = exporter::ParseSidecarJson(out.texture.sidecar_json, path + " (sidecar)");
     out.checksum_verified = true;  // FinishLoadedTexture compared it
   } else if (!out.texture.atlas_manifest_json.empty()) {
+    out.manifest =
+        exporter::ParseAtlasManifest(out.texture.atlas_manifest_json, path + " (manifest)");
     out.checksum_verified = true;
   } else {
     out.warnings.push_back(path + ": warning: no sidecar recorded or found beside it: θin " +
@@ -364,7 +381,8 @@ std::unique_ptr<BrdfSource> OpenEvalSource(
           p.measurement, p.extrapolation.params, processing::ResampleOptions{}, OutputNameOf(path));
     }
     case FileKind::kTexture:
-    case FileKind::kSidecar: {
+    case FileKind::kSidecar:
+    case FileKind::kAtlasManifest: {
       OpenedTexture t = OpenExportedTexture(path);
       if (warnings) warnings->insert(warnings->end(), t.warnings.begin(), t.warnings.end());
       if (!t.texture.IsSingleLut())

@@ -16,6 +16,7 @@
 #include "brdf/core/lut.h"
 #include "brdf/core/measurement.h"
 #include "brdf/core/models.h"
+#include "brdf/exporter/atlas.h"
 #include "brdf/exporter/sidecar.h"
 #include "brdf/exporter/texture_file.h"
 #include "brdf/processing/extrapolation.h"
@@ -101,21 +102,23 @@ PreparedMeasurement PrepareMeasurement(
     const std::string& path, FileKind kind,
     const std::optional<processing::ExtrapolationParams>& command_line);
 
-// An exported LUT or atlas read back: the texture, and the sidecar that describes it if there
-// is one (given directly, embedded in the KTX2, or found beside a DDS).
+// An exported LUT or atlas read back: the texture, and the sidecar or manifest that describes
+// it if there is one (given directly, embedded in the KTX2, or found beside a DDS).
 struct OpenedTexture {
   exporter::LoadedTexture texture;
   std::string texture_path;
-  std::optional<exporter::SidecarInfo> sidecar;  // for a single LUT
-  std::string sidecar_path;                      // the standalone sidecar read, if any
+  std::optional<exporter::SidecarInfo> sidecar;     // a single LUT's
+  std::optional<exporter::AtlasManifest> manifest;  // an atlas's
+  std::string sidecar_path;  // the standalone sidecar or manifest read, if any
   // The payload CRC-32 was compared with the one the metadata records (the readers throw on a
   // mismatch, so this is false only when there was no metadata to compare with).
   bool checksum_verified = false;
   std::vector<std::string> warnings;
 };
-// `path` is a .ktx2, a .dds or a sidecar .json; a sidecar leads to the texture it lists
-// (the .ktx2 first, else the .dds) in the sidecar's folder, and its recorded size and
-// checksum are checked against that texture. Throws IoError / FormatError.
+// `path` is a .ktx2, a .dds, a sidecar .json or an atlas manifest .json. A sidecar leads to the
+// texture it lists (the .ktx2 first, else the .dds) in its folder, a manifest to PREFIX.ktx2
+// (else PREFIX.dds) beside it; the size and checksum the JSON records are checked against
+// that texture. Throws IoError / FormatError.
 OpenedTexture OpenExportedTexture(const std::string& path);
 
 // An exported LUT sampled exactly as a GPU samples the 3D texture (brdf::Lut::SampleAngles:
