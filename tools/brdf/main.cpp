@@ -56,12 +56,17 @@ int main(int argc, char** argv) {
                    "Material file (.json), capture (.bpc), exported LUT (.ktx2, .dds) or "
                    "LUT sidecar (.json)")
       ->required();
-  eval_cmd->add_option("--in", eval_in, "Light direction THETA,PHI in degrees")
-      ->required()
-      ->check(AnglePairValidator());
-  eval_cmd->add_option("--out", eval_out, "View direction THETA,PHI in degrees")
-      ->required()
-      ->check(AnglePairValidator());
+  auto* eval_in_opt = eval_cmd->add_option("--in", eval_in, "Light direction THETA,PHI in degrees")
+                          ->check(AnglePairValidator());
+  auto* eval_out_opt =
+      eval_cmd->add_option("--out", eval_out, "View direction THETA,PHI in degrees")
+          ->check(AnglePairValidator());
+  auto* eval_pairs_opt = eval_cmd->add_option(
+      "--pairs", eval.pairs,
+      "Instead of --in/--out: a file ('-' for stdin) of lines 'THETA_IN PHI_IN THETA_OUT "
+      "PHI_OUT' in degrees; prints one line per pair");
+  eval_in_opt->needs(eval_out_opt)->excludes(eval_pairs_opt);
+  eval_out_opt->needs(eval_in_opt)->excludes(eval_pairs_opt);
   eval_cmd
       ->add_option("--extrapolate", eval.extrapolate,
                    "Captures: grazing extrapolation P,L (DESIGN §6); default: the "
@@ -71,8 +76,12 @@ int main(int argc, char** argv) {
       "Captures are interpolated as 'brdf convert' resamples them; exported LUTs are sampled "
       "as a GPU samples the 3D texture (centre-exact coordinates, trilinear, clamp-to-edge).\n");
   eval_cmd->callback([&] {
-    ParseAnglePair(eval_in, &eval.theta_in_deg, &eval.phi_in_deg);
-    ParseAnglePair(eval_out, &eval.theta_out_deg, &eval.phi_out_deg);
+    if (eval_in.empty() && eval.pairs.empty())
+      throw CLI::RequiredError("--in and --out (or --pairs)");
+    if (!eval_in.empty()) {
+      ParseAnglePair(eval_in, &eval.theta_in_deg, &eval.phi_in_deg);
+      ParseAnglePair(eval_out, &eval.theta_out_deg, &eval.phi_out_deg);
+    }
     exit_code = brdf::cli::RunEval(eval);
   });
 
