@@ -19,7 +19,7 @@ echo "== capturing the virtual sample library with the simulated scatterometer -
 "$brdf" materials
 for material in $("$brdf" materials --json | /usr/bin/python3 -c 'import json,sys; print(" ".join(m["name"] for m in json.load(sys.stdin)))'); do
   "$brdf" capture --device sim --material "$material" --sample "$material" \
-    --out "$out/captures/$material.bpc" --seed 1
+    --out "$out/captures/$material.bpc" --seed 1 --force
 done
 if "$brdf" convert --help >/dev/null 2>&1; then
   echo "== converting captures to RGB9E5 lookup textures -> $out/luts"

@@ -151,6 +151,10 @@ TEST(BpcPythonReader, AgreesWithTheCppReaderOnIntactCutAndDamagedFiles) {
       fs::temp_directory_path() / ("brdf_bpc_python_" + std::to_string(::getpid()));
   fs::remove_all(dir);
   fs::create_directories(dir);
+  struct Cleanup {
+    fs::path dir;
+    ~Cleanup() { fs::remove_all(dir); }
+  } cleanup{dir};
   const Measurement m = MakeMeasurement();
   const std::string full = EncodeBpc(m);
   std::vector<std::string> files;
@@ -234,7 +238,6 @@ TEST(BpcPythonReader, AgreesWithTheCppReaderOnIntactCutAndDamagedFiles) {
   // The sample of files really exercised both readers' damage paths.
   EXPECT_GT(with_problems, 40);
   EXPECT_GT(fatal, 0);
-  fs::remove_all(dir);
 }
 
 }  // namespace

@@ -632,5 +632,36 @@ TEST(Bpc, ReadingFromDiskMatchesParsingInMemory) {
   EXPECT_EQ(r.measurement.slices.size(), 3u);
 }
 
+TEST(Bpc, AFailedAppendLeavesAValidFileAndCanBeRetried) {
+  TempDir dir("diskfull");
+  const Measurement m = TestMeasurement(2, 3000);
+  const std::string path = dir.File("c.bpc");
+  BpcAppender a = BpcAppender::Create(path, m.metadata);
+  a.AppendSlice(m.slices[0]);
+  const auto good = fs::file_size(path);
+  // "Disk full" half way through slice 1: a file size limit (EFBIG).
+  rlimit old{};
+  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &old), 0);
+  const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
+  rlimit limited = old;
+  limited.rlim_cur = good + SliceChunkBytes(m.slices[1]) / 2;
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &limited), 0);
+  EXPECT_THROW(a.AppendSlice(m.slices[1]), IoError);
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &old), 0);
+  std::signal(SIGXFSZ, old_handler);
+  EXPECT_EQ(fs::file_size(path), good);
+  const BpcReadResult mid = ReadBpc(path);
+  EXPECT_TRUE(mid.problems.empty());
+  EXPECT_EQ(mid.measurement.slices.size(), 1u);
+  EXPECT_EQ(a.slice_count(), 1);
+  a.AppendSlice(m.slices[1]);  // space is back: the retry continues the file cleanly
+  a.Finish(m.metadata);
+  const BpcReadResult r = ReadBpc(path);
+  EXPECT_TRUE(r.problems.empty());
+  EXPECT_TRUE(r.finished);
+  ASSERT_EQ(r.measurement.slices.size(), 2u);
+  ExpectSameSlice(m.slices[1], r.measurement.slices[1]);
+}
+
 }  // namespace
 }  // namespace brdf

@@ -1,6 +1,8 @@
 # Further command sources: target_sources(brdf PRIVATE ...) and their libraries.
+target_sources(brdf PRIVATE brdf/cmd_info.cpp)
+target_sources(brdf PRIVATE brdf/cmd_capture.cpp)
+target_link_libraries(brdf PRIVATE brdf::device)
 target_sources(brdf PRIVATE
-  brdf/cmd_info.cpp
   brdf/cmd_convert.cpp
   brdf/cmd_atlas.cpp
   brdf/batch.cpp

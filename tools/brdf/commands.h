@@ -71,7 +71,12 @@ struct CaptureOptions {
   std::uint64_t seed = 1;
   std::string operator_notes;
   bool resume = false;
+  bool force = false;  // overwrite an existing file instead of refusing
   bool quiet = false;
+  std::string exposure = "auto";  // "auto" (per θout row), "auto-slice", or fixed milliseconds
+  // Faults the simulated instrument injects, for testing the recovery path:
+  // "disconnect:N", "stall:N", "corrupt:N" (N counts the instrument's frames), comma separated.
+  std::string sim_fault;
 };
 int RunCapture(const CaptureOptions& options);
 

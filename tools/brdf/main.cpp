@@ -85,6 +85,66 @@ int main(int argc, char** argv) {
     exit_code = brdf::cli::RunEval(eval);
   });
 
+  // brdf capture
+  brdf::cli::CaptureOptions capture;
+  auto* capture_cmd = app.add_subcommand(
+      "capture",
+      "Capture a sample slice by slice with a scatterometer into a .bpc file (each completed "
+      "slice is saved at once; --resume continues an interrupted capture)");
+  capture_cmd
+      ->add_option("--device", capture.device, "Instrument: sim (the simulated scatterometer)")
+      ->capture_default_str();
+  capture_cmd
+      ->add_option("--material", capture.material,
+                   "Virtual sample: a library name ('brdf materials') or a material .json")
+      ->required();
+  capture_cmd->add_option("--sample", capture.sample, "Sample name recorded in the file")
+      ->required();
+  capture_cmd->add_option("--out", capture.out, "Output .bpc file")->required();
+  capture_cmd
+      ->add_option("--theta-in", capture.theta_in_deg,
+                   "Incidence angles in degrees, comma separated, in capture order")
+      ->delimiter(',')
+      ->capture_default_str();
+  capture_cmd
+      ->add_option("--theta-out-max", capture.theta_out_max_deg,
+                   "Largest detector polar angle, degrees (sim)")
+      ->capture_default_str();
+  capture_cmd
+      ->add_option("--theta-out-step", capture.theta_out_step_deg,
+                   "Detector polar step, degrees (sim)")
+      ->capture_default_str();
+  capture_cmd
+      ->add_option("--phi-out-step", capture.phi_out_step_deg,
+                   "Detector azimuth step, degrees (sim)")
+      ->capture_default_str();
+  capture_cmd
+      ->add_option("--noise", capture.noise,
+                   "Detector noise level: 1 = reference instrument, 0 = ideal detector "
+                   "(noise-free, unsaturated signal)")
+      ->capture_default_str();
+  capture_cmd->add_option("--seed", capture.seed, "Seed of the simulated detector noise")
+      ->capture_default_str();
+  capture_cmd
+      ->add_option("--exposure", capture.exposure,
+                   "Exposure: auto (ranged per θout row), auto-slice, or a fixed time in ms")
+      ->capture_default_str();
+  capture_cmd->add_option("--operator-notes", capture.operator_notes,
+                          "Free text recorded in the file's metadata");
+  auto* resume_flag = capture_cmd->add_flag(
+      "--resume", capture.resume,
+      "Continue an interrupted capture in --out: keep its complete slices, measure the rest");
+  auto* force_flag =
+      capture_cmd->add_flag("--force", capture.force, "Overwrite --out if it already exists");
+  resume_flag->excludes(force_flag);
+  capture_cmd->add_flag("--quiet", capture.quiet, "No progress on stderr");
+  capture_cmd
+      ->add_option("--sim-fault", capture.sim_fault,
+                   "Testing: make the simulated instrument fail: disconnect:N, stall:N or "
+                   "corrupt:N (N = instrument frames sent), comma separated")
+      ->group("Testing");
+  capture_cmd->callback([&] { exit_code = brdf::cli::RunCapture(capture); });
+
   // brdf info
   brdf::cli::InfoOptions info;
   auto* info_cmd = app.add_subcommand(

@@ -694,7 +694,8 @@ BpcAppender::BpcAppender(BpcAppender&& other) noexcept
     : path_(std::move(other.path_)),
       file_(std::exchange(other.file_, nullptr)),
       slice_count_(other.slice_count_),
-      sample_count_(other.sample_count_) {}
+      sample_count_(other.sample_count_),
+      size_(other.size_) {}
 
 BpcAppender& BpcAppender::operator=(BpcAppender&& other) noexcept {
   if (this != &other) {
@@ -703,6 +704,7 @@ BpcAppender& BpcAppender::operator=(BpcAppender&& other) noexcept {
     file_ = std::exchange(other.file_, nullptr);
     slice_count_ = other.slice_count_;
     sample_count_ = other.sample_count_;
+    size_ = other.size_;
   }
   return *this;
 }
@@ -748,6 +750,7 @@ BpcAppender BpcAppender::Resume(const std::string& path, BpcReadResult* existing
   for (int index : r.slice_indices) next_index = std::max(next_index, index + 1);
   BpcAppender appender(path, f, next_index);
   appender.sample_count_ = r.measurement.SampleCount();
+  appender.size_ = r.valid_bytes;
   if (SyncFile(f) != 0) throw IoError(path + ": cannot sync after truncation: " + ErrnoText());
   if (existing != nullptr) *existing = std::move(r);
   return appender;
@@ -755,9 +758,30 @@ BpcAppender BpcAppender::Resume(const std::string& path, BpcReadResult* existing
 
 void BpcAppender::WriteDurably(const std::string& bytes) {
   if (file_ == nullptr) throw Error(path_ + ": capture file already finished or closed");
-  const bool ok =
-      std::fwrite(bytes.data(), 1, bytes.size(), file_) == bytes.size() && SyncFile(file_) == 0;
-  if (!ok) throw IoError(path_ + ": write failed: " + ErrnoText());
+  // Raw writes on the descriptor (no stdio buffer that could hold half a chunk after a failure).
+  const int fd = ::fileno(file_);
+  std::size_t done = 0;
+  bool ok = true;
+  while (done < bytes.size()) {
+    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) {
+      ok = false;
+      break;
+    }
+    done += static_cast<std::size_t>(n);
+  }
+  ok = ok && ::fsync(fd) == 0;
+  if (!ok) {
+    const std::string why = ErrnoText();
+    // Cut the partial chunk off again (disk full, quota, file size limit), so the file stays a
+    // valid prefix and a retry appends cleanly after the last complete chunk.
+    const bool restored = ::ftruncate(fd, static_cast<off_t>(size_)) == 0 &&
+                          ::lseek(fd, static_cast<off_t>(size_), SEEK_SET) >= 0;
+    throw IoError(path_ + ": write failed: " + why +
+                  (restored ? " (the file is left at its last complete chunk)" : ""));
+  }
+  size_ += bytes.size();
 }
 
 void BpcAppender::AppendSlice(const Slice& slice) {

@@ -1,1 +1,9 @@
 # Importers of third-party formats: target_sources(brdf_core PRIVATE ...) added by that part.
+target_sources(brdf_core PRIVATE
+  src/core/readers/text_util.cpp
+  src/core/readers/zemax.cpp
+  src/core/readers/lighttools.cpp
+  src/core/readers/csv.cpp
+  src/core/readers/gonio.cpp
+  src/core/readers/importers.cpp
+)

@@ -104,7 +104,8 @@ class BpcAppender {
   ~BpcAppender();
 
   // Writes one slice chunk (index = number of slices already in the file). Throws IoError,
-  // or Error if the appender is finished.
+  // or Error if the appender is finished. After a failed write (disk full) the file is cut back
+  // to its last complete chunk, so it stays valid and the call may be retried.
   void AppendSlice(const Slice& slice);
   // Writes the end chunk (capture end time and any final metadata) and closes the file.
   void Finish(const Metadata& final_metadata);
@@ -122,6 +123,7 @@ class BpcAppender {
   std::FILE* file_ = nullptr;
   int slice_count_ = 0;
   std::uint64_t sample_count_ = 0;
+  std::uint64_t size_ = 0;  // bytes durably written: the file ends on this chunk boundary
 };
 
 }  // namespace brdf

@@ -1,0 +1,151 @@
+// The host side of the scatterometer: drives an instrument over a Transport and turns its raw
+// detector counts into calibrated f_r.
+//
+// A capture runs identify → dark → white reference at every θin → one slice per θin
+// (Capture() below does all of it). Calibration follows a real lab's: for channel c,
+//   f_r = (C_s − D)/t_s ÷ ((C_w − D)/t_w) · ρ_w/π
+// with C_s the sample's reading at exposure t_s, C_w the white panel's reading at the same θin
+// and exposure t_w, D the dark reading, and ρ_w the panel's certificate reflectance
+// (white_reference.h). The panel is Lambertian, so its radiance ρ_w/π · cosθi carries the same
+// cosθi as the sample's f_r · cosθi and the ratio is f_r itself, never multiplied by cosθ.
+//
+// Each sample's sigma is the one-standard-deviation uncertainty from the detector noise of
+// the three readings (sample, white, dark), propagated to first order with the noise model the
+// instrument reports (read noise measured from the dark frames, shot noise from IDENTIFY). It
+// does not include the certificate's uncertainty of ρ_w, which scales a whole capture and is
+// recorded in the metadata instead. Values are not clamped: a sample under the noise floor may
+// be slightly negative, and is flagged.
+//
+// Flags: kFlagSaturated where the instrument reports that a frame of the reading clipped at
+// full scale; kFlagBelowNoiseFloor where the signal above dark, C_s − D, is below
+// noise_floor_sigmas × the read noise of a reading (σ_read/√frames) in any channel.
+//
+// Faults (timeout, disconnect, a damaged or lost frame, an unexpected reply) throw
+// brdf::DeviceError. Capture() hands every completed slice to its callback before it returns
+// or throws, so an interrupted capture loses only the slice in progress.
+#pragma once
+
+#include <array>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "brdf/core/measurement.h"
+#include "brdf/device/protocol.h"
+#include "brdf/device/transport.h"
+#include "brdf/device/white_reference.h"
+
+namespace brdf::device {
+
+// Largest slice the driver accepts from an instrument (a slice is held in memory while it
+// streams): 2^22 samples, room for 0.1° steps over the whole hemisphere.
+inline constexpr std::size_t kMaxSamplesPerSlice = std::size_t{1} << 22;
+
+struct InstrumentInfo {
+  IdentityInfo identity;
+  GeometryInfo geometry;
+};
+
+struct DarkCalibration {
+  std::array<double, 3> mean_counts{};
+  std::array<double, 3> read_noise_counts{};  // σ of one frame
+  int frames = 0;
+  std::string time;  // ISO 8601 UTC
+};
+
+struct WhiteCalibration {
+  double theta_in_deg = 0;
+  double exposure_ms = 0;
+  std::array<double, 3> counts{};  // dark not subtracted
+  int frames = 0;
+  std::string time;  // ISO 8601 UTC
+};
+
+struct SliceReport {
+  double theta_in_deg = 0;
+  std::size_t samples = 0;
+  std::size_t saturated = 0;
+  std::size_t below_noise_floor = 0;
+  double seconds = 0;  // wall-clock time of the slice
+};
+
+struct DriverOptions {
+  // Longest wait for a byte once a reply or stream frame is due. Real instruments need the
+  // longest exposure (2 s) plus readout; the loopback answers at once.
+  int timeout_ms = 5000;
+  double noise_floor_sigmas = 3.0;
+  WhiteReference white = SpectralonWhiteReference();
+};
+
+class Driver {
+ public:
+  // `transport` must outlive the driver.
+  explicit Driver(Transport& transport, DriverOptions options = {});
+
+  // IDENTIFY and GET_GEOMETRY. Throws DeviceError for an instrument speaking another major
+  // protocol version.
+  const InstrumentInfo& Connect();
+  const InstrumentInfo& info() const { return info_; }
+
+  // Exposure policy for the following slices (the white reference always auto-ranges).
+  void SetExposure(const ExposureSetting& setting);
+  // Shutter closed: the dark signal and the read noise per channel.
+  const DarkCalibration& MeasureDark();
+  // White reference in place at incidence θin (one of the instrument's θin).
+  const WhiteCalibration& MeasureWhite(double theta_in_deg);
+  // Streams one slice and calibrates it. Needs Connect, MeasureDark and MeasureWhite(θin)
+  // first (InvalidArgument otherwise, and for a θin the instrument does not offer).
+  Slice MeasureSlice(double theta_in_deg, SliceReport* report = nullptr);
+  // Stops a slice stream and waits for the acknowledgement.
+  void Abort();
+
+  // Instrument and calibration fields of the metadata (model, serial, firmware and protocol
+  // versions, calibration reference and time, software version, and the raw calibration
+  // readings under `extra`).
+  Metadata CalibrationMetadata() const;
+
+ private:
+  void Send(MessageType type, const std::vector<std::uint8_t>& payload);
+  Frame NextFrame(std::string_view waiting_for);
+  Frame Expect(MessageType request, MessageType reply);
+  [[noreturn]] void ThrowInstrumentError(const Frame& frame, MessageType request) const;
+  const WhiteCalibration* FindWhite(double theta_in_deg) const;
+
+  Transport& transport_;
+  DriverOptions options_;
+  FrameReader reader_;
+  std::uint8_t host_sequence_ = 0;
+  bool have_device_sequence_ = false;
+  std::uint8_t device_sequence_ = 0;
+  std::string last_damage_;  // first damaged frame since the last good one, to explain a loss
+  bool connected_ = false;
+  InstrumentInfo info_;
+  ExposureSetting exposure_;
+  bool have_dark_ = false;
+  DarkCalibration dark_;
+  std::vector<WhiteCalibration> whites_;
+};
+
+struct CapturePlan {
+  std::vector<double> theta_in_deg;  // slices to capture, in this order
+  ExposureSetting exposure;
+  // Sample name, operator notes and anything in `extra` are copied into the metadata; the
+  // driver fills the instrument, calibration and time fields.
+  Metadata metadata;
+};
+
+struct CaptureCallbacks {
+  // Once, after the calibration and before the first slice: the metadata a file header carries
+  // (capture_end still empty).
+  std::function<void(const Metadata&)> on_calibrated;
+  // As each slice completes, in capture order.
+  std::function<void(const Slice&, const SliceReport&)> on_slice;
+};
+
+// The whole capture: Connect, SetExposure, MeasureDark, MeasureWhite for every θin of the plan,
+// then MeasureSlice for each. Returns the final metadata (capture_end set). Throws DeviceError
+// on a fault, after every completed slice went to on_slice; InvalidArgument for a plan the
+// instrument cannot do (checked before anything is measured).
+Metadata Capture(Driver& driver, const CapturePlan& plan, const CaptureCallbacks& callbacks);
+
+}  // namespace brdf::device

@@ -1,0 +1,172 @@
+// The simulated scatterometer: firmware that measures a virtual sample and speaks the real
+// wire protocol (protocol.h) behind a transport.
+//
+// The simulator is the instrument, not a shortcut around it: the host driver talks to it
+// through LoopbackTransport exactly as it would talk to hardware, and receives raw detector
+// counts that it must calibrate itself. The virtual sample is any brdf::BrdfSource (an
+// analytic material now, measured databases later).
+//
+// Detector model, per channel c, for one ADC frame of exposure t (ms):
+//   counts = t · R_c · L_c + D_c + shot noise + read noise, clipped to [0, full scale]
+//   L_c = f_r,c(ωi, ωo) · cosθi        (radiance of the sample under unit irradiance)
+//   shot noise: Gaussian, variance g · (t · R_c · L_c)   (g: conversion gain, counts/electron)
+//   read noise: Gaussian, standard deviation σ_read
+// R_c is the channel's responsivity and D_c its dark signal (bias). A reading is the mean of
+// frames_per_reading frames, sent as float32, so it is not quantised to whole counts.
+//
+// The noise level s scales every detector imperfection: shot and read noise by s and the
+// dark signal by s. s = 1 is the reference instrument; s = 0 is an ideal detector with no
+// noise, no dark signal and no clipping, whose readings are exactly t · R_c · L_c in float32
+// (the noise-free, unsaturated signal tests compare with the analytic truth). The dark signal
+// is scaled too because a float32 reading of D_c + (a tiny signal) cannot hold the tiny signal
+// to float precision; an ideal detector has no bias.
+//
+// Exposure is auto-ranged per θout row (default): the firmware finds the row's brightest
+// sample with a probe exposure (simulated as the noise-free maximum of the row) and sets t so
+// it reaches `autorange_target_fraction` of the range above dark, within
+// [min_exposure_ms, max_exposure_ms]. The white reference is always ranged this way. A peak too
+// bright even at the shortest exposure clips, and the sample carries clip bits per channel. Noise
+// is drawn from a seeded generator restarted for every measurement from (seed, what is measured,
+// θin), so a slice is reproduced exactly whatever was measured before it (a resumed capture matches
+// an uninterrupted one).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <random>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "brdf/core/brdf_source.h"
+#include "brdf/device/protocol.h"
+
+namespace brdf::device {
+
+// Constants of one instrument model: geometry and detector. Table data (InstrumentModels()),
+// so a new model is a new row, not new code.
+struct InstrumentModel {
+  std::string model;                // reported by IDENTIFY
+  std::string firmware_version;     // reported by IDENTIFY
+  std::vector<float> theta_in_deg;  // incidence angles the light arm can be set to
+  float theta_out_max_deg = 75;
+  float theta_out_step_deg = 1;
+  float phi_out_step_deg = 1;
+
+  double adc_full_scale_counts = 65535;            // one frame clips here
+  int frames_per_reading = 16;                     // frames averaged per sample
+  int dark_frames = 64;                            // frames averaged by MEASURE_DARK
+  int white_frames = 64;                           // frames averaged by MEASURE_WHITE
+  std::array<double, 3> dark_offset_counts{};      // D_c at noise level 1
+  double read_noise_counts = 0;                    // σ_read per frame at noise level 1
+  double conversion_gain_counts_per_electron = 0;  // g
+  // R_c: counts per ms per unit radiance (f_r · cosθi under unit irradiance).
+  std::array<double, 3> responsivity_counts_per_ms{};
+  double min_exposure_ms = 1;
+  double max_exposure_ms = 2000;
+  double autorange_target_fraction = 0.8;  // of (full scale − dark)
+};
+
+// Every known model; the first is the reference instrument of DESIGN §1 (MiniDiff V2 class:
+// θin ∈ {0, 20, 40, 60}°, θout 0–75°, φout 0–359° at 1°).
+std::span<const InstrumentModel> InstrumentModels();
+const InstrumentModel& ReferenceInstrument();
+// Throws InvalidArgument listing the known names.
+const InstrumentModel& FindInstrumentModel(std::string_view model);
+
+// Faults to inject, for tests of the host's error handling. Frames are counted from 1 in the
+// order the firmware sends them; 0 disables a fault.
+struct FaultPlan {
+  std::uint64_t disconnect_after_frames = 0;  // the link drops after this many frames
+  std::uint64_t stall_after_frames = 0;       // the firmware stops answering after this many
+  std::uint64_t corrupt_frame = 0;            // this frame is sent with one payload bit flipped
+};
+
+struct SimulatorConfig {
+  InstrumentModel model = ReferenceInstrument();  // copy: adjust the geometry freely
+  std::string serial = "SIM-000001";
+  std::shared_ptr<const BrdfSource> sample;  // the virtual sample under the head (required)
+  // The white reference panel MEASURE_WHITE sees; null means a Lambertian with the
+  // Spectralon reflectance of white_reference.h (the panel the host calibrates against).
+  std::shared_ptr<const BrdfSource> white_reference;
+  double noise_level = 1.0;  // s above: 1 = reference instrument, 0 = ideal detector
+  std::uint64_t seed = 1;
+  FaultPlan faults;
+};
+
+// One raw reading that clipped, for tests only: real firmware reports clipping through the
+// clip bits of its messages and nothing else.
+struct ClipRecord {
+  float theta_in_deg = 0;
+  // θout row and φout column of the sample; 0xFFFF for both in a white reference reading.
+  std::uint16_t row = 0, column = 0;
+  std::uint8_t channels = 0;  // bit c: channel c clipped
+};
+
+class SimulatedFirmware {
+ public:
+  // Throws InvalidArgument for an unusable configuration (no sample, bad geometry, negative
+  // noise level).
+  explicit SimulatedFirmware(SimulatorConfig config);
+
+  // Bytes arriving from the host. Throws DeviceError once the link is down.
+  void Receive(std::span<const std::uint8_t> bytes);
+  // Copies up to out.size() bytes waiting to go to the host into `out`, producing the next
+  // frame of a slice stream when nothing else is waiting. Returns 0 when the firmware has
+  // nothing to say (idle, stalled, or the link is down).
+  std::size_t Transmit(std::span<std::uint8_t> out);
+
+  bool link_up() const { return link_up_; }
+  std::uint64_t frames_sent() const { return frames_sent_; }
+  const GeometryInfo& geometry() const { return geometry_; }
+  const SimulatorConfig& config() const { return config_; }
+  const std::vector<ClipRecord>& clip_log() const { return clip_log_; }
+
+ private:
+  struct Reading {
+    std::array<float, 3> counts{};
+    std::uint8_t clipped = 0;
+  };
+
+  void Handle(const Frame& frame);
+  void Send(MessageType type, const std::vector<std::uint8_t>& payload);
+  void SendError(ErrorCode code, std::uint8_t request_type, const std::string& message);
+  bool FindThetaIn(float theta_in_deg) const;
+  void StartSlice(float theta_in_deg);
+  void ProduceStreamFrame();
+  void PrepareRow(std::size_t row);
+  // Radiance L_c of the sample seen from (row, column) under the slice's light.
+  std::array<double, 3> RowRates(std::size_t row, std::vector<std::array<double, 3>>* rates) const;
+  float AutoExposure(double brightest_rate) const;
+  Reading Read(const std::array<double, 3>& rate, float exposure_ms, int frames);
+  void Reseed(std::uint64_t what, float theta_in_deg);
+
+  SimulatorConfig config_;
+  GeometryInfo geometry_;
+  std::shared_ptr<const BrdfSource> white_;
+  FrameReader input_;
+  std::vector<std::uint8_t> output_;  // bytes waiting for the host, from output_start_ on
+  std::size_t output_start_ = 0;
+  std::uint64_t frames_sent_ = 0;
+  std::uint8_t sequence_ = 0;
+  bool link_up_ = true;
+  bool stalled_ = false;
+  ExposureSetting exposure_;
+  std::mt19937_64 rng_;
+  std::normal_distribution<double> normal_;
+  std::vector<ClipRecord> clip_log_;
+
+  // The slice being streamed.
+  bool streaming_ = false;
+  float slice_theta_in_deg_ = 0;
+  Vec3 light_{};
+  float slice_exposure_ms_ = 0;  // kAutoPerSlice / kFixed
+  std::size_t next_row_ = 0, next_column_ = 0;
+  std::vector<Reading> row_readings_;
+  float row_exposure_ms_ = 0;
+  std::uint32_t slice_samples_ = 0, slice_clipped_ = 0;
+};
+
+}  // namespace brdf::device

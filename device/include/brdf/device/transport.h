@@ -1,0 +1,54 @@
+// Transports move bytes between the host and an instrument; they know nothing of frames.
+//
+// The driver (driver.h) speaks the protocol of protocol.h over any Transport. Real instruments
+// connect over USB bulk endpoints (libusb) or USB HID reports (hidapi); the simulated
+// instrument connects in-process through LoopbackTransport. A transport that carries fixed-size
+// reports (HID: 64 bytes) packs the byte stream into them itself: the protocol finds frames
+// in any chunking, so nothing above the transport depends on report sizes.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <span>
+#include <string>
+
+namespace brdf::device {
+
+class SimulatedFirmware;
+
+class Transport {
+ public:
+  virtual ~Transport() = default;
+
+  // Sends all of `bytes`. Throws brdf::DeviceError when the link is gone.
+  virtual void Write(std::span<const std::uint8_t> bytes) = 0;
+
+  // Receives between 1 and buffer.size() bytes into `buffer`, waiting at most `timeout_ms`
+  // for the first one; returns 0 when nothing arrived in that time (the caller decides
+  // whether that is a timeout). Throws brdf::DeviceError when the link is gone.
+  virtual std::size_t Read(std::span<std::uint8_t> buffer, int timeout_ms) = 0;
+
+  // Says what the transport is connected to, for messages: "loopback to SIM-000001".
+  virtual std::string Description() const = 0;
+};
+
+// Connects the host to a SimulatedFirmware in the same process and thread: Write hands the
+// bytes to the firmware, Read pulls the bytes the firmware has to send (it produces streamed
+// frames on demand, so a slice is never buffered whole). Runs on virtual time: when the
+// firmware has nothing to send, Read returns 0 at once, exactly what a real transport returns
+// after waiting `timeout_ms`. A fault injected into the firmware (FaultPlan) shows here as a
+// DeviceError (disconnect) or as Read returning 0 (stall).
+class LoopbackTransport final : public Transport {
+ public:
+  // `firmware` must outlive the transport.
+  explicit LoopbackTransport(SimulatedFirmware& firmware) : firmware_(firmware) {}
+
+  void Write(std::span<const std::uint8_t> bytes) override;
+  std::size_t Read(std::span<std::uint8_t> buffer, int timeout_ms) override;
+  std::string Description() const override;
+
+ private:
+  SimulatedFirmware& firmware_;
+};
+
+}  // namespace brdf::device

@@ -1,0 +1,367 @@
+#include "brdf/device/driver.h"
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "brdf/core/error.h"
+#include "brdf/core/geometry.h"
+
+namespace brdf::device {
+namespace {
+
+constexpr double kThetaMatchDeg = 1e-4;
+
+std::string Fmt(const char* format, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, format, v);
+  return buf;
+}
+
+std::string Triple(const std::array<double, 3>& v, const char* format = "%.9g") {
+  return Fmt(format, v[0]) + " " + Fmt(format, v[1]) + " " + Fmt(format, v[2]);
+}
+
+std::string AngleText(double deg) { return Fmt("%g", deg); }
+
+}  // namespace
+
+Driver::Driver(Transport& transport, DriverOptions options)
+    : transport_(transport), options_(std::move(options)) {}
+
+void Driver::Send(MessageType type, const std::vector<std::uint8_t>& payload) {
+  std::vector<std::uint8_t> bytes;
+  AppendFrame(bytes, static_cast<std::uint8_t>(type), host_sequence_++, payload);
+  transport_.Write(bytes);
+}
+
+Frame Driver::NextFrame(std::string_view waiting_for) {
+  std::array<std::uint8_t, 4096> buffer{};
+  for (;;) {
+    DecodeResult r = reader_.Next();
+    if (r.status == DecodeStatus::kComplete) {
+      const std::uint8_t expected = static_cast<std::uint8_t>(device_sequence_ + 1);
+      if (have_device_sequence_ && r.frame.sequence != expected)
+        throw DeviceError(transport_.Description() + ": frame lost while waiting for " +
+                          std::string(waiting_for) + ": expected sequence " +
+                          std::to_string(expected) + ", got " + std::to_string(r.frame.sequence) +
+                          (last_damage_.empty() ? "" : " (damaged frame: " + last_damage_ + ")"));
+      have_device_sequence_ = true;
+      device_sequence_ = r.frame.sequence;
+      last_damage_.clear();
+      return std::move(r.frame);
+    }
+    if (r.status == DecodeStatus::kInvalid) {
+      // Noise between frames is skipped; a damaged frame is remembered: if it was a real frame
+      // the next sequence number jumps and the loss is reported with this reason. The first
+      // damage after the last good frame is kept: what follows it is usually the damaged
+      // frame's own payload being searched for a frame start.
+      if (r.corrupt && last_damage_.empty()) last_damage_ = r.reason;
+      continue;
+    }
+    const std::size_t n = transport_.Read(buffer, options_.timeout_ms);
+    if (n == 0)
+      throw DeviceError(transport_.Description() + ": timeout: no answer within " +
+                        std::to_string(options_.timeout_ms) + " ms while waiting for " +
+                        std::string(waiting_for) +
+                        (last_damage_.empty() ? "" : " (damaged frame: " + last_damage_ + ")"));
+    reader_.Append(std::span<const std::uint8_t>(buffer.data(), n));
+  }
+}
+
+void Driver::ThrowInstrumentError(const Frame& frame, MessageType request) const {
+  const std::string request_name = MessageTypeName(static_cast<std::uint8_t>(request));
+  if (frame.type == static_cast<std::uint8_t>(MessageType::kError)) {
+    const ErrorReply e = DecodeError(frame.payload);
+    throw DeviceError(transport_.Description() + ": the instrument refused " + request_name + ": " +
+                      e.message + " (error code " + std::to_string(static_cast<int>(e.code)) + ")");
+  }
+  throw DeviceError(transport_.Description() + ": unexpected " + MessageTypeName(frame.type) +
+                    " in answer to " + request_name);
+}
+
+Frame Driver::Expect(MessageType request, MessageType reply) {
+  Frame f = NextFrame(MessageTypeName(static_cast<std::uint8_t>(reply)));
+  if (f.type != static_cast<std::uint8_t>(reply)) ThrowInstrumentError(f, request);
+  return f;
+}
+
+const InstrumentInfo& Driver::Connect() {
+  Send(MessageType::kIdentify, {});
+  info_.identity = DecodeIdentity(Expect(MessageType::kIdentify, MessageType::kIdentity).payload);
+  if (info_.identity.protocol_major != kProtocolMajor)
+    throw DeviceError(transport_.Description() + ": instrument speaks protocol " +
+                      std::to_string(info_.identity.protocol_major) + "." +
+                      std::to_string(info_.identity.protocol_minor) + ", this driver " +
+                      std::to_string(kProtocolMajor) + ".x (update the toolchain or firmware)");
+  Send(MessageType::kGetGeometry, {});
+  info_.geometry =
+      DecodeGeometry(Expect(MessageType::kGetGeometry, MessageType::kGeometry).payload);
+  const std::size_t per_slice = std::size_t{info_.geometry.rows} * info_.geometry.columns;
+  if (per_slice == 0 || per_slice > kMaxSamplesPerSlice)
+    throw DeviceError(transport_.Description() + ": geometry of " +
+                      std::to_string(info_.geometry.rows) + " × " +
+                      std::to_string(info_.geometry.columns) +
+                      " samples per slice is outside 1 … " + std::to_string(kMaxSamplesPerSlice));
+  connected_ = true;
+  have_dark_ = false;
+  whites_.clear();
+  return info_;
+}
+
+void Driver::SetExposure(const ExposureSetting& setting) {
+  Send(MessageType::kSetExposure, EncodeExposure(setting));
+  const std::uint8_t acked =
+      DecodeAck(Expect(MessageType::kSetExposure, MessageType::kAck).payload);
+  if (acked != static_cast<std::uint8_t>(MessageType::kSetExposure))
+    throw DeviceError(transport_.Description() + ": SET_EXPOSURE acknowledged as " +
+                      MessageTypeName(acked));
+  exposure_ = setting;
+}
+
+const DarkCalibration& Driver::MeasureDark() {
+  Send(MessageType::kMeasureDark, {});
+  const DarkReading d = DecodeDark(Expect(MessageType::kMeasureDark, MessageType::kDark).payload);
+  for (int c = 0; c < 3; ++c) {
+    dark_.mean_counts[c] = d.mean_counts[c];
+    dark_.read_noise_counts[c] = d.read_noise_counts[c];
+  }
+  dark_.frames = d.frames;
+  dark_.time = UtcNowIso8601();
+  have_dark_ = true;
+  return dark_;
+}
+
+const WhiteCalibration* Driver::FindWhite(double theta_in_deg) const {
+  for (const WhiteCalibration& w : whites_)
+    if (std::fabs(w.theta_in_deg - theta_in_deg) <= kThetaMatchDeg) return &w;
+  return nullptr;
+}
+
+const WhiteCalibration& Driver::MeasureWhite(double theta_in_deg) {
+  if (!have_dark_) throw InvalidArgument("MeasureWhite: measure the dark signal first");
+  Send(MessageType::kMeasureWhite, EncodeThetaIn(static_cast<float>(theta_in_deg)));
+  const WhiteReading r =
+      DecodeWhite(Expect(MessageType::kMeasureWhite, MessageType::kWhite).payload);
+  if (r.clipped_channels != 0)
+    throw DeviceError(transport_.Description() + ": white reference at θin " +
+                      AngleText(theta_in_deg) + "° saturated (clip bits " +
+                      std::to_string(r.clipped_channels) + "); cannot calibrate");
+  WhiteCalibration w;
+  w.theta_in_deg = r.theta_in_deg;
+  w.exposure_ms = r.exposure_ms;
+  for (int c = 0; c < 3; ++c) {
+    w.counts[c] = r.counts[c];
+    if (!(w.counts[c] - dark_.mean_counts[c] > 0))
+      throw DeviceError(transport_.Description() + ": white reference at θin " +
+                        AngleText(theta_in_deg) + "° gives no signal above dark in channel " +
+                        std::to_string(c) + " (" + Fmt("%g", w.counts[c]) + " counts, dark " +
+                        Fmt("%g", dark_.mean_counts[c]) + "); is the panel in place?");
+  }
+  w.frames = r.frames;
+  w.time = UtcNowIso8601();
+  std::erase_if(whites_, [&](const WhiteCalibration& old) {
+    return std::fabs(old.theta_in_deg - w.theta_in_deg) <= kThetaMatchDeg;
+  });
+  whites_.push_back(std::move(w));
+  return *FindWhite(r.theta_in_deg);
+}
+
+Slice Driver::MeasureSlice(double theta_in_deg, SliceReport* report) {
+  const auto start = std::chrono::steady_clock::now();
+  if (!connected_) throw InvalidArgument("MeasureSlice: connect to the instrument first");
+  if (!have_dark_) throw InvalidArgument("MeasureSlice: measure the dark signal first");
+  const WhiteCalibration* white = FindWhite(theta_in_deg);
+  if (white == nullptr)
+    throw InvalidArgument("MeasureSlice: measure the white reference at θin " +
+                          AngleText(theta_in_deg) + "° first");
+  const GeometryInfo& g = info_.geometry;
+
+  Send(MessageType::kMeasureSlice, EncodeThetaIn(static_cast<float>(theta_in_deg)));
+  const SliceBegin begin =
+      DecodeSliceBegin(Expect(MessageType::kMeasureSlice, MessageType::kSliceBegin).payload);
+  if (begin.rows != g.rows || begin.columns != g.columns)
+    throw DeviceError(transport_.Description() + ": slice of " + std::to_string(begin.rows) +
+                      " × " + std::to_string(begin.columns) + " samples announced, geometry says " +
+                      std::to_string(g.rows) + " × " + std::to_string(g.columns));
+
+  // Per-channel constants of the calibration (see the header for the formula).
+  const double frames = info_.identity.frames_per_reading;
+  const double shot = info_.identity.shot_variance_per_count;
+  std::array<double, 3> w_signal{}, var_w{}, var_dark{}, read_var{}, floor{}, scale{};
+  for (int c = 0; c < 3; ++c) {
+    const double sr = dark_.read_noise_counts[c];
+    read_var[c] = sr * sr;
+    w_signal[c] = white->counts[c] - dark_.mean_counts[c];
+    var_w[c] = (read_var[c] + shot * w_signal[c]) / white->frames;
+    var_dark[c] = read_var[c] / dark_.frames;
+    floor[c] = options_.noise_floor_sigmas * sr / std::sqrt(frames);
+    scale[c] = options_.white.rho[c] * kInvPi * white->exposure_ms / w_signal[c];
+  }
+
+  Slice slice;
+  slice.theta_in_deg = begin.theta_in_deg;
+  slice.phi_in_deg = 0;
+  slice.has_sigma = true;
+  slice.complete = true;
+  const std::size_t total = static_cast<std::size_t>(g.rows) * g.columns;
+  slice.samples.resize(total);
+  SliceReport rep;
+  rep.theta_in_deg = slice.theta_in_deg;
+
+  std::size_t next_row = 0, next_column = 0, received = 0;
+  for (;;) {
+    const Frame f = NextFrame("ROW_DATA");
+    if (f.type == static_cast<std::uint8_t>(MessageType::kSliceEnd)) {
+      const SliceEnd end = DecodeSliceEnd(f.payload);
+      if (received != total || end.samples != total)
+        throw DeviceError(transport_.Description() + ": slice θin " + AngleText(theta_in_deg) +
+                          "° ended after " + std::to_string(received) + " of " +
+                          std::to_string(total) + " samples");
+      break;
+    }
+    if (f.type != static_cast<std::uint8_t>(MessageType::kRowData))
+      ThrowInstrumentError(f, MessageType::kMeasureSlice);
+    const RowData row = DecodeRowData(f.payload);
+    if (row.row != next_row || row.first_column != next_column ||
+        next_column + row.samples.size() > g.columns || row.samples.empty())
+      throw DeviceError(transport_.Description() + ": ROW_DATA out of order: expected row " +
+                        std::to_string(next_row) + " column " + std::to_string(next_column) +
+                        ", got row " + std::to_string(row.row) + " columns " +
+                        std::to_string(row.first_column) + "+" +
+                        std::to_string(row.samples.size()));
+    if (!(row.exposure_ms > 0))
+      throw DeviceError(transport_.Description() + ": ROW_DATA with exposure " +
+                        Fmt("%g", row.exposure_ms) + " ms");
+    const float theta_out = g.ThetaOutDeg(row.row);
+    const double t_s = row.exposure_ms;
+    for (std::size_t i = 0; i < row.samples.size(); ++i) {
+      const std::size_t column = row.first_column + i;
+      const RowSample& rs = row.samples[i];
+      Sample& s = slice.samples[static_cast<std::size_t>(row.row) * g.columns + column];
+      s.theta_in_deg = begin.theta_in_deg;
+      s.phi_in_deg = 0;
+      s.theta_out_deg = theta_out;
+      s.phi_out_deg = g.PhiOutDeg(column);
+      bool below = false;
+      for (int c = 0; c < 3; ++c) {
+        const double signal = rs.counts[c] - dark_.mean_counts[c];
+        const double gain = scale[c] / t_s;  // f = gain · signal
+        const double ratio = signal / w_signal[c];
+        const double var_s = (read_var[c] + shot * std::max(0.0, signal)) / frames;
+        const double var_f =
+            gain * gain *
+            (var_s + ratio * ratio * var_w[c] + (ratio - 1) * (ratio - 1) * var_dark[c]);
+        s.rgb[c] = static_cast<float>(gain * signal);
+        s.sigma[c] = static_cast<float>(std::sqrt(var_f));
+        if (signal < floor[c]) below = true;
+      }
+      s.flags = 0;
+      if (rs.clipped_channels != 0) {
+        s.flags |= kFlagSaturated;
+        ++rep.saturated;
+      }
+      if (below) {
+        s.flags |= kFlagBelowNoiseFloor;
+        ++rep.below_noise_floor;
+      }
+    }
+    received += row.samples.size();
+    next_column += row.samples.size();
+    if (next_column == g.columns) {
+      next_column = 0;
+      ++next_row;
+    }
+  }
+  rep.samples = slice.samples.size();
+  rep.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  if (report) *report = rep;
+  return slice;
+}
+
+void Driver::Abort() {
+  Send(MessageType::kAbort, {});
+  for (;;) {
+    const Frame f = NextFrame("ACK of ABORT");
+    const auto type = static_cast<MessageType>(f.type);
+    if (type == MessageType::kRowData || type == MessageType::kSliceEnd ||
+        type == MessageType::kSliceBegin)
+      continue;  // the rest of the stream that was already on its way
+    if (type != MessageType::kAck) ThrowInstrumentError(f, MessageType::kAbort);
+    return;
+  }
+}
+
+Metadata Driver::CalibrationMetadata() const {
+  Metadata m;
+  const IdentityInfo& id = info_.identity;
+  m.instrument_model = id.model;
+  m.instrument_serial = id.serial;
+  m.firmware_version = id.firmware_version;
+  m.protocol_version = std::to_string(id.protocol_major) + "." + std::to_string(id.protocol_minor);
+  const WhiteReference& w = options_.white;
+  m.calibration_reference = std::string(w.name) + "; rho RGB " + Triple(w.rho, "%.6f") + " ± " +
+                            Triple(w.rho_uncertainty, "%.4f") + " (" + std::string(w.provenance) +
+                            ")";
+  m.calibration_time = whites_.empty() ? dark_.time : whites_.front().time;
+  m.software_version = SoftwareVersion();
+  m.extra["exposure_mode"] = std::string(ExposureModeName(exposure_.mode));
+  if (exposure_.mode == ExposureMode::kFixed)
+    m.extra["exposure_ms"] = Fmt("%.9g", exposure_.exposure_ms);
+  m.extra["frames_per_reading"] = std::to_string(id.frames_per_reading);
+  m.extra["adc_full_scale_counts"] = Fmt("%.9g", id.adc_full_scale_counts);
+  if (have_dark_) {
+    m.extra["dark_counts"] = Triple(dark_.mean_counts);
+    m.extra["read_noise_counts"] = Triple(dark_.read_noise_counts);
+    m.extra["dark_time"] = dark_.time;
+  }
+  for (const WhiteCalibration& wc : whites_) {
+    const std::string key = "white_theta_in_" + AngleText(wc.theta_in_deg);
+    m.extra[key + "_counts"] = Triple(wc.counts);
+    m.extra[key + "_exposure_ms"] = Fmt("%.9g", wc.exposure_ms);
+  }
+  return m;
+}
+
+Metadata Capture(Driver& driver, const CapturePlan& plan, const CaptureCallbacks& callbacks) {
+  const std::string start = UtcNowIso8601();
+  const InstrumentInfo& info = driver.Connect();
+  if (plan.theta_in_deg.empty()) throw InvalidArgument("capture plan has no incidence angle");
+  for (std::size_t i = 0; i < plan.theta_in_deg.size(); ++i) {
+    const double t = plan.theta_in_deg[i];
+    bool offered = false;
+    std::string list;
+    for (float a : info.geometry.theta_in_deg) {
+      offered = offered || std::fabs(a - t) <= kThetaMatchDeg;
+      list += (list.empty() ? "" : ", ") + AngleText(a);
+    }
+    if (!offered)
+      throw InvalidArgument("θin " + AngleText(t) + "° is not offered by " + info.identity.model +
+                            " (it measures θin = " + list + "°)");
+    for (std::size_t j = 0; j < i; ++j)
+      if (std::fabs(plan.theta_in_deg[j] - t) <= kThetaMatchDeg)
+        throw InvalidArgument("θin " + AngleText(t) + "° is listed twice");
+  }
+  driver.SetExposure(plan.exposure);
+  driver.MeasureDark();
+  for (double t : plan.theta_in_deg) driver.MeasureWhite(t);
+
+  auto merge = [&](Metadata m) {
+    m.sample_name = plan.metadata.sample_name;
+    m.operator_notes = plan.metadata.operator_notes;
+    for (const auto& [key, value] : plan.metadata.extra) m.extra[key] = value;
+    m.capture_start = start;
+    return m;
+  };
+  if (callbacks.on_calibrated) callbacks.on_calibrated(merge(driver.CalibrationMetadata()));
+  for (double t : plan.theta_in_deg) {
+    SliceReport report;
+    Slice slice = driver.MeasureSlice(t, &report);
+    if (callbacks.on_slice) callbacks.on_slice(slice, report);
+  }
+  Metadata final_metadata = merge(driver.CalibrationMetadata());
+  final_metadata.capture_end = UtcNowIso8601();
+  return final_metadata;
+}
+
+}  // namespace brdf::device

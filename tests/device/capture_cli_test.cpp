@@ -1,0 +1,227 @@
+// `brdf capture` run as a lab user runs it: the built tool against the simulated instrument.
+// Values are checked against models.h evaluated here, files with ReadBpc.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include "brdf/core/bpc.h"
+#include "brdf/core/file_util.h"
+#include "commands.h"
+#include "device_test_support.h"
+
+namespace brdf::device {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct ToolRun {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+class CaptureCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("brdf_capture_cli_test_" + std::to_string(::getpid()) + "_" +
+            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  ToolRun Run(const std::string& args) const {
+    const fs::path err_file = dir_ / "stderr.txt";
+    const std::string cmd = std::string(BRDF_TOOL) + " " + args + " 2>'" + err_file.string() + "'";
+    ToolRun r;
+    std::FILE* pipe = ::popen(cmd.c_str(), "r");
+    if (pipe == nullptr) return r;
+    char buf[4096];
+    for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, pipe)) > 0;) r.out.append(buf, n);
+    const int status = ::pclose(pipe);
+    r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    r.err = ReadFileText(err_file.string(), 1 << 20);
+    return r;
+  }
+
+  std::string Path(const std::string& name) const { return (dir_ / name).string(); }
+
+  fs::path dir_;
+};
+
+// A coarse grid keeps each run short: 16 rows × 72 columns per slice.
+const std::string kCoarse = " --theta-out-step 5 --phi-out-step 5";
+
+TEST_F(CaptureCli, NoiseFreeCaptureMatchesTheAnalyticMaterial) {
+  const std::string out = Path("red.bpc");
+  const ToolRun r =
+      Run("capture --device sim --material plastic_glossy_red --sample 'red tile' "
+          "--out " +
+          out + " --theta-in 0,40 --noise 0" + kCoarse);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.out.empty()) << "progress goes to stderr";
+  EXPECT_NE(r.err.find("slice 1/2 θin=0°: 1,152 samples"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("slice 2/2 θin=40°: 1,152 samples"), std::string::npos) << r.err;
+  const BpcReadResult file = ReadBpc(out);
+  EXPECT_TRUE(file.finished);
+  EXPECT_EQ(file.measurement.metadata.sample_name, "red tile");
+  ASSERT_EQ(file.measurement.slices.size(), 2u);
+  const Material m = testing::LibraryMaterial("plastic_glossy_red");
+  for (const Slice& s : file.measurement.slices) {
+    ASSERT_EQ(s.samples.size(), 1152u);
+    for (const Sample& x : s.samples) {
+      const Rgb t = testing::Truth(m, x);
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(x.rgb[c], t[c], 1e-5 * t[c]);
+    }
+  }
+}
+
+TEST_F(CaptureCli, InterruptedCaptureTellsHowToResumeAndResumeCompletesIt) {
+  for (const char* noise : {"0", "1"}) {
+    const std::string common =
+        std::string(" --material gold --sample g --noise ") + noise + kCoarse + " --seed 5";
+    const std::string whole = Path("whole.bpc"), cut = Path("cut.bpc");
+    fs::remove(whole);
+    fs::remove(cut);
+    ASSERT_EQ(Run("capture --out " + whole + common).exit_code, 0);
+
+    // 8 set-up frames, then 18 per slice: the link drops in the third slice.
+    const ToolRun broken = Run("capture --out " + cut + common + " --sim-fault disconnect:50");
+    EXPECT_EQ(broken.exit_code, 1);
+    EXPECT_NE(broken.err.find("disconnected"), std::string::npos) << broken.err;
+    EXPECT_NE(broken.err.find("2 of 4 slices are saved in " + cut), std::string::npos)
+        << broken.err;
+    EXPECT_NE(broken.err.find("--resume"), std::string::npos) << broken.err;
+    const BpcReadResult partial = ReadBpc(cut);
+    EXPECT_FALSE(partial.finished);
+    EXPECT_EQ(partial.measurement.slices.size(), 2u);
+
+    const ToolRun resumed = Run("capture --out " + cut + common + " --resume");
+    ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
+    EXPECT_NE(resumed.err.find("slice 3/4 θin=40°"), std::string::npos) << resumed.err;
+    const Measurement a = LoadBpc(whole), b = LoadBpc(cut);
+    ASSERT_EQ(b.slices.size(), 4u);
+    for (int k = 0; k < 4; ++k) {
+      ASSERT_EQ(a.slices[k].samples.size(), b.slices[k].samples.size());
+      for (std::size_t i = 0; i < a.slices[k].samples.size(); ++i) {
+        const Sample &x = a.slices[k].samples[i], &y = b.slices[k].samples[i];
+        ASSERT_EQ(x.rgb, y.rgb) << "noise " << noise << " slice " << k << " sample " << i;
+        ASSERT_EQ(x.sigma, y.sigma);
+        ASSERT_EQ(x.flags, y.flags);
+        ASSERT_EQ(x.theta_out_deg, y.theta_out_deg);
+        ASSERT_EQ(x.phi_out_deg, y.phi_out_deg);
+      }
+    }
+    EXPECT_EQ(b.metadata.extra.at("resumed_theta_in_deg"), "40,60");
+
+    const ToolRun again = Run("capture --out " + cut + common + " --resume");
+    EXPECT_EQ(again.exit_code, 0);
+    EXPECT_NE(again.err.find("nothing to resume"), std::string::npos) << again.err;
+  }
+}
+
+TEST_F(CaptureCli, CorruptFrameStopsTheCaptureWithACrcMessage) {
+  const std::string out = Path("c.bpc");
+  const ToolRun r = Run("capture --material paper_white --sample p --out " + out + kCoarse +
+                        " --sim-fault corrupt:30");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("CRC-32"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("1 of 4 slices are saved"), std::string::npos) << r.err;
+}
+
+TEST_F(CaptureCli, ResumeRefusesDifferentSettings) {
+  const std::string out = Path("s.bpc");
+  ASSERT_EQ(Run("capture --material gold --sample g --out " + out + kCoarse +
+                " --sim-fault disconnect:30")
+                .exit_code,
+            1);
+  const ToolRun other_seed =
+      Run("capture --material gold --sample g --out " + out + kCoarse + " --seed 2 --resume");
+  EXPECT_EQ(other_seed.exit_code, 1);
+  EXPECT_NE(other_seed.err.find("seed"), std::string::npos) << other_seed.err;
+  const ToolRun other_sample =
+      Run("capture --material gold --sample h --out " + out + kCoarse + " --resume");
+  EXPECT_EQ(other_sample.exit_code, 1);
+  EXPECT_NE(other_sample.err.find("holds sample 'g'"), std::string::npos) << other_sample.err;
+}
+
+TEST_F(CaptureCli, ResumeOfAFileWithoutAReadableHeaderSuggestsStartingOver) {
+  const std::string out = Path("junk.bpc");
+  {
+    std::FILE* f = std::fopen(out.c_str(), "wb");
+    std::fputs("not a capture", f);
+    std::fclose(f);
+  }
+  const ToolRun r = Run("capture --material gold --sample g --out " + out + kCoarse + " --resume");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("byte 0"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--force"), std::string::npos) << r.err;
+  EXPECT_EQ(ReadFileText(out, 100), "not a capture");
+}
+
+TEST_F(CaptureCli, RefusesToOverwriteAnExistingFileWithoutForce) {
+  const std::string out = Path("x.bpc");
+  {
+    std::FILE* f = std::fopen(out.c_str(), "wb");
+    std::fputs("precious", f);
+    std::fclose(f);
+  }
+  const ToolRun r = Run("capture --material gold --sample g --out " + out + kCoarse);
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("already exists"), std::string::npos) << r.err;
+  EXPECT_EQ(ReadFileText(out, 100), "precious");
+  EXPECT_EQ(Run("capture --material gold --sample g --out " + out + kCoarse + " --force --quiet")
+                .exit_code,
+            0);
+  EXPECT_TRUE(ReadBpc(out).finished);
+}
+
+TEST_F(CaptureCli, WrongArgumentsGiveOneClearLineAndNonZeroExit) {
+  const std::string out = " --out " + Path("bad.bpc");
+  struct Case {
+    std::string args, expect;
+  };
+  for (const Case& k : std::vector<Case>{
+           {"--material gold --sample g --noise -1" + out, "--noise"},
+           {"--material no_such_material --sample g" + out, "library"},
+           {"--material gold --sample g --device usb" + out, "--device"},
+           {"--material gold --sample g --theta-in 0,95" + out, "--theta-in"},
+           {"--material gold --sample g --exposure fast" + out, "--exposure"},
+           {"--material gold --sample g --sim-fault explode:3" + out, "--sim-fault"},
+           {"--material gold" + out, "--sample"},
+           {"--material gold --sample g --resume --force" + out, "excludes"},
+       }) {
+    const ToolRun r = Run("capture " + k.args);
+    EXPECT_NE(r.exit_code, 0) << k.args;
+    EXPECT_NE(r.err.find(k.expect), std::string::npos) << k.args << "\n" << r.err;
+    EXPECT_LE(std::count(r.err.begin(), r.err.end(), '\n'), 2) << r.err;
+    EXPECT_FALSE(fs::exists(Path("bad.bpc"))) << k.args;
+  }
+}
+
+TEST_F(CaptureCli, HelpShowsTheDefaultsOfTheCode) {
+  const ToolRun r = Run("capture --help");
+  ASSERT_EQ(r.exit_code, 0);
+  const cli::CaptureOptions defaults;
+  auto number = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return std::string(buf);
+  };
+  std::string theta_in;
+  for (double t : defaults.theta_in_deg) theta_in += (theta_in.empty() ? "" : ",") + number(t);
+  EXPECT_NE(r.out.find("--theta-in FLOAT=[" + theta_in + "]"), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("--noise FLOAT=" + number(defaults.noise)), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("--seed UINT=" + std::to_string(defaults.seed)), std::string::npos);
+  EXPECT_NE(r.out.find("--device TEXT=" + defaults.device), std::string::npos);
+  EXPECT_NE(r.out.find("--exposure TEXT=" + defaults.exposure), std::string::npos);
+  EXPECT_NE(r.out.find("--theta-out-step FLOAT=" + number(defaults.theta_out_step_deg)),
+            std::string::npos);
+}
+
+}  // namespace
+}  // namespace brdf::device

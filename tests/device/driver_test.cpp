@@ -1,0 +1,333 @@
+// The host driver against the simulated instrument: calibrated captures compared with the
+// analytic f_r of each library material (evaluated here with models.h), noise statistics,
+// flags, metadata, and device faults.
+#include "brdf/device/driver.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <regex>
+#include <set>
+#include <tuple>
+
+#include "brdf/core/error.h"
+#include "device_test_support.h"
+
+namespace brdf::device {
+namespace {
+
+using testing::Config;
+using testing::LibraryMaterial;
+using testing::LibraryNames;
+using testing::RunCapture;
+using testing::Truth;
+
+TEST(Capture, NoiseFreeMatchesTheAnalyticTruthAtEverySampleOfEveryLibraryMaterial) {
+  for (const std::string& name : LibraryNames()) {
+    const Material m = LibraryMaterial(name);
+    SimulatedFirmware fw(Config(m, 0));
+    testing::CaptureRun run;
+    RunCapture(fw, &run);
+    ASSERT_EQ(run.slices.size(), 4u) << name;
+    std::size_t samples = 0, worst_index = 0;
+    double worst = 0;
+    for (const Slice& slice : run.slices) {
+      EXPECT_TRUE(slice.complete);
+      for (const Sample& s : slice.samples) {
+        const Rgb truth = Truth(m, s);
+        for (int c = 0; c < 3; ++c) {
+          const double err = std::fabs(s.rgb[c] - truth[c]) / std::max(truth[c], 1e-30);
+          if (err > worst) {
+            worst = err;
+            worst_index = samples;
+          }
+          EXPECT_EQ(s.sigma[c], 0.0f);
+        }
+        EXPECT_EQ(s.flags, 0) << name << ": an ideal detector neither clips nor has a floor";
+        ++samples;
+      }
+    }
+    EXPECT_EQ(samples, 109440u) << name;
+    EXPECT_LT(worst, 1e-5) << name << ": worst relative error at sample " << worst_index;
+  }
+}
+
+TEST(Capture, RecordsEveryGridDirectionOnceInRowMajorOrder) {
+  SimulatedFirmware fw(Config(LibraryMaterial("paper_white"), 0, 5, 10));
+  testing::CaptureRun run;
+  RunCapture(fw, &run, {20, 60});
+  ASSERT_EQ(run.slices.size(), 2u);
+  EXPECT_EQ(run.slices[1].theta_in_deg, 60.0);
+  const auto& samples = run.slices[1].samples;
+  ASSERT_EQ(samples.size(), 16u * 36u);  // θout 0…75 by 5, φout 0…350 by 10
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    EXPECT_EQ(samples[i].theta_in_deg, 60.0f);
+    EXPECT_EQ(samples[i].phi_in_deg, 0.0f);
+    EXPECT_EQ(samples[i].theta_out_deg, static_cast<float>(5 * (i / 36)));
+    EXPECT_EQ(samples[i].phi_out_deg, static_cast<float>(10 * (i % 36)));
+  }
+}
+
+TEST(Capture, DefaultNoiseKeepsTheMedianRelativeErrorUnderTwoPercent) {
+  for (const std::string& name : LibraryNames()) {
+    const Material m = LibraryMaterial(name);
+    SimulatedFirmware fw(Config(m, 1));
+    testing::CaptureRun run;
+    RunCapture(fw, &run);
+    for (const Slice& slice : run.slices) {
+      for (int c = 0; c < 3; ++c) {
+        double max_truth = 0;
+        for (const Sample& s : slice.samples) max_truth = std::max(max_truth, Truth(m, s)[c]);
+        std::vector<double> errors;
+        for (const Sample& s : slice.samples) {
+          const double truth = Truth(m, s)[c];
+          if (truth > 0.01 * max_truth) errors.push_back(std::fabs(s.rgb[c] - truth) / truth);
+        }
+        ASSERT_FALSE(errors.empty());
+        std::nth_element(errors.begin(), errors.begin() + errors.size() / 2, errors.end());
+        const double median = errors[errors.size() / 2];
+        EXPECT_LT(median, 0.02) << name << " θin " << slice.theta_in_deg << " channel " << c;
+        EXPECT_GT(median, 0.0) << name << ": noise is on";
+      }
+    }
+  }
+}
+
+TEST(Capture, SigmaDescribesTheActualScatter) {
+  for (const char* name : {"paper_white", "plastic_glossy_red", "gold"}) {
+    const Material m = LibraryMaterial(name);
+    SimulatedFirmware fw(Config(m, 1, 1, 2));
+    testing::CaptureRun run;
+    RunCapture(fw, &run);
+    std::vector<double> z;
+    for (const Slice& slice : run.slices) {
+      EXPECT_TRUE(slice.has_sigma);
+      for (const Sample& s : slice.samples) {
+        if (s.flags != 0) continue;
+        const Rgb truth = Truth(m, s);
+        for (int c = 0; c < 3; ++c)
+          if (s.sigma[c] > 0) z.push_back(std::fabs(s.rgb[c] - truth[c]) / s.sigma[c]);
+      }
+    }
+    ASSERT_GT(z.size(), 10000u);
+    std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
+    // For Gaussian errors the median of |error/σ| is 0.6745.
+    EXPECT_NEAR(z[z.size() / 2], 0.6745, 0.1) << name;
+  }
+}
+
+TEST(Capture, SaturationFlagsAppearExactlyWhereTheRawSignalClipped) {
+  struct Case {
+    const char* material;
+    ExposureSetting exposure;
+  };
+  // Diamond's specular peak clips even at the shortest exposure; a long fixed exposure makes
+  // a glossy plastic clip over a wide area.
+  for (const Case& k :
+       {Case{"diamond_on_black", {}}, Case{"plastic_glossy_yellow", {ExposureMode::kFixed, 300}}}) {
+    SimulatedFirmware fw(Config(LibraryMaterial(k.material), 1, 1, 2));
+    testing::CaptureRun run;
+    RunCapture(fw, &run, {0, 20, 40, 60}, k.exposure);
+    const GeometryInfo& g = fw.geometry();
+    std::set<std::tuple<float, std::size_t>> flagged, clipped;
+    for (const Slice& slice : run.slices)
+      for (std::size_t i = 0; i < slice.samples.size(); ++i)
+        if (slice.samples[i].flags & kFlagSaturated)
+          flagged.insert({static_cast<float>(slice.theta_in_deg), i});
+    for (const ClipRecord& r : fw.clip_log())
+      clipped.insert({r.theta_in_deg, std::size_t{r.row} * g.columns + r.column});
+    EXPECT_FALSE(flagged.empty()) << k.material;
+    EXPECT_EQ(flagged, clipped) << k.material;
+  }
+}
+
+TEST(Capture, IdealDetectorNeverFlagsSaturationEvenBeyondFullScale) {
+  SimulatedFirmware fw(Config(LibraryMaterial("plastic_glossy_yellow"), 0, 5, 5));
+  testing::CaptureRun run;
+  RunCapture(fw, &run, {20}, {ExposureMode::kFixed, 300});
+  const Material m = LibraryMaterial("plastic_glossy_yellow");
+  for (const Sample& s : run.slices[0].samples) {
+    EXPECT_EQ(s.flags & kFlagSaturated, 0);
+    const Rgb truth = Truth(m, s);
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(s.rgb[c], truth[c], 1e-5 * truth[c]);
+  }
+}
+
+TEST(Capture, BelowNoiseFloorFlagsFollowTheExpectedSignal) {
+  // Glass on black has no diffuse part: away from the specular lobe the signal is zero.
+  const Material m = LibraryMaterial("glass_on_black");
+  const InstrumentModel& model = ReferenceInstrument();
+  const float exposure = 1;  // the shortest: most of the hemisphere gives well under a count
+  SimulatedFirmware fw(Config(m, 1, 1, 2));
+  testing::CaptureRun run;
+  RunCapture(fw, &run, {20}, {ExposureMode::kFixed, exposure});
+  const double reading_sigma = model.read_noise_counts / std::sqrt(model.frames_per_reading);
+  const double floor = 3 * reading_sigma;
+  const double cos_in = std::cos(DegToRad(20));
+  std::size_t above = 0, near_zero = 0, near_zero_flagged = 0;
+  for (const Sample& s : run.slices[0].samples) {
+    const Rgb f = Truth(m, s);
+    bool surely_above = true, some_channel_near_zero = false;
+    for (int c = 0; c < 3; ++c) {
+      const double signal = exposure * model.responsivity_counts_per_ms[c] * f[c] * cos_in;
+      const double sigma =
+          std::sqrt(reading_sigma * reading_sigma +
+                    model.conversion_gain_counts_per_electron * signal / model.frames_per_reading);
+      // The threshold uses the read noise measured from 64 dark frames (within ~30 %).
+      surely_above = surely_above && signal > 1.3 * floor + 6 * sigma;
+      some_channel_near_zero = some_channel_near_zero || signal < 0.25 * reading_sigma;
+    }
+    const bool flagged = (s.flags & kFlagBelowNoiseFloor) != 0;
+    if (surely_above) {
+      EXPECT_FALSE(flagged) << "θout " << s.theta_out_deg << " φout " << s.phi_out_deg;
+      ++above;
+    }
+    if (some_channel_near_zero) {
+      ++near_zero;
+      near_zero_flagged += flagged;
+    }
+  }
+  EXPECT_GT(above, 20u);
+  EXPECT_GT(near_zero, 1000u);
+  // A signal under σ/4 stays under a 3σ floor with probability ≥ 0.993, even if the measured
+  // read noise came out 10 % low.
+  EXPECT_GE(near_zero_flagged, near_zero * 97 / 100);
+}
+
+TEST(Capture, MetadataRecordsInstrumentCalibrationAndTimes) {
+  SimulatedFirmware fw(Config(LibraryMaterial("paper_white"), 1, 15, 15));
+  testing::CaptureRun run;
+  const Metadata md = RunCapture(fw, &run);
+  const std::regex iso(R"(\d{4}-\d\d-\d\dT\d\d:\d\d:\d\dZ)");
+  EXPECT_EQ(md.sample_name, "test sample");
+  EXPECT_EQ(md.instrument_model, ReferenceInstrument().model);
+  EXPECT_EQ(md.instrument_serial, "SIM-000001");
+  EXPECT_EQ(md.firmware_version, ReferenceInstrument().firmware_version);
+  EXPECT_EQ(md.protocol_version, "1.0");
+  EXPECT_NE(md.calibration_reference.find("Spectralon"), std::string::npos);
+  EXPECT_NE(md.calibration_reference.find("0.989747"), std::string::npos);
+  EXPECT_TRUE(std::regex_match(md.calibration_time, iso)) << md.calibration_time;
+  EXPECT_TRUE(std::regex_match(md.capture_start, iso)) << md.capture_start;
+  EXPECT_TRUE(std::regex_match(md.capture_end, iso)) << md.capture_end;
+  EXPECT_LE(md.capture_start, md.capture_end);
+  EXPECT_EQ(md.software_version, SoftwareVersion());
+  EXPECT_EQ(md.units, "1/sr");
+  EXPECT_EQ(md.extra.at("exposure_mode"), "auto-row");
+  EXPECT_EQ(md.extra.count("white_theta_in_60_counts"), 1u);
+}
+
+TEST(Capture, RefusesAnglesTheInstrumentDoesNotOfferBeforeMeasuring) {
+  SimulatedFirmware fw(Config(LibraryMaterial("paper_white"), 1, 15, 15));
+  testing::CaptureRun run;
+  EXPECT_THROW(RunCapture(fw, &run, {0, 30}), InvalidArgument);
+  EXPECT_THROW(RunCapture(fw, &run, {20, 20}), InvalidArgument);
+  EXPECT_TRUE(run.slices.empty());
+}
+
+// Frames the firmware sends before the first slice (IDENTITY, GEOMETRY, ACK, DARK, 4 WHITE)
+// and per slice of 16 rows × 72 columns (SLICE_BEGIN, 16 ROW_DATA, SLICE_END).
+constexpr std::uint64_t kSetupFrames = 8, kSliceFrames = 18;
+
+TEST(Capture, DisconnectMidSliceThrowsAfterDeliveringTheCompletedSlices) {
+  const Material m = LibraryMaterial("gold");
+  testing::CaptureRun reference;
+  SimulatedFirmware clean(Config(m, 0, 5, 5));
+  RunCapture(clean, &reference);
+
+  SimulatorConfig c = Config(m, 0, 5, 5);
+  c.faults.disconnect_after_frames = kSetupFrames + 2 * kSliceFrames + 5;
+  SimulatedFirmware fw(c);
+  testing::CaptureRun run;
+  try {
+    RunCapture(fw, &run);
+    FAIL() << "no DeviceError";
+  } catch (const DeviceError& e) {
+    EXPECT_NE(std::string(e.what()).find("disconnected"), std::string::npos) << e.what();
+  }
+  ASSERT_EQ(run.slices.size(), 2u);
+  for (int k = 0; k < 2; ++k) {
+    ASSERT_EQ(run.slices[k].samples.size(), reference.slices[k].samples.size());
+    for (std::size_t i = 0; i < run.slices[k].samples.size(); ++i)
+      EXPECT_EQ(run.slices[k].samples[i].rgb, reference.slices[k].samples[i].rgb);
+  }
+}
+
+TEST(Capture, CorruptFrameIsADeviceErrorNamingTheCrc) {
+  SimulatorConfig c = Config(LibraryMaterial("gold"), 1, 5, 5);
+  c.faults.corrupt_frame = kSetupFrames + kSliceFrames + 4;  // a ROW_DATA of slice 2
+  SimulatedFirmware fw(c);
+  testing::CaptureRun run;
+  try {
+    RunCapture(fw, &run);
+    FAIL() << "no DeviceError";
+  } catch (const DeviceError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("frame lost"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("CRC-32"), std::string::npos) << msg;
+  }
+  EXPECT_EQ(run.slices.size(), 1u);
+}
+
+TEST(Capture, CorruptLastFrameOfASliceIsReportedWhenTheAnswerTimesOut) {
+  SimulatorConfig c = Config(LibraryMaterial("gold"), 1, 5, 5);
+  c.faults.corrupt_frame = kSetupFrames + 4 * kSliceFrames;  // the final SLICE_END
+  SimulatedFirmware fw(c);
+  testing::CaptureRun run;
+  try {
+    RunCapture(fw, &run);
+    FAIL() << "no DeviceError";
+  } catch (const DeviceError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("timeout"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("SLICE_END"), std::string::npos) << msg;
+  }
+  EXPECT_EQ(run.slices.size(), 3u);
+}
+
+TEST(Capture, StalledInstrumentIsATimeout) {
+  SimulatorConfig c = Config(LibraryMaterial("gold"), 1, 5, 5);
+  c.faults.stall_after_frames = kSetupFrames + kSliceFrames + 1;
+  SimulatedFirmware fw(c);
+  testing::CaptureRun run;
+  try {
+    RunCapture(fw, &run);
+    FAIL() << "no DeviceError";
+  } catch (const DeviceError& e) {
+    EXPECT_NE(std::string(e.what()).find("timeout"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(run.slices.size(), 1u);
+}
+
+TEST(Driver, NeedsCalibrationBeforeASliceAndAbortsWhenIdle) {
+  SimulatedFirmware fw(Config(LibraryMaterial("paper_white"), 1, 15, 15));
+  LoopbackTransport link(fw);
+  Driver driver(link);
+  driver.Connect();
+  EXPECT_THROW(driver.MeasureSlice(20), InvalidArgument);
+  driver.MeasureDark();
+  EXPECT_THROW(driver.MeasureSlice(20), InvalidArgument);
+  driver.MeasureWhite(20);
+  SliceReport report;
+  const Slice s = driver.MeasureSlice(20, &report);
+  EXPECT_EQ(report.samples, s.samples.size());
+  EXPECT_EQ(report.theta_in_deg, 20.0);
+  driver.Abort();
+  EXPECT_EQ(driver.MeasureSlice(20).samples.size(), s.samples.size());
+}
+
+TEST(Driver, ReportsTheInstrumentsRefusal) {
+  SimulatedFirmware fw(Config(LibraryMaterial("paper_white"), 1, 15, 15));
+  LoopbackTransport link(fw);
+  Driver driver(link);
+  driver.Connect();
+  try {
+    driver.SetExposure({ExposureMode::kFixed, 1e5f});
+    FAIL() << "no DeviceError";
+  } catch (const DeviceError& e) {
+    EXPECT_NE(std::string(e.what()).find("refused SET_EXPOSURE"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace brdf::device
