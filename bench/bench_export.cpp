@@ -4,9 +4,9 @@
 //   build/bench/bench_export --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 
+#include <unistd.h>
 #include <filesystem>
 #include <string>
-#include <unistd.h>
 
 #include "brdf/core/geometry.h"
 #include "brdf/core/lut.h"
@@ -91,12 +91,14 @@ void BM_WriteDds(benchmark::State& state) {  // encode + write
 BENCHMARK(BM_WriteDds)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_WriteExrFloat(benchmark::State& state) {
-  for (auto _ : state) WriteExrComposite(Dir() + "/ggx.exr", GgxLut(), Meta(), ExrPixelType::kFloat);
+  for (auto _ : state)
+    WriteExrComposite(Dir() + "/ggx.exr", GgxLut(), Meta(), ExrPixelType::kFloat);
 }
 BENCHMARK(BM_WriteExrFloat)->Unit(benchmark::kMillisecond)->UseRealTime();
 
 void BM_WriteExrHalf(benchmark::State& state) {
-  for (auto _ : state) WriteExrComposite(Dir() + "/ggx_half.exr", GgxLut(), Meta(), ExrPixelType::kHalf);
+  for (auto _ : state)
+    WriteExrComposite(Dir() + "/ggx_half.exr", GgxLut(), Meta(), ExrPixelType::kHalf);
 }
 BENCHMARK(BM_WriteExrHalf)->Unit(benchmark::kMillisecond)->UseRealTime();
 

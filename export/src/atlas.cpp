@@ -41,7 +41,8 @@ std::vector<double> CheckMaterials(const std::vector<AtlasMaterial>& materials) 
       throw InvalidArgument("atlas: material '" + m.name + "': " + e.what());
     }
     if (!names.insert(m.name).second)
-      throw InvalidArgument("atlas: material name '" + m.name + "' appears twice; names must be unique");
+      throw InvalidArgument("atlas: material name '" + m.name +
+                            "' appears twice; names must be unique");
   }
   const AtlasMaterial& first = materials.front();
   for (const AtlasMaterial& m : materials)
@@ -108,12 +109,14 @@ FloatImage AtlasImage(const std::vector<AtlasMaterial>& materials) {
 Lut ExtractAtlasCell(const PackedVolume& atlas_volume, const AtlasLayout& layout, int m,
                      std::vector<double> theta_in_deg) {
   if (m < 0 || m >= layout.materials)
-    throw InvalidArgument(fmt::format("atlas: material index {} outside 0..{}", m, layout.materials - 1));
-  if (atlas_volume.width != layout.TextureWidth() || atlas_volume.height != layout.TextureHeight() ||
-      atlas_volume.depth != layout.slices)
-    throw InvalidArgument(fmt::format("atlas: a {} × {} × {} volume does not match the layout {} × {} × {}",
-                                      atlas_volume.width, atlas_volume.height, atlas_volume.depth,
-                                      layout.TextureWidth(), layout.TextureHeight(), layout.slices));
+    throw InvalidArgument(
+        fmt::format("atlas: material index {} outside 0..{}", m, layout.materials - 1));
+  if (atlas_volume.width != layout.TextureWidth() ||
+      atlas_volume.height != layout.TextureHeight() || atlas_volume.depth != layout.slices)
+    throw InvalidArgument(
+        fmt::format("atlas: a {} × {} × {} volume does not match the layout {} × {} × {}",
+                    atlas_volume.width, atlas_volume.height, atlas_volume.depth,
+                    layout.TextureWidth(), layout.TextureHeight(), layout.slices));
   PackedVolume cell;
   cell.width = Lut::kWidth;
   cell.height = Lut::kHeight;
@@ -141,12 +144,13 @@ std::string AtlasManifestJson(const Atlas& atlas, const std::vector<std::string>
     materials.push_back({{"index", m},
                          {"name", atlas.names[m]},
                          {"source", atlas.sources[m]},
-                         {"cell", {{"column", column},
-                                   {"row", row},
-                                   {"x0", column * Lut::kWidth},
-                                   {"y0", row * Lut::kHeight},
-                                   {"width", Lut::kWidth},
-                                   {"height", Lut::kHeight}}}});
+                         {"cell",
+                          {{"column", column},
+                           {"row", row},
+                           {"x0", column * Lut::kWidth},
+                           {"y0", row * Lut::kHeight},
+                           {"width", Lut::kWidth},
+                           {"height", Lut::kHeight}}}});
   }
   j["materials"] = std::move(materials);
   j["grid"] = {
@@ -162,10 +166,12 @@ std::string AtlasManifestJson(const Atlas& atlas, const std::vector<std::string>
       {"image_slice_rows", l.composite.rows},
       {"image_width", l.ImageWidth()},
       {"image_height", l.ImageHeight()},
-      {"image_order", "slice k at column k mod image_slice_columns, row k div "
-                      "image_slice_columns (row-major, ascending theta_in, top-left first)"},
-      {"delta_in_deg", atlas.theta_in_deg.size() >= 2 ? atlas.theta_in_deg[1] - atlas.theta_in_deg[0] : 0.0}};
-  ordered_json convention = detail::TexelConventionJson();
+      {"image_order",
+       "slice k at column k mod image_slice_columns, row k div "
+       "image_slice_columns (row-major, ascending theta_in, top-left first)"},
+      {"delta_in_deg",
+       atlas.theta_in_deg.size() >= 2 ? atlas.theta_in_deg[1] - atlas.theta_in_deg[0] : 0.0}};
+  ordered_json convention = detail::TexelConventionJson(atlas.theta_in_deg);
   convention["atlas_cell"] =
       "u = (x0 + phi_d/1deg + 0.5)/texture_width, v = (y0 + theta_d/1deg + 0.5)/texture_height, "
       "w as for one LUT; clamp u to [(x0 + 0.5)/texture_width, (x0 + 360.5)/texture_width] and v "
@@ -184,7 +190,8 @@ std::vector<std::string> WriteAtlas(const std::string& prefix,
                                     ExrPixelType exr_type) {
   const Atlas atlas = BuildAtlas(materials);
   const std::string stem = std::filesystem::path(prefix).filename().string();
-  const std::vector<std::string> files = {stem + ".ktx2", stem + ".dds", stem + ".exr", stem + ".json"};
+  const std::vector<std::string> files = {stem + ".ktx2", stem + ".dds", stem + ".exr",
+                                          stem + ".json"};
   const std::string manifest = AtlasManifestJson(atlas, files);
   std::vector<std::string> written;
   WriteKtx2(prefix + ".ktx2", atlas.volume, KeyValues{{"brdf.atlas", manifest}});
@@ -221,7 +228,8 @@ AtlasManifest ParseAtlasManifest(std::string_view json_text, const std::string& 
     throw FormatError(file, "member 'materials'", "a non-empty array", list.type_name());
   if (m.theta_in_deg.empty())
     throw FormatError(file, "member 'theta_in_deg'", "at least one value", "an empty array");
-  m.layout = ComputeAtlasLayout(static_cast<int>(list.size()), static_cast<int>(m.theta_in_deg.size()));
+  m.layout =
+      ComputeAtlasLayout(static_cast<int>(list.size()), static_cast<int>(m.theta_in_deg.size()));
   if (g.Int("cell_columns") != m.layout.cells.columns || g.Int("cell_rows") != m.layout.cells.rows)
     throw FormatError(file, "member 'grid.cell_columns'",
                       fmt::format("{} × {} cells for {} materials", m.layout.cells.columns,
@@ -231,8 +239,8 @@ AtlasManifest ParseAtlasManifest(std::string_view json_text, const std::string& 
     const std::string prefix = fmt::format("materials[{}].", i);
     detail::JsonFields e(list[i], file, prefix);
     detail::JsonFields c(e.Object("cell"), file, prefix + "cell.");
-    AtlasManifestEntry entry{e.String("name"), e.String("source"), e.Int("index"),
-                             c.Int("column"), c.Int("row"), c.Int("x0"), c.Int("y0")};
+    AtlasManifestEntry entry{e.String("name"), e.String("source"), e.Int("index"), c.Int("column"),
+                             c.Int("row"),     c.Int("x0"),        c.Int("y0")};
     m.materials.push_back(std::move(entry));
   }
   detail::JsonFields p(f.Object("payload"), file, "payload.");

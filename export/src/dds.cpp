@@ -11,7 +11,7 @@
 namespace brdf::exporter {
 namespace {
 
-constexpr std::uint32_t kMagic = 0x20534444;  // "DDS "
+constexpr std::uint32_t kMagic = 0x20534444;       // "DDS "
 constexpr std::uint32_t kFourCcDx10 = 0x30315844;  // "DX10"
 constexpr std::uint32_t kDdsdCaps = 0x1, kDdsdHeight = 0x2, kDdsdWidth = 0x4, kDdsdPitch = 0x8,
                         kDdsdPixelFormat = 0x1000, kDdsdMipMapCount = 0x20000,
@@ -48,9 +48,9 @@ std::string EncodeDds(const PackedVolume& volume) {
   AppendU32(out, static_cast<std::uint32_t>(volume.width));
   AppendU32(out, static_cast<std::uint32_t>(volume.width) * 4);  // row pitch in bytes
   AppendU32(out, static_cast<std::uint32_t>(volume.depth));
-  AppendU32(out, 1);  // dwMipMapCount
+  AppendU32(out, 1);                               // dwMipMapCount
   for (int i = 0; i < 11; ++i) AppendU32(out, 0);  // dwReserved1
-  AppendU32(out, 32);  // DDS_PIXELFORMAT.dwSize
+  AppendU32(out, 32);                              // DDS_PIXELFORMAT.dwSize
   AppendU32(out, kDdpfFourCc);
   AppendU32(out, kFourCcDx10);
   for (int i = 0; i < 5; ++i) AppendU32(out, 0);  // bit count and masks unused with FOURCC
@@ -79,7 +79,8 @@ LoadedTexture ParseDds(const std::uint8_t* data, std::size_t size, const std::st
   ByteReader r(data, size, file);
   if (size < 4 || std::memcmp(data, "DDS ", 4) != 0) {
     std::uint32_t got = 0;
-    for (std::size_t i = 0; i < std::min<std::size_t>(size, 4); ++i) got |= std::uint32_t{data[i]} << (8 * i);
+    for (std::size_t i = 0; i < std::min<std::size_t>(size, 4); ++i)
+      got |= std::uint32_t{data[i]} << (8 * i);
     throw FormatError(file, BytePosition(0), "the DDS magic \"DDS \"",
                       size < 4 ? "a file of " + std::to_string(size) + " bytes" : FourCcText(got));
   }
@@ -88,14 +89,16 @@ LoadedTexture ParseDds(const std::uint8_t* data, std::size_t size, const std::st
     const std::uint64_t at = r.offset();
     const std::uint32_t got = r.U32(what);
     if (got != expected)
-      throw FormatError(file, BytePosition(at),
-                        fmt::format("{} {}{}", what, expected, *meaning ? fmt::format(" ({})", meaning) : ""),
-                        std::to_string(got));
+      throw FormatError(
+          file, BytePosition(at),
+          fmt::format("{} {}{}", what, expected, *meaning ? fmt::format(" ({})", meaning) : ""),
+          std::to_string(got));
   };
   expect(124, "DDS_HEADER.dwSize");
   const std::uint64_t at_flags = r.offset();
   const std::uint32_t flags = r.U32("DDS_HEADER.dwFlags");
-  const std::uint32_t required = kDdsdCaps | kDdsdHeight | kDdsdWidth | kDdsdPixelFormat | kDdsdDepth;
+  const std::uint32_t required =
+      kDdsdCaps | kDdsdHeight | kDdsdWidth | kDdsdPixelFormat | kDdsdDepth;
   if ((flags & required) != required)
     throw FormatError(file, BytePosition(at_flags),
                       "dwFlags with CAPS, HEIGHT, WIDTH, PIXELFORMAT and DEPTH (a volume texture)",
@@ -107,7 +110,8 @@ LoadedTexture ParseDds(const std::uint8_t* data, std::size_t size, const std::st
     const std::uint64_t at = r.offset();
     const std::uint32_t v = r.U32(what);
     if (v == 0 || v > (1u << 16))
-      throw FormatError(file, BytePosition(at), std::string(what) + " in 1..65536", std::to_string(v));
+      throw FormatError(file, BytePosition(at), std::string(what) + " in 1..65536",
+                        std::to_string(v));
     return static_cast<int>(v);
   };
   t.volume.height = dimension("dwHeight");
@@ -125,9 +129,10 @@ LoadedTexture ParseDds(const std::uint8_t* data, std::size_t size, const std::st
     const std::uint64_t at = r.offset();
     const std::uint32_t mips = r.U32("dwMipMapCount");
     if ((flags & kDdsdMipMapCount) && mips > 1)
-      throw FormatError(file, BytePosition(at), "dwMipMapCount 1 (one level)", std::to_string(mips));
+      throw FormatError(file, BytePosition(at), "dwMipMapCount 1 (one level)",
+                        std::to_string(mips));
   }
-  r.Skip(44);  // dwReserved1
+  r.Bytes(44, "DDS_HEADER.dwReserved1");
   expect(32, "DDS_PIXELFORMAT.dwSize");
   {
     const std::uint64_t at = r.offset();
@@ -139,9 +144,10 @@ LoadedTexture ParseDds(const std::uint8_t* data, std::size_t size, const std::st
     const std::uint32_t four_cc = r.U32("DDS_PIXELFORMAT.dwFourCC");
     if (four_cc != kFourCcDx10)
       throw FormatError(file, BytePosition(at_cc),
-                        "FourCC \"DX10\" (a DDS_HEADER_DXT10 extension header)", FourCcText(four_cc));
+                        "FourCC \"DX10\" (a DDS_HEADER_DXT10 extension header)",
+                        FourCcText(four_cc));
   }
-  r.Skip(20);  // bit count and masks
+  r.Bytes(20, "DDS_PIXELFORMAT bit count and masks");
   r.U32("dwCaps");
   {
     const std::uint64_t at = r.offset();
@@ -150,13 +156,12 @@ LoadedTexture ParseDds(const std::uint8_t* data, std::size_t size, const std::st
       throw FormatError(file, BytePosition(at), "dwCaps2 with DDSCAPS2_VOLUME (0x200000)",
                         fmt::format("0x{:08x}", caps2));
   }
-  r.Skip(12);  // dwCaps3, dwCaps4, dwReserved2
+  r.Bytes(12, "dwCaps3, dwCaps4 and dwReserved2");
   {
     const std::uint64_t at = r.offset();
     const std::uint32_t dxgi = r.U32("DDS_HEADER_DXT10.dxgiFormat");
     if (dxgi != kDxgiFormatR9g9b9e5Sharedexp)
-      throw FormatError(file, BytePosition(at),
-                        "DXGI format 67 (DXGI_FORMAT_R9G9B9E5_SHAREDEXP)",
+      throw FormatError(file, BytePosition(at), "DXGI format 67 (DXGI_FORMAT_R9G9B9E5_SHAREDEXP)",
                         "unsupported DXGI format " + std::to_string(dxgi));
   }
   expect(kResourceDimensionTexture3d, "resourceDimension", "D3D10_RESOURCE_DIMENSION_TEXTURE3D");

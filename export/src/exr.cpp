@@ -20,8 +20,7 @@ void WriteImageAtomically(const std::string& path, const char* format, const OII
                           OIIO::TypeDesc data_type, const void* data) {
   AtomicOutputPath out_path(path);
   auto out = OIIO::ImageOutput::create(format);
-  if (!out)
-    throw IoError(path + ": OpenImageIO has no " + format + " writer: " + OIIO::geterror());
+  if (!out) throw IoError(path + ": OpenImageIO has no " + format + " writer: " + OIIO::geterror());
   if (!out->open(out_path.temp_path(), spec))
     throw IoError(path + ": cannot create " + format + " file: " + out->geterror());
   const bool wrote = out->write_image(data_type, data);
@@ -49,16 +48,17 @@ Lut LutFromComposite(const FloatImage& image, std::vector<double> theta_in_deg) 
   if (k_count < 1) throw InvalidArgument("composite: need at least one θin value");
   const GridLayout grid = SquareishGrid(k_count);
   if (image.width != grid.columns * Lut::kWidth || image.height != grid.rows * Lut::kHeight)
-    throw InvalidArgument(fmt::format(
-        "composite: {} slices need a {} × {} image ({} × {} slices), got {} × {}", k_count,
-        grid.columns * Lut::kWidth, grid.rows * Lut::kHeight, grid.columns, grid.rows, image.width,
-        image.height));
+    throw InvalidArgument(
+        fmt::format("composite: {} slices need a {} × {} image ({} × {} slices), got {} × {}",
+                    k_count, grid.columns * Lut::kWidth, grid.rows * Lut::kHeight, grid.columns,
+                    grid.rows, image.width, image.height));
   Lut lut;
   lut.Resize(theta_in_deg.size());
   lut.theta_in_deg = std::move(theta_in_deg);
   for (int k = 0; k < k_count; ++k)
     for (int j = 0; j < Lut::kHeight; ++j) {
-      const float* src = image.Pixel(grid.CellColumn(k) * Lut::kWidth, grid.CellRow(k) * Lut::kHeight + j);
+      const float* src =
+          image.Pixel(grid.CellColumn(k) * Lut::kWidth, grid.CellRow(k) * Lut::kHeight + j);
       std::copy(src, src + Lut::kWidth * 3, lut.Texel(k, j, 0));
     }
   return lut;
@@ -68,8 +68,8 @@ void WriteExr(const std::string& path, const FloatImage& image, ExrPixelType typ
               const StringAttributes& attributes) {
   if (image.width < 1 || image.height < 1 ||
       image.rgb.size() != static_cast<std::size_t>(image.width) * image.height * 3)
-    throw InvalidArgument(fmt::format("EXR: inconsistent image {} × {} with {} floats",
-                                      image.width, image.height, image.rgb.size()));
+    throw InvalidArgument(fmt::format("EXR: inconsistent image {} × {} with {} floats", image.width,
+                                      image.height, image.rgb.size()));
   OIIO::ImageSpec spec(image.width, image.height, 3,
                        type == ExrPixelType::kHalf ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
   spec.channelnames = {"R", "G", "B"};
@@ -145,15 +145,16 @@ ExrFile ReadExr(const std::string& path) {
   const OIIO::ImageSpec& spec = in->spec();
   if (spec.nchannels < 3 || spec.channelnames.size() < 3 || spec.channelnames[0] != "R" ||
       spec.channelnames[1] != "G" || spec.channelnames[2] != "B")
-    throw FormatError(path, "channel list", "channels R, G, B",
-                      fmt::format("{} channels ({})", spec.nchannels,
-                                  fmt::join(spec.channelnames, ", ")));
+    throw FormatError(
+        path, "channel list", "channels R, G, B",
+        fmt::format("{} channels ({})", spec.nchannels, fmt::join(spec.channelnames, ", ")));
   if (spec.width < 1 || spec.height < 1 || spec.depth != 1 ||
       static_cast<std::uint64_t>(spec.width) * spec.height > (1ull << 30))
     throw FormatError(path, "data window", "a 2D image of at most 2^30 pixels",
                       fmt::format("{} × {} × {}", spec.width, spec.height, spec.depth));
   ExrFile file;
-  file.pixel_type = spec.format == OIIO::TypeDesc::HALF ? ExrPixelType::kHalf : ExrPixelType::kFloat;
+  file.pixel_type =
+      spec.format == OIIO::TypeDesc::HALF ? ExrPixelType::kHalf : ExrPixelType::kFloat;
   file.image.width = spec.width;
   file.image.height = spec.height;
   file.image.rgb.resize(static_cast<std::size_t>(spec.width) * spec.height * 3);

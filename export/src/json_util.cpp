@@ -12,23 +12,26 @@ namespace brdf::exporter::detail {
 
 ordered_json GridJson(const PackedVolume& payload, const std::vector<double>& theta_in_deg) {
   const double delta = theta_in_deg.size() >= 2 ? theta_in_deg[1] - theta_in_deg[0] : 0.0;
-  return ordered_json{
-      {"frame",
-       "specular frame of theta_in (DESIGN 5): omega_d = S(theta_in) omega_out, "
-       "S = [[-cos, 0, -sin], [0, -1, 0], [-sin, 0, cos]]; phi_in = 0"},
-      {"width", payload.width},
-      {"height", payload.height},
-      {"slices", payload.depth},
-      {"phi_d_deg", {{"first", 0}, {"step", 1}, {"count", 361}}},
-      {"theta_d_deg", {{"first", 0}, {"step", 1}, {"count", 181}}},
-      {"delta_in_deg", delta},
-      {"seam", "column 360 repeats column 0 (phi_d = 360 deg = 0 deg)"},
-      {"below_horizon", "edge extension: theta_out > 90 deg holds the value at theta_out = 90 deg "
-                        "with the same phi_out"}};
+  return ordered_json{{"frame",
+                       "specular frame of theta_in (DESIGN 5): omega_d = S(theta_in) omega_out, "
+                       "S = [[-cos, 0, -sin], [0, -1, 0], [-sin, 0, cos]]; phi_in = 0"},
+                      {"width", payload.width},
+                      {"height", payload.height},
+                      {"slices", payload.depth},
+                      {"phi_d_deg", {{"first", 0}, {"step", 1}, {"count", 361}}},
+                      {"theta_d_deg", {{"first", 0}, {"step", 1}, {"count", 181}}},
+                      {"delta_in_deg", delta},
+                      {"seam", "column 360 repeats column 0 (phi_d = 360 deg = 0 deg)"},
+                      {"below_horizon",
+                       "edge extension: theta_out > 90 deg holds the value at theta_out = 90 deg "
+                       "with the same phi_out"}};
 }
 
-ordered_json TexelConventionJson() {
-  return ordered_json{{"centre_exact", TexelCentreFormula()}, {"published", PublishedFormula()}};
+ordered_json TexelConventionJson(const std::vector<double>& theta_in_deg) {
+  const double delta = theta_in_deg.size() >= 2 ? theta_in_deg[1] - theta_in_deg[0] : 0.0;
+  return ordered_json{{"centre_exact", TexelCentreFormula()},
+                      {"published", PublishedFormula()},
+                      {"glsl", ShaderSnippetGlsl(delta, static_cast<int>(theta_in_deg.size()))}};
 }
 
 std::string Hex32(std::uint32_t v) { return fmt::format("0x{:08x}", v); }
@@ -37,7 +40,8 @@ std::uint32_t ParseHex32(const std::string& text, const std::string& file,
                          const std::string& position) {
   const bool ok = text.size() == 10 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X') &&
                   text.find_first_not_of("0123456789abcdefABCDEF", 2) == std::string::npos;
-  if (!ok) throw FormatError(file, position, "a hexadecimal \"0x\" + 8 digits value", "\"" + text + "\"");
+  if (!ok)
+    throw FormatError(file, position, "a hexadecimal \"0x\" + 8 digits value", "\"" + text + "\"");
   return static_cast<std::uint32_t>(std::stoul(text.substr(2), nullptr, 16));
 }
 
@@ -47,13 +51,15 @@ ordered_json PayloadJson(const PackedVolume& payload) {
        "RGB9E5 per EXT_texture_shared_exponent (N=9, B=15, Emax=31): "
        "VK_FORMAT_E5B9G9R9_UFLOAT_PACK32 (123), DXGI_FORMAT_R9G9B9E5_SHAREDEXP (67); "
        "R bits 0-8, G 9-17, B 18-26, exponent 27-31"},
-      {"texel_order", "32-bit little-endian words; x (phi_d) fastest, then y (theta_d rows, top "
-                      "first), then z (theta_in slices, ascending)"},
+      {"texel_order",
+       "32-bit little-endian words; x (phi_d) fastest, then y (theta_d rows, top "
+       "first), then z (theta_in slices, ascending)"},
       {"bytes", payload.ByteSize()},
       {"checksum",
        {{"algorithm", "crc32"},
-        {"definition", "CRC-32 (IEEE 802.3, polynomial 0xEDB88320 reflected, as zlib crc32) of "
-                       "the payload bytes as stored in the KTX2 level 0 image and the DDS data"},
+        {"definition",
+         "CRC-32 (IEEE 802.3, polynomial 0xEDB88320 reflected, as zlib crc32) of "
+         "the payload bytes as stored in the KTX2 level 0 image and the DDS data"},
         {"value", Hex32(payload.Crc32())}}}};
 }
 
@@ -79,8 +85,8 @@ JsonFields::JsonFields(const ordered_json& object, std::string file, std::string
     : object_(object), file_(std::move(file)), prefix_(std::move(prefix)) {}
 
 void JsonFields::Fail(const char* name, const std::string& expected) const {
-  const std::string got = !object_.contains(name) ? std::string("nothing (member missing)")
-                                                  : object_[name].dump();
+  const std::string got =
+      !object_.contains(name) ? std::string("nothing (member missing)") : object_[name].dump();
   throw FormatError(file_, "member '" + prefix_ + name + "'", expected,
                     got.size() > 80 ? got.substr(0, 77) + "..." : got);
 }
@@ -108,7 +114,8 @@ int JsonFields::Int(const char* name) const {
 }
 
 std::uint64_t JsonFields::UInt64(const char* name) const {
-  if (!object_.contains(name) || !object_[name].is_number_unsigned()) Fail(name, "a non-negative integer");
+  if (!object_.contains(name) || !object_[name].is_number_unsigned())
+    Fail(name, "a non-negative integer");
   return object_[name].get<std::uint64_t>();
 }
 

@@ -16,8 +16,8 @@ using nlohmann::ordered_json;
 
 // {"frame": ..., "width": 361, "height": 181, "slices": K, "phi_d_deg": {...}, ...}
 ordered_json GridJson(const PackedVolume& payload, const std::vector<double>& theta_in_deg);
-// {"centre_exact": TexelCentreFormula(), "published": PublishedFormula()}
-ordered_json TexelConventionJson();
+// {"centre_exact": TexelCentreFormula(), "published": PublishedFormula(), "glsl": snippet}
+ordered_json TexelConventionJson(const std::vector<double>& theta_in_deg);
 // {"encoding": ..., "texel_order": ..., "bytes": N, "checksum": {"algorithm": "crc32", ...}}
 ordered_json PayloadJson(const PackedVolume& payload);
 // "0x1234abcd"

@@ -14,10 +14,10 @@
 namespace brdf::exporter {
 namespace {
 
-constexpr std::array<std::uint8_t, 12> kIdentifier = {0xAB, 'K', 'T',  'X',  ' ',  '2',
+constexpr std::array<std::uint8_t, 12> kIdentifier = {0xAB, 'K',  'T',  'X',  ' ',  '2',
                                                       '0',  0xBB, '\r', '\n', 0x1A, '\n'};
-constexpr std::size_t kHeaderEnd = 12 + 9 * 4;        // identifier + header
-constexpr std::size_t kIndexEnd = kHeaderEnd + 32;    // + dfd/kvd/sgd index
+constexpr std::size_t kHeaderEnd = 12 + 9 * 4;          // identifier + header
+constexpr std::size_t kIndexEnd = kHeaderEnd + 32;      // + dfd/kvd/sgd index
 constexpr std::size_t kLevelIndexEnd = kIndexEnd + 24;  // + one level index entry
 
 // Data Format Descriptor field encodings (Khronos Data Format Specification 1.3, basic block).
@@ -25,7 +25,7 @@ constexpr std::uint32_t kDfVersion13 = 2;
 constexpr std::uint32_t kModelRgbsda = 1, kPrimariesBt709 = 1, kTransferLinear = 1;
 constexpr std::uint32_t kQualifierExponent = 0x20;  // KHR_DF_SAMPLE_DATATYPE_EXPONENT
 constexpr std::uint32_t kBasicBlockBytes = 24 + 6 * 16;
-constexpr std::uint32_t kMantissaUpper = 8448;     // as the spec's shared-exponent example
+constexpr std::uint32_t kMantissaUpper = 8448;  // as the spec's shared-exponent example
 constexpr std::uint32_t kExponentLower = 15, kExponentUpper = 31;  // bias, maximum
 
 std::uint32_t SampleWord0(std::uint32_t bit_offset, std::uint32_t bit_length,
@@ -59,8 +59,9 @@ KeyValues WithStandardKeys(const KeyValues& key_values) {
   // so compare as unsigned to be exact for non-ASCII keys.
   std::sort(all.begin(), all.end(), [](const auto& a, const auto& b) {
     return std::lexicographical_compare(
-        a.first.begin(), a.first.end(), b.first.begin(), b.first.end(),
-        [](char x, char y) { return static_cast<unsigned char>(x) < static_cast<unsigned char>(y); });
+        a.first.begin(), a.first.end(), b.first.begin(), b.first.end(), [](char x, char y) {
+          return static_cast<unsigned char>(x) < static_cast<unsigned char>(y);
+        });
   });
   for (std::size_t i = 1; i < all.size(); ++i)
     if (all[i].first == all[i - 1].first)
@@ -74,10 +75,11 @@ void Expect32(ByteReader& r, std::uint32_t expected, std::string_view what,
   const std::uint64_t at = r.offset();
   const std::uint32_t got = r.U32(what);
   if (got != expected)
-    throw FormatError(r.file(), BytePosition(at),
-                      fmt::format("{} {}{}", what, expected,
-                                  meaning.empty() ? std::string() : " (" + std::string(meaning) + ")"),
-                      std::to_string(got));
+    throw FormatError(
+        r.file(), BytePosition(at),
+        fmt::format("{} {}{}", what, expected,
+                    meaning.empty() ? std::string() : " (" + std::string(meaning) + ")"),
+        std::to_string(got));
 }
 
 void ValidateDfd(const std::uint8_t* data, std::size_t size, std::uint64_t base,
@@ -115,7 +117,8 @@ void ValidateDfd(const std::uint8_t* data, std::size_t size, std::uint64_t base,
                                                   "G exponent", "B mantissa", "B exponent"};
   for (int s = 0; s < 6; ++s) {
     const std::size_t w = 7 + 4 * s;
-    const std::string name = std::string("DFD sample ") + std::to_string(s) + " (" + kSampleNames[s] + ")";
+    const std::string name =
+        std::string("DFD sample ") + std::to_string(s) + " (" + kSampleNames[s] + ")";
     const std::uint64_t at = r.offset();
     const std::uint32_t got = r.U32(name);
     if (got != expected[w])
@@ -135,8 +138,8 @@ void ValidateDfd(const std::uint8_t* data, std::size_t size, std::uint64_t base,
 
 std::vector<std::uint32_t> E5b9g9r9DataFormatDescriptor() {
   std::vector<std::uint32_t> d;
-  d.push_back(4 + kBasicBlockBytes);                  // dfdTotalSize
-  d.push_back(0);                                     // vendorId 0, descriptorType 0
+  d.push_back(4 + kBasicBlockBytes);  // dfdTotalSize
+  d.push_back(0);                     // vendorId 0, descriptorType 0
   d.push_back(kDfVersion13 | (kBasicBlockBytes << 16));
   d.push_back(kModelRgbsda | (kPrimariesBt709 << 8) | (kTransferLinear << 16));  // flags 0
   d.push_back(0);  // texelBlockDimension0..3 = 0: 1×1×1×1
@@ -221,10 +224,11 @@ LoadedTexture ParseKtx2(const std::uint8_t* data, std::size_t size, const std::s
   ByteReader r(data, size, file);
   if (size < 12 || std::memcmp(data, kIdentifier.data(), 12) != 0) {
     std::string got = size < 12 ? fmt::format("a file of {} bytes", size) : std::string("bytes");
-    for (std::size_t i = 0; i < std::min<std::size_t>(size, 12); ++i) got += fmt::format(" {:02x}", data[i]);
-    throw FormatError(file, BytePosition(0),
-                      "the KTX 2.0 identifier ab 4b 54 58 20 32 30 bb 0d 0a 1a 0a («KTX 20»\\r\\n\\x1A\\n)",
-                      got);
+    for (std::size_t i = 0; i < std::min<std::size_t>(size, 12); ++i)
+      got += fmt::format(" {:02x}", data[i]);
+    throw FormatError(
+        file, BytePosition(0),
+        "the KTX 2.0 identifier ab 4b 54 58 20 32 30 bb 0d 0a 1a 0a («KTX 20»\\r\\n\\x1A\\n)", got);
   }
   r.Skip(12);
   Expect32(r, kVkFormatE5b9g9r9UfloatPack32, "vkFormat", "VK_FORMAT_E5B9G9R9_UFLOAT_PACK32");
@@ -236,7 +240,8 @@ LoadedTexture ParseKtx2(const std::uint8_t* data, std::size_t size, const std::s
     const std::uint64_t at = r.offset();
     const std::uint32_t v = r.U32(what);
     if (v == 0 || v > (1u << 16))
-      throw FormatError(file, BytePosition(at), std::string(what) + " in 1..65536", std::to_string(v));
+      throw FormatError(file, BytePosition(at), std::string(what) + " in 1..65536",
+                        std::to_string(v));
     return static_cast<int>(v);
   };
   t.volume.width = dimension("pixelWidth");
@@ -248,7 +253,8 @@ LoadedTexture ParseKtx2(const std::uint8_t* data, std::size_t size, const std::s
     const std::uint64_t at = r.offset();
     const std::uint32_t levels = r.U32("levelCount");
     if (levels > 1)
-      throw FormatError(file, BytePosition(at), "levelCount 1 (one mip level)", std::to_string(levels));
+      throw FormatError(file, BytePosition(at), "levelCount 1 (one mip level)",
+                        std::to_string(levels));
   }
   Expect32(r, 0, "supercompressionScheme", "none");
   const std::uint32_t dfd_offset = r.U32("dfdByteOffset");
@@ -274,9 +280,10 @@ LoadedTexture ParseKtx2(const std::uint8_t* data, std::size_t size, const std::s
   };
   check_range(dfd_offset, dfd_length, kHeaderEnd, "the Data Format Descriptor");
   if (dfd_length != 4 + kBasicBlockBytes)
-    throw FormatError(file, BytePosition(kHeaderEnd + 4),
-                      fmt::format("dfdByteLength {} (one basic block of 6 samples)", 4 + kBasicBlockBytes),
-                      std::to_string(dfd_length));
+    throw FormatError(
+        file, BytePosition(kHeaderEnd + 4),
+        fmt::format("dfdByteLength {} (one basic block of 6 samples)", 4 + kBasicBlockBytes),
+        std::to_string(dfd_length));
   ValidateDfd(data + dfd_offset, dfd_length, dfd_offset, file);
 
   check_range(kvd_offset, kvd_length, kHeaderEnd + 8, "the key/value data");
@@ -303,8 +310,8 @@ LoadedTexture ParseKtx2(const std::uint8_t* data, std::size_t size, const std::s
                                static_cast<std::uint64_t>(t.volume.depth);
   if (level_length != texels * 4)
     throw FormatError(file, BytePosition(kIndexEnd + 8),
-                      fmt::format("level 0 byteLength {} ({} × {} × {} texels × 4 bytes)", texels * 4,
-                                  t.volume.width, t.volume.height, t.volume.depth),
+                      fmt::format("level 0 byteLength {} ({} × {} × {} texels × 4 bytes)",
+                                  texels * 4, t.volume.width, t.volume.height, t.volume.depth),
                       std::to_string(level_length));
   if (level_uncompressed != level_length)
     throw FormatError(file, BytePosition(kIndexEnd + 16),

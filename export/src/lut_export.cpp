@@ -42,7 +42,8 @@ LutExportResult ExportLut(const std::string& out_dir, const Lut& lut, TextureMet
   const std::string& name = metadata.name;
   if (name.empty() || name == "." || name == ".." ||
       name.find_first_of("/\\") != std::string::npos || name.find('\0') != std::string::npos)
-    throw InvalidArgument("LUT export: the output name must be a plain file name, got '" + name + "'");
+    throw InvalidArgument("LUT export: the output name must be a plain file name, got '" + name +
+                          "'");
   const PackedVolume packed = PackLut(lut);
   const LutExportFormats& f = options.formats;
   metadata.companion_files.clear();

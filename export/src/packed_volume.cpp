@@ -46,22 +46,22 @@ void ValidateLutForExport(const Lut& lut) {
   if (k == 0) throw InvalidArgument("LUT export: the LUT has no θin slices");
   const std::size_t expected = k * Lut::kHeight * Lut::kWidth * 3;
   if (lut.texels.size() != expected)
-    throw InvalidArgument(fmt::format(
-        "LUT export: expected {} floats for {} slices of {} × {} RGB texels, got {}", expected, k,
-        Lut::kWidth, Lut::kHeight, lut.texels.size()));
+    throw InvalidArgument(
+        fmt::format("LUT export: expected {} floats for {} slices of {} × {} RGB texels, got {}",
+                    expected, k, Lut::kWidth, Lut::kHeight, lut.texels.size()));
   for (double t : lut.theta_in_deg)
     if (!std::isfinite(t) || t < 0.0 || t >= 90.0)
-      throw InvalidArgument(fmt::format(
-          "LUT export: θin values must lie in [0°, 90°), got [{}]", FormatThetaList(lut.theta_in_deg)));
+      throw InvalidArgument(fmt::format("LUT export: θin values must lie in [0°, 90°), got [{}]",
+                                        FormatThetaList(lut.theta_in_deg)));
   if (k >= 2) {
     const double delta = lut.theta_in_deg[1] - lut.theta_in_deg[0];
     for (std::size_t i = 1; i < k; ++i) {
       const double step = lut.theta_in_deg[i] - lut.theta_in_deg[i - 1];
       if (!(step > 0.0) || std::abs(step - delta) > 1e-9 * std::max(1.0, delta))
-        throw InvalidArgument(fmt::format(
-            "LUT export: θin must be strictly increasing and evenly spaced (the shader "
-            "addresses slice k as θin/Δin), got [{}]",
-            FormatThetaList(lut.theta_in_deg)));
+        throw InvalidArgument(
+            fmt::format("LUT export: θin must be strictly increasing and evenly spaced (the shader "
+                        "addresses slice k as θin/Δin), got [{}]",
+                        FormatThetaList(lut.theta_in_deg)));
     }
   }
 }
@@ -86,10 +86,10 @@ Lut UnpackLut(const PackedVolume& volume, std::vector<double> theta_in_deg) {
     throw InvalidArgument(fmt::format("LUT: {} slices but {} θin values [{}]", volume.depth,
                                       theta_in_deg.size(), FormatThetaList(theta_in_deg)));
   if (volume.words.size() != static_cast<std::size_t>(volume.width) * volume.height * volume.depth)
-    throw InvalidArgument(fmt::format("LUT: expected {} texels, got {}",
-                                      static_cast<std::size_t>(volume.width) * volume.height *
-                                          volume.depth,
-                                      volume.words.size()));
+    throw InvalidArgument(
+        fmt::format("LUT: expected {} texels, got {}",
+                    static_cast<std::size_t>(volume.width) * volume.height * volume.depth,
+                    volume.words.size()));
   Lut lut;
   lut.Resize(theta_in_deg.size());
   lut.theta_in_deg = std::move(theta_in_deg);

@@ -22,7 +22,7 @@ std::string SidecarJson(const PackedVolume& payload, const std::vector<double>& 
   j["theta_in_deg"] = theta_in_deg;
   j["grid"] = detail::GridJson(payload, theta_in_deg);
   j["values"] = "f_r in 1/sr, linear Rec.709 RGB, not multiplied by cos(theta)";
-  j["texel_convention"] = detail::TexelConventionJson();
+  j["texel_convention"] = detail::TexelConventionJson(theta_in_deg);
   if (metadata.extrapolation) {
     const ExtrapolationInfo& e = *metadata.extrapolation;
     j["extrapolation"] = {
@@ -36,8 +36,9 @@ std::string SidecarJson(const PackedVolume& payload, const std::vector<double>& 
   j["fitted_models"] = ordered_json::array();
   for (const std::string& text : metadata.fitted_models_json)
     j["fitted_models"].push_back(detail::ParseEmbeddedJson(text, "fitted model"));
-  j["tool"] = {{"name", "brdf-toolchain"},
-               {"version", metadata.tool_version.empty() ? BrdfToolVersion() : metadata.tool_version}};
+  j["tool"] = {
+      {"name", "brdf-toolchain"},
+      {"version", metadata.tool_version.empty() ? BrdfToolVersion() : metadata.tool_version}};
   j["payload"] = detail::PayloadJson(payload);
   j["files"] = metadata.companion_files;
   return j.dump(2) + "\n";
@@ -63,9 +64,10 @@ SidecarInfo ParseSidecarJson(std::string_view json_text, const std::string& file
   info.height = g.Int("height");
   info.slices = g.Int("slices");
   if (static_cast<std::size_t>(info.slices) != info.theta_in_deg.size())
-    throw FormatError(file, "member 'grid.slices'",
-                      fmt::format("the number of theta_in_deg values ({})", info.theta_in_deg.size()),
-                      std::to_string(info.slices));
+    throw FormatError(
+        file, "member 'grid.slices'",
+        fmt::format("the number of theta_in_deg values ({})", info.theta_in_deg.size()),
+        std::to_string(info.slices));
   if (j.contains("extrapolation") && !j["extrapolation"].is_null()) {
     detail::JsonFields e(f.Object("extrapolation"), file, "extrapolation.");
     info.extrapolation = ExtrapolationInfo{e.Number("p"), e.Number("l"), e.Number("theta_b_deg")};
@@ -83,7 +85,8 @@ SidecarInfo ParseSidecarJson(std::string_view json_text, const std::string& file
   if (c.String("algorithm") != "crc32")
     throw FormatError(file, "member 'payload.checksum.algorithm'", "\"crc32\"",
                       "\"" + c.String("algorithm") + "\"");
-  info.payload_crc32 = detail::ParseHex32(c.String("value"), file, "member 'payload.checksum.value'");
+  info.payload_crc32 =
+      detail::ParseHex32(c.String("value"), file, "member 'payload.checksum.value'");
   if (j.contains("files")) info.files = f.StringArray("files");
   return info;
 }

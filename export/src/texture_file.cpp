@@ -19,10 +19,13 @@ void CheckRecordedPayload(const LoadedTexture& t, const std::string& what, int w
                           int depth, std::uint64_t bytes, std::uint32_t crc) {
   const PackedVolume& v = t.volume;
   if (width != v.width || height != v.height || depth != v.depth)
-    throw FormatError(t.file, what, fmt::format("a {} × {} × {} texture as the metadata records", width, height, depth),
-                      fmt::format("{} × {} × {}", v.width, v.height, v.depth));
+    throw FormatError(
+        t.file, what,
+        fmt::format("a {} × {} × {} texture as the metadata records", width, height, depth),
+        fmt::format("{} × {} × {}", v.width, v.height, v.depth));
   if (bytes != v.ByteSize())
-    throw FormatError(t.file, what, fmt::format("a payload of {} bytes as the metadata records", bytes),
+    throw FormatError(t.file, what,
+                      fmt::format("a payload of {} bytes as the metadata records", bytes),
                       std::to_string(v.ByteSize()) + " bytes");
   const std::uint32_t actual = v.Crc32();
   if (actual != crc)
@@ -41,10 +44,10 @@ void FinishLoadedTexture(LoadedTexture& t) {
     t.theta_in_deg = info.theta_in_deg;
     t.theta_in_from_metadata = true;
   } else if (!t.atlas_manifest_json.empty()) {
-    const AtlasManifest m = ParseAtlasManifest(t.atlas_manifest_json, t.file + " (embedded manifest)");
+    const AtlasManifest m =
+        ParseAtlasManifest(t.atlas_manifest_json, t.file + " (embedded manifest)");
     CheckRecordedPayload(t, "embedded atlas manifest", m.texture_width, m.texture_height,
-                         static_cast<int>(m.theta_in_deg.size()), m.payload_bytes,
-                         m.payload_crc32);
+                         static_cast<int>(m.theta_in_deg.size()), m.payload_bytes, m.payload_crc32);
     t.theta_in_deg = m.theta_in_deg;
     t.theta_in_from_metadata = true;
   } else if (t.theta_in_deg.size() != static_cast<std::size_t>(t.volume.depth)) {

@@ -28,7 +28,8 @@ struct Five {
     luts.push_back(test::PatternLut(theta, 41));
     luts.push_back(test::PatternLut(theta, 42));
     const char* names[] = {"ggx", "lafortune", "lambert", "pattern41", "pattern42"};
-    for (int m = 0; m < 5; ++m) materials.push_back({names[m], &luts[m], std::string("src/") + names[m]});
+    for (int m = 0; m < 5; ++m)
+      materials.push_back({names[m], &luts[m], std::string("src/") + names[m]});
   }
 };
 

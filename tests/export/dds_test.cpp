@@ -30,8 +30,7 @@ constexpr std::uint32_t DDSD_CAPS = 0x1, DDSD_HEIGHT = 0x2, DDSD_WIDTH = 0x4, DD
                         DDSD_PIXELFORMAT = 0x1000, DDSD_MIPMAPCOUNT = 0x20000,
                         DDSD_LINEARSIZE = 0x80000, DDSD_DEPTH = 0x800000, DDPF_FOURCC = 0x4,
                         DDSCAPS_TEXTURE = 0x1000, DDSCAPS2_VOLUME = 0x200000,
-                        DXGI_FORMAT_R9G9B9E5_SHAREDEXP = 67,
-                        D3D10_RESOURCE_DIMENSION_TEXTURE3D = 4;
+                        DXGI_FORMAT_R9G9B9E5_SHAREDEXP = 67, D3D10_RESOURCE_DIMENSION_TEXTURE3D = 4;
 
 std::uint32_t FourCc(const char* s) {
   return static_cast<std::uint32_t>(s[0]) | (static_cast<std::uint32_t>(s[1]) << 8) |
@@ -80,7 +79,8 @@ TEST(Dds, HeaderFieldsMatchTheDocumentedLayout) {
   EXPECT_EQ(Le32(b, kMagicAt), FourCc("DDS "));
   EXPECT_EQ(Le32(b, kSizeAt), 124u);
   const std::uint32_t flags = Le32(b, kFlagsAt);
-  for (std::uint32_t bit : {DDSD_CAPS, DDSD_HEIGHT, DDSD_WIDTH, DDSD_PITCH, DDSD_PIXELFORMAT, DDSD_DEPTH})
+  for (std::uint32_t bit :
+       {DDSD_CAPS, DDSD_HEIGHT, DDSD_WIDTH, DDSD_PITCH, DDSD_PIXELFORMAT, DDSD_DEPTH})
     EXPECT_TRUE(flags & bit) << std::hex << "flag 0x" << bit << " missing in 0x" << flags;
   EXPECT_FALSE(flags & DDSD_LINEARSIZE);  // uncompressed: a pitch, not a linear size
   EXPECT_EQ(Le32(b, kHeightAt), 181u);
@@ -100,8 +100,8 @@ TEST(Dds, HeaderFieldsMatchTheDocumentedLayout) {
   EXPECT_TRUE(Le32(b, kCaps2At) & DDSCAPS2_VOLUME);
   EXPECT_EQ(Le32(b, kDxgiAt), DXGI_FORMAT_R9G9B9E5_SHAREDEXP);
   EXPECT_EQ(Le32(b, kDimensionAt), D3D10_RESOURCE_DIMENSION_TEXTURE3D);
-  EXPECT_EQ(Le32(b, kMiscFlagAt), 0u);  // not a cube map
-  EXPECT_EQ(Le32(b, kArraySizeAt), 1u);  // 3D textures are never arrays
+  EXPECT_EQ(Le32(b, kMiscFlagAt), 0u);    // not a cube map
+  EXPECT_EQ(Le32(b, kArraySizeAt), 1u);   // 3D textures are never arrays
   EXPECT_LE(Le32(b, kMiscFlags2At), 4u);  // a DDS_ALPHA_MODE value
   EXPECT_EQ(b.size(), kDataAt + 361u * 181u * 4u * 4u);
 }

@@ -97,7 +97,8 @@ inline void WriteAll(const std::string& path, const std::vector<std::uint8_t>& b
 }
 
 inline std::uint32_t Le32(const std::vector<std::uint8_t>& b, std::size_t at) {
-  return b.at(at) | (b.at(at + 1) << 8) | (b.at(at + 2) << 16) | (std::uint32_t{b.at(at + 3)} << 24);
+  return b.at(at) | (b.at(at + 1) << 8) | (b.at(at + 2) << 16) |
+         (std::uint32_t{b.at(at + 3)} << 24);
 }
 inline std::uint64_t Le64(const std::vector<std::uint8_t>& b, std::size_t at) {
   return Le32(b, at) | (std::uint64_t{Le32(b, at + 4)} << 32);
@@ -108,7 +109,8 @@ inline void SetLe32(std::vector<std::uint8_t>& b, std::size_t at, std::uint32_t 
 
 // A fresh empty folder under the build tree for one test.
 inline std::string TestDir(const std::string& name) {
-  const std::filesystem::path dir = std::filesystem::path(BRDF_BINARY_DIR) / "test-output" / "export" / name;
+  const std::filesystem::path dir =
+      std::filesystem::path(BRDF_BINARY_DIR) / "test-output" / "export" / name;
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir.string();

@@ -64,7 +64,8 @@ std::string ExpectFormatError(const std::vector<std::uint8_t>& bytes, const std:
 TEST(Ktx2, HeaderFieldsFollowTheSpecification) {
   const Written w = WriteGgx(test::TestDir("ktx2_header"));
   const auto& b = w.bytes;
-  const std::uint8_t id[12] = {0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A};
+  const std::uint8_t id[12] = {0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32,
+                               0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A};
   ASSERT_GE(b.size(), 104u);
   EXPECT_TRUE(std::equal(id, id + 12, b.begin()));
   EXPECT_EQ(Le32(b, kVkFormatAt), 123u);  // VK_FORMAT_E5B9G9R9_UFLOAT_PACK32
@@ -99,22 +100,41 @@ TEST(Ktx2, DataFormatDescriptorIsTheKhronosE5B9G9R9Descriptor) {
   // per channel a 9-bit mantissa sample (upper 8448) and a 5-bit exponent sample (lower 15,
   // upper 31, qualifier EXPONENT 0x20). Bit lengths are stored minus one.
   const std::uint32_t expected[31] = {
-      124,                  // dfdTotalSize
-      0,                    // vendorId 0 | descriptorType 0
-      2u | (120u << 16),    // versionNumber 2 | descriptorBlockSize 120
+      124,                                       // dfdTotalSize
+      0,                                         // vendorId 0 | descriptorType 0
+      2u | (120u << 16),                         // versionNumber 2 | descriptorBlockSize 120
       1u | (1u << 8) | (1u << 16) | (0u << 24),  // model, primaries, transfer, flags
-      0,                    // texelBlockDimension 0,0,0,0
-      4,                    // bytesPlane0 = 4
-      0,                    // bytesPlane4..7
-      0u | (8u << 16) | (0x00u << 24), 0, 0, 8448,    // R mantissa: bits 0..8
-      27u | (4u << 16) | (0x20u << 24), 0, 15, 31,    // R exponent: bits 27..31
-      9u | (8u << 16) | (0x01u << 24), 0, 0, 8448,    // G mantissa: bits 9..17
-      27u | (4u << 16) | (0x21u << 24), 0, 15, 31,    // G exponent
-      18u | (8u << 16) | (0x02u << 24), 0, 0, 8448,   // B mantissa: bits 18..26
-      27u | (4u << 16) | (0x22u << 24), 0, 15, 31};   // B exponent
+      0,                                         // texelBlockDimension 0,0,0,0
+      4,                                         // bytesPlane0 = 4
+      0,                                         // bytesPlane4..7
+      0u | (8u << 16) | (0x00u << 24),
+      0,
+      0,
+      8448,  // R mantissa: bits 0..8
+      27u | (4u << 16) | (0x20u << 24),
+      0,
+      15,
+      31,  // R exponent: bits 27..31
+      9u | (8u << 16) | (0x01u << 24),
+      0,
+      0,
+      8448,  // G mantissa: bits 9..17
+      27u | (4u << 16) | (0x21u << 24),
+      0,
+      15,
+      31,  // G exponent
+      18u | (8u << 16) | (0x02u << 24),
+      0,
+      0,
+      8448,  // B mantissa: bits 18..26
+      27u | (4u << 16) | (0x22u << 24),
+      0,
+      15,
+      31};  // B exponent
   const Written w = WriteGgx(test::TestDir("ktx2_dfd"));
   const std::size_t at = Le32(w.bytes, kDfdOffsetAt);
-  for (int i = 0; i < 31; ++i) EXPECT_EQ(Le32(w.bytes, at + 4 * i), expected[i]) << "DFD word " << i;
+  for (int i = 0; i < 31; ++i)
+    EXPECT_EQ(Le32(w.bytes, at + 4 * i), expected[i]) << "DFD word " << i;
 }
 
 TEST(Ktx2, KeyValueDataIsSortedNulTerminatedAndCarriesTheSidecar) {
@@ -130,7 +150,8 @@ TEST(Ktx2, KeyValueDataIsSortedNulTerminatedAndCarriesTheSidecar) {
     const std::size_t nul = entry.find('\0');
     ASSERT_NE(nul, std::string::npos);
     ASSERT_EQ(entry.back(), '\0') << "value not NUL-terminated";
-    const std::string key = entry.substr(0, nul), value = entry.substr(nul + 1, entry.size() - nul - 2);
+    const std::string key = entry.substr(0, nul),
+                      value = entry.substr(nul + 1, entry.size() - nul - 2);
     keys.push_back(key);
     if (key == "KTXwriter") writer = value;
     if (key == "KTXorientation") orientation = value;
@@ -178,7 +199,8 @@ TEST(Ktx2, ReadsBackTheQuantisedLutAndItsMetadata) {
 
 TEST(Ktx2, SingleSliceAndManySlicesRoundTrip) {
   const std::string dir = test::TestDir("ktx2_slices");
-  for (std::vector<double> theta : {std::vector<double>{0}, std::vector<double>{0, 10, 20, 30, 40, 50, 60, 70, 80}}) {
+  for (std::vector<double> theta :
+       {std::vector<double>{0}, std::vector<double>{0, 10, 20, 30, 40, 50, 60, 70, 80}}) {
     const Lut lut = test::PatternLut(theta, static_cast<std::uint32_t>(theta.size()));
     const std::string path = dir + "/n" + std::to_string(theta.size()) + ".ktx2";
     WriteKtx2(path, lut, Meta("pattern"));
@@ -191,8 +213,9 @@ TEST(Ktx2, SingleSliceAndManySlicesRoundTrip) {
 
 TEST(Ktx2, RejectsTruncatedFilesWithPositionAndExpectation) {
   const Written w = WriteGgx(test::TestDir("ktx2_truncated"));
-  for (std::size_t keep : {std::size_t{0}, std::size_t{5}, std::size_t{11}, std::size_t{40},
-                           std::size_t{90}, std::size_t{150}, w.bytes.size() / 2, w.bytes.size() - 1}) {
+  for (std::size_t keep :
+       {std::size_t{0}, std::size_t{5}, std::size_t{11}, std::size_t{40}, std::size_t{90},
+        std::size_t{150}, w.bytes.size() / 2, w.bytes.size() - 1}) {
     const std::vector<std::uint8_t> cut(w.bytes.begin(), w.bytes.begin() + keep);
     const std::string msg = ExpectFormatError(cut, "cut.ktx2");
     EXPECT_NE(msg.find("cut.ktx2"), std::string::npos) << msg;
@@ -271,7 +294,8 @@ TEST(Ktx2, KeysAreValidated) {
   EXPECT_THROW(EncodeKtx2(v, {{"a", "1"}, {"a", "2"}}), InvalidArgument);
   // A user-supplied KTXwriter is replaced by ours, not duplicated.
   const std::string file = EncodeKtx2(v, {{"KTXwriter", "someone else"}, {"zz", "last"}});
-  const auto t = ParseKtx2(reinterpret_cast<const std::uint8_t*>(file.data()), file.size(), "tiny.ktx2");
+  const auto t =
+      ParseKtx2(reinterpret_cast<const std::uint8_t*>(file.data()), file.size(), "tiny.ktx2");
   int writers = 0;
   for (const auto& [k, val] : t.key_values) writers += k == "KTXwriter";
   EXPECT_EQ(writers, 1);
@@ -284,7 +308,8 @@ TEST(Ktx2, WritingIntoAMissingFolderFailsAndLeavesNothing) {
   EXPECT_THROW(WriteKtx2(dir + "/missing/x.ktx2", lut, Meta("x")), IoError);
   WriteKtx2(dir + "/x.ktx2", lut, Meta("x"));
   std::vector<std::string> names;
-  for (const auto& e : std::filesystem::directory_iterator(dir)) names.push_back(e.path().filename().string());
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    names.push_back(e.path().filename().string());
   EXPECT_EQ(names, std::vector<std::string>{"x.ktx2"});  // no temporary left behind
 }
 

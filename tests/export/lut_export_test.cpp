@@ -15,7 +15,8 @@ namespace {
 
 std::vector<std::string> Listing(const std::string& dir) {
   std::vector<std::string> names;
-  for (const auto& e : std::filesystem::directory_iterator(dir)) names.push_back(e.path().filename().string());
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    names.push_back(e.path().filename().string());
   std::sort(names.begin(), names.end());
   return names;
 }
@@ -28,7 +29,8 @@ TEST(ExportLut, WritesEveryFormatUnderItsFinalNameOnly) {
   meta.source = "analytic";
   const LutExportResult r = ExportLut(dir, lut, meta);
   EXPECT_EQ(r.written.size(), 5u);
-  EXPECT_EQ(Listing(dir), (std::vector<std::string>{"ggx.dds", "ggx.exr", "ggx.json", "ggx.ktx2", "ggx.png"}));
+  EXPECT_EQ(Listing(dir),
+            (std::vector<std::string>{"ggx.dds", "ggx.exr", "ggx.json", "ggx.ktx2", "ggx.png"}));
   EXPECT_EQ(r.payload_bytes, 361u * 181u * 4u * 4u);
   const SidecarInfo info = ReadSidecar(dir + "/ggx.json");
   EXPECT_EQ(info.files, (std::vector<std::string>{"ggx.ktx2", "ggx.dds", "ggx.exr", "ggx.png"}));

@@ -19,11 +19,14 @@ namespace {
 // differently from the library: long double arithmetic, frexp for floor(log2(x)), pow for the
 // powers of two, channels handled through arrays.
 std::uint32_t ReferenceEncode(float r, float g, float b) {
-  constexpr long double kSharedExpMax = (512.0L - 1.0L) / 512.0L * 65536.0L;  // (2^N−1)/2^N·2^(Emax−B)
+  constexpr long double kSharedExpMax =
+      (512.0L - 1.0L) / 512.0L * 65536.0L;  // (2^N−1)/2^N·2^(Emax−B)
   long double c[3];
   const float in[3] = {r, g, b};
   for (int i = 0; i < 3; ++i)
-    c[i] = std::isnan(in[i]) ? 0.0L : std::max(0.0L, std::min(kSharedExpMax, static_cast<long double>(in[i])));
+    c[i] = std::isnan(in[i])
+               ? 0.0L
+               : std::max(0.0L, std::min(kSharedExpMax, static_cast<long double>(in[i])));
   const long double max_c = std::max(c[0], std::max(c[1], c[2]));
   int floor_log2;
   if (max_c == 0.0L) {
@@ -95,7 +98,8 @@ TEST(Rgb9e5, RoundUpCorrectionMovesToTheNextExponent) {
   // The halfway point above 511 at every exponent rounds up into the next exponent.
   for (int e = 0; e < 31; ++e) {
     const float v = static_cast<float>(std::ldexp(511.5, e - 24));
-    EXPECT_EQ(EncodeRgb9e5(v, 0, 0), Word(256, 0, 0, static_cast<std::uint32_t>(e + 1))) << "e=" << e;
+    EXPECT_EQ(EncodeRgb9e5(v, 0, 0), Word(256, 0, 0, static_cast<std::uint32_t>(e + 1)))
+        << "e=" << e;
   }
   // Just below the halfway point it stays at 511.
   const float below = std::nextafter(static_cast<float>(std::ldexp(511.5, 0)), 0.0f);
@@ -154,7 +158,8 @@ TEST(Rgb9e5, MatchesReferenceOnRandomFloats) {
   std::uniform_int_distribution<int> expo(-30, 18);
   for (int n = 0; n < 300'000; ++n) {
     float c[3];
-    for (float& x : c) x = n % 2 ? std::ldexp(mant(rng), expo(rng)) : std::bit_cast<float>(bits(rng));
+    for (float& x : c)
+      x = n % 2 ? std::ldexp(mant(rng), expo(rng)) : std::bit_cast<float>(bits(rng));
     ASSERT_EQ(EncodeRgb9e5(c[0], c[1], c[2]), ReferenceEncode(c[0], c[1], c[2]))
         << c[0] << " " << c[1] << " " << c[2];
   }
@@ -176,7 +181,8 @@ TEST(Rgb9e5, CanonicalMeansExponentZeroOrLargestMantissaAtLeast256) {
       for (std::uint32_t other : {0u, 1u, 255u, 256u, 511u}) {
         const std::uint32_t w = Word(m, other / 2, other, e);
         const auto rgb = DecodeRgb9e5(w);
-        ASSERT_EQ(IsCanonicalRgb9e5(w), ReferenceEncode(rgb[0], rgb[1], rgb[2]) == w) << std::hex << w;
+        ASSERT_EQ(IsCanonicalRgb9e5(w), ReferenceEncode(rgb[0], rgb[1], rgb[2]) == w)
+            << std::hex << w;
       }
 }
 
@@ -244,9 +250,9 @@ TEST(Rgb9e5, PackedLutOfFourSlicesIs361By181By4TexelsOfFourBytes) {
   EXPECT_EQ(v.height, 181);
   EXPECT_EQ(v.depth, 4);
   // Texel order: x fastest, then rows, then slices.
-  EXPECT_EQ(v.words[(2u * 181 + 17) * 361 + 100], ReferenceEncode(lut.Texel(2, 17, 100)[0],
-                                                                  lut.Texel(2, 17, 100)[1],
-                                                                  lut.Texel(2, 17, 100)[2]));
+  EXPECT_EQ(v.words[(2u * 181 + 17) * 361 + 100],
+            ReferenceEncode(lut.Texel(2, 17, 100)[0], lut.Texel(2, 17, 100)[1],
+                            lut.Texel(2, 17, 100)[2]));
 }
 
 TEST(Rgb9e5, UnpackLutDecodesEveryTexel) {
@@ -254,8 +260,10 @@ TEST(Rgb9e5, UnpackLutDecodesEveryTexel) {
   const Lut back = UnpackLut(PackLut(lut), lut.theta_in_deg);
   ASSERT_EQ(back.texels.size(), lut.texels.size());
   for (std::size_t t = 0; t < lut.texels.size() / 3; ++t) {
-    const std::uint32_t w = ReferenceEncode(lut.texels[3 * t], lut.texels[3 * t + 1], lut.texels[3 * t + 2]);
-    for (int c = 0; c < 3; ++c) ASSERT_EQ(static_cast<double>(back.texels[3 * t + c]), ReferenceDecode(w, c));
+    const std::uint32_t w =
+        ReferenceEncode(lut.texels[3 * t], lut.texels[3 * t + 1], lut.texels[3 * t + 2]);
+    for (int c = 0; c < 3; ++c)
+      ASSERT_EQ(static_cast<double>(back.texels[3 * t + c]), ReferenceDecode(w, c));
   }
 }
 

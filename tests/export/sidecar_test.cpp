@@ -27,7 +27,8 @@ TextureMetadata FullMeta() {
 TEST(Sidecar, BitwiseReferenceCrcHasTheStandardCheckValue) {
   // The CRC-32 check value of "123456789" is 0xCBF43926 (IEEE 802.3 / zlib).
   const std::string s = "123456789";
-  EXPECT_EQ(test::BitwiseCrc32(reinterpret_cast<const std::uint8_t*>(s.data()), s.size()), 0xCBF43926u);
+  EXPECT_EQ(test::BitwiseCrc32(reinterpret_cast<const std::uint8_t*>(s.data()), s.size()),
+            0xCBF43926u);
 }
 
 TEST(Sidecar, HoldsEveryFieldDesignSection7Names) {
@@ -45,11 +46,17 @@ TEST(Sidecar, HoldsEveryFieldDesignSection7Names) {
   EXPECT_NE(centre.find("v = (theta_d/1deg + 0.5)/181"), std::string::npos) << centre;
   EXPECT_NE(published.find("u = phi_d/(2 pi)"), std::string::npos) << published;
   EXPECT_NE(published.find("v = theta_d/pi"), std::string::npos) << published;
+  const std::string glsl = j["texel_convention"]["glsl"];
+  EXPECT_NE(glsl.find("(phi_d + 0.5) / 361.0"), std::string::npos) << glsl;
+  EXPECT_NE(glsl.find("(theta_d + 0.5) / 181.0"), std::string::npos) << glsl;
+  EXPECT_NE(glsl.find("(theta_in_deg / 20.0 + 0.5) / 4.0"), std::string::npos) << glsl;
+  EXPECT_NE(glsl.find("theta_in_deg / 60.0)"), std::string::npos) << glsl;  // published: θin/θin,max
   EXPECT_EQ(j["extrapolation"]["p"], 0.2);
   EXPECT_EQ(j["extrapolation"]["l"], 0.3);
   EXPECT_EQ(j["extrapolation"]["theta_b_deg"], 75.0);
   EXPECT_EQ(j["fitted_models"][0]["model"], "lambert");
-  EXPECT_TRUE(std::regex_match(j["tool"]["version"].get<std::string>(), std::regex(R"(\d+\.\d+\.\d+)")));
+  EXPECT_TRUE(
+      std::regex_match(j["tool"]["version"].get<std::string>(), std::regex(R"(\d+\.\d+\.\d+)")));
   EXPECT_EQ(j["payload"]["bytes"], 361u * 181u * 4u * 4u);
   EXPECT_EQ(j["payload"]["checksum"]["algorithm"], "crc32");
   EXPECT_EQ(j["files"].size(), 4u);
@@ -106,7 +113,8 @@ TEST(Sidecar, ParserNamesTheBadMember) {
     ParseSidecarJson(j.dump(), "felt.json");
     FAIL() << "accepted";
   } catch (const FormatError& e) {
-    EXPECT_NE(std::string(e.what()).find("felt.json: member 'theta_in_deg'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("felt.json: member 'theta_in_deg'"), std::string::npos)
+        << e.what();
   }
   try {
     ParseSidecarJson("{\"kind\": ", "broken.json");

@@ -48,7 +48,8 @@ int main(int argc, char** argv) {
     brdf::exporter::WriteSidecar(dir + "/ramp.json", packed, ramp.theta_in_deg, meta);
     const std::vector<brdf::Lut> luts = {Ramp(0), Ramp(1), Ramp(2)};
     std::vector<brdf::exporter::AtlasMaterial> materials;
-    for (int m = 0; m < 3; ++m) materials.push_back({"ramp" + std::to_string(m), &luts[m], "fixture"});
+    for (int m = 0; m < 3; ++m)
+      materials.push_back({"ramp" + std::to_string(m), &luts[m], "fixture"});
     brdf::exporter::WriteAtlas(dir + "/atlas", materials);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "write_ktx2_fixture: %s\n", e.what());

@@ -86,6 +86,7 @@ struct AtlasManifest {
   std::uint32_t payload_crc32 = 0;
 };
 // Throws FormatError naming the member.
-AtlasManifest ParseAtlasManifest(std::string_view json_text, const std::string& file = "<manifest>");
+AtlasManifest ParseAtlasManifest(std::string_view json_text,
+                                 const std::string& file = "<manifest>");
 
 }  // namespace brdf::exporter

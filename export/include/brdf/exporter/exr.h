@@ -67,8 +67,8 @@ void WritePngComposite(const std::string& path, const Lut& lut);
 std::vector<unsigned char> ToneMapForPng(const FloatImage& image);
 
 struct ExrFile {
-  FloatImage image;               // R, G, B as float whatever the stored type
-  StringAttributes attributes;    // every string attribute of the header
+  FloatImage image;             // R, G, B as float whatever the stored type
+  StringAttributes attributes;  // every string attribute of the header
   ExrPixelType pixel_type = ExrPixelType::kFloat;
   std::string Attribute(const std::string& name) const;  // "" when absent
 };

@@ -13,9 +13,9 @@ namespace brdf::exporter {
 
 // Grazing extrapolation parameters of DESIGN §6 used to fill θout between θb and 90°.
 struct ExtrapolationInfo {
-  double p = 1.0;            // value factor at 90° (1 = clamping)
-  double l = 0.5;            // Bézier control abscissa in [0, 1] (0.5 = linear ramp)
-  double theta_b_deg = 75;   // the last measured θout of the data
+  double p = 1.0;           // value factor at 90° (1 = clamping)
+  double l = 0.5;           // Bézier control abscissa in [0, 1] (0.5 = linear ramp)
+  double theta_b_deg = 75;  // the last measured θout of the data
 };
 
 struct TextureMetadata {
@@ -53,9 +53,21 @@ struct GridLayout {
 GridLayout SquareishGrid(int count);
 
 // The texel conventions of DESIGN §5, in words, for sidecars, manifests and shader snippets.
-// Centre-exact (ours): u = (φd/1° + 0.5)/361, v = (θd/1° + 0.5)/181, w = (θin/Δin + 0.5)/K.
+// Centre-exact (ours): u = (φd/1° + 0.5)/361, v = (θd/1° + 0.5)/181, w = (θin/Δin + 0.5)/K
+// (with θin − θin,0 in place of θin when the first slice is not at 0°). In a shader
+// (ShaderSnippetGlsl), with ω_d = S(θin)·ω_out the view direction in the specular frame:
+//   float theta_d = degrees(acos(clamp(w_d.z, -1.0, 1.0)));
+//   float phi_d = degrees(atan(w_d.y, w_d.x)); if (phi_d < 0.0) phi_d += 360.0;
+//   vec3 f = texture(lut, vec3((phi_d + 0.5) / 361.0, (theta_d + 0.5) / 181.0,
+//                              (theta_in_deg / DELTA_IN_DEG + 0.5) / K)).rgb;
+// The sampler uses linear filtering and CLAMP_TO_EDGE on all three axes; f is f_r in 1/sr
+// (multiply by cosθout and the light for radiance). The published form
+//   vec3(phi_d / 360.0, theta_d / 180.0, theta_in_deg / THETA_IN_MAX_DEG)
+// is half a texel off on every axis.
 std::string TexelCentreFormula();
 // The published formula u = φd/2π, v = θd/π, w = θin/θin,max, which drops the half-texel term.
 std::string PublishedFormula();
+// The GLSL lookup above as one text (DELTA_IN_DEG and K filled in).
+std::string ShaderSnippetGlsl(double delta_in_deg, int slices);
 
 }  // namespace brdf::exporter
