@@ -7,6 +7,8 @@
 #
 #   bench/e2e/convert_batch.sh [BUILD_DIR [REPETITIONS [JOBS]]]
 #
+# BRDF_CONVERT_ARGS adds options to every `brdf convert` run (e.g. "--exr-type half").
+#
 # Needs the targets brdf and bench_e2e_io_floor built in BUILD_DIR (default: build). The 216
 # captures are made once with `brdf capture --device sim` (18 library materials × 12 noise
 # seeds, the reference instrument's geometry and noise) and cached in BUILD_DIR/bench-e2e/;
@@ -19,6 +21,7 @@ build=${1:-build}
 reps=${2:-3}
 jobs=${3:-2}
 count=216
+read -r -a extra <<< "${BRDF_CONVERT_ARGS:-}"
 brdf=$build/tools/brdf
 floor=$build/bench/bench_e2e_io_floor
 work=$build/bench-e2e
@@ -64,7 +67,7 @@ for ((r = 1; r <= reps; ++r)); do
   out=$work/out_$r
   rm -rf "$out"
   sync
-  /usr/bin/time -v -o "$work/time_$r.txt" "$brdf" convert "$caps" --out "$out" --jobs "$jobs" --quiet \
+  /usr/bin/time -v -o "$work/time_$r.txt" "$brdf" convert "$caps" --out "$out" --jobs "$jobs" --quiet "${extra[@]}" \
     > "$work/convert_$r.log"
   walls+=("$(wall_seconds "$work/time_$r.txt")")
   cpus+=("$(awk -F': ' '/User time|System time/ {s += $2} END {print s}' "$work/time_$r.txt")")
@@ -103,8 +106,8 @@ fp=$(printf '%s\n' "${plain[@]}" | median)
 fd=$(printf '%s\n' "${durable[@]}" | median)
 awk -v n="$n" -v w="$w" -v c="$c" -v m="$m" -v fp="$fp" -v fd="$fd" -v ib="$in_bytes" \
     -v ob="$out_bytes" -v of="$out_files" -v reps="$reps" -v jobs="$jobs" \
-    -v l0="$load_start" -v l1="$load_end" 'BEGIN {
-  printf "brdf convert: %d captures (%.0f MB) -> %d files (%.0f MB), --jobs %d, %d repetitions\n", n, ib / 1e6, of, ob / 1e6, jobs, reps
+    -v l0="$load_start" -v l1="$load_end" -v x="${BRDF_CONVERT_ARGS:-}" 'BEGIN {
+  printf "brdf convert: %d captures (%.0f MB) -> %d files (%.0f MB), --jobs %d %s, %d repetitions\n", n, ib / 1e6, of, ob / 1e6, jobs, x, reps
   printf "load average at start %s, at end %s\n", l0, l1
   printf "median wall              %8.2f s   (%.1f ms per capture)\n", w, 1000 * w / n
   printf "median CPU (user+sys)    %8.2f s   (%.1f ms per capture)\n", c, 1000 * c / n

@@ -155,6 +155,12 @@ void OutputGuard::RemoveNew() const {
   }
 }
 
+exporter::ExrPixelType ParseExrPixelType(const std::string& text) {
+  if (text == "float") return exporter::ExrPixelType::kFloat;
+  if (text == "half") return exporter::ExrPixelType::kHalf;
+  throw InvalidArgument("--exr-type: expected 'float' or 'half', got '" + text + "'");
+}
+
 std::string ReasonWithoutPath(const std::string& path, const std::string& message) {
   if (message.size() > path.size() + 2 && message.compare(0, path.size(), path) == 0 &&
       message.compare(path.size(), 2, ": ") == 0)

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "brdf/exporter/exr.h"
 #include "commands.h"
 #include "sources.h"
 
@@ -79,6 +80,9 @@ class OutputGuard {
   std::vector<std::string> paths_;
   std::vector<Identity> before_;
 };
+
+// "float" or "half" (--exr-type) as the exporter's pixel type; throws InvalidArgument otherwise.
+exporter::ExrPixelType ParseExrPixelType(const std::string& text);
 
 // "<path>: <reason>" → reason, for the summary (messages of this toolchain start with the path).
 std::string ReasonWithoutPath(const std::string& path, const std::string& message);

@@ -39,6 +39,7 @@ struct ConvertOptions {
   std::string out;                  // output folder (created if missing)
   std::string extrapolate;          // "P,L"; empty: per-material JSON, else 1,0.5
   std::string formats = kAllLutFormats;
+  std::string exr_type = "float";  // EXR pixel type: "float" or "half"
   int jobs = DefaultJobs();
   bool quiet = false;  // no progress bar
 };
@@ -48,6 +49,7 @@ struct AtlasOptions {
   std::vector<std::string> inputs;  // files and folders
   std::string out;                  // prefix: writes PREFIX.ktx2, .dds, .exr, .json
   std::string extrapolate;
+  std::string exr_type = "float";
   int jobs = DefaultJobs();
   bool quiet = false;
 };

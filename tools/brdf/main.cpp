@@ -178,6 +178,11 @@ int main(int argc, char** argv) {
   convert_cmd->add_option("--formats", convert.formats, "Comma-separated outputs to write")
       ->capture_default_str();
   convert_cmd
+      ->add_option("--exr-type", convert.exr_type,
+                   "EXR pixel type: float, or half (faster to write, a quarter of the bytes)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"float", "half"}));
+  convert_cmd
       ->add_option("--jobs", convert.jobs,
                    "Inputs converted in parallel (default: hardware threads)")
       ->capture_default_str()
@@ -215,6 +220,9 @@ int main(int argc, char** argv) {
       ->add_option("--extrapolate", atlas.extrapolate,
                    "Grazing extrapolation P,L for inputs without their own; default 1,0.5")
       ->capture_default_str();
+  atlas_cmd->add_option("--exr-type", atlas.exr_type, "EXR pixel type: float or half")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"float", "half"}));
   atlas_cmd->add_option("--jobs", atlas.jobs, "Inputs resampled in parallel")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
