@@ -50,7 +50,9 @@ int main(int argc, char** argv) {
   brdf::cli::EvalOptions eval;
   std::string eval_in, eval_out;
   auto* eval_cmd = app.add_subcommand(
-      "eval", "Print f_r (1/sr, linear RGB) of a BRDF source for one pair of directions");
+      "eval",
+      "Print f_r (1/sr, linear RGB) of a material, capture or exported LUT for a pair of "
+      "directions (or many, with --pairs)");
   eval_cmd
       ->add_option("file", eval.file,
                    "Material file (.json), capture (.bpc), exported LUT (.ktx2, .dds) or "
