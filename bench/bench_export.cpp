@@ -102,6 +102,19 @@ void BM_WriteExrHalf(benchmark::State& state) {
 }
 BENCHMARK(BM_WriteExrHalf)->Unit(benchmark::kMillisecond)->UseRealTime();
 
+void BM_WriteExrFloatUncompressed(benchmark::State& state) {
+  for (auto _ : state)
+    WriteExrComposite(Dir() + "/ggx_raw.exr", GgxLut(), Meta(),
+                      {ExrPixelType::kFloat, ExrCompression::kNone});
+}
+BENCHMARK(BM_WriteExrFloatUncompressed)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_ToneMapForPng(benchmark::State& state) {
+  const FloatImage image = CompositeImage(GgxLut());
+  for (auto _ : state) benchmark::DoNotOptimize(ToneMapForPng(image));
+}
+BENCHMARK(BM_ToneMapForPng)->Unit(benchmark::kMillisecond);
+
 void BM_WritePng(benchmark::State& state) {
   for (auto _ : state) WritePngComposite(Dir() + "/ggx.png", GgxLut());
 }

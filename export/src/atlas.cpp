@@ -187,7 +187,7 @@ std::string AtlasManifestJson(const Atlas& atlas, const std::vector<std::string>
 
 std::vector<std::string> WriteAtlas(const std::string& prefix,
                                     const std::vector<AtlasMaterial>& materials,
-                                    ExrPixelType exr_type) {
+                                    const ExrOptions& exr_options) {
   const Atlas atlas = BuildAtlas(materials);
   const std::string stem = std::filesystem::path(prefix).filename().string();
   const std::vector<std::string> files = {stem + ".ktx2", stem + ".dds", stem + ".exr",
@@ -198,7 +198,7 @@ std::vector<std::string> WriteAtlas(const std::string& prefix,
   written.push_back(prefix + ".ktx2");
   WriteDds(prefix + ".dds", atlas.volume);
   written.push_back(prefix + ".dds");
-  WriteExr(prefix + ".exr", AtlasImage(materials), exr_type,
+  WriteExr(prefix + ".exr", AtlasImage(materials), exr_options,
            {{"brdf:atlas", manifest},
             {"brdf:theta_in_deg", FormatThetaList(atlas.theta_in_deg)},
             {"brdf:layout",

@@ -66,7 +66,7 @@ LutExportResult ExportLut(const std::string& out_dir, const Lut& lut, TextureMet
     result.written.push_back(path(".dds"));
   }
   if (f.exr) {
-    WriteExrComposite(path(".exr"), lut, packed, metadata, options.exr_type);
+    WriteExrComposite(path(".exr"), lut, packed, metadata, options.exr);
     result.written.push_back(path(".exr"));
   }
   if (f.png) {

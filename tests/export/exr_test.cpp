@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <filesystem>
 
 #include <OpenImageIO/imageio.h>
 #include <nlohmann/json.hpp>
@@ -131,6 +132,17 @@ TEST(Exr, HalfPrecisionStoresHalfsWithinTheirRounding) {
   }
 }
 
+TEST(Exr, UncompressedFilesHoldTheSameValues) {
+  const std::string dir = test::TestDir("exr_raw");
+  const Lut lut = test::AnalyticLut(test::Lafortune20(), {0, 20, 40, 60});
+  WriteExrComposite(dir + "/zip.exr", lut, Meta());
+  WriteExrComposite(dir + "/raw.exr", lut, Meta(), {ExrPixelType::kFloat, ExrCompression::kNone});
+  EXPECT_EQ(ReadExr(dir + "/raw.exr").image.rgb, ReadExr(dir + "/zip.exr").image.rgb);
+  // Uncompressed float RGB: at least 722·362·3·4 bytes of pixels.
+  EXPECT_GE(std::filesystem::file_size(dir + "/raw.exr"), 722u * 362u * 12u);
+  EXPECT_LT(std::filesystem::file_size(dir + "/zip.exr"), 722u * 362u * 12u);
+}
+
 TEST(Png, ToneMappedCompositeIs722By362EightBitRgb) {
   const std::string dir = test::TestDir("png");
   const Lut lut = test::AnalyticLut(test::Ggx03(), {0, 20, 40, 60});
@@ -159,6 +171,28 @@ TEST(Png, ToneMapSendsThe99thPercentileToWhiteAndZeroToBlack) {
   const double srgb_half = 1.055 * std::pow(0.5, 1.0 / 2.4) - 0.055;
   EXPECT_EQ(out[3 * 33], static_cast<unsigned char>(std::lround(255 * srgb_half)));
   for (int p = 1; p <= 100; ++p) EXPECT_GE(out[3 * p], out[3 * (p - 1)]);  // monotone
+}
+
+TEST(Png, ToneMapFollowsTheDocumentedFormulaAcrossTheRange) {
+  // Two grey pixels: g and 1. L99 is the larger (index round(0.99 · 1) = 1), so s = 1 and
+  // pixel 0 becomes round(255 · sRGB(2g / (1 + g))), computed here in double.
+  int exact = 0, total = 0;
+  for (int n = 1; n <= 20000; ++n) {
+    const double g = n / 20000.0;
+    FloatImage image;
+    image.width = 2;
+    image.height = 1;
+    image.rgb = {static_cast<float>(g), static_cast<float>(g), static_cast<float>(g), 1, 1, 1};
+    const double mapped = 2 * g / (1 + g);
+    const double srgb =
+        mapped <= 0.0031308 ? 12.92 * mapped : 1.055 * std::pow(mapped, 1 / 2.4) - 0.055;
+    const long want = std::lround(255 * srgb);
+    const int got = ToneMapForPng(image)[0];
+    ASSERT_LE(std::abs(got - want), 1) << g;  // float vs double at a rounding boundary
+    exact += got == want;
+    ++total;
+  }
+  EXPECT_GE(exact, total - total / 1000);
 }
 
 }  // namespace

@@ -49,7 +49,7 @@ TEST(ExportLut, WritesOnlyTheSelectedFormats) {
   const Lut lut = test::PatternLut({0, 20}, 9);
   TextureMetadata meta;
   meta.name = "p";
-  ExportLut(dir, lut, meta, {ParseExportFormats("dds,json"), ExrPixelType::kHalf});
+  ExportLut(dir, lut, meta, {ParseExportFormats("dds,json"), {ExrPixelType::kHalf}});
   EXPECT_EQ(Listing(dir), (std::vector<std::string>{"p.dds", "p.json"}));
   EXPECT_EQ(ReadSidecar(dir + "/p.json").files, std::vector<std::string>{"p.dds"});
 }

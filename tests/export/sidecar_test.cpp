@@ -50,7 +50,8 @@ TEST(Sidecar, HoldsEveryFieldDesignSection7Names) {
   EXPECT_NE(glsl.find("(phi_d + 0.5) / 361.0"), std::string::npos) << glsl;
   EXPECT_NE(glsl.find("(theta_d + 0.5) / 181.0"), std::string::npos) << glsl;
   EXPECT_NE(glsl.find("(theta_in_deg / 20.0 + 0.5) / 4.0"), std::string::npos) << glsl;
-  EXPECT_NE(glsl.find("theta_in_deg / 60.0)"), std::string::npos) << glsl;  // published: θin/θin,max
+  EXPECT_NE(glsl.find("theta_in_deg / 60.0)"), std::string::npos)
+      << glsl;  // published: θin/θin,max
   EXPECT_EQ(j["extrapolation"]["p"], 0.2);
   EXPECT_EQ(j["extrapolation"]["l"], 0.3);
   EXPECT_EQ(j["extrapolation"]["theta_b_deg"], 75.0);

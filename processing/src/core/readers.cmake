@@ -6,4 +6,10 @@ target_sources(brdf_core PRIVATE
   src/core/readers/csv.cpp
   src/core/readers/gonio.cpp
   src/core/readers/importers.cpp
+  src/core/readers/rgl_tensor.cpp
+  src/core/readers/rgl_brdf.cpp
+)
+target_sources(brdf_core PRIVATE
+  src/core/readers/merl.cpp
+  src/core/sha256.cpp
 )

@@ -66,7 +66,7 @@ std::string AtlasManifestJson(const Atlas& atlas, const std::vector<std::string>
 // the EXR ("brdf:atlas"). Throws InvalidArgument / IoError.
 std::vector<std::string> WriteAtlas(const std::string& prefix,
                                     const std::vector<AtlasMaterial>& materials,
-                                    ExrPixelType exr_type = ExrPixelType::kFloat);
+                                    const ExrOptions& exr_options = {});
 
 // Material m's cell of an atlas volume, decoded into a LUT with the given θin list.
 Lut ExtractAtlasCell(const PackedVolume& atlas_volume, const AtlasLayout& layout, int m,

@@ -6,8 +6,9 @@
 // grid in each cell instead (atlas.h). Pixel values are the LUT's floats, not the RGB9E5
 // quantised ones, so the EXR is the reference the textures can be compared against.
 //
-// EXR: channels R, G, B, half or float, ZIP compression; the metadata travels as string
-// header attributes: "brdf:sidecar" (the full sidecar JSON, or "brdf:atlas" for an atlas
+// EXR: channels R, G, B, half or float, ZIP (default) or no compression (half holds values up to
+// 65504; larger ones become +inf, whereas the RGB9E5 textures clamp at 65408); the metadata travels
+// as string header attributes: "brdf:sidecar" (the full sidecar JSON, or "brdf:atlas" for an atlas
 // manifest), "brdf:theta_in_deg" ("0, 20, 40, 60"), "brdf:layout" ("2 x 2 slices, row-major,
 // ascending theta_in, top-left first"), "brdf:texel_convention", "brdf:payload_crc32", and
 // "Software".
@@ -31,6 +32,18 @@
 namespace brdf::exporter {
 
 enum class ExrPixelType { kHalf, kFloat };
+// ZIP (deflate, 16 scanlines) shrinks a half composite about 7× and a float one about 1.5×
+// at two to three times the writing time (bench_export); kNone is the fastest.
+enum class ExrCompression { kZip, kNone };
+
+struct ExrOptions {
+  // Implicit from a pixel type, so `WriteExr(path, image, ExrPixelType::kHalf, ...)` reads well.
+  ExrOptions(ExrPixelType pixel_type = ExrPixelType::kFloat,  // NOLINT(google-explicit-constructor)
+             ExrCompression compression_kind = ExrCompression::kZip)
+      : type(pixel_type), compression(compression_kind) {}
+  ExrPixelType type;
+  ExrCompression compression;
+};
 
 // Interleaved RGB floats, row-major, row 0 at the top.
 struct FloatImage {
@@ -51,14 +64,14 @@ using StringAttributes = std::vector<std::pair<std::string, std::string>>;
 
 // Writes an RGB EXR atomically (OIIO writes a temporary sibling that is renamed into place).
 // Throws IoError when OpenImageIO cannot create or write the file.
-void WriteExr(const std::string& path, const FloatImage& image, ExrPixelType type,
+void WriteExr(const std::string& path, const FloatImage& image, const ExrOptions& options,
               const StringAttributes& attributes);
 // The composite of a LUT with the sidecar's metadata in its header. `packed` is PackLut(lut)
 // (for the checksum); the overload without it packs the LUT itself.
 void WriteExrComposite(const std::string& path, const Lut& lut, const PackedVolume& packed,
-                       const TextureMetadata& metadata, ExrPixelType type = ExrPixelType::kFloat);
+                       const TextureMetadata& metadata, const ExrOptions& options = {});
 void WriteExrComposite(const std::string& path, const Lut& lut, const TextureMetadata& metadata,
-                       ExrPixelType type = ExrPixelType::kFloat);
+                       const ExrOptions& options = {});
 
 // The tone-mapped 8-bit sRGB PNG described above, written atomically.
 void WritePng(const std::string& path, const FloatImage& image);

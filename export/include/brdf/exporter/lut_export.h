@@ -27,7 +27,7 @@ LutExportFormats ParseExportFormats(std::string_view list);
 
 struct LutExportOptions {
   LutExportFormats formats;
-  ExrPixelType exr_type = ExrPixelType::kFloat;
+  ExrOptions exr;
 };
 
 struct LutExportResult {

@@ -23,7 +23,7 @@ struct PackedVolume {
   std::size_t Index(int x, int y, int z) const {
     return (static_cast<std::size_t>(z) * height + y) * width + x;
   }
-  // Payload size in bytes (4 per texel): 1,045,444 for one LUT of K = 4.
+  // Payload size in bytes (4 per texel): 361·181·4·4 = 1,045,456 for one LUT of K = 4.
   std::size_t ByteSize() const { return words.size() * 4; }
   // The payload as stored in the files: each word little-endian, in Index order.
   std::string Bytes() const;

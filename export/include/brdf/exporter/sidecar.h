@@ -10,7 +10,8 @@
 // Checksum: CRC-32 (IEEE 802.3, reflected polynomial 0xEDB88320, as zlib's crc32) of the
 // RGB9E5 payload bytes exactly as stored in the KTX2 level 0 image and the DDS data: 4 bytes
 // per texel, little-endian words, x fastest then y (rows, top first) then z (slices, θin
-// ascending). The payload size is recorded too (1,045,444 bytes for K = 4).
+// ascending). The payload size is recorded too: 361·181·K·4 bytes, 1,045,456 for K = 4
+// (DESIGN §5 prints 1,045,444, an arithmetic slip for the same product).
 //
 // Example (abridged):
 //   { "kind": "brdf-lut-sidecar", "format_version": 1, "name": "gold", "source": "gold.bpc",
@@ -20,7 +21,7 @@
 //                           "published": "u = phi_d/(2 pi), ..." },
 //     "extrapolation": { "p": 1, "l": 0.5, "theta_b_deg": 75, ... },
 //     "fitted_models": [], "tool": { "name": "brdf-toolchain", "version": "0.1.0" },
-//     "payload": { "bytes": 1045444, "checksum": { "algorithm": "crc32", "value": "0x…" } },
+//     "payload": { "bytes": 1045456, "checksum": { "algorithm": "crc32", "value": "0x…" } },
 //     "files": ["gold.ktx2", "gold.dds"] }
 #pragma once
 
