@@ -155,10 +155,21 @@ void OutputGuard::RemoveNew() const {
   }
 }
 
-exporter::ExrPixelType ParseExrPixelType(const std::string& text) {
-  if (text == "float") return exporter::ExrPixelType::kFloat;
-  if (text == "half") return exporter::ExrPixelType::kHalf;
-  throw InvalidArgument("--exr-type: expected 'float' or 'half', got '" + text + "'");
+exporter::ExrOptions ParseExrOptions(const std::string& type, const std::string& compression) {
+  exporter::ExrOptions options;
+  if (type == "float")
+    options.type = exporter::ExrPixelType::kFloat;
+  else if (type == "half")
+    options.type = exporter::ExrPixelType::kHalf;
+  else
+    throw InvalidArgument("--exr-type: expected 'float' or 'half', got '" + type + "'");
+  if (compression == "zip")
+    options.compression = exporter::ExrCompression::kZip;
+  else if (compression == "none")
+    options.compression = exporter::ExrCompression::kNone;
+  else
+    throw InvalidArgument("--exr-compression: expected 'zip' or 'none', got '" + compression + "'");
+  return options;
 }
 
 std::string ReasonWithoutPath(const std::string& path, const std::string& message) {

@@ -81,8 +81,9 @@ class OutputGuard {
   std::vector<Identity> before_;
 };
 
-// "float" or "half" (--exr-type) as the exporter's pixel type; throws InvalidArgument otherwise.
-exporter::ExrPixelType ParseExrPixelType(const std::string& text);
+// --exr-type ("float" or "half") and --exr-compression ("zip" or "none") as the exporter's EXR
+// options; throws InvalidArgument naming a bad value.
+exporter::ExrOptions ParseExrOptions(const std::string& type, const std::string& compression);
 
 // "<path>: <reason>" → reason, for the summary (messages of this toolchain start with the path).
 std::string ReasonWithoutPath(const std::string& path, const std::string& message);

@@ -28,7 +28,8 @@ int RunAtlas(const AtlasOptions& options) {
   std::optional<processing::ExtrapolationParams> extrapolate;
   if (!options.extrapolate.empty())
     extrapolate = processing::ParseExtrapolation(options.extrapolate);
-  const exporter::ExrPixelType exr_type = ParseExrPixelType(options.exr_type);
+  const exporter::ExrOptions exr_options =
+      ParseExrOptions(options.exr_type, options.exr_compression);
   if (options.jobs < 1)
     throw InvalidArgument("--jobs: expected at least 1, got " + std::to_string(options.jobs));
 
@@ -103,7 +104,7 @@ int RunAtlas(const AtlasOptions& options) {
   std::vector<std::string> written;
   try {
     // BuildAtlas inside WriteAtlas refuses different θin sets, naming both materials.
-    written = exporter::WriteAtlas(options.out, materials, exr_type);
+    written = exporter::WriteAtlas(options.out, materials, exr_options);
   } catch (...) {
     guard.RemoveNew();
     throw;

@@ -91,7 +91,7 @@ int RunConvert(const ConvertOptions& options) {
   if (options.out.empty()) throw InvalidArgument("--out: an output folder is required");
   exporter::LutExportOptions export_options;
   export_options.formats = exporter::ParseExportFormats(options.formats);
-  export_options.exr_type = ParseExrPixelType(options.exr_type);
+  export_options.exr = ParseExrOptions(options.exr_type, options.exr_compression);
   std::optional<processing::ExtrapolationParams> extrapolate;
   if (!options.extrapolate.empty())
     extrapolate = processing::ParseExtrapolation(options.extrapolate);

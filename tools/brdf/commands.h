@@ -39,7 +39,8 @@ struct ConvertOptions {
   std::string out;                  // output folder (created if missing)
   std::string extrapolate;          // "P,L"; empty: per-material JSON, else 1,0.5
   std::string formats = kAllLutFormats;
-  std::string exr_type = "float";  // EXR pixel type: "float" or "half"
+  std::string exr_type = "float";       // EXR pixel type: "float" or "half"
+  std::string exr_compression = "zip";  // EXR compression: "zip" or "none"
   int jobs = DefaultJobs();
   bool quiet = false;  // no progress bar
 };
@@ -50,6 +51,7 @@ struct AtlasOptions {
   std::string out;                  // prefix: writes PREFIX.ktx2, .dds, .exr, .json
   std::string extrapolate;
   std::string exr_type = "float";
+  std::string exr_compression = "zip";
   int jobs = DefaultJobs();
   bool quiet = false;
 };

@@ -55,8 +55,8 @@ int main(int argc, char** argv) {
       "directions (or many, with --pairs)");
   eval_cmd
       ->add_option("file", eval.file,
-                   "Material file (.json), capture (.bpc), exported LUT (.ktx2, .dds) or "
-                   "LUT sidecar (.json)")
+                   "Material file (.json), capture (.bpc), exported LUT (.ktx2, .dds), LUT "
+                   "sidecar (.json), or measured data (.bsdf RGL, .binary MERL)")
       ->required();
   auto* eval_in_opt = eval_cmd->add_option("--in", eval_in, "Light direction THETA,PHI in degrees")
                           ->check(AnglePairValidator());
@@ -181,9 +181,15 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   convert_cmd
       ->add_option("--exr-type", convert.exr_type,
-                   "EXR pixel type: float, or half (faster to write, a quarter of the bytes)")
+                   "EXR pixel type: float, or half (faster to write, smaller)")
       ->capture_default_str()
       ->check(CLI::IsMember({"float", "half"}));
+  convert_cmd
+      ->add_option("--exr-compression", convert.exr_compression,
+                   "EXR compression: zip, or none (float EXRs: about 1.25× the bytes, several "
+                   "times faster to write)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"zip", "none"}));
   convert_cmd
       ->add_option("--jobs", convert.jobs,
                    "Inputs converted in parallel (default: hardware threads)")
@@ -225,6 +231,9 @@ int main(int argc, char** argv) {
   atlas_cmd->add_option("--exr-type", atlas.exr_type, "EXR pixel type: float or half")
       ->capture_default_str()
       ->check(CLI::IsMember({"float", "half"}));
+  atlas_cmd->add_option("--exr-compression", atlas.exr_compression, "EXR compression: zip or none")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"zip", "none"}));
   atlas_cmd->add_option("--jobs", atlas.jobs, "Inputs resampled in parallel")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);

@@ -395,10 +395,13 @@ std::unique_ptr<BrdfSource> OpenEvalSource(
                             "an exported LUT");
       return std::make_unique<LutBrdf>(std::move(t.texture.lut), OutputNameOf(path));
     }
+    case FileKind::kUnknown:
+      // Measured databases and whatever else the core library opens (.bsdf, .binary, ...).
+      return OpenBrdfSource(path);
     default:
       throw InvalidArgument(path + ": cannot evaluate a " + std::string(FileKindName(kind)) +
-                            " (brdf eval reads material .json, .bpc, .ktx2, .dds and LUT "
-                            "sidecar .json files)");
+                            " (brdf eval reads material .json, .bpc, .ktx2, .dds, LUT "
+                            "sidecar .json, and the measured formats of brdf::OpenBrdfSource)");
   }
 }
 

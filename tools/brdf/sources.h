@@ -140,8 +140,9 @@ class LutBrdf final : public BrdfSource {
 
 // Opens any evaluable file for `brdf eval`: a material file (analytic), a .bpc capture
 // (interpolated by processing::MeasurementBrdf with the extrapolation ChooseExtrapolation
-// picks), a .ktx2 / .dds LUT or a sidecar (LutBrdf). Atlases are refused (they hold many
-// materials). Warnings (an unfinished capture, a DDS without sidecar whose θin list is
+// picks), a .ktx2 / .dds LUT or a sidecar (LutBrdf); any other file goes to
+// brdf::OpenBrdfSource (measured databases: RGL .bsdf, MERL .binary). Atlases are refused (they
+// hold many materials). Warnings (an unfinished capture, a DDS without sidecar whose θin list is
 // assumed) are appended to `warnings`.
 std::unique_ptr<BrdfSource> OpenEvalSource(
     const std::string& path, const std::optional<processing::ExtrapolationParams>& command_line,
