@@ -39,8 +39,11 @@ struct ConvertOptions {
   std::string out;                  // output folder (created if missing)
   std::string extrapolate;          // "P,L"; empty: per-material JSON, else 1,0.5
   std::string formats = kAllLutFormats;
-  std::string exr_type = "float";       // EXR pixel type: "float" or "half"
-  std::string exr_compression = "zip";  // EXR compression: "zip" or "none"
+  std::string exr_type = "float";  // EXR pixel type: "float" or "half"
+  // EXR compression: "none" or "zip". None by default: ZIP shrinks a float composite of
+  // measured (noisy) data by only ~20 % and costs more than everything else of a conversion
+  // (docs/benchmarks.md).
+  std::string exr_compression = "none";
   int jobs = DefaultJobs();
   bool quiet = false;  // no progress bar
 };
