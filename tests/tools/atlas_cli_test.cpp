@@ -58,6 +58,14 @@ TEST_F(AtlasCommand, EachCellEqualsThatMaterialsOwnLut) {
           differing += atlas.Word(x0 + i, y0 + j, k) != own.Word(i, j, k);
     EXPECT_EQ(differing, 0u);
   }
+  // The same atlas from the exported LUTs instead of the material files: identical texels.
+  std::string ktx2_args;
+  for (const auto& [name, m] : mats) ktx2_args += " " + Quote(dir_ / "own" / (name + ".ktx2"));
+  const ToolRun again =
+      RunTool("atlas" + ktx2_args + " --out " + Quote(dir_ / "again" / "atlas") + " --quiet", dir_);
+  ASSERT_EQ(again.exit_code, 0) << again.out << again.err;
+  EXPECT_TRUE(ReadKtx2Layout(dir_ / "again" / "atlas.ktx2").payload == atlas.payload);
+
   // The fourth cell (column 1, row 1) is unused and zero.
   std::size_t non_zero = 0;
   for (std::size_t k = 0; k < 4; ++k)
