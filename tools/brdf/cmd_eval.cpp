@@ -1,11 +1,22 @@
+// `brdf eval FILE --in T,P --out T,P`: f_r of any evaluable file for one pair of directions.
+// Material files are evaluated analytically, captures interpolated (processing::MeasurementBrdf,
+// with the extrapolation `brdf convert` would use), exported LUTs sampled exactly as a GPU
+// samples the texture (sources.h, LutBrdf), so a texel can be checked against its source.
+#include <cmath>
 #include <cstdio>
+#include <iostream>
 #include <memory>
+#include <optional>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include "brdf/core/brdf_source.h"
 #include "brdf/core/error.h"
+#include "brdf/core/file_util.h"
 #include "brdf/core/geometry.h"
-#include "cli_support.h"
 #include "commands.h"
+#include "sources.h"
 
 namespace brdf::cli {
 
@@ -18,16 +29,70 @@ void CheckPolar(double theta_deg, const char* which) {
                           std::to_string(theta_deg));
 }
 
+struct Pair {
+  double theta_in_deg, phi_in_deg, theta_out_deg, phi_out_deg;
+};
+
+// Reads the --pairs list (at most 64 MiB).
+std::vector<Pair> ReadPairs(const std::string& path) {
+  std::string text;
+  if (path == "-") {
+    std::ostringstream all;
+    all << std::cin.rdbuf();
+    text = all.str();
+  } else {
+    text = ReadFileText(path, 64u << 20);
+  }
+  const std::string name = path == "-" ? "<stdin>" : path;
+  std::vector<Pair> pairs;
+  std::istringstream lines(text);
+  std::string line;
+  for (std::uint64_t n = 1; std::getline(lines, line); ++n) {
+    const auto first = line.find_first_not_of(" \t\r");
+    if (first == std::string::npos || line[first] == '#') continue;
+    std::string spaced = line;
+    for (char& c : spaced)
+      if (c == ',') c = ' ';
+    std::istringstream in(spaced);
+    Pair p{};
+    std::string rest;
+    if (!(in >> p.theta_in_deg >> p.phi_in_deg >> p.theta_out_deg >> p.phi_out_deg) || (in >> rest))
+      throw FormatError(name, LinePosition(n),
+                        "four angles in degrees: THETA_IN PHI_IN THETA_OUT PHI_OUT",
+                        "'" + line + "'");
+    if (!(p.theta_in_deg >= 0 && p.theta_in_deg <= 90 && p.theta_out_deg >= 0 &&
+          p.theta_out_deg <= 90 && std::isfinite(p.phi_in_deg) && std::isfinite(p.phi_out_deg)))
+      throw FormatError(name, LinePosition(n), "polar angles in [0, 90] and finite azimuths",
+                        "'" + line + "'");
+    pairs.push_back(p);
+  }
+  return pairs;
+}
+
 }  // namespace
 
 int RunEval(const EvalOptions& options) {
-  CheckPolar(options.theta_in_deg, "in");
-  CheckPolar(options.theta_out_deg, "out");
-  const std::unique_ptr<BrdfSource> source = OpenBrdfSource(options.file);
-  const Vec3 wi = SphericalDirectionDeg(options.theta_in_deg, options.phi_in_deg);
-  const Vec3 wo = SphericalDirectionDeg(options.theta_out_deg, options.phi_out_deg);
-  const Rgb f = source->Eval(wi, wo);
-  std::printf("%.9g %.9g %.9g\n", f[0], f[1], f[2]);
+  std::vector<Pair> pairs;
+  if (!options.pairs.empty()) {
+    pairs = ReadPairs(options.pairs);
+  } else {
+    CheckPolar(options.theta_in_deg, "in");
+    CheckPolar(options.theta_out_deg, "out");
+    pairs.push_back(
+        {options.theta_in_deg, options.phi_in_deg, options.theta_out_deg, options.phi_out_deg});
+  }
+  std::optional<processing::ExtrapolationParams> extrapolate;
+  if (!options.extrapolate.empty())
+    extrapolate = processing::ParseExtrapolation(options.extrapolate);
+  std::vector<std::string> warnings;
+  const std::unique_ptr<BrdfSource> source = OpenEvalSource(options.file, extrapolate, &warnings);
+  for (const std::string& w : warnings) std::fprintf(stderr, "%s\n", w.c_str());
+  for (const Pair& p : pairs) {
+    const Vec3 wi = SphericalDirectionDeg(p.theta_in_deg, p.phi_in_deg);
+    const Vec3 wo = SphericalDirectionDeg(p.theta_out_deg, p.phi_out_deg);
+    const Rgb f = source->Eval(wi, wo);
+    std::printf("%.9g %.9g %.9g\n", f[0], f[1], f[2]);
+  }
   return 0;
 }
 

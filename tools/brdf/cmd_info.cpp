@@ -1,9 +1,12 @@
 // `brdf info FILE [--json]`: what a file holds. Dispatches on the file extension; each format
 // has one describer below that fills a JSON document, and the text form is printed from the
-// same document so the two views can never disagree.
+// same document so the two views can never disagree. A .json is told apart by its content
+// (material file, LUT sidecar, atlas manifest).
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <set>
 #include <string>
@@ -19,8 +22,11 @@
 #include "brdf/core/measurement.h"
 #include "brdf/core/models.h"
 #include "brdf/core/zemax.h"
+#include "brdf/exporter/packed_volume.h"
+#include "brdf/exporter/rgb9e5.h"
 #include "cli_support.h"
 #include "commands.h"
+#include "sources.h"
 
 namespace brdf::cli {
 
@@ -296,15 +302,115 @@ bool IsImportedFormat(const Json& j) {
          f == "merl";
 }
 
-// Describers by extension. Other formats (.ktx2, .dds, export sidecars) add a row here; a
-// .json is a material file when it has a "model" member.
+std::string Hex32(std::uint32_t v) {
+  char buf[16];
+  std::snprintf(buf, sizeof buf, "0x%08x", v);
+  return buf;
+}
+
+// An exported LUT or atlas (.ktx2, .dds) or the sidecar / manifest describing one. Value ranges
+// are of the RGB9E5 values as stored (decoded exactly), per θin slice; for an atlas over the
+// cells that hold a material.
+Json DescribeTexture(const std::string& path) {
+  const OpenedTexture t = OpenExportedTexture(path);
+  const exporter::LoadedTexture& tex = t.texture;
+  const exporter::PackedVolume& v = tex.volume;
+  Json j;
+  j["file"] = path;
+  j["format"] = t.manifest || !tex.IsSingleLut() ? "atlas" : "lut";
+  j["texture_file"] = t.texture_path;
+  j["container"] = tex.container == exporter::TextureContainer::kKtx2
+                       ? "KTX2 (vkFormat 123, VK_FORMAT_E5B9G9R9_UFLOAT_PACK32)"
+                       : "DDS (DXGI_FORMAT_R9G9B9E5_SHAREDEXP, 67)";
+  j["file_bytes"] = std::filesystem::file_size(t.texture_path);
+  if (!t.sidecar_path.empty()) j["json_file"] = t.sidecar_path;
+  j["width"] = v.width;
+  j["height"] = v.height;
+  j["slices"] = v.depth;
+  j["theta_in_deg"] = tex.theta_in_deg;
+  j["theta_in_from_metadata"] = tex.theta_in_from_metadata;
+  j["payload_bytes"] = v.ByteSize();
+  j["payload_crc32"] = Hex32(v.Crc32());
+  j["checksum"] = t.checksum_verified ? "verified against the recorded CRC-32"
+                                      : "not verified (no sidecar or manifest)";
+  if (t.sidecar) {
+    j["name"] = t.sidecar->name;
+    j["source"] = t.sidecar->source;
+    j["tool_version"] = t.sidecar->tool_version;
+    if (t.sidecar->extrapolation)
+      j["extrapolation"] = {{"p", t.sidecar->extrapolation->p},
+                            {"l", t.sidecar->extrapolation->l},
+                            {"theta_b_deg", t.sidecar->extrapolation->theta_b_deg}};
+    else
+      j["extrapolation"] = nullptr;
+    j["files"] = t.sidecar->files;
+  }
+  // Cells holding data: the whole texture for a LUT, the materials' cells for an atlas.
+  std::vector<std::array<int, 2>> origins = {{0, 0}};
+  int cell_w = v.width, cell_h = v.height;
+  if (t.manifest) {
+    j["materials"] = Json::array();
+    origins.clear();
+    for (const auto& m : t.manifest->materials) {
+      j["materials"].push_back({{"index", m.index},
+                                {"name", m.name},
+                                {"source", m.source},
+                                {"column", m.column},
+                                {"row", m.row},
+                                {"x0", m.x0},
+                                {"y0", m.y0}});
+      origins.push_back({m.x0, m.y0});
+    }
+    cell_w = Lut::kWidth;
+    cell_h = Lut::kHeight;
+  }
+  j["value_ranges"] = Json::array();
+  for (int k = 0; k < v.depth; ++k) {
+    std::array<double, 3> lo{}, hi{}, sum{};
+    lo.fill(std::numeric_limits<double>::infinity());
+    hi.fill(-std::numeric_limits<double>::infinity());
+    std::size_t n = 0;
+    for (const auto& [x0, y0] : origins)
+      for (int y = y0; y < std::min(y0 + cell_h, v.height); ++y)
+        for (int x = x0; x < std::min(x0 + cell_w, v.width); ++x, ++n) {
+          const std::array<float, 3> rgb = exporter::DecodeRgb9e5(v.words[v.Index(x, y, k)]);
+          for (int c = 0; c < 3; ++c) {
+            lo[c] = std::min<double>(lo[c], rgb[c]);
+            hi[c] = std::max<double>(hi[c], rgb[c]);
+            sum[c] += rgb[c];
+          }
+        }
+    std::array<double, 3> mean{};
+    for (int c = 0; c < 3; ++c) mean[c] = n ? sum[c] / static_cast<double>(n) : 0.0;
+    j["value_ranges"].push_back(
+        {{"theta_in_deg", Number(k < static_cast<int>(tex.theta_in_deg.size()) ? tex.theta_in_deg[k]
+                                                                               : std::nan(""))},
+         {"rgb_min", Triple(lo)},
+         {"rgb_max", Triple(hi)},
+         {"rgb_mean", Triple(mean)}});
+  }
+  j["warnings"] = t.warnings;
+  return j;
+}
+
+// A .json is a material file, a LUT sidecar or an atlas manifest, told apart by content.
+Json DescribeJson(const std::string& path) {
+  const FileKind kind = ClassifyFile(path);
+  if (kind == FileKind::kSidecar || kind == FileKind::kAtlasManifest) return DescribeTexture(path);
+  if (kind == FileKind::kMaterial) return DescribeMaterial(path);
+  throw InvalidArgument(path + ": a " + std::string(FileKindName(kind)) +
+                        "; brdf info reads material files, LUT sidecars and atlas manifests");
+}
+
+// Describers by extension.
 struct Describer {
   const char* extension;
   Json (*describe)(const std::string& path);
 };
 constexpr Describer kDescribers[] = {
-    {".bpc", DescribeBpc},      {".json", DescribeMaterial},   {".bsdf", DescribeImported},
-    {".csv", DescribeImported}, {".binary", DescribeImported},
+    {".bpc", DescribeBpc},         {".json", DescribeJson},     {".ktx2", DescribeTexture},
+    {".dds", DescribeTexture},     {".bsdf", DescribeImported}, {".csv", DescribeImported},
+    {".binary", DescribeImported},
 };
 
 std::string Fixed(const Json& v, const char* format = "%.6g") {
@@ -461,6 +567,58 @@ void PrintImportedText(const Json& j) {
   if (j.contains("advice")) std::printf("note: %s\n", j["advice"].get<std::string>().c_str());
 }
 
+void PrintTextureText(const Json& j) {
+  const bool atlas = j["format"] == "atlas";
+  std::printf("%s: %s, %s\n", j["file"].get<std::string>().c_str(),
+              atlas ? "atlas texture" : "LUT texture", j["container"].get<std::string>().c_str());
+  if (j.contains("json_file"))
+    std::printf("  texture        %s (%s bytes)\n", j["texture_file"].get<std::string>().c_str(),
+                std::to_string(j["file_bytes"].get<std::uint64_t>()).c_str());
+  else
+    std::printf("  file bytes     %s\n",
+                std::to_string(j["file_bytes"].get<std::uint64_t>()).c_str());
+  if (j.contains("name"))
+    std::printf("  name           %s\n", j["name"].get<std::string>().c_str());
+  if (j.contains("source"))
+    std::printf("  source         %s\n", j["source"].get<std::string>().c_str());
+  std::string thetas;
+  for (const auto& t : j["theta_in_deg"]) thetas += (thetas.empty() ? "" : ", ") + Fixed(t, "%g");
+  std::printf("  dimensions     %d × %d × %d texels (RGB9E5)\n", j["width"].get<int>(),
+              j["height"].get<int>(), j["slices"].get<int>());
+  std::printf("  theta_in       %s deg%s\n", thetas.c_str(),
+              j["theta_in_from_metadata"].get<bool>() ? "" : " (assumed: no metadata)");
+  std::printf("  payload        %s bytes, CRC-32 %s, %s\n",
+              std::to_string(j["payload_bytes"].get<std::uint64_t>()).c_str(),
+              j["payload_crc32"].get<std::string>().c_str(),
+              j["checksum"].get<std::string>().c_str());
+  if (j.contains("extrapolation")) {
+    if (j["extrapolation"].is_null())
+      std::printf("  extrapolation  none (measured up to the horizon)\n");
+    else
+      std::printf("  extrapolation  p %s, l %s, beyond theta_b %s deg\n",
+                  Fixed(j["extrapolation"]["p"], "%g").c_str(),
+                  Fixed(j["extrapolation"]["l"], "%g").c_str(),
+                  Fixed(j["extrapolation"]["theta_b_deg"], "%g").c_str());
+  }
+  if (j.contains("tool_version"))
+    std::printf("  written by     brdf-toolchain %s\n",
+                j["tool_version"].get<std::string>().c_str());
+  if (atlas && j.contains("materials")) {
+    std::printf("  materials      %zu\n", j["materials"].size());
+    for (const Json& m : j["materials"])
+      std::printf("    %d %s: cell column %d, row %d (texel origin %d, %d), from %s\n",
+                  m["index"].get<int>(), m["name"].get<std::string>().c_str(),
+                  m["column"].get<int>(), m["row"].get<int>(), m["x0"].get<int>(),
+                  m["y0"].get<int>(), m["source"].get<std::string>().c_str());
+  }
+  std::printf("  f_r (1/sr, r g b) per slice%s:\n", atlas ? " over the material cells" : "");
+  for (const Json& r : j["value_ranges"])
+    std::printf("    theta_in %s deg: min %s  max %s  mean %s\n",
+                Fixed(r["theta_in_deg"], "%g").c_str(), TripleText(r["rgb_min"]).c_str(),
+                TripleText(r["rgb_max"]).c_str(), TripleText(r["rgb_mean"]).c_str());
+  for (const auto& w : j["warnings"]) std::printf("%s\n", w.get<std::string>().c_str());
+}
+
 }  // namespace
 
 int RunInfo(const InfoOptions& options) {
@@ -474,6 +632,8 @@ int RunInfo(const InfoOptions& options) {
       PrintBpcText(j);
     } else if (IsImportedFormat(j)) {
       PrintImportedText(j);
+    } else if (j["format"] == "lut" || j["format"] == "atlas") {
+      PrintTextureText(j);
     } else {
       PrintMaterialText(j);
     }

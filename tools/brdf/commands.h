@@ -20,8 +20,45 @@ struct EvalOptions {
   std::string file;
   double theta_in_deg = 0, phi_in_deg = 0;
   double theta_out_deg = 0, phi_out_deg = 0;
+  std::string extrapolate;  // "P,L" for captures; empty: per-material JSON, else 1,0.5
+  // Many directions at once instead of --in/--out: a file ("-" = stdin) of lines
+  // "THETA_IN PHI_IN THETA_OUT PHI_OUT" (degrees, blanks or commas between); one output line
+  // each. Empty lines and lines starting with '#' are skipped.
+  std::string pairs;
 };
 int RunEval(const EvalOptions& options);
+
+// std::thread::hardware_concurrency(), at least 1: the default of --jobs.
+int DefaultJobs();
+
+// The export formats `brdf convert` writes unless told otherwise.
+inline constexpr const char* kAllLutFormats = "ktx2,dds,exr,png,json";
+
+struct ConvertOptions {
+  std::vector<std::string> inputs;  // files and folders
+  std::string out;                  // output folder (created if missing)
+  std::string extrapolate;          // "P,L"; empty: per-material JSON, else 1,0.5
+  std::string formats = kAllLutFormats;
+  std::string exr_type = "float";  // EXR pixel type: "float" or "half"
+  // EXR compression: "none" or "zip". None by default: ZIP shrinks a float composite of
+  // measured (noisy) data by only ~20 % and costs more than everything else of a conversion
+  // (docs/benchmarks.md).
+  std::string exr_compression = "none";
+  int jobs = DefaultJobs();
+  bool quiet = false;  // no progress bar
+};
+int RunConvert(const ConvertOptions& options);
+
+struct AtlasOptions {
+  std::vector<std::string> inputs;  // files and folders
+  std::string out;                  // prefix: writes PREFIX.ktx2, .dds, .exr, .json
+  std::string extrapolate;
+  std::string exr_type = "float";
+  std::string exr_compression = "zip";
+  int jobs = DefaultJobs();
+  bool quiet = false;
+};
+int RunAtlas(const AtlasOptions& options);
 
 struct MaterialsOptions {
   bool json = false;

@@ -50,17 +50,40 @@ int main(int argc, char** argv) {
   brdf::cli::EvalOptions eval;
   std::string eval_in, eval_out;
   auto* eval_cmd = app.add_subcommand(
-      "eval", "Print f_r (1/sr, linear RGB) of a BRDF source for one pair of directions");
-  eval_cmd->add_option("file", eval.file, "Material file (.json) or other BRDF source")->required();
-  eval_cmd->add_option("--in", eval_in, "Light direction THETA,PHI in degrees")
-      ->required()
-      ->check(AnglePairValidator());
-  eval_cmd->add_option("--out", eval_out, "View direction THETA,PHI in degrees")
-      ->required()
-      ->check(AnglePairValidator());
+      "eval",
+      "Print f_r (1/sr, linear RGB) of a material, capture or exported LUT for a pair of "
+      "directions (or many, with --pairs)");
+  eval_cmd
+      ->add_option("file", eval.file,
+                   "Material file (.json), capture (.bpc), exported LUT (.ktx2, .dds), LUT "
+                   "sidecar (.json), or measured data (.bsdf RGL, .binary MERL)")
+      ->required();
+  auto* eval_in_opt = eval_cmd->add_option("--in", eval_in, "Light direction THETA,PHI in degrees")
+                          ->check(AnglePairValidator());
+  auto* eval_out_opt =
+      eval_cmd->add_option("--out", eval_out, "View direction THETA,PHI in degrees")
+          ->check(AnglePairValidator());
+  auto* eval_pairs_opt = eval_cmd->add_option(
+      "--pairs", eval.pairs,
+      "Instead of --in/--out: a file ('-' for stdin) of lines 'THETA_IN PHI_IN THETA_OUT "
+      "PHI_OUT' in degrees; prints one line per pair");
+  eval_in_opt->needs(eval_out_opt)->excludes(eval_pairs_opt);
+  eval_out_opt->needs(eval_in_opt)->excludes(eval_pairs_opt);
+  eval_cmd
+      ->add_option("--extrapolate", eval.extrapolate,
+                   "Captures: grazing extrapolation P,L (DESIGN §6); default: the "
+                   "per-material JSON beside the file, else 1,0.5")
+      ->capture_default_str();
+  eval_cmd->footer(
+      "Captures are interpolated as 'brdf convert' resamples them; exported LUTs are sampled "
+      "as a GPU samples the 3D texture (centre-exact coordinates, trilinear, clamp-to-edge).\n");
   eval_cmd->callback([&] {
-    ParseAnglePair(eval_in, &eval.theta_in_deg, &eval.phi_in_deg);
-    ParseAnglePair(eval_out, &eval.theta_out_deg, &eval.phi_out_deg);
+    if (eval_in.empty() && eval.pairs.empty())
+      throw CLI::RequiredError("--in and --out (or --pairs)");
+    if (!eval_in.empty()) {
+      ParseAnglePair(eval_in, &eval.theta_in_deg, &eval.phi_in_deg);
+      ParseAnglePair(eval_out, &eval.theta_out_deg, &eval.phi_out_deg);
+    }
     exit_code = brdf::cli::RunEval(eval);
   });
 
@@ -129,13 +152,101 @@ int main(int argc, char** argv) {
   auto* info_cmd = app.add_subcommand(
       "info",
       "Describe a file: a .bpc capture (slices, samples, ranges, statistics, flags, "
-      "metadata, damage), a material .json (model and parameters) or a third-party "
-      "measurement (Zemax or LightTools .bsdf with the integrated TIS per incidence, CSV "
-      "point cloud, goniometer table)");
-  info_cmd->add_option("file", info.file, "File to describe (.bpc, .json, .bsdf, .csv, .binary)")
+      "metadata, damage), a material .json (model and parameters), an exported LUT or atlas "
+      "(.ktx2, .dds) or its sidecar / manifest .json (dimensions, θin, payload, checksum, "
+      "extrapolation, value ranges), or a third-party measurement (Zemax or LightTools .bsdf "
+      "with the integrated TIS per incidence, CSV point cloud, goniometer table, RGL .bsdf, "
+      "MERL .binary)");
+  info_cmd
+      ->add_option("file", info.file,
+                   "File to describe (.bpc, .json, .ktx2, .dds, .bsdf, .csv, .binary)")
       ->required();
   info_cmd->add_flag("--json", info.json, "Print JSON instead of text");
   info_cmd->callback([&] { exit_code = brdf::cli::RunInfo(info); });
+
+  // brdf convert
+  brdf::cli::ConvertOptions convert;
+  auto* convert_cmd = app.add_subcommand(
+      "convert",
+      "Turn captures (.bpc) and material files (.json) into engine-ready LUTs: "
+      "DIR/<name>.ktx2, .dds (RGB9E5 3D textures), .exr (float composite), .png (tone-mapped "
+      "contact image) and .json (sidecar)");
+  convert_cmd
+      ->add_option("inputs", convert.inputs,
+                   "Capture files, material files, or folders of them (not recursive)")
+      ->required();
+  convert_cmd->add_option("--out", convert.out, "Output folder (created if missing)")->required();
+  convert_cmd
+      ->add_option("--extrapolate", convert.extrapolate,
+                   "Grazing extrapolation P,L (DESIGN §6) for inputs without their own; "
+                   "default 1,0.5 (clamping)")
+      ->capture_default_str();
+  convert_cmd->add_option("--formats", convert.formats, "Comma-separated outputs to write")
+      ->capture_default_str();
+  convert_cmd
+      ->add_option("--exr-type", convert.exr_type,
+                   "EXR pixel type: float, or half (faster to write, smaller)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"float", "half"}));
+  convert_cmd
+      ->add_option("--exr-compression", convert.exr_compression,
+                   "EXR compression: none, or zip (float EXRs of measured data: about 20 % "
+                   "smaller, and a conversion takes twice as long)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"zip", "none"}));
+  convert_cmd
+      ->add_option("--jobs", convert.jobs,
+                   "Inputs converted in parallel (default: hardware threads)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  convert_cmd->add_flag("--quiet", convert.quiet, "No progress bar");
+  convert_cmd->footer(
+      "Material files are first captured noise-free on the reference geometry (theta_in 0, 20, "
+      "40, 60; theta_out 0-75; phi_out 0-359; 1 degree steps), then resampled like a capture.\n"
+      "Extrapolation, most specific first: <name>.extrapolate.json beside the input, the "
+      "material file's own \"extrapolate\" member, --extrapolate, then 1,0.5.\n"
+      "Damaged captures: a capture missing slices is not a complete LUT. A corrupt chunk, a "
+      "file cut inside a slice, or a slice the instrument did not finish fails that input "
+      "(with the byte offset and how to resume or recapture). A capture whose only damage is "
+      "a missing or cut end chunk is converted with a warning if every planned theta_in "
+      "slice is intact (the plan is the capture's metadata extra \"theta_in_deg\", else 0, "
+      "20, 40, 60).\n"
+      "A failing input is reported and skipped; the others are converted. Every file is "
+      "written atomically; a failed input leaves none of its outputs. Exit code 0 if all "
+      "inputs converted, 1 if any failed.\n");
+  convert_cmd->callback([&] { exit_code = brdf::cli::RunConvert(convert); });
+
+  // brdf atlas
+  brdf::cli::AtlasOptions atlas;
+  auto* atlas_cmd = app.add_subcommand(
+      "atlas",
+      "Pack many materials into one atlas texture (DESIGN §5): PREFIX.ktx2, .dds, .exr and "
+      "PREFIX.json (manifest naming every material's cell)");
+  atlas_cmd
+      ->add_option("inputs", atlas.inputs,
+                   "Captures, material files, exported LUTs (.ktx2, .dds, sidecar .json), "
+                   "or folders of captures and material files")
+      ->required();
+  atlas_cmd->add_option("--out", atlas.out, "Output prefix (PREFIX.ktx2, ...)")->required();
+  atlas_cmd
+      ->add_option("--extrapolate", atlas.extrapolate,
+                   "Grazing extrapolation P,L for inputs without their own; default 1,0.5")
+      ->capture_default_str();
+  atlas_cmd->add_option("--exr-type", atlas.exr_type, "EXR pixel type: float or half")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"float", "half"}));
+  atlas_cmd->add_option("--exr-compression", atlas.exr_compression, "EXR compression: zip or none")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"zip", "none"}));
+  atlas_cmd->add_option("--jobs", atlas.jobs, "Inputs resampled in parallel")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  atlas_cmd->add_flag("--quiet", atlas.quiet, "No progress bar");
+  atlas_cmd->footer(
+      "Materials are placed in input order (folders sorted by file name). All must share one "
+      "theta_in list; materials with different sets are refused by name. Nothing is written "
+      "if any input fails.\n");
+  atlas_cmd->callback([&] { exit_code = brdf::cli::RunAtlas(atlas); });
 
   // brdf materials
   brdf::cli::MaterialsOptions materials;

@@ -1,0 +1,122 @@
+// `brdf atlas INPUT... --out PREFIX`: many materials in one texture (DESIGN §5) for deferred
+// renderers, with a manifest JSON.
+//
+// Every input becomes a LUT exactly as `brdf convert` makes it (captures and material files
+// are resampled with their extrapolation; exported LUTs are used as stored), on --jobs worker
+// threads. An atlas is all or nothing: if any input fails, or the θin sets differ, every
+// problem is reported and nothing is written.
+#include <tbb/global_control.h>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+#include <set>
+
+#include "batch.h"
+#include "brdf/core/error.h"
+#include "brdf/exporter/atlas.h"
+#include "brdf/exporter/packed_volume.h"
+#include "commands.h"
+#include "progress.h"
+#include "sources.h"
+
+namespace brdf::cli {
+
+namespace fs = std::filesystem;
+
+int RunAtlas(const AtlasOptions& options) {
+  if (options.out.empty()) throw InvalidArgument("--out: an output prefix is required");
+  std::optional<processing::ExtrapolationParams> extrapolate;
+  if (!options.extrapolate.empty())
+    extrapolate = processing::ParseExtrapolation(options.extrapolate);
+  const exporter::ExrOptions exr_options =
+      ParseExrOptions(options.exr_type, options.exr_compression);
+  if (options.jobs < 1)
+    throw InvalidArgument("--jobs: expected at least 1, got " + std::to_string(options.jobs));
+
+  DiscoveredInputs found = DiscoverInputs(options.inputs, InputKinds{.exported_luts = true});
+  if (found.inputs.empty() && found.failures.empty())
+    throw InvalidArgument("no captures, material files or exported LUTs found in the inputs");
+
+  const std::vector<std::string> outputs = {options.out + ".ktx2", options.out + ".dds",
+                                            options.out + ".exr", options.out + ".json"};
+  {
+    std::set<std::string> inputs;
+    std::error_code ec;
+    for (const BatchInput& in : found.inputs)
+      inputs.insert(fs::weakly_canonical(in.path, ec).string());
+    for (const std::string& out : outputs)
+      if (inputs.count(fs::weakly_canonical(out, ec).string()))
+        throw InvalidArgument("--out " + options.out + ": the atlas file " + out +
+                              " would overwrite an input; choose another prefix");
+  }
+  std::vector<BatchFailure> failures = found.failures;
+  for (const BatchFailure& f : failures)
+    std::fprintf(stderr, "%s: FAILED: %s\n", f.path.c_str(), f.reason.c_str());
+
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism,
+                            static_cast<std::size_t>(options.jobs));
+  processing::ResampleOptions resample;
+  resample.parallel = found.inputs.size() == 1 && options.jobs > 1;
+  std::vector<Lut> luts(found.inputs.size());
+
+  Progress progress("atlas", found.inputs.size(), !options.quiet);
+  const std::vector<JobResult> results = RunJobs(
+      found.inputs.size(), options.jobs,
+      [&](std::size_t i, JobResult& result) {
+        const BatchInput& in = found.inputs[i];
+        InputLut built = LutFromInput(in.path, in.kind, extrapolate, resample);
+        exporter::ValidateLutForExport(built.lut);
+        result.warnings = std::move(built.warnings);
+        luts[i] = std::move(built.lut);
+      },
+      [&](std::size_t i, const JobResult& result) {
+        const BatchInput& in = found.inputs[i];
+        for (const std::string& w : result.warnings) progress.Message(w);
+        if (!result.ok)
+          progress.Message(in.path + ": FAILED: " + ReasonWithoutPath(in.path, result.error));
+        progress.Advance(in.path, !result.ok);
+      });
+  progress.Finish();
+
+  for (std::size_t i = 0; i < results.size(); ++i)
+    if (!results[i].ok)
+      failures.push_back(
+          {found.inputs[i].path, ReasonWithoutPath(found.inputs[i].path, results[i].error)});
+  const std::size_t total = found.inputs.size() + found.failures.size();
+  if (!failures.empty()) {
+    std::printf("atlas not written: %s\n",
+                BatchSummary("read", total - failures.size(), total, failures).c_str());
+    return 1;
+  }
+
+  std::vector<exporter::AtlasMaterial> materials;
+  for (std::size_t i = 0; i < luts.size(); ++i)
+    materials.push_back({found.inputs[i].name, &luts[i], found.inputs[i].path});
+  const fs::path parent = fs::path(options.out).parent_path();
+  if (!parent.empty()) {
+    std::error_code ec;
+    fs::create_directories(parent, ec);
+    if (!fs::is_directory(parent))
+      throw IoError(parent.string() + ": cannot create the output folder" +
+                    (ec ? ": " + ec.message() : std::string()));
+  }
+  const OutputGuard guard(outputs);
+  std::vector<std::string> written;
+  try {
+    // BuildAtlas inside WriteAtlas refuses different θin sets, naming both materials.
+    written = exporter::WriteAtlas(options.out, materials, exr_options);
+  } catch (...) {
+    guard.RemoveNew();
+    throw;
+  }
+  const exporter::AtlasLayout layout =
+      exporter::ComputeAtlasLayout(static_cast<int>(materials.size()), luts.front().slices());
+  std::printf("atlas of %zu material%s (%d × %d cells; texture %d × %d × %d, θin %s°):\n",
+              materials.size(), materials.size() == 1 ? "" : "s", layout.cells.columns,
+              layout.cells.rows, layout.TextureWidth(), layout.TextureHeight(), layout.slices,
+              exporter::FormatThetaList(luts.front().theta_in_deg).c_str());
+  for (const std::string& w : written) std::printf("  %s\n", w.c_str());
+  return 0;
+}
+
+}  // namespace brdf::cli

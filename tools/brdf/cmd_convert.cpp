@@ -1,0 +1,175 @@
+// `brdf convert INPUT... --out DIR`: captures and material files to engine-ready LUTs.
+//
+// Per input: open it (sources.h: the damaged-capture rule, noise-free capture of material
+// files, the extrapolation choice), resample it (processing::BuildLut), and write every
+// selected format with exporter::ExportLut, each file atomically. Inputs run on --jobs worker
+// threads, one input per worker at a time, so memory stays at a few inputs' worth whatever the
+// batch size. A failing input is reported and skipped; the exit code is 1 if any failed.
+#include <tbb/global_control.h>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <set>
+
+#include "batch.h"
+#include "brdf/core/error.h"
+#include "brdf/exporter/lut_export.h"
+#include "commands.h"
+#include "progress.h"
+#include "sources.h"
+
+namespace brdf::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+// The files ExportLut writes for `name`, in its order.
+std::vector<std::string> OutputPaths(const fs::path& dir, const std::string& name,
+                                     const exporter::LutExportFormats& f) {
+  std::vector<std::string> paths;
+  const auto add = [&](bool on, const char* ext) {
+    if (on) paths.push_back((dir / (name + ext)).string());
+  };
+  add(f.ktx2, ".ktx2");
+  add(f.dds, ".dds");
+  add(f.exr, ".exr");
+  add(f.png, ".png");
+  add(f.json, ".json");
+  return paths;
+}
+
+std::string Canonical(const std::string& p) {
+  std::error_code ec;
+  const fs::path c = fs::weakly_canonical(p, ec);
+  return ec ? fs::path(p).lexically_normal().string() : c.string();
+}
+
+// Refuses inputs whose outputs would collide with another input's outputs or overwrite an
+// input (a material "gold.json" converted into its own folder would be replaced by the sidecar
+// "gold.json"). Such inputs move from `inputs` to `failures`.
+void RefuseCollisions(const fs::path& out_dir, const exporter::LutExportFormats& formats,
+                      std::vector<BatchInput>& inputs, std::vector<BatchFailure>& failures) {
+  std::set<std::string> input_paths;
+  for (const BatchInput& in : inputs) input_paths.insert(Canonical(in.path));
+  std::map<std::string, std::vector<std::size_t>> by_name;
+  for (std::size_t i = 0; i < inputs.size(); ++i) by_name[inputs[i].name].push_back(i);
+  std::vector<bool> refused(inputs.size(), false);
+  std::map<std::size_t, std::string> reasons;
+  for (const auto& [name, indices] : by_name) {
+    if (indices.size() < 2) continue;
+    for (std::size_t i : indices) {
+      std::string others;
+      for (std::size_t o : indices)
+        if (o != i) others += (others.empty() ? "" : ", ") + inputs[o].path;
+      reasons[i] = "its outputs " + (out_dir / (name + ".*")).string() +
+                   " would also be written for " + others + "; rename one of them";
+    }
+  }
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    if (reasons.count(i)) continue;
+    for (const std::string& out : OutputPaths(out_dir, inputs[i].name, formats))
+      if (input_paths.count(Canonical(out))) {
+        reasons[i] = "its output " + out + " would overwrite an input; choose another --out folder";
+        break;
+      }
+  }
+  std::vector<BatchInput> kept;
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    if (const auto it = reasons.find(i); it != reasons.end())
+      failures.push_back({inputs[i].path, it->second});
+    else
+      kept.push_back(std::move(inputs[i]));
+  }
+  inputs = std::move(kept);
+}
+
+}  // namespace
+
+int RunConvert(const ConvertOptions& options) {
+  if (options.out.empty()) throw InvalidArgument("--out: an output folder is required");
+  exporter::LutExportOptions export_options;
+  export_options.formats = exporter::ParseExportFormats(options.formats);
+  export_options.exr = ParseExrOptions(options.exr_type, options.exr_compression);
+  std::optional<processing::ExtrapolationParams> extrapolate;
+  if (!options.extrapolate.empty())
+    extrapolate = processing::ParseExtrapolation(options.extrapolate);
+  if (options.jobs < 1)
+    throw InvalidArgument("--jobs: expected at least 1, got " + std::to_string(options.jobs));
+
+  DiscoveredInputs found = DiscoverInputs(options.inputs);
+  if (found.inputs.empty() && found.failures.empty()) {
+    std::string args;
+    for (const auto& a : options.inputs) args += (args.empty() ? "" : ", ") + a;
+    throw InvalidArgument("no captures (.bpc) or material files (.json) found in " + args);
+  }
+  const fs::path out_dir(options.out);
+  std::error_code ec;
+  fs::create_directories(out_dir, ec);
+  if (!fs::is_directory(out_dir))
+    throw IoError(options.out + ": cannot create the output folder" +
+                  (ec ? ": " + ec.message() : std::string()));
+  RefuseCollisions(out_dir, export_options.formats, found.inputs, found.failures);
+
+  const std::size_t total = found.inputs.size() + found.failures.size();
+  std::vector<BatchFailure> failures = found.failures;
+  for (const BatchFailure& f : failures)
+    std::fprintf(stderr, "%s: FAILED: %s\n", f.path.c_str(), f.reason.c_str());
+  if (!found.skipped.empty() && !options.quiet)
+    std::fprintf(stderr,
+                 "note: skipped %zu file%s in the input folders that %s not captures or "
+                 "material files\n",
+                 found.skipped.size(), found.skipped.size() == 1 ? "" : "s",
+                 found.skipped.size() == 1 ? "is" : "are");
+
+  // One input per worker; an input resamples on several threads only when it is alone.
+  const bool alone = found.inputs.size() == 1;
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism,
+                            static_cast<std::size_t>(options.jobs));
+  processing::ResampleOptions resample;
+  resample.parallel = alone && options.jobs > 1;
+
+  Progress progress("convert", found.inputs.size(), !options.quiet);
+  const std::vector<JobResult> results = RunJobs(
+      found.inputs.size(), options.jobs,
+      [&](std::size_t i, JobResult& result) {
+        const BatchInput& in = found.inputs[i];
+        InputLut built = LutFromInput(in.path, in.kind, extrapolate, resample);
+        result.warnings = std::move(built.warnings);
+        exporter::TextureMetadata metadata;
+        metadata.name = in.name;
+        metadata.source = in.path;
+        metadata.extrapolation = built.extrapolation;
+        const OutputGuard guard(OutputPaths(out_dir, in.name, export_options.formats));
+        try {
+          exporter::ExportLut(out_dir.string(), built.lut, metadata, export_options);
+        } catch (...) {
+          // No partial set: remove what this conversion already renamed into place (the
+          // writer that failed removed its own temporary file).
+          guard.RemoveNew();
+          throw;
+        }
+      },
+      [&](std::size_t i, const JobResult& result) {
+        const BatchInput& in = found.inputs[i];
+        for (const std::string& w : result.warnings) progress.Message(w);
+        if (!result.ok)
+          progress.Message(in.path + ": FAILED: " + ReasonWithoutPath(in.path, result.error));
+        progress.Advance(in.path, !result.ok);
+      });
+  progress.Finish();
+
+  std::size_t converted = 0;
+  for (std::size_t i = 0; i < results.size(); ++i) {
+    if (results[i].ok)
+      ++converted;
+    else
+      failures.push_back(
+          {found.inputs[i].path, ReasonWithoutPath(found.inputs[i].path, results[i].error)});
+  }
+  std::printf("%s\n", BatchSummary("converted", converted, total, failures).c_str());
+  return failures.empty() ? 0 : 1;
+}
+
+}  // namespace brdf::cli
