@@ -56,7 +56,9 @@ int main(int argc, char** argv) {
   eval_cmd
       ->add_option("file", eval.file,
                    "Material file (.json), capture (.bpc), exported LUT (.ktx2, .dds), LUT "
-                   "sidecar (.json), or measured data (.bsdf RGL, .binary MERL)")
+                   "sidecar (.json), or measured data: RGL .bsdf, MERL .binary, or a table "
+                   "interpolated like a capture (Zemax or LightTools .bsdf, CSV point cloud, "
+                   "goniometer table; detected by content)")
       ->required();
   auto* eval_in_opt = eval_cmd->add_option("--in", eval_in, "Light direction THETA,PHI in degrees")
                           ->check(AnglePairValidator());
