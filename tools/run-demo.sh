@@ -21,10 +21,10 @@ for material in $("$brdf" materials --json | /usr/bin/python3 -c 'import json,sy
   "$brdf" capture --device sim --material "$material" --sample "$material" \
     --out "$out/captures/$material.bpc" --seed 1 --force
 done
-if "$brdf" convert --help >/dev/null 2>&1; then
-  echo "== converting captures to RGB9E5 lookup textures -> $out/luts"
-  "$brdf" convert "$out/captures" --out "$out/luts"
-  "$brdf" atlas "$out/captures" --out "$out/atlas/library"
-fi
-echo "== done: $(ls "$out/captures" | wc -l) captures in $out/captures"
-"$brdf" info "$out/captures/gold.bpc"
+echo "== converting captures to RGB9E5 lookup textures -> $out/luts"
+"$brdf" convert "$out/captures" --out "$out/luts"
+echo "== packing the library into one atlas -> $out/atlas"
+mkdir -p "$out/atlas"
+"$brdf" atlas "$out/captures" --out "$out/atlas/library"
+echo "== done: $(ls "$out/captures" | wc -l) captures in $out/captures, LUTs in $out/luts, atlas in $out/atlas"
+"$brdf" info "$out/luts/gold.ktx2"

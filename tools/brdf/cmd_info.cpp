@@ -40,24 +40,7 @@ constexpr const char* kFlagNames[4] = {"saturated", "below_noise_floor", "interp
 Json Number(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 Json Triple(const std::array<double, 3>& v) { return {Number(v[0]), Number(v[1]), Number(v[2])}; }
 
-Json MetadataJson(const Metadata& m) {
-  Json j;
-  j["sample_name"] = m.sample_name;
-  j["instrument_model"] = m.instrument_model;
-  j["instrument_serial"] = m.instrument_serial;
-  j["firmware_version"] = m.firmware_version;
-  j["protocol_version"] = m.protocol_version;
-  j["calibration_reference"] = m.calibration_reference;
-  j["calibration_time"] = m.calibration_time;
-  j["capture_start"] = m.capture_start;
-  j["capture_end"] = m.capture_end;
-  j["operator_notes"] = m.operator_notes;
-  j["units"] = m.units;
-  j["software_version"] = m.software_version;
-  j["extra"] = Json::object();
-  for (const auto& [k, v] : m.extra) j["extra"][k] = v;
-  return j;
-}
+Json MetadataJson(const Metadata& m) { return Json::parse(MetadataToJsonText(m)); }
 
 const char* KindName(BpcProblemKind kind) {
   switch (kind) {
@@ -71,24 +54,17 @@ const char* KindName(BpcProblemKind kind) {
   return "unknown";
 }
 
-Json DescribeBpc(const std::string& path) {
-  const BpcReadResult r = ReadBpc(path);
-  const Measurement& m = r.measurement;
-  Json j;
-  j["file"] = path;
-  j["format"] = "bpc";
-  j["file_bytes"] = std::filesystem::file_size(path);
-  j["finished"] = r.finished;
-  j["valid_bytes"] = r.valid_bytes;
-  j["theta_in_deg"] = m.ThetaInDeg();
-  j["sample_count"] = m.SampleCount();
+// Adds the slices, statistics and metadata of `m` (a .bpc capture or an imported table) under
+// the keys of `brdf info --json`. `slice_indices` gives the file's chunk index of each slice.
+void AddPointCloudJson(const Measurement& m, Json* j,
+                       const std::vector<int>* slice_indices = nullptr) {
   std::array<std::size_t, 4> totals{};
-  j["slices"] = Json::array();
+  Json slices = Json::array();
   for (std::size_t i = 0; i < m.slices.size(); ++i) {
     const Slice& slice = m.slices[i];
     const SliceStats st = ComputeSliceStats(slice);
     Json s;
-    s["index"] = r.slice_indices[i];
+    s["index"] = slice_indices ? (*slice_indices)[i] : static_cast<int>(i);
     s["theta_in_deg"] = st.theta_in_deg;
     s["phi_in_deg"] = slice.phi_in_deg;
     s["samples"] = st.samples;
@@ -105,12 +81,27 @@ Json DescribeBpc(const std::string& path) {
       totals[b] += st.flag_counts[b];
     }
     s["flag_counts"] = flags;
-    j["slices"].push_back(s);
+    slices.push_back(s);
   }
+  (*j)["theta_in_deg"] = m.ThetaInDeg();
+  (*j)["sample_count"] = m.SampleCount();
+  (*j)["slices"] = slices;
   Json flags;
   for (int b = 0; b < 4; ++b) flags[kFlagNames[b]] = totals[b];
-  j["flag_counts"] = flags;
-  j["metadata"] = MetadataJson(m.metadata);
+  (*j)["flag_counts"] = flags;
+  (*j)["metadata"] = MetadataJson(m.metadata);
+}
+
+Json DescribeBpc(const std::string& path) {
+  const BpcReadResult r = ReadBpc(path);
+  const Measurement& m = r.measurement;
+  Json j;
+  j["file"] = path;
+  j["format"] = "bpc";
+  j["file_bytes"] = std::filesystem::file_size(path);
+  j["finished"] = r.finished;
+  j["valid_bytes"] = r.valid_bytes;
+  AddPointCloudJson(m, &j, &r.slice_indices);
   j["problems"] = Json::array();
   bool truncated = false;
   for (const BpcProblem& p : r.problems) {
@@ -164,42 +155,6 @@ Json DescribeMaterial(const std::string& path) {
 // store them plus what only the source format holds (header, Zemax TIS lines). .bsdf is shared
 // by RGL and Zemax (and LightTools exports), .csv by point clouds and goniometer tables, so
 // the format is decided by content with DetectImportFormat.
-
-// Adds the slices, statistics and metadata of `m` under the same keys DescribeBpc uses.
-void AddPointCloudJson(const Measurement& m, Json* j) {
-  std::array<std::size_t, 4> totals{};
-  Json slices = Json::array();
-  for (std::size_t i = 0; i < m.slices.size(); ++i) {
-    const Slice& slice = m.slices[i];
-    const SliceStats st = ComputeSliceStats(slice);
-    Json s;
-    s["index"] = i;
-    s["theta_in_deg"] = st.theta_in_deg;
-    s["phi_in_deg"] = slice.phi_in_deg;
-    s["samples"] = st.samples;
-    s["complete"] = st.complete;
-    s["has_sigma"] = slice.has_sigma;
-    s["theta_out_deg"] = {Number(st.theta_out_min_deg), Number(st.theta_out_max_deg)};
-    s["phi_out_deg"] = {Number(st.phi_out_min_deg), Number(st.phi_out_max_deg)};
-    s["rgb_min"] = Triple(st.min);
-    s["rgb_max"] = Triple(st.max);
-    s["rgb_mean"] = Triple(st.mean);
-    Json flags;
-    for (int b = 0; b < 4; ++b) {
-      flags[kFlagNames[b]] = st.flag_counts[b];
-      totals[b] += st.flag_counts[b];
-    }
-    s["flag_counts"] = flags;
-    slices.push_back(s);
-  }
-  (*j)["theta_in_deg"] = m.ThetaInDeg();
-  (*j)["sample_count"] = m.SampleCount();
-  (*j)["slices"] = slices;
-  Json flags;
-  for (int b = 0; b < 4; ++b) flags[kFlagNames[b]] = totals[b];
-  (*j)["flag_counts"] = flags;
-  (*j)["metadata"] = MetadataJson(m.metadata);
-}
 
 // The integrated scatter next to the file's TIS lines, per channel, rotation and incidence
 // (IntegrateZemaxTis: "integrated" is the whole-hemisphere estimate, "covered" the part the

@@ -798,4 +798,6 @@ void BpcAppender::Finish(const Metadata& final_metadata) {
   if (rc != 0) throw IoError(path_ + ": close failed: " + ErrnoText());
 }
 
+std::string MetadataToJsonText(const Metadata& metadata) { return MetadataToJson(metadata).dump(); }
+
 }  // namespace brdf

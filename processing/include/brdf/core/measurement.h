@@ -75,6 +75,9 @@ struct SliceStats {
 };
 SliceStats ComputeSliceStats(const Slice& slice);
 
+// The metadata as the JSON object the .bpc header stores (docs/formats/bpc.md), as text.
+std::string MetadataToJsonText(const Metadata& metadata);
+
 // ISO 8601 UTC timestamp of now, to the second ("2026-11-22T10:04:05Z").
 std::string UtcNowIso8601();
 
