@@ -124,6 +124,57 @@ TEST_F(CaptureCli, InterruptedCaptureTellsHowToResumeAndResumeCompletesIt) {
   }
 }
 
+TEST_F(CaptureCli, InterruptedCaptureRecordsItsPlanSoConvertNamesTheMissingSlices) {
+  // 8 set-up frames (dark + a white per θin with 4 θin; 7 with 3), then 18 per slice on the
+  // coarse grid: disconnect:50 / :45 drop the link in the third slice, after two saved.
+  struct Case {
+    std::string theta_in, fault, key, missing;
+  };
+  // 0,30,60 differs from the reference instrument's 0,20,40,60 that `brdf convert` assumes
+  // when a capture records no plan: only the recorded plan names 60° alone as missing.
+  for (const Case& c : {Case{"0,20,40,60", "50", "0,20,40,60", "missing 40, 60°"},
+                        Case{"0,30,60", "45", "0,30,60", "missing 60°)"}}) {
+    SCOPED_TRACE(c.theta_in);
+    const std::string out = Path("plan.bpc");
+    fs::remove(out);
+    const std::string common = " --material gold --sample g --theta-in " + c.theta_in + kCoarse;
+    const ToolRun broken =
+        Run("capture --out " + out + common + " --sim-fault disconnect:" + c.fault);
+    ASSERT_EQ(broken.exit_code, 1) << broken.err;
+    ASSERT_EQ(ReadBpc(out).measurement.slices.size(), 2u);
+
+    const ToolRun info = Run("info --json " + out);
+    ASSERT_EQ(info.exit_code, 0) << info.err;
+    EXPECT_NE(info.out.find("\"theta_in_deg\": \"" + c.key + "\""), std::string::npos) << info.out;
+
+    const ToolRun convert = Run("convert " + out + " --out " + Path("lut") + " --quiet");
+    EXPECT_EQ(convert.exit_code, 1);
+    EXPECT_NE(convert.out.find("converted 0 of 1"), std::string::npos) << convert.out;
+    EXPECT_NE(convert.out.find(c.missing), std::string::npos) << convert.out;
+    EXPECT_NE(convert.out.find("--resume"), std::string::npos) << convert.out;
+
+    // Resuming keeps the plan and completes the capture, which then converts.
+    const ToolRun resumed = Run("capture --out " + out + common + " --resume --quiet");
+    ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
+    EXPECT_EQ(ReadBpc(out).measurement.metadata.extra.at("theta_in_deg"), c.key);
+    const ToolRun done =
+        Run("convert " + out + " --out " + Path("lut") + " --formats ktx2 --quiet");
+    EXPECT_EQ(done.exit_code, 0) << done.out << done.err;
+  }
+}
+
+TEST_F(CaptureCli, ResumeRefusesADifferentThetaInPlan) {
+  const std::string out = Path("p.bpc");
+  ASSERT_EQ(Run("capture --material gold --sample g --out " + out + kCoarse +
+                " --sim-fault disconnect:30")
+                .exit_code,
+            1);
+  const ToolRun r = Run("capture --material gold --sample g --out " + out + kCoarse +
+                        " --theta-in 0,20,40 --resume");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("theta_in_deg = 0,20,40,60"), std::string::npos) << r.err;
+}
+
 TEST_F(CaptureCli, CorruptFrameStopsTheCaptureWithACrcMessage) {
   const std::string out = Path("c.bpc");
   const ToolRun r = Run("capture --material paper_white --sample p --out " + out + kCoarse +
