@@ -464,7 +464,10 @@ void PrintImportedText(const Json& j) {
         text = value.get<std::string>();
       } else if (value.is_array()) {
         text = std::to_string(value.size()) + ":";
-        for (const auto& v : value) text += " " + Fixed(v, "%g");
+        for (const auto& v : value) {
+          text += ' ';
+          text += Fixed(v, "%g");
+        }
       } else {
         text = value.dump();
       }
