@@ -1,4 +1,4 @@
-// Runs the fuzz entry (protocol_fuzz.cpp) on inputs generated here: random bytes, valid
+// Runs the fuzz entry (fuzz/protocol_fuzzer.cpp) on inputs generated here: random bytes, valid
 // streams of every message with random damage, and forged headers with extreme fields.
 // Passing means no crash, hang or escape of a non-brdf exception.
 #include <gtest/gtest.h>

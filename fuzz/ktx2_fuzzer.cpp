@@ -1,6 +1,6 @@
 // libFuzzer target for the KTX2 reader (BRDF_BUILD_FUZZERS=ON with clang). Any input must either
 // parse or throw brdf::Error; a crash, hang, sanitizer report or other exception is a bug.
-// Seed corpus: tests/export/corpus/*.ktx2.
+// Seed corpus: tests/export/corpus/*.ktx2; run by the fuzz_readers test (fuzz/run_fuzzers.sh).
 #include <cstddef>
 #include <cstdint>
 

@@ -1,7 +1,8 @@
 // Fuzz entry for everything that parses bytes from the other end of the link: the frame
 // decoder, every payload decoder, the host driver fed a hostile instrument, and the simulated
 // firmware fed a hostile host. Built as a libFuzzer target with BRDF_BUILD_FUZZERS (clang);
-// protocol_fuzz_smoke_test runs the same entry on generated inputs in every build.
+// protocol_fuzz_smoke_test runs the same entry on generated inputs in every build. Seeds:
+// fuzz/corpus/protocol (make_protocol_corpus.py).
 //
 // Contract checked: no crash, no hang, no unbounded allocation; failures are brdf::Error.
 #include <cstddef>
