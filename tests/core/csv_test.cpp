@@ -144,3 +144,25 @@ TEST(Csv, ReportsLineAndColumnOfBadValues) {
 
 }  // namespace
 }  // namespace brdf
+
+namespace brdf {
+namespace {
+
+// Found by csv_fuzzer: a finite double beyond the float32 range (FLT_MAX ≈ 3.40282e38) became
+// inf in the capture, which no writer can store; the largest float itself is kept.
+TEST(Csv, RefusesValuesBeyondFloat32RangeNamingTheLine) {
+  const std::string header = "theta_in,phi_in,theta_out,phi_out,r,g,b,sigma_r,sigma_g,sigma_b\n";
+  try {
+    ParseCsv(header + "20,0,35,180,0.1,0.1,0.1,1e39,0,0\n", "big.csv");
+    FAIL() << "no exception";
+  } catch (const FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find("big.csv: line 2"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("1e39"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(ParseCsv(header + "20,0,35,180,-1e39,0.1,0.1,0,0,0\n", "big.csv"), FormatError);
+  const Measurement m = ParseCsv(header + "20,0,35,180,3.4028235e38,0.1,0.1,0,0,0\n", "ok.csv");
+  EXPECT_EQ(m.slices.at(0).samples.at(0).rgb[0], 3.4028235e38f);
+}
+
+}  // namespace
+}  // namespace brdf

@@ -353,6 +353,10 @@ Measurement LightToolsToMeasurement(const LightToolsBsdf& lt, const std::string&
         std::array<double, 3> v{};
         for (std::size_t c = 0; c < channels; ++c) v[c] = g[c]->values[a * n_rad + r];
         if (lt.spectral == LightToolsSpectral::kXyz) v = XyzToLinearRec709(v);
+        if (!(text::FitsFloat(v[0]) && text::FitsFloat(v[1]) && text::FitsFloat(v[2])))
+          throw FormatError(file, "data block at AOI " + text::FormatShortest(aoi),
+                            "tristimulus values whose linear RGB stays within float32 range",
+                            "values beyond it");
         if (lt.spectral == LightToolsSpectral::kMonochrome) v = {v[0], v[0], v[0]};
         for (int side = 0; side < (mirror && rad[r] != 0.0 ? 2 : 1); ++side) {
           const double rel_side = side == 0 ? rel : 360.0 - rel;

@@ -115,6 +115,11 @@ double ParseFiniteDouble(std::string_view token, const std::string& file, std::u
     Fail(file, line, std::string(what) + " (a number)", Printable(token));
   if (ec == std::errc::result_out_of_range || !std::isfinite(v))
     Fail(file, line, std::string(what) + " (a finite number)", Printable(token));
+  // Measurements are stored as float32: a finite double beyond its range would become inf
+  // and the capture could not be written back (found by csv_fuzzer).
+  if (!FitsFloat(v))
+    Fail(file, line, std::string(what) + " (a number within the float32 range, |v| <= 3.4e38)",
+         Printable(token));
   return v;
 }
 

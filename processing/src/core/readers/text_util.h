@@ -9,6 +9,7 @@
 // UTF-8 to a terminal.
 #pragma once
 
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -42,6 +43,9 @@ bool EqualsIgnoreCase(std::string_view a, std::string_view b);
 // Throws FormatError(file, "line N", expected, got).
 [[noreturn]] void Fail(const std::string& file, std::uint64_t line, std::string_view expected,
                        std::string_view got);
+
+// Whether `v` rounds to a finite float32 (measurements are stored as float32).
+inline bool FitsFloat(double v) { return std::isfinite(static_cast<float>(v)); }
 
 // Parses a whole token as a finite double (decimal or scientific, optional leading '+').
 // `what` names the quantity in the message ("ScatterRadial angle").

@@ -395,6 +395,10 @@ Measurement ZemaxToMeasurement(const ZemaxBsdf& z, const std::string& file,
             const std::array<double, 3> c =
                 XyzToLinearRec709({z.Value(0, rot, aoi, a, r), z.Value(1, rot, aoi, a, r),
                                    z.Value(2, rot, aoi, a, r)});
+            if (!(text::FitsFloat(c[0]) && text::FitsFloat(c[1]) && text::FitsFloat(c[2])))
+              throw FormatError(file, "data at AOI " + text::FormatShortest(s.theta_in_deg),
+                                "tristimulus values whose linear RGB stays within float32 range",
+                                "values beyond it");
             for (int i = 0; i < 3; ++i) rgb[i] = static_cast<float>(c[i]);
           } else {
             rgb.fill(static_cast<float>(z.Value(0, rot, aoi, a, r)));
