@@ -174,7 +174,7 @@ int RunCapture(const CaptureOptions& o) {
   // What is already on disk.
   std::error_code ec;
   const bool exists = fs::exists(o.out, ec);
-  std::vector<double> todo = o.theta_in_deg;
+  std::vector<double> pending = o.theta_in_deg;
   std::optional<BpcReadResult> existing;
   if (exists && !o.resume && !o.force)
     throw InvalidArgument(o.out +
@@ -205,20 +205,20 @@ int RunCapture(const CaptureOptions& o) {
                               " (rerun with the original settings)");
     }
     for (const Slice& done : existing->measurement.slices) {
-      const auto it = std::find_if(todo.begin(), todo.end(), [&](double t) {
+      const auto it = std::find_if(pending.begin(), pending.end(), [&](double t) {
         return std::fabs(t - done.theta_in_deg) <= 1e-6;
       });
-      if (it == todo.end())
+      if (it == pending.end())
         throw InvalidArgument("--resume: " + o.out + " holds a slice at θin " +
                               Deg(done.theta_in_deg) + "° that --theta-in does not list");
-      todo.erase(it);
+      pending.erase(it);
     }
   } else if (o.resume && !o.quiet) {
     std::fprintf(stderr, "%s does not exist yet: starting a new capture\n", o.out.c_str());
   }
 
   const std::size_t total = o.theta_in_deg.size();
-  const std::size_t done_before = total - todo.size();
+  const std::size_t done_before = total - pending.size();
   std::optional<BpcAppender> appender;
   if (existing) {
     appender.emplace(BpcAppender::Resume(o.out, nullptr));
@@ -228,7 +228,7 @@ int RunCapture(const CaptureOptions& o) {
   }
 
   device::CapturePlan plan;
-  plan.theta_in_deg = todo;
+  plan.theta_in_deg = pending;
   plan.exposure = exposure;
   plan.metadata.sample_name = o.sample;
   plan.metadata.operator_notes = o.operator_notes;
@@ -241,7 +241,8 @@ int RunCapture(const CaptureOptions& o) {
     if (!appender) appender.emplace(BpcAppender::Create(o.out, header));
     if (!o.quiet)
       std::fprintf(stderr, "%s %s: dark and white reference measured at %zu θin\n",
-                   header.instrument_model.c_str(), header.instrument_serial.c_str(), todo.size());
+                   header.instrument_model.c_str(), header.instrument_serial.c_str(),
+                   pending.size());
   };
   callbacks.on_slice = [&](const Slice& slice, const device::SliceReport& report) {
     appender->AppendSlice(slice);
@@ -265,7 +266,7 @@ int RunCapture(const CaptureOptions& o) {
 
   Metadata final_metadata;
   try {
-    if (!todo.empty()) final_metadata = device::Capture(driver, plan, callbacks);
+    if (!pending.empty()) final_metadata = device::Capture(driver, plan, callbacks);
   } catch (const DeviceError& e) {
     std::fprintf(stderr, "brdf: error: %s\n", e.what());
     if (appender) {
@@ -285,7 +286,7 @@ int RunCapture(const CaptureOptions& o) {
     // The header keeps the original capture's start, calibration and notes; what the resumed
     // part measured differently is added beside it.
     Metadata merged = existing->measurement.metadata;
-    if (todo.empty()) {
+    if (pending.empty()) {
       final_metadata = merged;
     } else {
       for (const auto& [key, value] : final_metadata.extra) {
@@ -299,7 +300,7 @@ int RunCapture(const CaptureOptions& o) {
       merged.extra["capture_start_resume"] = final_metadata.capture_start;
     }
     std::string resumed;
-    for (double t : todo) resumed += (resumed.empty() ? "" : ",") + Deg(t);
+    for (double t : pending) resumed += (resumed.empty() ? "" : ",") + Deg(t);
     merged.extra["resumed_theta_in_deg"] = resumed;
     merged.capture_end = UtcNowIso8601();
     final_metadata = merged;
