@@ -4,7 +4,11 @@
 #include <bit>
 #include <cstdint>
 #include <cstring>
+#include <string>
 #include <vector>
+
+#include "brdf/core/error.h"
+#include "brdf/core/file_util.h"
 
 namespace brdf::exporter::detail {
 
@@ -18,6 +22,17 @@ inline void CopyLittleEndianWords(const std::uint8_t* src, std::vector<std::uint
                  (static_cast<std::uint32_t>(src[2]) << 16) |
                  (static_cast<std::uint32_t>(src[3]) << 24);
   }
+}
+
+// Reads one u32 texture dimension and checks it is in 1..65536 (both containers' limit here),
+// naming the header field and its byte offset when it is not.
+inline int ReadDimension(ByteReader& r, const std::string& file, const char* what) {
+  const std::uint64_t at = r.offset();
+  const std::uint32_t v = r.U32(what);
+  if (v == 0 || v > (1u << 16))
+    throw FormatError(file, BytePosition(at), std::string(what) + " in 1..65536",
+                      std::to_string(v));
+  return static_cast<int>(v);
 }
 
 }  // namespace brdf::exporter::detail

@@ -106,14 +106,7 @@ LoadedTexture ParseDds(const std::uint8_t* data, std::size_t size, const std::st
   LoadedTexture t;
   t.file = file;
   t.container = TextureContainer::kDds;
-  const auto dimension = [&](const char* what) {
-    const std::uint64_t at = r.offset();
-    const std::uint32_t v = r.U32(what);
-    if (v == 0 || v > (1u << 16))
-      throw FormatError(file, BytePosition(at), std::string(what) + " in 1..65536",
-                        std::to_string(v));
-    return static_cast<int>(v);
-  };
+  const auto dimension = [&](const char* what) { return detail::ReadDimension(r, file, what); };
   t.volume.height = dimension("dwHeight");
   t.volume.width = dimension("dwWidth");
   {

@@ -236,14 +236,7 @@ LoadedTexture ParseKtx2(const std::uint8_t* data, std::size_t size, const std::s
   LoadedTexture t;
   t.file = file;
   t.container = TextureContainer::kKtx2;
-  const auto dimension = [&](const char* what) {
-    const std::uint64_t at = r.offset();
-    const std::uint32_t v = r.U32(what);
-    if (v == 0 || v > (1u << 16))
-      throw FormatError(file, BytePosition(at), std::string(what) + " in 1..65536",
-                        std::to_string(v));
-    return static_cast<int>(v);
-  };
+  const auto dimension = [&](const char* what) { return detail::ReadDimension(r, file, what); };
   t.volume.width = dimension("pixelWidth");
   t.volume.height = dimension("pixelHeight");
   t.volume.depth = dimension("pixelDepth (a 3D texture: one slice per theta_in)");
