@@ -14,13 +14,13 @@ file(RELATIVE_PATH BRDF_MODULE_DIR_FROM_EXE
      "${CMAKE_INSTALL_PREFIX}/${CMAKE_INSTALL_BINDIR}"
      "${CMAKE_INSTALL_PREFIX}/${BRDF_INSTALL_MODULE_DIR}")
 
-# brdf_add_lazy_module(NAME SOURCES src... LIBS lib...)
-#   Builds lib<NAME>.so into the module folder, installs it, hides every symbol except the
+# brdf_add_lazy_module(NAME [NO_INSTALL] SOURCES src... LIBS lib...)
+#   Builds lib<NAME>.so into the module folder, installs it (unless NO_INSTALL: test fixtures), hides every symbol except the
 #   BRDF_MODULE_ENTRY functions and defines BRDF_VERSION_STRING for BRDF_DEFINE_MODULE_ABI().
 #   Whatever the module links (LIBS) is mapped only when the module is loaded. A static
 #   project library linked into a module must be built with POSITION_INDEPENDENT_CODE ON.
 function(brdf_add_lazy_module name)
-  cmake_parse_arguments(ARG "" "" "SOURCES;LIBS" ${ARGN})
+  cmake_parse_arguments(ARG "NO_INSTALL" "" "SOURCES;LIBS" ${ARGN})
   add_library(${name} MODULE ${ARG_SOURCES})
   set_target_properties(${name} PROPERTIES
     LIBRARY_OUTPUT_DIRECTORY "${BRDF_BUILD_MODULE_DIR}"
@@ -30,5 +30,7 @@ function(brdf_add_lazy_module name)
   target_link_libraries(${name} PRIVATE brdf::warnings ${ARG_LIBS})
   # A module must not depend on symbols of the program that loads it.
   target_link_options(${name} PRIVATE "LINKER:--no-undefined")
-  install(TARGETS ${name} LIBRARY DESTINATION "${BRDF_INSTALL_MODULE_DIR}")
+  if(NOT ARG_NO_INSTALL)
+    install(TARGETS ${name} LIBRARY DESTINATION "${BRDF_INSTALL_MODULE_DIR}")
+  endif()
 endfunction()

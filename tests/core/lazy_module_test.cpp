@@ -105,6 +105,16 @@ TEST_F(LazyModuleTest, RealModuleLoadsOnFirstUseAndReportsAMissingEntryPoint) {
   EXPECT_EQ(std::string(module.Entry<Abi>("brdf_module_abi")()), BRDF_MODULE_ABI_TAG);
 }
 
+TEST_F(LazyModuleTest, ModuleLinkingAProjectLibraryRunsItsCode) {
+  ::setenv("BRDF_MODULE_DIR", BRDF_TEST_MODULE_DIR, 1);
+  LazyModule module("libbrdf_lazy_module_fixture.so", "testing the loader");
+  auto* position =
+      module.Entry<void(unsigned long long, std::string*)>("brdf_test_byte_position");
+  std::string text;
+  position(1840, &text);
+  EXPECT_EQ(text, "byte 1840");  // the spelling error.h documents
+}
+
 TEST_F(LazyModuleTest, ModuleOfAnotherBuildIsRefused) {
   // A shared object without brdf_module_abi stands for a module of another build.
   ::setenv("BRDF_MODULE_DIR", dir_.c_str(), 1);
