@@ -68,7 +68,9 @@ struct ExrImage {
   RgbImage image;               // R, G, B as float whatever the stored type
   StringAttributes attributes;  // every string attribute of the header, in header order
   ExrPixelType pixel_type = ExrPixelType::kFloat;  // the type of the R channel
-  ExrCompression compression = ExrCompression::kNone;  // kZip also for ZIPS
+  // kZip for ZIP and ZIPS; kNone for no compression and for the kinds this toolchain never
+  // writes (RLE, PIZ, PXR24, B44, DWA), which OpenEXR decodes all the same.
+  ExrCompression compression = ExrCompression::kNone;
   std::string Attribute(const std::string& name) const;  // "" when absent
 };
 
