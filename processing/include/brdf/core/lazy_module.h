@@ -22,6 +22,23 @@
 // A module that is missing, cannot be loaded or comes from another build gives one IoError line
 // naming the module, what it is needed for, the folders searched and what to do.
 //
+// Adding a module, e.g. the Ceres fitter:
+//   CMake:   brdf_add_lazy_module(brdf_fit_ceres SOURCES fit_module.cpp fit_ceres.cpp
+//                                 LIBS brdf::processing Ceres::ceres)
+//            add_dependencies(brdf_processing brdf_fit_ceres)  # built with what calls it
+//   module (fit_module.cpp):
+//            BRDF_DEFINE_MODULE_ABI()
+//            BRDF_MODULE_ENTRY bool brdf_fit(const In* in, Out* out, std::string* error) {
+//              try { *out = FitWithCeres(*in); return true; }
+//              catch (const std::exception& e) { *error = e.what(); return false; }
+//            }
+//   caller (in the light library, no Ceres header):
+//            static LazyModule module("libbrdf_fit_ceres.so", "fitting a material");
+//            auto* fit = module.Entry<bool(const In*, Out*, std::string*)>("brdf_fit");
+//            if (!fit(&in, &out, &error)) throw InvalidArgument(error);
+// Project libraries a module links must be position-independent (brdf_core and
+// brdf_processing are); the module gets its own hidden copy of them.
+//
 // Thread-safe: the first Symbol() call loads the module once; later calls only look up.
 // The module stays loaded until the process ends (objects it created may still be alive).
 #pragma once
