@@ -25,7 +25,8 @@
 // Adding a module, e.g. the Ceres fitter:
 //   CMake:   brdf_add_lazy_module(brdf_fit_ceres SOURCES fit_module.cpp fit_ceres.cpp
 //                                 LIBS brdf::processing Ceres::ceres)
-//            add_dependencies(brdf_processing brdf_fit_ceres)  # built with what calls it
+//            add_dependencies(brdf brdf_fit_ceres)  # the programs that call it (not
+//                                  # brdf_processing itself: the module links it, a cycle)
 //   module (fit_module.cpp):
 //            BRDF_DEFINE_MODULE_ABI()
 //            BRDF_MODULE_ENTRY bool brdf_fit(const In* in, Out* out, std::string* error) {
