@@ -25,8 +25,8 @@
 #include "brdf/exporter/packed_volume.h"
 #include "brdf/exporter/rgb9e5.h"
 #include "cli_support.h"
+#include "brdf/sources/open.h"
 #include "commands.h"
-#include "sources.h"
 
 namespace brdf::cli {
 
@@ -114,15 +114,12 @@ Json DescribeBpc(const std::string& path) {
   }
   if (!r.finished) {
     if (r.intact_data_after_damage) {
-      j["advice"] =
-          "intact slices follow damaged data; a resume would discard them. Rewrite the "
-          "intact slices to a new file instead.";
+      j["advice"] = "intact slices follow damaged data; a resume would discard them: " +
+                    RemedyText(Remedy{RemedyKind::kRepairCapture, path});
     } else {
       j["advice"] =
           std::string(truncated ? "the capture was interrupted" : "the capture is unfinished") +
-          ": to continue it, rerun the same 'brdf capture ... --out " + path +
-          "' command with --resume (the file is cut back to its " + std::to_string(r.valid_bytes) +
-          " intact bytes first)";
+          ": " + RemedyText(Remedy{RemedyKind::kResumeCapture, path, r.valid_bytes});
     }
   }
   return j;
@@ -180,14 +177,7 @@ Json ZemaxTisJson(const ZemaxBsdf& z) {
   return rows;
 }
 
-Json DescribeImported(const std::string& path) {
-  ImportFormat format;
-  try {
-    format = DetectImportFormat(path);
-  } catch (const FormatError& e) {
-    // The detector's hint names `brdf import --format`, which info does not have.
-    throw FormatError(e.file(), e.position(), e.expected(), e.got());
-  }
+Json DescribeImported(const std::string& path, ImportFormat format) {
   Json j;
   j["file"] = path;
   j["format"] = ImportFormatName(format);
@@ -267,7 +257,7 @@ std::string Hex32(std::uint32_t v) {
 // are of the RGB9E5 values as stored (decoded exactly), per θin slice; for an atlas over the
 // cells that hold a material.
 Json DescribeTexture(const std::string& path) {
-  const OpenedTexture t = OpenExportedTexture(path);
+  const sources::OpenedTexture t = sources::OpenExportedTexture(path);
   const exporter::LoadedTexture& tex = t.texture;
   const exporter::PackedVolume& v = tex.volume;
   Json j;
@@ -347,26 +337,6 @@ Json DescribeTexture(const std::string& path) {
   j["warnings"] = t.warnings;
   return j;
 }
-
-// A .json is a material file, a LUT sidecar or an atlas manifest, told apart by content.
-Json DescribeJson(const std::string& path) {
-  const FileKind kind = ClassifyFile(path);
-  if (kind == FileKind::kSidecar || kind == FileKind::kAtlasManifest) return DescribeTexture(path);
-  if (kind == FileKind::kMaterial) return DescribeMaterial(path);
-  throw InvalidArgument(path + ": a " + std::string(FileKindName(kind)) +
-                        "; brdf info reads material files, LUT sidecars and atlas manifests");
-}
-
-// Describers by extension.
-struct Describer {
-  const char* extension;
-  Json (*describe)(const std::string& path);
-};
-constexpr Describer kDescribers[] = {
-    {".bpc", DescribeBpc},         {".json", DescribeJson},     {".ktx2", DescribeTexture},
-    {".dds", DescribeTexture},     {".bsdf", DescribeImported}, {".csv", DescribeImported},
-    {".binary", DescribeImported},
-};
 
 std::string Fixed(const Json& v, const char* format = "%.6g") {
   if (v.is_null()) return "-";
@@ -580,28 +550,36 @@ void PrintTextureText(const Json& j) {
 }  // namespace
 
 int RunInfo(const InfoOptions& options) {
-  const std::string ext = LowerExtension(options.file);
-  for (const Describer& d : kDescribers) {
-    if (ext != d.extension) continue;
-    const Json j = d.describe(options.file);
-    if (options.json) {
-      std::printf("%s\n", j.dump(2, ' ', false, Json::error_handler_t::replace).c_str());
-    } else if (j["format"] == "bpc") {
-      PrintBpcText(j);
-    } else if (IsImportedFormat(j)) {
-      PrintImportedText(j);
-    } else if (j["format"] == "lut" || j["format"] == "atlas") {
-      PrintTextureText(j);
-    } else {
-      PrintMaterialText(j);
-    }
-    return 0;
+  using sources::FileKind;
+  const FileKind kind = sources::DetectFileKind(options.file);
+  Json j;
+  if (kind == FileKind::kCapture) {
+    j = DescribeBpc(options.file);
+  } else if (kind == FileKind::kMaterial) {
+    j = DescribeMaterial(options.file);
+  } else if (sources::IsExportedLut(kind)) {
+    j = DescribeTexture(options.file);
+  } else if (const std::optional<ImportFormat> format = sources::ImportFormatOf(kind)) {
+    j = DescribeImported(options.file, *format);
+  } else {
+    throw InvalidArgument(options.file + ": a " + std::string(sources::FileKindName(kind)) +
+                          "; brdf info reads captures (.bpc), material files, exported LUTs "
+                          "(.ktx2, .dds, sidecar and atlas manifest .json), RGL .bsdf, MERL "
+                          ".binary, Zemax and LightTools BSDF tables, CSV point clouds and "
+                          "goniometer tables");
   }
-  std::string known;
-  for (const Describer& d : kDescribers)
-    known += (known.empty() ? "" : ", ") + std::string(d.extension);
-  throw InvalidArgument(options.file + ": unknown file type '" + ext + "' (brdf info reads " +
-                        known + ")");
+  if (options.json) {
+    std::printf("%s\n", j.dump(2, ' ', false, Json::error_handler_t::replace).c_str());
+  } else if (j["format"] == "bpc") {
+    PrintBpcText(j);
+  } else if (IsImportedFormat(j)) {
+    PrintImportedText(j);
+  } else if (j["format"] == "lut" || j["format"] == "atlas") {
+    PrintTextureText(j);
+  } else {
+    PrintMaterialText(j);
+  }
+  return 0;
 }
 
 }  // namespace brdf::cli

@@ -8,6 +8,7 @@
 
 #include "brdf/core/error.h"
 #include "brdf/core/measurement.h"
+#include "cli_support.h"
 #include "commands.h"
 
 namespace {
@@ -301,7 +302,9 @@ int main(int argc, char** argv) {
                  e.what());
     return 2;
   } catch (const brdf::Error& e) {
-    std::fprintf(stderr, "brdf: error: %s\n", e.what());
+    const std::string command =
+        app.get_subcommands().empty() ? std::string() : app.get_subcommands().front()->get_name();
+    std::fprintf(stderr, "brdf: error: %s\n", brdf::cli::ErrorLine(e, command).c_str());
     return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "brdf: internal error: %s\n", e.what());

@@ -395,6 +395,7 @@ class BpcParser {
         if (why.empty()) {
           result_.measurement.slices.push_back(std::move(slice));
           result_.slice_indices.push_back(stored_slice);
+          result_.slice_offsets.push_back(pos);
           expected_slice = stored_slice + 1;
         } else {
           AddProblem(BpcProblemKind::kCorrupt, pos, end - pos, stored_slice,
@@ -426,6 +427,7 @@ class BpcParser {
         break;
       }
     }
+    result_.header_metadata = result_.measurement.metadata;
     if (result_.finished) result_.measurement.metadata = end_metadata_;
     return std::move(result_);
   }
@@ -509,7 +511,7 @@ class BpcParser {
     if (slice >= 0) position += " (slice " + std::to_string(slice) + ")";
     std::string hint;
     if (kind == BpcProblemKind::kTruncated)
-      hint = "damaged tail of an interrupted capture; complete it with 'brdf capture ... --resume'";
+      hint = "damaged tail of an interrupted capture";
     problem.message = FormatError(file_, position, expected, got, hint).what();
     problem.expected = std::move(expected);
     problem.got = std::move(got);
@@ -607,6 +609,7 @@ std::optional<BpcReadResult> ReadIntactStreaming(int fd, std::uint64_t size,
       if (crc != ch.payload_crc) return std::nullopt;
       result.measurement.slices.push_back(std::move(slice));
       result.slice_indices.push_back(static_cast<int>(ch.slice_index));
+      result.slice_offsets.push_back(pos);
     } else if (TagIs(h, kTagEnd)) {
       std::vector<std::uint8_t> payload(static_cast<std::size_t>(n));
       if (!ReadExact(fd, payload.data(), payload.size()) ||
@@ -614,6 +617,7 @@ std::optional<BpcReadResult> ReadIntactStreaming(int fd, std::uint64_t size,
           pos + kChunkHeaderSize + n != size)
         return std::nullopt;
       try {
+        result.header_metadata = result.measurement.metadata;
         result.measurement.metadata =
             DecodeEndPayload(payload.data(), payload.size(), path, pos + kChunkHeaderSize);
       } catch (const FormatError&) {
@@ -633,6 +637,7 @@ std::optional<BpcReadResult> ReadIntactStreaming(int fd, std::uint64_t size,
     pos += kChunkHeaderSize + n;
     result.valid_bytes = pos;
   }
+  if (!result.finished) result.header_metadata = result.measurement.metadata;
   return result;
 }
 
@@ -735,8 +740,8 @@ BpcAppender BpcAppender::Resume(const std::string& path, BpcReadResult* existing
     throw FormatError(path, BytePosition(r.valid_bytes),
                       "damage only at the tail of an interrupted capture",
                       "intact chunks after a damaged one",
-                      "resuming would truncate them; rewrite the file with the intact slices "
-                      "instead");
+                      "resuming would truncate them",
+                      Remedy{RemedyKind::kRepairCapture, path});
   if (::truncate(path.c_str(), static_cast<off_t>(r.valid_bytes)) != 0)
     throw IoError(path + ": cannot truncate to " + std::to_string(r.valid_bytes) +
                   " bytes: " + ErrnoText());

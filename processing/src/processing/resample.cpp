@@ -31,8 +31,9 @@ std::string Who(const Measurement& m) {
                                         : "measurement '" + m.metadata.sample_name + "'";
 }
 
-// Slice indices in ascending θin, checked against DESIGN §5's θin,k = k·Δin.
-std::vector<std::size_t> UniformThetaInOrder(const Measurement& m, double* delta_in) {
+// Slice indices in ascending θin, checked against DESIGN §5's θin,k = k·Δin (only distinct
+// when !uniform; *delta_in is then 0).
+std::vector<std::size_t> ThetaInOrder(const Measurement& m, bool uniform, double* delta_in) {
   if (m.slices.empty()) throw InvalidArgument(Who(m) + " has no slices; cannot build a LUT");
   std::vector<std::size_t> order(m.slices.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
@@ -52,6 +53,8 @@ std::vector<std::size_t> UniformThetaInOrder(const Measurement& m, double* delta
     if (m.slices[order[k]].theta_in_deg - m.slices[order[k - 1]].theta_in_deg <= kThetaInTolDeg)
       fail("duplicate incidence angle " + Num(m.slices[order[k]].theta_in_deg) + "° (slices " +
            std::to_string(order[k - 1]) + " and " + std::to_string(order[k]) + ")");
+  *delta_in = 0.0;
+  if (!uniform) return order;
   const double first = m.slices[order.front()].theta_in_deg;
   if (std::fabs(first) > kThetaInTolDeg) fail("the first is not 0°");
   *delta_in = 0.0;
@@ -91,7 +94,8 @@ Lut BuildLut(const Measurement& measurement, const ExtrapolationParams& params,
   params.Validate();
   options.Validate();
   double delta_in = 0;
-  const std::vector<std::size_t> order = UniformThetaInOrder(measurement, &delta_in);
+  const std::vector<std::size_t> order =
+      ThetaInOrder(measurement, options.require_uniform_theta_in, &delta_in);
   const int k_slices = static_cast<int>(order.size());
 
   std::vector<std::unique_ptr<internal::SliceInterpolator>> slices(order.size());
@@ -111,7 +115,11 @@ Lut BuildLut(const Measurement& measurement, const ExtrapolationParams& params,
 
   Lut lut;
   lut.Resize(order.size());
-  for (int k = 0; k < k_slices; ++k) lut.theta_in_deg[static_cast<std::size_t>(k)] = k * delta_in;
+  for (int k = 0; k < k_slices; ++k)
+    lut.theta_in_deg[static_cast<std::size_t>(k)] =
+        options.require_uniform_theta_in
+            ? k * delta_in
+            : measurement.slices[order[static_cast<std::size_t>(k)]].theta_in_deg;
 
   // Texel directions ω_d at texel centres (θd, φd) = (j·1°, i·1°); column 360 is copied from
   // column 0 afterwards so the seam is bit-identical.

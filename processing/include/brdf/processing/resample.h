@@ -61,6 +61,11 @@ struct ResampleOptions {
   bool parallel = true;
   // k of the scattered method: how many nearest samples each fit uses, in [4, 64].
   int neighbours = 16;
+  // false accepts any set of distinct θin in [0°, 90°) (evaluation of imported tables such as a
+  // Zemax file measured at 10°, 30°, 50°): LUT slice k is then the k-th smallest measured θin,
+  // and Lut::SampleAngles interpolates between neighbouring slices the same way. Such a LUT is
+  // for evaluation only; the exported textures need θin,k = k·Δin.
+  bool require_uniform_theta_in = true;
 
   // Throws InvalidArgument naming the bad option.
   void Validate() const;
