@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cerrno>
@@ -314,12 +315,27 @@ std::string DecodeSlicePayload(const std::uint8_t* p, std::uint64_t n, Slice* sl
 }
 
 // The final metadata of an end chunk payload (CRC already matched). Throws FormatError.
+// `result` (may be null) receives the end chunk's slice and sample counts, -1 when absent or
+// not integers (the reader reports what it finds; brdf::sources checks them against the file).
 Metadata DecodeEndPayload(const std::uint8_t* p, std::size_t n, const std::string& file,
-                          std::uint64_t offset) {
+                          std::uint64_t offset, BpcReadResult* result = nullptr) {
   const Json j = ParseJsonPayload(p, n, file, offset, "end");
   const auto it = j.find("metadata");
   if (it == j.end()) throw FormatError(file, BytePosition(offset), "a 'metadata' member", "none");
-  return MetadataFromJson(*it, file, offset, "end chunk");
+  Metadata m = MetadataFromJson(*it, file, offset, "end chunk");
+  if (result) {
+    const auto count = [&](const char* key) -> std::int64_t {
+      const auto c = j.find(key);
+      if (c == j.end() || !c->is_number_unsigned()) return -1;
+      return static_cast<std::int64_t>(std::min<std::uint64_t>(
+          c->get<std::uint64_t>(),
+          static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max())));
+    };
+    result->end_slice_count = count("slice_count");
+    result->end_sample_count = count("sample_count");
+    result->end_offset = offset - kChunkHeaderSize;
+  }
+  return m;
 }
 
 class BpcParser {
@@ -407,7 +423,7 @@ class BpcParser {
         // A CRC-valid end chunk with unusable JSON was written wrong, not damaged in transit;
         // it is reported like damage so the slices before it stay readable.
         try {
-          end_metadata_ = DecodeEndPayload(payload, n, file_, pos + kChunkHeaderSize);
+          end_metadata_ = DecodeEndPayload(payload, n, file_, pos + kChunkHeaderSize, &result_);
           result_.finished = true;
         } catch (const FormatError& e) {
           AddProblem(BpcProblemKind::kCorrupt, pos, end - pos, -1, e.expected(), e.got());
@@ -619,7 +635,7 @@ std::optional<BpcReadResult> ReadIntactStreaming(int fd, std::uint64_t size,
       try {
         result.header_metadata = result.measurement.metadata;
         result.measurement.metadata =
-            DecodeEndPayload(payload.data(), payload.size(), path, pos + kChunkHeaderSize);
+            DecodeEndPayload(payload.data(), payload.size(), path, pos + kChunkHeaderSize, &result);
       } catch (const FormatError&) {
         return std::nullopt;
       }

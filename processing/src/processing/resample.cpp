@@ -89,10 +89,109 @@ void ResampleOptions::Validate() const {
                           std::to_string(neighbours));
 }
 
+std::vector<LutInputProblem> FindLutInputProblems(const Measurement& m,
+                                                  const ResampleOptions& options) {
+  using Kind = LutInputProblem::Kind;
+  std::vector<LutInputProblem> out;
+  const auto add = [&](Kind kind, int slice, std::string message) {
+    LutInputProblem p;
+    p.kind = kind;
+    p.slice = slice;
+    if (slice >= 0) p.theta_in_deg = m.slices[static_cast<std::size_t>(slice)].theta_in_deg;
+    p.message = std::move(message);
+    out.push_back(std::move(p));
+    return &out.back();
+  };
+  if (m.slices.empty()) {
+    add(Kind::kNoSlices, -1, "no slices");
+    return out;
+  }
+  const auto name = [&](std::size_t i) {
+    return "slice " + std::to_string(i) + " (θin = " + Num(m.slices[i].theta_in_deg) + "°)";
+  };
+  bool angles_ok = true;
+  for (std::size_t i = 0; i < m.slices.size(); ++i) {
+    const Slice& s = m.slices[i];
+    if (!(s.theta_in_deg >= 0.0 && s.theta_in_deg < 90.0)) {
+      add(Kind::kThetaInOutOfRange, static_cast<int>(i),
+          name(i) + ": θin must be in [0°, 90°) for a reflection measurement");
+      angles_ok = false;
+    } else if (!std::isfinite(s.phi_in_deg)) {
+      add(Kind::kThetaInOutOfRange, static_cast<int>(i), name(i) + ": φin is not a finite number");
+      angles_ok = false;
+    }
+  }
+  if (angles_ok) {
+    try {
+      double delta = 0;
+      ThetaInOrder(m, options.require_uniform_theta_in, &delta);
+    } catch (const InvalidArgument& e) {
+      const std::string text = e.what();
+      const std::string prefix = Who(m) + ": ";
+      add(text.find("duplicate") != std::string::npos ? Kind::kDuplicateThetaIn
+                                                       : Kind::kThetaInNotUniform,
+          -1, text.compare(0, prefix.size(), prefix) == 0 ? text.substr(prefix.size()) : text);
+    }
+  }
+  float theta_b = 0;
+  for (std::size_t i = 0; i < m.slices.size(); ++i) {
+    const Slice& s = m.slices[i];
+    struct Defect {
+      std::string what;
+      std::size_t count = 0, first = 0;
+    };
+    std::vector<Defect> defects;
+    std::size_t valid = 0, invalid = 0;
+    for (std::size_t n = 0; n < s.samples.size(); ++n) {
+      const Sample& x = s.samples[n];
+      if (x.flags & kFlagInvalid) {
+        ++invalid;
+        continue;
+      }
+      if (const char* d = internal::SampleDefect(x)) {
+        auto it = std::find_if(defects.begin(), defects.end(),
+                               [&](const Defect& e) { return e.what == d; });
+        if (it == defects.end())
+          defects.push_back({d, 1, n});
+        else
+          ++it->count;
+        continue;
+      }
+      ++valid;
+      theta_b = std::max(theta_b, std::fabs(x.theta_out_deg));
+    }
+    for (const Defect& d : defects) {
+      const Sample& x = s.samples[d.first];
+      const std::string values = "θout " + Num(x.theta_out_deg) + "°, φout " +
+                                 Num(x.phi_out_deg) + "°, rgb " + Num(x.rgb[0]) + " " +
+                                 Num(x.rgb[1]) + " " + Num(x.rgb[2]);
+      LutInputProblem* p = add(
+          Kind::kBadSamples, static_cast<int>(i),
+          name(i) + ": " + std::to_string(d.count) + " sample" + (d.count == 1 ? "" : "s") +
+              " with " + d.what + " (first: sample " + std::to_string(d.first) + ", " + values +
+              "); a sample without a usable value must be flagged invalid");
+      p->sample_count = d.count;
+      p->first_sample = d.first;
+    }
+    if (valid == 0 && defects.empty())
+      add(Kind::kNoValidSample, static_cast<int>(i),
+          name(i) + ": no valid sample (" + std::to_string(s.samples.size()) + " samples, " +
+              std::to_string(invalid) + " flagged invalid); cannot interpolate");
+  }
+  if (out.empty() && !(theta_b > 0.0f))
+    add(Kind::kDegenerateRange, -1,
+        "every valid sample is at θout = 0° (measured range θout 0°–0°): there is nothing to "
+        "interpolate or extrapolate from");
+  return out;
+}
+
 Lut BuildLut(const Measurement& measurement, const ExtrapolationParams& params,
              const ResampleOptions& options, ResampleReport* report) {
   params.Validate();
   options.Validate();
+  if (const std::vector<LutInputProblem> problems = FindLutInputProblems(measurement, options);
+      !problems.empty())
+    throw InvalidArgument(Who(measurement) + ": " + problems.front().message);
   double delta_in = 0;
   const std::vector<std::size_t> order =
       ThetaInOrder(measurement, options.require_uniform_theta_in, &delta_in);

@@ -6,6 +6,7 @@
 
 #include "brdf/core/file_util.h"
 #include "brdf/core/virtual_capture.h"
+#include "brdf/processing/resample.h"
 #include "text.h"
 
 namespace brdf::sources {
@@ -32,6 +33,66 @@ std::uint64_t ChunkBytes(const BpcReadResult& r, std::size_t i) {
 
 std::string SlicesText(std::size_t n) {
   return std::to_string(n) + " intact slice" + (n == 1 ? "" : "s");
+}
+
+// Slice indices and the end chunk's counts against what the file holds: CRC-valid chunks that
+// disagree were written wrong (a broken writer or a tampered file), not damaged in transit.
+void CheckStructure(CaptureAssessment& a) {
+  const BpcReadResult& r = a.read;
+  std::size_t slice_chunks = r.measurement.slices.size();
+  for (const BpcProblem& p : r.problems)
+    if (p.slice_index >= 0 && p.kind == BpcProblemKind::kCorrupt) ++slice_chunks;
+  const Remedy repair{RemedyKind::kRepairCapture, a.path, r.valid_bytes, a.missing_theta_in_deg};
+  for (std::size_t i = 0; i < r.slice_indices.size(); ++i) {
+    const int index = r.slice_indices[i];
+    const std::string where = BytePosition(r.slice_offsets[i]) + " (slice chunk " +
+                              std::to_string(i) + " of the intact ones)";
+    bool duplicate = false;
+    for (std::size_t k = 0; k < i; ++k) duplicate = duplicate || r.slice_indices[k] == index;
+    if (duplicate)
+      a.refusals.push_back({where, "a slice index not used before",
+                            "slice index " + std::to_string(index) + " a second time",
+                            "two chunks claim to be the same slice", repair});
+    else if (index < 0 || static_cast<std::size_t>(index) >= slice_chunks)
+      a.refusals.push_back(
+          {where, "a slice index below the number of slice chunks (" +
+                      std::to_string(slice_chunks) + ")",
+           "slice index " + std::to_string(index), "the file's slices are numbered wrong", repair});
+  }
+  if (r.finished && r.problems.empty()) {
+    const std::string where = BytePosition(r.end_offset) + " (end chunk)";
+    if (r.end_slice_count != static_cast<std::int64_t>(r.measurement.slices.size()))
+      a.refusals.push_back(
+          {where, "slice_count " + std::to_string(r.measurement.slices.size()) +
+                      " (the slices in the file)",
+           r.end_slice_count < 0 ? std::string("no slice count")
+                                 : "slice_count " + std::to_string(r.end_slice_count),
+           "the end chunk does not describe this file", repair});
+    if (r.end_sample_count != static_cast<std::int64_t>(r.measurement.SampleCount()))
+      a.refusals.push_back(
+          {where, "sample_count " + std::to_string(r.measurement.SampleCount()) +
+                      " (the samples in the file)",
+           r.end_sample_count < 0 ? std::string("no sample count")
+                                  : "sample_count " + std::to_string(r.end_sample_count),
+           "the end chunk does not describe this file", repair});
+  }
+}
+
+// The values, by the rule BuildLut applies (any distinct θin: eval accepts those too).
+void CheckValues(CaptureAssessment& a) {
+  if (a.read.measurement.slices.empty()) return;  // reported as missing slices
+  processing::ResampleOptions options;
+  options.require_uniform_theta_in = false;
+  for (const processing::LutInputProblem& p :
+       processing::FindLutInputProblems(a.read.measurement, options)) {
+    std::string where = "values";
+    if (p.slice >= 0 && static_cast<std::size_t>(p.slice) < a.read.slice_offsets.size())
+      where = BytePosition(a.read.slice_offsets[static_cast<std::size_t>(p.slice)]) +
+              " (slice " + std::to_string(a.read.slice_indices[static_cast<std::size_t>(p.slice)]) +
+              ")";
+    a.refusals.push_back({where, "values a LUT can be built from", p.message, {},
+                          Remedy{RemedyKind::kRecapture, a.path}});
+  }
 }
 
 }  // namespace
@@ -78,58 +139,63 @@ CaptureAssessment AssessCapture(const std::string& path, BpcReadResult read) {
       const std::string where =
           BytePosition(p.offset) +
           (p.slice_index >= 0 ? " (slice " + std::to_string(p.slice_index) + ")" : std::string());
-      a.refusal = CaptureRefusal{
+      a.refusals.push_back(CaptureRefusal{
           where, p.expected, p.got,
           "corrupt chunk; a LUT needs every slice intact; " + intact +
               (r.intact_data_after_damage ? ", some of them after the damage"
                                           : " end at byte " + std::to_string(r.valid_bytes)),
-          continue_remedy};
-      return a;
+          continue_remedy});
+      continue;
     }
     if (p.kind == BpcProblemKind::kTruncated) {
       if (p.slice_index >= 0) {
-        a.refusal = CaptureRefusal{
+        a.refusals.push_back(CaptureRefusal{
             BytePosition(p.offset) + " (slice " + std::to_string(p.slice_index) + ")",
             p.expected, p.got,
             "the capture was interrupted inside slice " + std::to_string(p.slice_index) +
                 "; a LUT needs every slice; " + intact + " end at byte " +
                 std::to_string(r.valid_bytes),
-            continue_remedy};
-        return a;
+            continue_remedy});
+        continue;
       }
       tail_cut_outside_slices = true;
     }
   }
-  for (const Slice& s : r.measurement.slices)
-    if (!s.complete) {
-      a.refusal = CaptureRefusal{
-          "slice θin " + Deg(s.theta_in_deg) + "°", "a complete slice",
+  for (std::size_t i = 0; i < r.measurement.slices.size(); ++i) {
+    const Slice& s = r.measurement.slices[i];
+    if (!s.complete)
+      a.refusals.push_back(CaptureRefusal{
+          BytePosition(r.slice_offsets[i]) + " (slice " + std::to_string(r.slice_indices[i]) +
+              ", θin " + Deg(s.theta_in_deg) + "°)",
+          "a complete slice",
           "a slice the instrument stopped before finishing (" + std::to_string(s.samples.size()) +
               " samples)",
           "a LUT needs every slice complete",
-          Remedy{RemedyKind::kRepairCapture, path, r.valid_bytes, a.missing_theta_in_deg}};
-      return a;
-    }
-  if (!r.finished) {
+          Remedy{RemedyKind::kRepairCapture, path, r.valid_bytes, a.missing_theta_in_deg}});
+  }
+  CheckStructure(a);
+  CheckValues(a);
+  if (!r.finished && a.refusals.empty()) {
     if (!a.missing_theta_in_deg.empty()) {
-      a.refusal = CaptureRefusal{
+      a.refusals.push_back(CaptureRefusal{
           BytePosition(r.valid_bytes),
           "slices for every planned θin (" + DegList(a.planned_theta_in_deg) + "°)",
           "the end of an unfinished capture with θin " +
               (a.present_theta_in_deg.empty() ? std::string("none")
                                               : DegList(a.present_theta_in_deg) + "°") +
               " only (missing " + DegList(a.missing_theta_in_deg) + "°)",
-          {}, continue_remedy};
-      return a;
+          {}, continue_remedy});
+    } else {
+      a.warnings.push_back(
+          path + ": warning: no intact end chunk (" +
+          (tail_cut_outside_slices
+               ? "the file is cut after the last slice, at byte " + std::to_string(r.valid_bytes)
+               : std::string("the capture was never finalised")) +
+          "), but all " + std::to_string(a.planned_theta_in_deg.size()) + " planned slices (θin " +
+          DegList(a.planned_theta_in_deg) + "°) are intact: using them");
     }
-    a.warnings.push_back(
-        path + ": warning: no intact end chunk (" +
-        (tail_cut_outside_slices
-             ? "the file is cut after the last slice, at byte " + std::to_string(r.valid_bytes)
-             : std::string("the capture was never finalised")) +
-        "), but all " + std::to_string(a.planned_theta_in_deg.size()) + " planned slices (θin " +
-        DegList(a.planned_theta_in_deg) + "°) are intact: using them");
   }
+  if (!a.refusals.empty()) a.refusal = a.refusals.front();
   for (const BpcProblem& p : r.problems)
     if (p.kind == BpcProblemKind::kTrailingData)
       a.warnings.push_back(path + ": warning: " + std::to_string(p.size) +

@@ -34,7 +34,11 @@ struct CaptureRefusal {
   FormatError ToError(const std::string& file) const;
 };
 
-// The damaged-capture rule applied to one file.
+// The damaged-capture rule applied to one file, together with the checks of the file's
+// structure (slice indices, the end chunk's counts) and of its values
+// (processing::FindLutInputProblems with any θin set: NaN values, angles out of range, duplicate
+// θin, a slice without valid samples, a degenerate measured range). `brdf info`, `convert` and
+// `eval` all apply this one assessment, so they cannot disagree about a capture.
 struct CaptureAssessment {
   std::string path;
   BpcReadResult read;  // everything ReadBpc found (intact slices, problems, valid bytes)
@@ -43,7 +47,8 @@ struct CaptureAssessment {
   bool plan_recorded = false;                  // planned_theta_in_deg came from the file
   std::vector<double> present_theta_in_deg;    // intact, complete slices, in file order
   std::vector<double> missing_theta_in_deg;    // planned but not present (in plan order)
-  std::optional<CaptureRefusal> refusal;       // set when the capture cannot become a LUT
+  std::optional<CaptureRefusal> refusal;       // the first of `refusals`, if any
+  std::vector<CaptureRefusal> refusals;        // every reason the capture cannot become a LUT
   std::vector<std::string> warnings;           // full sentences starting with the path
 
   bool usable() const { return !refusal.has_value(); }
