@@ -5,6 +5,7 @@
 #include <cmath>
 
 #include "brdf/core/error.h"
+#include "brdf/core/virtual_capture.h"
 #include "brdf/device/white_reference.h"
 
 namespace brdf::device {
@@ -14,10 +15,12 @@ InstrumentModel MakeReferenceModel() {
   InstrumentModel m;
   m.model = "BRDF-SIM MD2";
   m.firmware_version = "2.4.1-sim";
-  m.theta_in_deg = {0, 20, 40, 60};
-  m.theta_out_max_deg = 75;
-  m.theta_out_step_deg = 1;
-  m.phi_out_step_deg = 1;
+  // The reference geometry is defined once, in brdf::core (virtual_capture.h).
+  const CaptureGeometry& g = ReferenceGeometry();
+  m.theta_in_deg.assign(g.theta_in_deg.begin(), g.theta_in_deg.end());
+  m.theta_out_max_deg = static_cast<float>(g.theta_out_max_deg);
+  m.theta_out_step_deg = static_cast<float>(g.theta_out_step_deg);
+  m.phi_out_step_deg = static_cast<float>(g.phi_out_step_deg);
   // A 16-bit camera-type detector: ~32,800 e⁻ full well at 2 counts per electron, 6 counts of
   // read noise, a bias near 500 counts. Responsivities give the Spectralon panel at normal
   // incidence (L = 0.315) about 600 counts/ms, so it auto-ranges to ~80 ms; the darkest

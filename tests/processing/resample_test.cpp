@@ -473,7 +473,7 @@ TEST(BuildLut, RejectsUnusableSamplesNamingThem) {
   ExpectInvalid(empty, {"slice 0", "no valid sample"});
   Measurement nan_value = meas;
   nan_value.slices[1].samples[17].rgb[2] = std::numeric_limits<float>::quiet_NaN();
-  ExpectInvalid(nan_value, {"slice 1", "sample 17", "kFlagInvalid"});
+  ExpectInvalid(nan_value, {"slice 1", "sample 17", "flagged invalid"});
   Measurement below = meas;
   below.slices[0].samples[5].theta_out_deg = 95.0f;
   ExpectInvalid(below, {"slice 0", "sample 5", "θout", "95"});

@@ -31,9 +31,14 @@ class CaptureInputs : public ToolTest {
 TEST_F(CaptureInputs, EvalOfCaptureMatchesAnalytic) {
   const Analytic m = Ggx03();
   const fs::path bpc = WriteCapture("ggx", m);
-  // On lattice nodes the capture's own (float) values; between nodes within the four nodes'
-  // range; between slices (θin 30°) the mean of the two slices on a node; beyond θb = 75° the
-  // value at 75° (defaults: clamping).
+  // `brdf eval` of a capture samples the float LUT `brdf convert` builds from it (one
+  // evaluation path). Where the query is a texel centre of that LUT and the texel's direction a
+  // capture node (the plane of incidence at whole degrees of θd) it is the capture's own
+  // (float) value; elsewhere the LUT's bilinear interpolation over 1° texels, within 1e-3 of the
+  // formula for this GGX α = 0.3 (second differences of f over one texel stay below 1 % of f
+  // here, and the bilinear error is at most 1/8 of them); between slices (θin 30°, mirror
+  // direction: θd = 0 in both neighbouring slices) the mean of the two slices' mirror values;
+  // beyond θb = 75° the value at 75° (defaults: clamping).
   WriteText(dir_ / "pairs.txt",
             "20 0 30 180\n"
             "40 0 12 33\n"
@@ -50,11 +55,12 @@ TEST_F(CaptureInputs, EvalOfCaptureMatchesAnalytic) {
   std::vector<std::array<double, 3>> got;
   while (std::getline(lines, line)) got.push_back(ParseTriple(line));
   ASSERT_EQ(got.size(), 8u);
-  const auto near = [](const std::array<double, 3>& a, const std::array<double, 3>& b) {
-    for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 2e-7 * std::fabs(b[c]) + 1e-12) << c;
+  const auto near = [](const std::array<double, 3>& a, const std::array<double, 3>& b,
+                       double rel = 2e-7) {
+    for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], rel * std::fabs(b[c]) + 1e-12) << c;
   };
   near(got[0], m.FAngles(20, 30, 180));
-  near(got[1], m.FAngles(40, 12, 33));
+  near(got[1], m.FAngles(40, 12, 33), 1e-3);
   near(got[2], m.FAngles(0, 0, 0));
   near(got[3], m.FAngles(60, 60, 180));
   for (int c = 0; c < 3; ++c) {
@@ -64,12 +70,12 @@ TEST_F(CaptureInputs, EvalOfCaptureMatchesAnalytic) {
         lo = std::min(lo, m.FAngles(40, t, p)[c]);
         hi = std::max(hi, m.FAngles(40, t, p)[c]);
       }
-    EXPECT_GE(got[4][c], lo * (1 - 1e-6));
-    EXPECT_LE(got[4][c], hi * (1 + 1e-6));
-    const double mid = 0.5 * (m.FAngles(20, 30, 180)[c] + m.FAngles(40, 30, 180)[c]);
+    EXPECT_GE(got[4][c], lo * (1 - 1e-3));
+    EXPECT_LE(got[4][c], hi * (1 + 1e-3));
+    const double mid = 0.5 * (m.FAngles(20, 20, 180)[c] + m.FAngles(40, 40, 180)[c]);
     EXPECT_NEAR(got[5][c], mid, 1e-6 * mid);
   }
-  near(got[6], m.FAngles(20, 75, 10));
+  near(got[6], m.FAngles(20, 75, 10), 1e-3);
   near(got[7], got[0]);  // isotropic: only φout − φin matters
 
   // With --extrapolate 0.2,0.3: f(75°)·((1 − α) + α·0.2), α = b((85 − 75)/15, 0.3).
@@ -80,7 +86,7 @@ TEST_F(CaptureInputs, EvalOfCaptureMatchesAnalytic) {
   const auto f75 = m.FAngles(20, 75, 10);
   const auto gx = ParseTriple(x.out);
   for (int c = 0; c < 3; ++c)
-    EXPECT_NEAR(gx[c], f75[c] * ((1 - alpha) + alpha * 0.2), 1e-6 * f75[c]);
+    EXPECT_NEAR(gx[c], f75[c] * ((1 - alpha) + alpha * 0.2), 1e-3 * f75[c]);
 }
 
 TEST_F(CaptureInputs, BatchWithCorruptAndTruncatedCapturesConvertsTheRest) {

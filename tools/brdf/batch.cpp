@@ -11,6 +11,7 @@
 #include <thread>
 
 #include "brdf/core/error.h"
+#include "cli_support.h"
 
 namespace brdf::cli {
 
@@ -20,7 +21,7 @@ namespace {
 
 bool IsInputKind(FileKind kind, const InputKinds& kinds) {
   if (kind == FileKind::kCapture || kind == FileKind::kMaterial) return true;
-  return kinds.exported_luts && (kind == FileKind::kTexture || kind == FileKind::kSidecar);
+  return kinds.exported_luts && (sources::IsTexture(kind) || kind == FileKind::kSidecar);
 }
 
 std::string Accepted(const InputKinds& kinds) {
@@ -44,7 +45,7 @@ DiscoveredInputs DiscoverInputs(const std::vector<std::string>& arguments,
   std::set<std::string> seen;
   const auto add = [&](const std::string& path, FileKind kind) {
     if (!seen.insert(Identity(path)).second) return;
-    out.inputs.push_back(BatchInput{path, OutputNameOf(path), kind});
+    out.inputs.push_back(BatchInput{path, sources::OutputNameOf(path), kind});
   };
   for (const std::string& arg : arguments) {
     std::error_code ec;
@@ -62,25 +63,25 @@ DiscoveredInputs DiscoverInputs(const std::vector<std::string>& arguments,
         const std::string path = f.string();
         FileKind kind = FileKind::kUnknown;
         try {
-          kind = ClassifyFile(path);
+          kind = sources::DetectFileKind(path);
         } catch (const Error& e) {
-          // Only JSON files are opened here; one that does not parse might be a broken material.
+          // A JSON file that does not parse might be a broken material: a failure, not a skip.
           out.failures.push_back({path, ReasonWithoutPath(path, e.what())});
           continue;
         }
         if (IsInputKind(kind, kinds))
           add(path, kind);
         else
-          out.skipped.push_back(path + " (" + FileKindName(kind) + ")");
+          out.skipped.push_back(path + " (" + sources::FileKindName(kind) + ")");
       }
     } else if (fs::is_regular_file(st)) {
       try {
-        const FileKind kind = ClassifyFile(arg);
+        const FileKind kind = sources::DetectFileKind(arg);
         if (IsInputKind(kind, kinds))
           add(arg, kind);
         else
           out.failures.push_back(
-              {arg, "not an input: expected " + Accepted(kinds) + ", got a " + FileKindName(kind)});
+              {arg, "not an input: expected " + Accepted(kinds) + ", got a " + sources::FileKindName(kind)});
       } catch (const Error& e) {
         out.failures.push_back({arg, ReasonWithoutPath(arg, e.what())});
       }
@@ -114,7 +115,7 @@ std::vector<JobResult> RunJobs(std::size_t count, int jobs,
         r.error = "out of memory";
       } catch (const std::exception& e) {
         r.ok = false;
-        r.error = e.what();
+        r.error = ErrorLine(e);
       } catch (...) {
         r.ok = false;
         r.error = "unknown error";

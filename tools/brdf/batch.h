@@ -9,10 +9,12 @@
 #include <vector>
 
 #include "brdf/exporter/exr.h"
+#include "brdf/sources/detect.h"
 #include "commands.h"
-#include "sources.h"
 
 namespace brdf::cli {
+
+using sources::FileKind;
 
 struct BatchInput {
   std::string path;  // as given, or folder/name for a file found in a folder

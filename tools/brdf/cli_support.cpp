@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 
@@ -10,6 +11,67 @@
 namespace brdf::cli {
 
 namespace fs = std::filesystem;
+
+namespace {
+
+std::string DegList(const std::vector<double>& values) {
+  std::string out;
+  for (double v : values) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    out += (out.empty() ? "" : ", ") + std::string(buf);
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string RemedyText(const Remedy& remedy, const std::string& command) {
+  const std::string& f = remedy.file;
+  const std::string missing =
+      remedy.theta_in_deg.empty() ? std::string()
+                                  : " (it captures θin " + DegList(remedy.theta_in_deg) + "°)";
+  switch (remedy.kind) {
+    case RemedyKind::kNone:
+      return {};
+    case RemedyKind::kResumeCapture:
+      return "to continue the capture, rerun the 'brdf capture ... --out " + f +
+             "' command that made it with --resume" + missing + "; it keeps the first " +
+             std::to_string(remedy.valid_bytes) + " intact bytes";
+    case RemedyKind::kRepairCapture:
+      return "run 'brdf repair " + f +
+             " --out FIXED.bpc' to keep every intact slice, then rerun the 'brdf capture' "
+             "command with --out FIXED.bpc --resume" +
+             missing;
+    case RemedyKind::kRecapture:
+      return "recapture the sample";
+    case RemedyKind::kForceOverwrite:
+      return "add --force to overwrite " + f;
+    case RemedyKind::kAllowBtdf:
+      return command == "import" ? "add --allow-btdf to store it mirrored into the reflection "
+                                   "hemisphere; 'brdf info' reads it as it is"
+                                 : "'brdf import --allow-btdf' stores it mirrored into the "
+                                   "reflection hemisphere";
+    case RemedyKind::kNameFormat:
+      return command == "import" ? "name the format with --format"
+                                 : "if you know its format, 'brdf import --format NAME' reads it";
+    case RemedyKind::kCaptureEvaluable:
+      return "'brdf import " + f + " --out FILE.bpc' captures it noise-free at the reference "
+             "geometry; 'brdf eval' evaluates it directly";
+    case RemedyKind::kEvaluateSingleLut:
+      return "evaluate one material's own LUT (written by 'brdf convert')";
+  }
+  return {};
+}
+
+std::string ErrorLine(const std::exception& error, const std::string& command) {
+  std::string line = error.what();
+  if (const auto* e = dynamic_cast<const Error*>(&error)) {
+    const std::string remedy = RemedyText(e->remedy(), command);
+    if (!remedy.empty()) line += "; " + remedy;
+  }
+  return line;
+}
 
 std::string MaterialLibraryDir() {
   if (const char* env = std::getenv("BRDF_MATERIALS_DIR"); env != nullptr && *env != '\0')

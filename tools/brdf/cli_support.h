@@ -1,10 +1,21 @@
 // Helpers shared by the brdf subcommands (no CLI11 here).
 #pragma once
 
+#include <exception>
 #include <string>
 #include <vector>
 
+#include "brdf/core/error.h"
+
 namespace brdf::cli {
+
+// What the user can do about an error, in the tool's own words ("run 'brdf repair cap.bpc
+// --out FIXED.bpc', then resume FIXED.bpc"); empty for RemedyKind::kNone. `command` is the
+// subcommand that failed ("info", "import"), for remedies that depend on its options.
+std::string RemedyText(const Remedy& remedy, const std::string& command = {});
+
+// The one line printed for an error: its message, then "; <remedy>" when it carries one.
+std::string ErrorLine(const std::exception& error, const std::string& command = {});
 
 // The folder of the virtual sample library: $BRDF_MATERIALS_DIR if set, else the
 // repository's data-samples/materials.

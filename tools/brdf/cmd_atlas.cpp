@@ -15,9 +15,9 @@
 #include "brdf/core/error.h"
 #include "brdf/exporter/atlas.h"
 #include "brdf/exporter/packed_volume.h"
+#include "brdf/sources/open.h"
 #include "commands.h"
 #include "progress.h"
-#include "sources.h"
 
 namespace brdf::cli {
 
@@ -64,7 +64,7 @@ int RunAtlas(const AtlasOptions& options) {
       found.inputs.size(), options.jobs,
       [&](std::size_t i, JobResult& result) {
         const BatchInput& in = found.inputs[i];
-        InputLut built = LutFromInput(in.path, in.kind, extrapolate, resample);
+        sources::InputLut built = sources::LutFromInput(in.path, in.kind, extrapolate, resample);
         exporter::ValidateLutForExport(built.lut);
         result.warnings = std::move(built.warnings);
         luts[i] = std::move(built.lut);

@@ -126,7 +126,7 @@ void Validate(const CaptureOptions& o) {
 // Settings that must agree between an interrupted capture and its resumption, as recorded in
 // the metadata `extra` map. "theta_in_deg" is the planned θin list ("0,20,40,60"), written into
 // the header before the first slice so that `brdf convert` can tell an interrupted capture
-// missing slices from a complete one (sources.cpp PlannedThetaIn reads it). A resumption must
+// missing slices from a complete one (brdf::PlannedThetaInDeg in brdf/core/virtual_capture.h reads it). A resumption must
 // plan the same list: the header on disk is not rewritten, so a different list would make the
 // recorded plan untrue.
 std::map<std::string, std::string> SettingsOf(const CaptureOptions& o,

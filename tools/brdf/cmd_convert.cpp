@@ -1,6 +1,6 @@
 // `brdf convert INPUT... --out DIR`: captures and material files to engine-ready LUTs.
 //
-// Per input: open it (sources.h: the damaged-capture rule, noise-free capture of material
+// Per input: open it (brdf::sources: the damaged-capture rule, noise-free capture of material
 // files, the extrapolation choice), resample it (processing::BuildLut), and write every
 // selected format with exporter::ExportLut, each file atomically. Inputs run on --jobs worker
 // threads, one input per worker at a time, so memory stays at a few inputs' worth whatever the
@@ -15,9 +15,9 @@
 #include "batch.h"
 #include "brdf/core/error.h"
 #include "brdf/exporter/lut_export.h"
+#include "brdf/sources/open.h"
 #include "commands.h"
 #include "progress.h"
-#include "sources.h"
 
 namespace brdf::cli {
 
@@ -135,7 +135,7 @@ int RunConvert(const ConvertOptions& options) {
       found.inputs.size(), options.jobs,
       [&](std::size_t i, JobResult& result) {
         const BatchInput& in = found.inputs[i];
-        InputLut built = LutFromInput(in.path, in.kind, extrapolate, resample);
+        sources::InputLut built = sources::LutFromInput(in.path, in.kind, extrapolate, resample);
         result.warnings = std::move(built.warnings);
         exporter::TextureMetadata metadata;
         metadata.name = in.name;

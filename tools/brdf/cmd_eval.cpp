@@ -1,12 +1,14 @@
 // `brdf eval FILE --in T,P --out T,P`: f_r of any evaluable file for one pair of directions.
-// Material files are evaluated analytically, captures interpolated (processing::MeasurementBrdf,
-// with the extrapolation `brdf convert` would use), exported LUTs sampled exactly as a GPU
-// samples the texture (sources.h, LutBrdf), so a texel can be checked against its source.
+// The file is opened by brdf::sources::OpenBrdf (brdf/sources/open.h): material files are
+// evaluated analytically, captures and tables resampled into the float LUT `brdf convert` would
+// build and sampled exactly as a GPU samples the exported texture, so a capture, its LUT and
+// the exported texture agree by construction.
 #include <cmath>
 #include <cstdio>
 #include <iostream>
 #include <memory>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -15,8 +17,8 @@
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
 #include "brdf/core/geometry.h"
+#include "brdf/sources/open.h"
 #include "commands.h"
-#include "sources.h"
 
 namespace brdf::cli {
 
@@ -84,13 +86,17 @@ int RunEval(const EvalOptions& options) {
   std::optional<processing::ExtrapolationParams> extrapolate;
   if (!options.extrapolate.empty())
     extrapolate = processing::ParseExtrapolation(options.extrapolate);
-  std::vector<std::string> warnings;
-  const std::unique_ptr<BrdfSource> source = OpenEvalSource(options.file, extrapolate, &warnings);
-  for (const std::string& w : warnings) std::fprintf(stderr, "%s\n", w.c_str());
+  sources::OpenOptions open_options;
+  open_options.extrapolation = extrapolate;
+  const sources::OpenedSource source = sources::OpenBrdf(options.file, open_options);
+  for (const std::string& w : source.warnings) std::fprintf(stderr, "%s\n", w.c_str());
+  std::set<double> warned_theta_in;  // one warning per θin beyond the measured range
   for (const Pair& p : pairs) {
+    if (const auto w = source.BeyondMeasuredWarning(p.theta_in_deg, options.file))
+      if (warned_theta_in.insert(p.theta_in_deg).second) std::fprintf(stderr, "%s\n", w->c_str());
     const Vec3 wi = SphericalDirectionDeg(p.theta_in_deg, p.phi_in_deg);
     const Vec3 wo = SphericalDirectionDeg(p.theta_out_deg, p.phi_out_deg);
-    const Rgb f = source->Eval(wi, wo);
+    const Rgb f = source.brdf->Eval(wi, wo);
     std::printf("%.9g %.9g %.9g\n", f[0], f[1], f[2]);
   }
   return 0;

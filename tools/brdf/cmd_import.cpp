@@ -4,9 +4,13 @@
 //
 // Point-cloud formats (Zemax and LightTools BSDF tables, CSV point clouds, goniometer tables)
 // are read by brdf::ImportFile (brdf/core/importers.h) and written unchanged. RGL and MERL
-// files are evaluable BRDFs, not point clouds: CaptureEvaluable below captures them.
+// files are evaluable BRDFs, not point clouds: they become the toolchain's one noise-free
+// virtual capture at the reference geometry (brdf::CaptureNoiseFree,
+// brdf/core/virtual_capture.h), samples in MERL's unmeasured bins flagged invalid. The format
+// is detected by brdf::sources::DetectFileKind, the rule every command uses.
 #include <cstdio>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "brdf/core/bpc.h"
@@ -18,78 +22,42 @@
 #include "brdf/core/merl.h"
 #include "brdf/core/models.h"
 #include "brdf/core/rgl.h"
+#include "brdf/core/virtual_capture.h"
+#include "brdf/sources/detect.h"
 #include "cli_support.h"
 #include "commands.h"
 
 namespace brdf::cli {
 
-namespace {
-
-// The reference instrument's geometry (DESIGN §1): light at θin 0°, 20°, 40°, 60° (φin = 0),
-// detector at θout 0°–75° and φout 0°–359°, 1° steps.
-constexpr double kReferenceThetaInDeg[] = {0, 20, 40, 60};
-constexpr int kReferenceThetaOutMaxDeg = 75;
-constexpr int kReferencePhiOutCount = 360;
-
-// Evaluable formats (RGL, MERL) hold a BRDF, not samples: the .bpc is a virtual, noise-free
-// capture of it at the reference geometry, f_r = source.Eval(wi, wo) per sample (what
-// `brdf capture --device sim --material FILE --noise 0` measures, without the simulated
-// detector), no σ, and no flags except kFlagInvalid where a MERL table marks the bin as not
-// measured. Should tools/brdf/sources.h's noise-free capture of a Material be generalised to
-// any BrdfSource, this function becomes that call.
-Measurement CaptureEvaluable(const std::string& path, ImportFormat format) {
-  // By format, not extension: `--format rgl` may name a file called anything.
-  std::unique_ptr<BrdfSource> source;
-  const MerlBrdf* merl = nullptr;  // MERL marks unmeasured bins: those samples are flagged
-  if (format == ImportFormat::kRgl) {
-    source = std::make_unique<RglBrdf>(RglBrdf::Load(path));
-  } else {
-    auto loaded = std::make_unique<MerlBrdf>(MerlBrdf::Load(path));
-    merl = loaded.get();
-    source = std::move(loaded);
-  }
-  Measurement m;
-  m.metadata.sample_name = path;
-  m.metadata.extra["source_file"] = path;
-  m.metadata.extra["source_format"] = ImportFormatName(format);
-  m.metadata.extra["capture"] =
-      "virtual, noise-free: f_r evaluated at the reference geometry (theta_in 0, 20, 40, 60; "
-      "theta_out 0-75; phi_out 0-359; 1 deg steps)";
-  for (const double theta_in : kReferenceThetaInDeg) {
-    Slice slice;
-    slice.theta_in_deg = theta_in;
-    slice.samples.reserve((kReferenceThetaOutMaxDeg + 1) * kReferencePhiOutCount);
-    const Vec3 wi = SphericalDirectionDeg(theta_in, 0.0);
-    for (int theta_out = 0; theta_out <= kReferenceThetaOutMaxDeg; ++theta_out) {
-      for (int phi_out = 0; phi_out < kReferencePhiOutCount; ++phi_out) {
-        Sample x;
-        x.theta_in_deg = static_cast<float>(theta_in);
-        x.theta_out_deg = static_cast<float>(theta_out);
-        x.phi_out_deg = static_cast<float>(phi_out);
-        const Vec3 wo = SphericalDirectionDeg(theta_out, phi_out);
-        const Rgb f = source->Eval(wi, wo);
-        for (int c = 0; c < 3; ++c) x.rgb[c] = static_cast<float>(f[c]);
-        if (merl != nullptr && !merl->IsMeasured(wi, wo)) x.flags = kFlagInvalid;
-        slice.samples.push_back(x);
-      }
-    }
-    m.slices.push_back(std::move(slice));
-  }
-  return m;
-}
-
-}  // namespace
-
 int RunImport(const ImportOptions& options) {
   const ImportFormat requested = ImportFormatFromName(options.format);
   // Detecting first also checks that the input can be opened before the output is judged.
-  const ImportFormat format =
-      requested == ImportFormat::kAuto ? DetectImportFormat(options.file) : requested;
+  ImportFormat format = requested;
+  if (requested == ImportFormat::kAuto) {
+    const sources::FileKind kind = sources::DetectFileKind(options.file);
+    const std::optional<ImportFormat> detected = sources::ImportFormatOf(kind);
+    if (!detected)
+      throw FormatError(options.file, "file content",
+                        "a third-party measurement (RGL .bsdf, Zemax or LightTools BSDF text, "
+                        "MERL .binary, CSV point cloud, goniometer table)",
+                        std::string("a ") + sources::FileKindName(kind), {},
+                        kind == sources::FileKind::kUnknown
+                            ? Remedy{RemedyKind::kNameFormat, options.file}
+                            : Remedy{});
+    format = *detected;
+  }
   CheckOutputPath(options.out, options.file, ".bpc", options.force);
 
   Measurement m;
   if (format == ImportFormat::kRgl || format == ImportFormat::kMerl) {
-    m = CaptureEvaluable(options.file, format);
+    // By format, not extension: `--format rgl` may name a file called anything.
+    if (format == ImportFormat::kRgl)
+      m = CaptureNoiseFree(RglBrdf::Load(options.file));
+    else
+      m = CaptureNoiseFree(MerlBrdf::Load(options.file));
+    m.metadata.sample_name = options.file;
+    m.metadata.extra["source_file"] = options.file;
+    m.metadata.extra["source_format"] = ImportFormatName(format);
   } else {
     brdf::ImportOptions import_options;
     import_options.allow_btdf = options.allow_btdf;

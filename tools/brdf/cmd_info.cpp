@@ -8,6 +8,7 @@
 #include <filesystem>
 #include <limits>
 #include <nlohmann/json.hpp>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -18,15 +19,20 @@
 #include "brdf/core/file_util.h"
 #include "brdf/core/gonio.h"
 #include "brdf/core/importers.h"
+#include "brdf/core/geometry.h"
 #include "brdf/core/lighttools.h"
 #include "brdf/core/measurement.h"
+#include "brdf/core/merl.h"
 #include "brdf/core/models.h"
+#include "brdf/core/rgl.h"
 #include "brdf/core/zemax.h"
 #include "brdf/exporter/packed_volume.h"
 #include "brdf/exporter/rgb9e5.h"
+#include "brdf/processing/resample.h"
+#include "brdf/sources/capture.h"
+#include "brdf/sources/open.h"
 #include "cli_support.h"
 #include "commands.h"
-#include "sources.h"
 
 namespace brdf::cli {
 
@@ -92,8 +98,24 @@ void AddPointCloudJson(const Measurement& m, Json* j,
   (*j)["metadata"] = MetadataJson(m.metadata);
 }
 
+// The reasons `brdf convert` / `brdf eval` refuse a measurement (the same library checks they
+// apply), as one line each, plus convert's own requirement of θin = k·Δin.
+void AddRefusalsJson(const std::string& path, const std::vector<std::string>& refusals,
+                     const Measurement* m, Json* j) {
+  Json list = Json::array();
+  for (const std::string& r : refusals) list.push_back(r);
+  if (m != nullptr && !m->slices.empty() && refusals.empty()) {
+    for (const processing::LutInputProblem& p : processing::FindLutInputProblems(*m))
+      if (p.kind == processing::LutInputProblem::Kind::kThetaInNotUniform)
+        list.push_back(path + ": 'brdf convert' refuses it: " + p.message);
+  }
+  (*j)["refusals"] = list;
+  (*j)["usable"] = refusals.empty();
+}
+
 Json DescribeBpc(const std::string& path) {
-  const BpcReadResult r = ReadBpc(path);
+  const sources::CaptureAssessment a = sources::AssessCapture(path);
+  const BpcReadResult& r = a.read;
   const Measurement& m = r.measurement;
   Json j;
   j["file"] = path;
@@ -112,17 +134,22 @@ Json DescribeBpc(const std::string& path) {
                              {"slice", p.slice_index},
                              {"message", p.message}});
   }
+  std::vector<std::string> refusals;
+  for (const sources::CaptureRefusal& refusal : a.refusals)
+    refusals.push_back(ErrorLine(refusal.ToError(path), "info"));
+  AddRefusalsJson(path, refusals, &m, &j);
+  j["planned_theta_in_deg"] = a.planned_theta_in_deg;
+  j["plan_recorded"] = a.plan_recorded;
+  j["missing_theta_in_deg"] = a.missing_theta_in_deg;
+  j["warnings"] = a.warnings;
   if (!r.finished) {
     if (r.intact_data_after_damage) {
-      j["advice"] =
-          "intact slices follow damaged data; a resume would discard them. Rewrite the "
-          "intact slices to a new file instead.";
+      j["advice"] = "intact slices follow damaged data; a resume would discard them: " +
+                    RemedyText(Remedy{RemedyKind::kRepairCapture, path});
     } else {
       j["advice"] =
           std::string(truncated ? "the capture was interrupted" : "the capture is unfinished") +
-          ": to continue it, rerun the same 'brdf capture ... --out " + path +
-          "' command with --resume (the file is cut back to its " + std::to_string(r.valid_bytes) +
-          " intact bytes first)";
+          ": " + RemedyText(Remedy{RemedyKind::kResumeCapture, path, r.valid_bytes});
     }
   }
   return j;
@@ -180,15 +207,9 @@ Json ZemaxTisJson(const ZemaxBsdf& z) {
   return rows;
 }
 
-Json DescribeImported(const std::string& path) {
-  ImportFormat format;
-  try {
-    format = DetectImportFormat(path);
-  } catch (const FormatError& e) {
-    // The detector's hint names `brdf import --format`, which info does not have.
-    throw FormatError(e.file(), e.position(), e.expected(), e.got());
-  }
+Json DescribeImported(const std::string& path, ImportFormat format) {
   Json j;
+  std::optional<Measurement> table_m;  // a point-cloud format, as `brdf import` stores it
   j["file"] = path;
   j["format"] = ImportFormatName(format);
   j["file_bytes"] = std::filesystem::file_size(path);
@@ -206,7 +227,7 @@ Json DescribeImported(const std::string& path) {
       h["scatter_radial_deg"] = z.scatter_radial_deg;
       j["header"] = h;
       // A BTDF table is described as `brdf import --allow-btdf` stores it.
-      AddPointCloudJson(ZemaxToMeasurement(z, path, ZemaxImportOptions{true}), &j);
+      table_m = ZemaxToMeasurement(z, path, ZemaxImportOptions{true});
       j["tis"] = ZemaxTisJson(z);
       if (z.btdf)
         j["advice"] = "ScatterType BTDF (line " + std::to_string(z.scatter_type_line) +
@@ -225,7 +246,7 @@ Json DescribeImported(const std::string& path) {
       h["scatter_radial_deg"] = lt.scatter_radial_deg;
       h["blocks"] = lt.blocks.size();
       j["header"] = h;
-      AddPointCloudJson(LightToolsToMeasurement(lt, path, LightToolsImportOptions{true}), &j);
+      table_m = LightToolsToMeasurement(lt, path, LightToolsImportOptions{true});
       break;
     }
     case ImportFormat::kGonio: {
@@ -234,19 +255,73 @@ Json DescribeImported(const std::string& path) {
       h["wavelengths_nm"] = table.wavelengths_nm;
       h["rows"] = table.rows.size();
       j["header"] = h;
-      AddPointCloudJson(GonioToMeasurement(table, path), &j);
+      table_m = GonioToMeasurement(table, path);
       break;
     }
     case ImportFormat::kCsv:
-      AddPointCloudJson(ReadCsv(path), &j);
+      table_m = ReadCsv(path);
       break;
-    case ImportFormat::kRgl:
-    case ImportFormat::kMerl:
+    case ImportFormat::kRgl: {
+      // Parsed and checked exactly as 'brdf eval' and 'brdf import' load it.
+      const RglBrdf rgl = RglBrdf::Load(path);
+      const RglInfo& info = rgl.info();
+      const TensorFile tensor = TensorFile::Read(path);
+      Json h;
+      h["description"] = info.description;
+      std::vector<double> theta_i_deg, phi_i_deg;
+      for (double t : info.theta_i_rad) theta_i_deg.push_back(RadToDeg(t));
+      for (double p : info.phi_i_rad) phi_i_deg.push_back(RadToDeg(p));
+      h["theta_i_deg"] = theta_i_deg;
+      h["phi_i_deg"] = phi_i_deg;
+      h["isotropic"] = info.isotropic ? "yes" : "no";
+      h["jacobian"] = info.jacobian ? "yes" : "no";
+      h["vndf_resolution"] = std::to_string(info.vndf_theta_res) + " x " +
+                             std::to_string(info.vndf_phi_res);
+      h["rgb_resolution"] = std::to_string(info.rgb_res) + " x " + std::to_string(info.rgb_res);
+      h["negative_rgb_values"] = std::to_string(info.negative_rgb_values) + " of " +
+                                 std::to_string(info.rgb_values);
+      std::string fields;
+      for (const TensorField& f : tensor.fields())
+        fields += (fields.empty() ? "" : ", ") + f.name + " " + f.ShapeString();
+      h["fields"] = fields;
+      j["header"] = h;
+      j["theta_in_deg"] = theta_i_deg;
+      j["advice"] = "an evaluable BRDF, not a point cloud: 'brdf eval' evaluates it, 'brdf import " +
+                    path + " --out FILE.bpc' captures it noise-free at the reference geometry";
+      break;
+    }
+    case ImportFormat::kMerl: {
+      const MerlBrdf merl = MerlBrdf::Load(path);
+      const auto& u = merl.info().unmeasured_bins;
+      constexpr std::uint64_t kBins = static_cast<std::uint64_t>(kMerlThetaHalfBins) *
+                                      kMerlThetaDiffBins * kMerlPhiDiffBins;
+      Json h;
+      h["resolution"] = std::to_string(kMerlThetaHalfBins) + " x " +
+                        std::to_string(kMerlThetaDiffBins) + " x " +
+                        std::to_string(kMerlPhiDiffBins) +
+                        " bins (theta_half, theta_diff, phi_diff)";
+      h["unmeasured_bins"] = "red " + std::to_string(u[0]) + ", green " + std::to_string(u[1]) +
+                             ", blue " + std::to_string(u[2]) + " of " + std::to_string(kBins);
+      j["header"] = h;
+      j["unmeasured_bins"] = {u[0], u[1], u[2]};
+      j["advice"] = "an evaluable BRDF, not a point cloud: 'brdf eval' evaluates it, 'brdf import " +
+                    path + " --out FILE.bpc' captures it noise-free at the reference geometry "
+                    "(samples in unmeasured bins flagged invalid)";
+      break;
+    }
     case ImportFormat::kAuto:
-      j["advice"] =
-          "an evaluable BRDF, not a point cloud: 'brdf eval' evaluates it, 'brdf import " + path +
-          " --out FILE.bpc' captures it noise-free at the reference geometry";
       break;
+  }
+  if (table_m) {
+    AddPointCloudJson(*table_m, &j);
+    // 'brdf eval' resamples a table like a capture: the same checks (any θin set).
+    processing::ResampleOptions any_theta_in;
+    any_theta_in.require_uniform_theta_in = false;
+    std::vector<std::string> refusals;
+    for (const processing::LutInputProblem& p :
+         processing::FindLutInputProblems(*table_m, any_theta_in))
+      refusals.push_back(path + ": " + p.message);
+    AddRefusalsJson(path, refusals, nullptr, &j);
   }
   return j;
 }
@@ -267,7 +342,7 @@ std::string Hex32(std::uint32_t v) {
 // are of the RGB9E5 values as stored (decoded exactly), per θin slice; for an atlas over the
 // cells that hold a material.
 Json DescribeTexture(const std::string& path) {
-  const OpenedTexture t = OpenExportedTexture(path);
+  const sources::OpenedTexture t = sources::OpenExportedTexture(path);
   const exporter::LoadedTexture& tex = t.texture;
   const exporter::PackedVolume& v = tex.volume;
   Json j;
@@ -348,26 +423,6 @@ Json DescribeTexture(const std::string& path) {
   return j;
 }
 
-// A .json is a material file, a LUT sidecar or an atlas manifest, told apart by content.
-Json DescribeJson(const std::string& path) {
-  const FileKind kind = ClassifyFile(path);
-  if (kind == FileKind::kSidecar || kind == FileKind::kAtlasManifest) return DescribeTexture(path);
-  if (kind == FileKind::kMaterial) return DescribeMaterial(path);
-  throw InvalidArgument(path + ": a " + std::string(FileKindName(kind)) +
-                        "; brdf info reads material files, LUT sidecars and atlas manifests");
-}
-
-// Describers by extension.
-struct Describer {
-  const char* extension;
-  Json (*describe)(const std::string& path);
-};
-constexpr Describer kDescribers[] = {
-    {".bpc", DescribeBpc},         {".json", DescribeJson},     {".ktx2", DescribeTexture},
-    {".dds", DescribeTexture},     {".bsdf", DescribeImported}, {".csv", DescribeImported},
-    {".binary", DescribeImported},
-};
-
 std::string Fixed(const Json& v, const char* format = "%.6g") {
   if (v.is_null()) return "-";
   char buf[64];
@@ -377,6 +432,19 @@ std::string Fixed(const Json& v, const char* format = "%.6g") {
 
 std::string TripleText(const Json& v) {
   return Fixed(v[0]) + " " + Fixed(v[1]) + " " + Fixed(v[2]);
+}
+
+void PrintRefusalsText(const Json& j) {
+  if (j.contains("warnings"))
+    for (const auto& w : j["warnings"]) std::printf("%s\n", w.get<std::string>().c_str());
+  if (!j.contains("refusals")) return;
+  if (j["refusals"].empty()) {
+    std::printf("usable: yes ('brdf convert' and 'brdf eval' accept it)\n");
+    return;
+  }
+  std::printf("usable: no; 'brdf convert' and 'brdf eval' refuse it: %zu reason%s\n",
+              j["refusals"].size(), j["refusals"].size() == 1 ? "" : "s");
+  for (const auto& r : j["refusals"]) std::printf("  %s\n", r.get<std::string>().c_str());
 }
 
 void PrintBpcText(const Json& j) {
@@ -421,6 +489,7 @@ void PrintBpcText(const Json& j) {
     for (const Json& p : j["problems"])
       std::printf("  %s\n", p["message"].get<std::string>().c_str());
   }
+  PrintRefusalsText(j);
   if (j.contains("advice")) std::printf("note: %s\n", j["advice"].get<std::string>().c_str());
 }
 
@@ -522,6 +591,7 @@ void PrintImportedText(const Json& j) {
         "  (integrated: the table's zeros past the horizon and beyond its last radial "
         "angle edge-filled; covered: the table alone, a lower bound)\n");
   }
+  PrintRefusalsText(j);
   if (j.contains("advice")) std::printf("note: %s\n", j["advice"].get<std::string>().c_str());
 }
 
@@ -580,28 +650,45 @@ void PrintTextureText(const Json& j) {
 }  // namespace
 
 int RunInfo(const InfoOptions& options) {
-  const std::string ext = LowerExtension(options.file);
-  for (const Describer& d : kDescribers) {
-    if (ext != d.extension) continue;
-    const Json j = d.describe(options.file);
-    if (options.json) {
-      std::printf("%s\n", j.dump(2, ' ', false, Json::error_handler_t::replace).c_str());
-    } else if (j["format"] == "bpc") {
-      PrintBpcText(j);
-    } else if (IsImportedFormat(j)) {
-      PrintImportedText(j);
-    } else if (j["format"] == "lut" || j["format"] == "atlas") {
-      PrintTextureText(j);
-    } else {
-      PrintMaterialText(j);
-    }
-    return 0;
+  using sources::FileKind;
+  const FileKind kind = sources::DetectFileKind(options.file);
+  Json j;
+  if (kind == FileKind::kCapture) {
+    j = DescribeBpc(options.file);
+  } else if (kind == FileKind::kMaterial) {
+    j = DescribeMaterial(options.file);
+  } else if (sources::IsExportedLut(kind)) {
+    j = DescribeTexture(options.file);
+  } else if (const std::optional<ImportFormat> format = sources::ImportFormatOf(kind)) {
+    j = DescribeImported(options.file, *format);
+  } else {
+    throw InvalidArgument(options.file + ": a " + std::string(sources::FileKindName(kind)) +
+                          "; brdf info reads captures (.bpc), material files, exported LUTs "
+                          "(.ktx2, .dds, sidecar and atlas manifest .json), RGL .bsdf, MERL "
+                          ".binary, Zemax and LightTools BSDF tables, CSV point clouds and "
+                          "goniometer tables");
   }
-  std::string known;
-  for (const Describer& d : kDescribers)
-    known += (known.empty() ? "" : ", ") + std::string(d.extension);
-  throw InvalidArgument(options.file + ": unknown file type '" + ext + "' (brdf info reads " +
-                        known + ")");
+  if (options.json) {
+    std::printf("%s\n", j.dump(2, ' ', false, Json::error_handler_t::replace).c_str());
+  } else if (j["format"] == "bpc") {
+    PrintBpcText(j);
+  } else if (IsImportedFormat(j)) {
+    PrintImportedText(j);
+  } else if (j["format"] == "lut" || j["format"] == "atlas") {
+    PrintTextureText(j);
+  } else {
+    PrintMaterialText(j);
+  }
+  // A file that convert or eval would refuse is damaged: say so on stderr and fail, so scripts
+  // can check files with `brdf info`.
+  if (j.contains("usable") && !j["usable"].get<bool>()) {
+    const std::size_t n = j["refusals"].size();
+    std::fprintf(stderr, "brdf: %s: %zu problem%s that 'brdf convert' and 'brdf eval' refuse%s\n",
+                 options.file.c_str(), n, n == 1 ? "" : "s",
+                 options.json ? " (listed under \"refusals\")" : " (listed above)");
+    return 1;
+  }
+  return 0;
 }
 
 }  // namespace brdf::cli

@@ -7,6 +7,8 @@ target_sources(brdf PRIVATE
   brdf/cmd_convert.cpp
   brdf/cmd_atlas.cpp
   brdf/batch.cpp
-  brdf/sources.cpp
+  brdf/cmd_repair.cpp
 )
 target_link_libraries(brdf PRIVATE brdf::processing brdf::exporter TBB::tbb Threads::Threads)
+# The input rules (what a file is, damaged captures, opening any source): brdf::sources.
+target_link_libraries(brdf PRIVATE brdf::sources)

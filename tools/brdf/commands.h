@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "brdf/core/virtual_capture.h"
+
 namespace brdf::cli {
 
 struct InfoOptions {
@@ -90,10 +92,11 @@ struct CaptureOptions {
   std::string material;  // library name or file
   std::string sample;    // sample name recorded in the metadata
   std::string out;       // .bpc path
-  std::vector<double> theta_in_deg = {0, 20, 40, 60};
-  double theta_out_max_deg = 75;
-  double theta_out_step_deg = 1;
-  double phi_out_step_deg = 1;
+  // Defaults: the reference geometry (brdf/core/virtual_capture.h).
+  std::vector<double> theta_in_deg = ReferenceGeometry().theta_in_deg;
+  double theta_out_max_deg = ReferenceGeometry().theta_out_max_deg;
+  double theta_out_step_deg = ReferenceGeometry().theta_out_step_deg;
+  double phi_out_step_deg = ReferenceGeometry().phi_out_step_deg;
   double noise = 1.0;  // 0 = noise-free and unsaturated; 1 = the reference instrument's noise
   std::uint64_t seed = 1;
   std::string operator_notes;
@@ -106,5 +109,15 @@ struct CaptureOptions {
   std::string sim_fault;
 };
 int RunCapture(const CaptureOptions& options);
+
+// `brdf repair DAMAGED.bpc --out FIXED.bpc`: every intact slice of a damaged or unfinished
+// capture written to a new, unfinished capture that `brdf capture --resume` completes
+// (brdf::sources::RepairCapture).
+struct RepairOptions {
+  std::string file;   // the damaged .bpc
+  std::string out;    // the new .bpc, written atomically
+  bool force = false;  // overwrite an existing --out
+};
+int RunRepair(const RepairOptions& options);
 
 }  // namespace brdf::cli

@@ -8,6 +8,7 @@
 
 #include "brdf/core/error.h"
 #include "brdf/core/measurement.h"
+#include "cli_support.h"
 #include "commands.h"
 
 namespace {
@@ -292,6 +293,23 @@ int main(int argc, char** argv) {
   export_csv_cmd->add_flag("--force", export_csv.force, "Overwrite --out if it already exists");
   export_csv_cmd->callback([&] { exit_code = brdf::cli::RunExportCsv(export_csv); });
 
+  // brdf repair
+  brdf::cli::RepairOptions repair;
+  auto* repair_cmd = app.add_subcommand(
+      "repair",
+      "Write every intact slice of a damaged or unfinished capture to a new .bpc that "
+      "'brdf capture --resume' completes; names every part it drops (slice, theta_in, byte "
+      "offset, reason)");
+  repair_cmd->add_option("file", repair.file, "Damaged or unfinished capture (.bpc)")->required();
+  repair_cmd->add_option("--out", repair.out, "New capture (.bpc, written atomically)")
+      ->required();
+  repair_cmd->add_flag("--force", repair.force, "Overwrite --out if it already exists");
+  repair_cmd->footer(
+      "The new file keeps the original header (sample, settings, planned theta_in list) and "
+      "has no end chunk: resume it with the 'brdf capture' command that made the original, "
+      "with --out set to the new file and --resume, to capture the missing slices.");
+  repair_cmd->callback([&] { exit_code = brdf::cli::RunRepair(repair); });
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -301,7 +319,9 @@ int main(int argc, char** argv) {
                  e.what());
     return 2;
   } catch (const brdf::Error& e) {
-    std::fprintf(stderr, "brdf: error: %s\n", e.what());
+    const std::string command =
+        app.get_subcommands().empty() ? std::string() : app.get_subcommands().front()->get_name();
+    std::fprintf(stderr, "brdf: error: %s\n", brdf::cli::ErrorLine(e, command).c_str());
     return 1;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "brdf: internal error: %s\n", e.what());

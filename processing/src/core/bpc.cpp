@@ -4,6 +4,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cerrno>
@@ -314,12 +315,27 @@ std::string DecodeSlicePayload(const std::uint8_t* p, std::uint64_t n, Slice* sl
 }
 
 // The final metadata of an end chunk payload (CRC already matched). Throws FormatError.
+// `result` (may be null) receives the end chunk's slice and sample counts, -1 when absent or
+// not integers (the reader reports what it finds; brdf::sources checks them against the file).
 Metadata DecodeEndPayload(const std::uint8_t* p, std::size_t n, const std::string& file,
-                          std::uint64_t offset) {
+                          std::uint64_t offset, BpcReadResult* result = nullptr) {
   const Json j = ParseJsonPayload(p, n, file, offset, "end");
   const auto it = j.find("metadata");
   if (it == j.end()) throw FormatError(file, BytePosition(offset), "a 'metadata' member", "none");
-  return MetadataFromJson(*it, file, offset, "end chunk");
+  Metadata m = MetadataFromJson(*it, file, offset, "end chunk");
+  if (result) {
+    const auto count = [&](const char* key) -> std::int64_t {
+      const auto c = j.find(key);
+      if (c == j.end() || !c->is_number_unsigned()) return -1;
+      return static_cast<std::int64_t>(std::min<std::uint64_t>(
+          c->get<std::uint64_t>(),
+          static_cast<std::uint64_t>(std::numeric_limits<std::int64_t>::max())));
+    };
+    result->end_slice_count = count("slice_count");
+    result->end_sample_count = count("sample_count");
+    result->end_offset = offset - kChunkHeaderSize;
+  }
+  return m;
 }
 
 class BpcParser {
@@ -395,6 +411,7 @@ class BpcParser {
         if (why.empty()) {
           result_.measurement.slices.push_back(std::move(slice));
           result_.slice_indices.push_back(stored_slice);
+          result_.slice_offsets.push_back(pos);
           expected_slice = stored_slice + 1;
         } else {
           AddProblem(BpcProblemKind::kCorrupt, pos, end - pos, stored_slice,
@@ -406,7 +423,7 @@ class BpcParser {
         // A CRC-valid end chunk with unusable JSON was written wrong, not damaged in transit;
         // it is reported like damage so the slices before it stay readable.
         try {
-          end_metadata_ = DecodeEndPayload(payload, n, file_, pos + kChunkHeaderSize);
+          end_metadata_ = DecodeEndPayload(payload, n, file_, pos + kChunkHeaderSize, &result_);
           result_.finished = true;
         } catch (const FormatError& e) {
           AddProblem(BpcProblemKind::kCorrupt, pos, end - pos, -1, e.expected(), e.got());
@@ -426,6 +443,7 @@ class BpcParser {
         break;
       }
     }
+    result_.header_metadata = result_.measurement.metadata;
     if (result_.finished) result_.measurement.metadata = end_metadata_;
     return std::move(result_);
   }
@@ -509,7 +527,7 @@ class BpcParser {
     if (slice >= 0) position += " (slice " + std::to_string(slice) + ")";
     std::string hint;
     if (kind == BpcProblemKind::kTruncated)
-      hint = "damaged tail of an interrupted capture; complete it with 'brdf capture ... --resume'";
+      hint = "damaged tail of an interrupted capture";
     problem.message = FormatError(file_, position, expected, got, hint).what();
     problem.expected = std::move(expected);
     problem.got = std::move(got);
@@ -607,6 +625,7 @@ std::optional<BpcReadResult> ReadIntactStreaming(int fd, std::uint64_t size,
       if (crc != ch.payload_crc) return std::nullopt;
       result.measurement.slices.push_back(std::move(slice));
       result.slice_indices.push_back(static_cast<int>(ch.slice_index));
+      result.slice_offsets.push_back(pos);
     } else if (TagIs(h, kTagEnd)) {
       std::vector<std::uint8_t> payload(static_cast<std::size_t>(n));
       if (!ReadExact(fd, payload.data(), payload.size()) ||
@@ -614,8 +633,9 @@ std::optional<BpcReadResult> ReadIntactStreaming(int fd, std::uint64_t size,
           pos + kChunkHeaderSize + n != size)
         return std::nullopt;
       try {
+        result.header_metadata = result.measurement.metadata;
         result.measurement.metadata =
-            DecodeEndPayload(payload.data(), payload.size(), path, pos + kChunkHeaderSize);
+            DecodeEndPayload(payload.data(), payload.size(), path, pos + kChunkHeaderSize, &result);
       } catch (const FormatError&) {
         return std::nullopt;
       }
@@ -633,6 +653,7 @@ std::optional<BpcReadResult> ReadIntactStreaming(int fd, std::uint64_t size,
     pos += kChunkHeaderSize + n;
     result.valid_bytes = pos;
   }
+  if (!result.finished) result.header_metadata = result.measurement.metadata;
   return result;
 }
 
@@ -735,8 +756,8 @@ BpcAppender BpcAppender::Resume(const std::string& path, BpcReadResult* existing
     throw FormatError(path, BytePosition(r.valid_bytes),
                       "damage only at the tail of an interrupted capture",
                       "intact chunks after a damaged one",
-                      "resuming would truncate them; rewrite the file with the intact slices "
-                      "instead");
+                      "resuming would truncate them",
+                      Remedy{RemedyKind::kRepairCapture, path});
   if (::truncate(path.c_str(), static_cast<off_t>(r.valid_bytes)) != 0)
     throw IoError(path + ": cannot truncate to " + std::to_string(r.valid_bytes) +
                   " bytes: " + ErrnoText());

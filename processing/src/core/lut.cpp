@@ -49,14 +49,30 @@ std::array<float, 3> Lut::SampleTrilinear(double u, double v, double w) const {
   return out;
 }
 
+double Lut::SliceCoordinate(double theta_in) const {
+  const double delta = DeltaInDeg();
+  if (theta_in_deg.size() < 2 || !(delta > 0)) return 0.0;
+  bool uniform = true;
+  for (std::size_t k = 0; k < theta_in_deg.size() && uniform; ++k)
+    uniform = std::fabs(theta_in_deg[k] - (theta_in_deg.front() + static_cast<double>(k) * delta)) <=
+              1e-9 * std::max(1.0, std::fabs(theta_in_deg[k]));
+  if (uniform) return (theta_in - theta_in_deg.front()) / delta;
+  // Piecewise linear between neighbouring entries; beyond the ends, extended with the end
+  // intervals' spacing (the sampler clamps anyway).
+  const auto upper = std::upper_bound(theta_in_deg.begin(), theta_in_deg.end(), theta_in);
+  std::size_t i = static_cast<std::size_t>(upper - theta_in_deg.begin());
+  i = std::clamp<std::size_t>(i, 1, theta_in_deg.size() - 1);
+  const double a = theta_in_deg[i - 1], b = theta_in_deg[i];
+  return static_cast<double>(i - 1) + (theta_in - a) / (b - a);
+}
+
 std::array<float, 3> Lut::SampleAngles(double theta_in, double theta_out_deg,
                                        double phi_out_deg) const {
   const Vec3 w_out = SphericalDirectionDeg(theta_out_deg, phi_out_deg);
   const Vec3 w_d = SpecularFrame::FromThetaInDeg(theta_in).ToSpecular(w_out);
   const double theta_d = RadToDeg(ThetaOf(w_d));
   const double phi_d = RadToDeg(PhiOf(w_d));
-  const double delta = DeltaInDeg();
-  const double k = delta > 0 ? (theta_in - theta_in_deg.front()) / delta : 0.0;
+  const double k = SliceCoordinate(theta_in);
   const double u = (phi_d / kTexelDeg + 0.5) / kWidth;
   const double v = (theta_d / kTexelDeg + 0.5) / kHeight;
   const double w = (k + 0.5) / slices();

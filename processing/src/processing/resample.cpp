@@ -31,8 +31,9 @@ std::string Who(const Measurement& m) {
                                         : "measurement '" + m.metadata.sample_name + "'";
 }
 
-// Slice indices in ascending θin, checked against DESIGN §5's θin,k = k·Δin.
-std::vector<std::size_t> UniformThetaInOrder(const Measurement& m, double* delta_in) {
+// Slice indices in ascending θin, checked against DESIGN §5's θin,k = k·Δin (only distinct
+// when !uniform; *delta_in is then 0).
+std::vector<std::size_t> ThetaInOrder(const Measurement& m, bool uniform, double* delta_in) {
   if (m.slices.empty()) throw InvalidArgument(Who(m) + " has no slices; cannot build a LUT");
   std::vector<std::size_t> order(m.slices.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
@@ -52,6 +53,8 @@ std::vector<std::size_t> UniformThetaInOrder(const Measurement& m, double* delta
     if (m.slices[order[k]].theta_in_deg - m.slices[order[k - 1]].theta_in_deg <= kThetaInTolDeg)
       fail("duplicate incidence angle " + Num(m.slices[order[k]].theta_in_deg) + "° (slices " +
            std::to_string(order[k - 1]) + " and " + std::to_string(order[k]) + ")");
+  *delta_in = 0.0;
+  if (!uniform) return order;
   const double first = m.slices[order.front()].theta_in_deg;
   if (std::fabs(first) > kThetaInTolDeg) fail("the first is not 0°");
   *delta_in = 0.0;
@@ -86,12 +89,112 @@ void ResampleOptions::Validate() const {
                           std::to_string(neighbours));
 }
 
+std::vector<LutInputProblem> FindLutInputProblems(const Measurement& m,
+                                                  const ResampleOptions& options) {
+  using Kind = LutInputProblem::Kind;
+  std::vector<LutInputProblem> out;
+  const auto add = [&](Kind kind, int slice, std::string message) {
+    LutInputProblem p;
+    p.kind = kind;
+    p.slice = slice;
+    if (slice >= 0) p.theta_in_deg = m.slices[static_cast<std::size_t>(slice)].theta_in_deg;
+    p.message = std::move(message);
+    out.push_back(std::move(p));
+    return &out.back();
+  };
+  if (m.slices.empty()) {
+    add(Kind::kNoSlices, -1, "no slices");
+    return out;
+  }
+  const auto name = [&](std::size_t i) {
+    return "slice " + std::to_string(i) + " (θin = " + Num(m.slices[i].theta_in_deg) + "°)";
+  };
+  bool angles_ok = true;
+  for (std::size_t i = 0; i < m.slices.size(); ++i) {
+    const Slice& s = m.slices[i];
+    if (!(s.theta_in_deg >= 0.0 && s.theta_in_deg < 90.0)) {
+      add(Kind::kThetaInOutOfRange, static_cast<int>(i),
+          name(i) + ": θin must be in [0°, 90°) for a reflection measurement");
+      angles_ok = false;
+    } else if (!std::isfinite(s.phi_in_deg)) {
+      add(Kind::kThetaInOutOfRange, static_cast<int>(i), name(i) + ": φin is not a finite number");
+      angles_ok = false;
+    }
+  }
+  if (angles_ok) {
+    try {
+      double delta = 0;
+      ThetaInOrder(m, options.require_uniform_theta_in, &delta);
+    } catch (const InvalidArgument& e) {
+      const std::string text = e.what();
+      const std::string prefix = Who(m) + ": ";
+      add(text.find("duplicate") != std::string::npos ? Kind::kDuplicateThetaIn
+                                                       : Kind::kThetaInNotUniform,
+          -1, text.compare(0, prefix.size(), prefix) == 0 ? text.substr(prefix.size()) : text);
+    }
+  }
+  float theta_b = 0;
+  for (std::size_t i = 0; i < m.slices.size(); ++i) {
+    const Slice& s = m.slices[i];
+    struct Defect {
+      std::string what;
+      std::size_t count = 0, first = 0;
+    };
+    std::vector<Defect> defects;
+    std::size_t valid = 0, invalid = 0;
+    for (std::size_t n = 0; n < s.samples.size(); ++n) {
+      const Sample& x = s.samples[n];
+      if (x.flags & kFlagInvalid) {
+        ++invalid;
+        continue;
+      }
+      if (const char* d = internal::SampleDefect(x)) {
+        auto it = std::find_if(defects.begin(), defects.end(),
+                               [&](const Defect& e) { return e.what == d; });
+        if (it == defects.end())
+          defects.push_back({d, 1, n});
+        else
+          ++it->count;
+        continue;
+      }
+      ++valid;
+      theta_b = std::max(theta_b, std::fabs(x.theta_out_deg));
+    }
+    for (const Defect& d : defects) {
+      const Sample& x = s.samples[d.first];
+      const std::string values = "θout " + Num(x.theta_out_deg) + "°, φout " +
+                                 Num(x.phi_out_deg) + "°, rgb " + Num(x.rgb[0]) + " " +
+                                 Num(x.rgb[1]) + " " + Num(x.rgb[2]);
+      LutInputProblem* p = add(
+          Kind::kBadSamples, static_cast<int>(i),
+          name(i) + ": " + std::to_string(d.count) + " sample" + (d.count == 1 ? "" : "s") +
+              " with " + d.what + " (first: sample " + std::to_string(d.first) + ", " + values +
+              "); a sample without a usable value must be flagged invalid");
+      p->sample_count = d.count;
+      p->first_sample = d.first;
+    }
+    if (valid == 0 && defects.empty())
+      add(Kind::kNoValidSample, static_cast<int>(i),
+          name(i) + ": no valid sample (" + std::to_string(s.samples.size()) + " samples, " +
+              std::to_string(invalid) + " flagged invalid); cannot interpolate");
+  }
+  if (out.empty() && !(theta_b > 0.0f))
+    add(Kind::kDegenerateRange, -1,
+        "every valid sample is at θout = 0° (measured range θout 0°–0°): there is nothing to "
+        "interpolate or extrapolate from");
+  return out;
+}
+
 Lut BuildLut(const Measurement& measurement, const ExtrapolationParams& params,
              const ResampleOptions& options, ResampleReport* report) {
   params.Validate();
   options.Validate();
+  if (const std::vector<LutInputProblem> problems = FindLutInputProblems(measurement, options);
+      !problems.empty())
+    throw InvalidArgument(Who(measurement) + ": " + problems.front().message);
   double delta_in = 0;
-  const std::vector<std::size_t> order = UniformThetaInOrder(measurement, &delta_in);
+  const std::vector<std::size_t> order =
+      ThetaInOrder(measurement, options.require_uniform_theta_in, &delta_in);
   const int k_slices = static_cast<int>(order.size());
 
   std::vector<std::unique_ptr<internal::SliceInterpolator>> slices(order.size());
@@ -111,7 +214,11 @@ Lut BuildLut(const Measurement& measurement, const ExtrapolationParams& params,
 
   Lut lut;
   lut.Resize(order.size());
-  for (int k = 0; k < k_slices; ++k) lut.theta_in_deg[static_cast<std::size_t>(k)] = k * delta_in;
+  for (int k = 0; k < k_slices; ++k)
+    lut.theta_in_deg[static_cast<std::size_t>(k)] =
+        options.require_uniform_theta_in
+            ? k * delta_in
+            : measurement.slices[order[static_cast<std::size_t>(k)]].theta_in_deg;
 
   // Texel directions ω_d at texel centres (θd, φd) = (j·1°, i·1°); column 360 is copied from
   // column 0 afterwards so the seam is bit-identical.

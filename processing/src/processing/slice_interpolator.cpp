@@ -80,6 +80,17 @@ void CheckSliceThetaIn(const Slice& slice, std::size_t slice_index) {
     throw InvalidArgument(SliceName(slice, slice_index) + ": φin is not a finite number");
 }
 
+const char* SampleDefect(const Sample& s) {
+  if (s.flags & kFlagInvalid) return nullptr;
+  const double theta = s.theta_out_deg;
+  if (!(theta >= -90.0 && theta <= 90.0)) return "θout outside [−90°, 90°]";
+  if (!std::isfinite(s.phi_out_deg)) return "φout not a finite number";
+  if (!std::isfinite(s.rgb[0])) return "red value not a finite number";
+  if (!std::isfinite(s.rgb[1])) return "green value not a finite number";
+  if (!std::isfinite(s.rgb[2])) return "blue value not a finite number";
+  return nullptr;
+}
+
 CleanSlice CleanSliceSamples(const Slice& slice, std::size_t slice_index) {
   CleanSlice out;
   out.points.reserve(slice.samples.size());
@@ -94,16 +105,9 @@ CleanSlice CleanSliceSamples(const Slice& slice, std::size_t slice_index) {
     };
     double theta = s.theta_out_deg;
     double phi = s.phi_out_deg;
-    if (!(theta >= -90.0 && theta <= 90.0))
-      throw InvalidArgument(where() +
-                            ": θout must be in [−90°, 90°] (mark unusable samples "
-                            "kFlagInvalid), got " +
-                            Num(theta));
-    if (!std::isfinite(phi)) throw InvalidArgument(where() + ": φout is not a finite number");
-    for (int c = 0; c < 3; ++c)
-      if (!std::isfinite(s.rgb[c]))
-        throw InvalidArgument(where() + ": value " + std::to_string(c) +
-                              " is not a finite number (mark unusable samples kFlagInvalid)");
+    if (const char* defect = SampleDefect(s))
+      throw InvalidArgument(where() + ": " + defect +
+                            " (a sample without a usable value must be flagged invalid)");
     if (theta < 0) {  // in-plane goniometer convention: −θ is the opposite azimuth
       theta = -theta;
       phi += 180.0;

@@ -34,6 +34,10 @@ struct CleanSlice {
 // names the slice in messages. Throws InvalidArgument.
 CleanSlice CleanSliceSamples(const Slice& slice, std::size_t slice_index);
 
+// Why a sample not flagged invalid cannot be used ("θout outside [−90°, 90°]", "red value not a
+// finite number"), or nullptr. The one rule of CleanSliceSamples and FindLutInputProblems.
+const char* SampleDefect(const Sample& sample);
+
 // Validates the slice's own θin (finite, [0°, 90°)). Throws InvalidArgument.
 void CheckSliceThetaIn(const Slice& slice, std::size_t slice_index);
 

@@ -49,11 +49,19 @@ struct BpcProblem {
 struct BpcReadResult {
   Measurement measurement;           // every intact slice, in file order; the end chunk's
                                      // metadata if finished, else the header's
+  Metadata header_metadata;          // the header chunk's metadata (what the capture started
+                                     // with; a resume compares its settings with these)
   std::vector<BpcProblem> problems;  // empty for an intact file (finished or not)
   bool finished = false;             // the end chunk (capture end metadata) is present and intact
   std::uint64_t valid_bytes = 0;     // length of the longest intact prefix (ends on a chunk
                                      // boundary); a resume truncates here
   std::vector<int> slice_indices;    // slice index of each returned slice (gaps mark damaged ones)
+  std::vector<std::uint64_t> slice_offsets;  // byte offset of each returned slice's chunk
+  // What the end chunk says the file holds (-1 when not finished or not recorded), and where
+  // the end chunk starts. Not checked by the reader: brdf::sources compares them with the
+  // slices (a writer that lied).
+  std::int64_t end_slice_count = -1, end_sample_count = -1;
+  std::uint64_t end_offset = 0;
   bool intact_data_after_damage = false;  // an intact chunk follows a damaged one, so
                                           // truncating to valid_bytes would discard it
 };

@@ -21,6 +21,14 @@ class BrdfSource {
 
   // Short name for metadata and messages ("gold", "paper_white_rgb.bsdf").
   virtual std::string Name() const = 0;
+
+  // False where the source holds no value for the pair (a MERL bin marked not measured), so a
+  // virtual capture can flag the sample invalid instead of recording a made-up black.
+  virtual bool HasValue(const Vec3& wi, const Vec3& wo) const {
+    (void)wi;
+    (void)wo;
+    return true;
+  }
 };
 
 class AnalyticBrdf final : public BrdfSource {

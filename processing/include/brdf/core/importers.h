@@ -7,6 +7,8 @@
 // Measurement by a virtual capture; ImportFile recognises them and says so (see ImportFile).
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
 #include <string>
 #include <string_view>
 
@@ -29,7 +31,20 @@ ImportFormat ImportFormatFromName(std::string_view name);
 //   gonio      a CSV header starting Incident_angle,Measure_angle
 //   CSV        a CSV header naming theta_in, theta_out, r, g, b
 // Throws FormatError naming the file when none matches, IoError when it cannot be read.
+// The remedy of that FormatError is RemedyKind::kNameFormat.
 ImportFormat DetectImportFormat(const std::string& path);
+
+// How many leading bytes the content rule looks at.
+inline constexpr std::size_t kImportDetectionBytes = 64 * 1024;
+
+// The first kImportDetectionBytes of `path` (fewer for a shorter file). Throws IoError.
+std::string ReadDetectionHead(const std::string& path);
+
+// The same rule over bytes already read: `head` is the file's first bytes (up to
+// kImportDetectionBytes), `file_size` its size, `extension` its lower- or upper-case extension
+// with the dot (".bsdf"). Returns kAuto when no format matches.
+ImportFormat DetectImportFormatFromHead(std::string_view head, std::uint64_t file_size,
+                                        std::string_view extension);
 
 struct ImportOptions {
   // Accept transmission (BTDF) tables, mirrored into the reflection hemisphere (zemax.h).
@@ -38,8 +53,8 @@ struct ImportOptions {
 
 // Reads `path` as a Measurement (f_r in 1/sr, linear Rec.709, our frame of DESIGN §4).
 // kAuto detects the format with DetectImportFormat. For kRgl and kMerl it throws
-// InvalidArgument ("evaluable format: use `brdf capture --device sim --material FILE`"):
-// those need a virtual capture, wired where the capture code lives.
+// InvalidArgument with RemedyKind::kCaptureEvaluable: those need a virtual capture
+// (CaptureNoiseFree in brdf/core/virtual_capture.h).
 // Throws FormatError / IoError from the readers, naming file and line or byte offset.
 Measurement ImportFile(const std::string& path, ImportFormat format = ImportFormat::kAuto,
                        const ImportOptions& options = {});

@@ -39,8 +39,15 @@ struct Lut {
   // clamp-to-edge addressing.
   std::array<float, 3> SampleTrilinear(double u, double v, double w) const;
   // The same lookup from angles (degrees): ω_out given by (θout, φout), light at (θin, 0).
+  // θin between two slices interpolates linearly between them at the same specular-frame
+  // coordinates (θd, φd); θin outside [θin,0, θin,K−1] takes the nearest slice (clamp-to-edge).
+  // A θin list that is not k·Δin (an evaluation-only LUT, see processing::ResampleOptions) is
+  // interpolated the same way between its neighbouring entries.
   std::array<float, 3> SampleAngles(double theta_in_deg, double theta_out_deg,
                                     double phi_out_deg) const;
+  // The fractional slice coordinate of `theta_in_deg` (k + t), before clamping: θin/Δin for a
+  // k·Δin list, piecewise linear between entries otherwise.
+  double SliceCoordinate(double theta_in_deg) const;
 };
 
 }  // namespace brdf

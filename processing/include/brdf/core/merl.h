@@ -80,6 +80,7 @@ class MerlBrdf final : public BrdfSource {
   // False when any channel of the pair's bin is marked not measured (or the pair is below
   // the horizon), so a caller can tell a measured black from a hole.
   bool IsMeasured(const Vec3& wi, const Vec3& wo) const;
+  bool HasValue(const Vec3& wi, const Vec3& wo) const override { return IsMeasured(wi, wo); }
 
   std::string Name() const override { return name_; }
   const MerlInfo& info() const { return info_; }

@@ -1,5 +1,7 @@
-// A captured measurement evaluated as a continuous BRDF, for `brdf eval FILE.bpc`, the
-// viewer and comparisons against exported LUTs.
+// A captured measurement evaluated as a continuous BRDF without the LUT's 1° texel grid (the
+// viewer, comparisons against exported LUTs). `brdf eval` does not use it: it evaluates
+// captures through the float LUT (brdf::sources::OpenBrdf), which interpolates between θin in
+// the specular frame; this class still interpolates at fixed ω_out (see below).
 //
 // MeasurementBrdf interpolates the point cloud exactly as BuildLut (resample.h) does: within a
 // slice the same regular-grid or scattered interpolation over (θout, φout), the DESIGN §6

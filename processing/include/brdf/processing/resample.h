@@ -37,6 +37,7 @@
 #pragma once
 
 #include <cstddef>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -61,6 +62,11 @@ struct ResampleOptions {
   bool parallel = true;
   // k of the scattered method: how many nearest samples each fit uses, in [4, 64].
   int neighbours = 16;
+  // false accepts any set of distinct θin in [0°, 90°) (evaluation of imported tables such as a
+  // Zemax file measured at 10°, 30°, 50°): LUT slice k is then the k-th smallest measured θin,
+  // and Lut::SampleAngles interpolates between neighbouring slices the same way. Such a LUT is
+  // for evaluation only; the exported textures need θin,k = k·Δin.
+  bool require_uniform_theta_in = true;
 
   // Throws InvalidArgument naming the bad option.
   void Validate() const;
@@ -86,12 +92,42 @@ struct ResampleReport {
   std::vector<SliceResampleReport> slices;  // ascending θin, one per LUT slice
 };
 
+// One reason BuildLut refuses a measurement (or, for kDegenerateRange, would build a LUT with no
+// angular information).
+struct LutInputProblem {
+  enum class Kind {
+    kNoSlices,
+    kThetaInOutOfRange,  // θin not in [0°, 90°) or φin not finite
+    kDuplicateThetaIn,
+    kThetaInNotUniform,  // not k·Δin from 0° (only when options.require_uniform_theta_in)
+    kBadSamples,         // samples not flagged invalid with unusable angles or values
+    kNoValidSample,      // a slice whose every sample is flagged invalid
+    kDegenerateRange,    // every valid sample at θout = 0: nothing to interpolate over
+  };
+  Kind kind = Kind::kNoSlices;
+  int slice = -1;                    // index into measurement.slices; -1 for the whole
+  double theta_in_deg = 0;           // of `slice`
+  std::size_t sample_count = 0;      // kBadSamples: how many samples of the slice
+  std::size_t first_sample = 0;      // kBadSamples: index of the first one
+  std::string message;  // one sentence without the file name: "slice 2 (θin = 40°): 3 samples
+                        // with red value not a finite number (first: sample 17)"
+};
+
+// Every problem of `measurement` that BuildLut(measurement, params, options) refuses, in slice
+// order, bad samples summarised per slice and defect. BuildLut itself throws the first of these,
+// so `brdf info`, `convert` and `eval` can never disagree about a file. Also reports
+// kDegenerateRange, which BuildLut refuses too: a LUT extrapolated from the pole alone is not a
+// measurement.
+std::vector<LutInputProblem> FindLutInputProblems(const Measurement& measurement,
+                                                  const ResampleOptions& options = {});
+
 // Builds the LUT of DESIGN §5 from `measurement` with the §6 extrapolation `params`.
 // Requirements (InvalidArgument otherwise, naming the sample and what is wrong):
 //  - at least one slice; the θin values, in any order, are k·Δin for k = 0…K−1 (uniform,
 //    starting at 0°, no duplicates; within 1e-3°); LUT slice k is θin = k·Δin exactly;
 //  - every slice has at least one valid sample; valid samples have finite values, finite φout
-//    and θout ∈ [−90°, 90°].
+//    and θout ∈ [−90°, 90°]; some valid sample has θout > 0.
+// (FindLutInputProblems lists every violation; BuildLut throws InvalidArgument with the first.)
 // `report`, when not null, receives θb, the methods used and sample counts.
 Lut BuildLut(const Measurement& measurement, const ExtrapolationParams& params = {},
              const ResampleOptions& options = {}, ResampleReport* report = nullptr);

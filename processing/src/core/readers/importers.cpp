@@ -74,21 +74,13 @@ ImportFormat ImportFormatFromName(std::string_view name) {
                         "' (known: auto, rgl, zemax, lighttools, merl, csv, gonio)");
 }
 
-ImportFormat DetectImportFormat(const std::string& path) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (f == nullptr) throw IoError(path + ": cannot open: " + std::strerror(errno));
-  std::string head(64 * 1024, '\0');
-  const std::size_t got = std::fread(head.data(), 1, head.size(), f);
-  std::fclose(f);
-  head.resize(got);
-  std::error_code ec;
-  const std::uint64_t size = std::filesystem::file_size(path, ec);
-  const std::string ext = Lower(std::filesystem::path(path).extension().string());
-
+ImportFormat DetectImportFormatFromHead(std::string_view head, std::uint64_t file_size,
+                                        std::string_view extension) {
+  const std::string ext = Lower(std::string(extension));
   if (head.size() >= 12 && std::memcmp(head.data(), "tensor_file\0", 12) == 0)
     return ImportFormat::kRgl;
   if (ext == ".binary") return ImportFormat::kMerl;
-  if (!ec && size == kMerlBytes && head.size() >= 12) {
+  if (file_size == kMerlBytes && head.size() >= 12) {
     const unsigned char* p = reinterpret_cast<const unsigned char*>(head.data());
     const auto i32 = [&](int k) {
       return static_cast<std::uint32_t>(p[4 * k]) |
@@ -114,10 +106,33 @@ ImportFormat DetectImportFormat(const std::string& path) {
     theta_out = theta_out || fld == "theta_out" || fld == "theta_out_deg";
   }
   if (theta_in && theta_out) return ImportFormat::kCsv;
+  return ImportFormat::kAuto;
+}
+
+std::string ReadDetectionHead(const std::string& path) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (f == nullptr) throw IoError(path + ": cannot open: " + std::strerror(errno));
+  std::string head(kImportDetectionBytes, '\0');
+  const std::size_t got = std::fread(head.data(), 1, head.size(), f);
+  const bool failed = std::ferror(f) != 0;
+  std::fclose(f);
+  if (failed) throw IoError(path + ": cannot read");
+  head.resize(got);
+  return head;
+}
+
+ImportFormat DetectImportFormat(const std::string& path) {
+  const std::string head = ReadDetectionHead(path);
+  std::error_code ec;
+  const std::uint64_t size = std::filesystem::file_size(path, ec);
+  const std::string ext = Lower(std::filesystem::path(path).extension().string());
+  const ImportFormat format = DetectImportFormatFromHead(head, ec ? 0 : size, ext);
+  if (format != ImportFormat::kAuto) return format;
   throw FormatError(path, "file content",
                     "a known measurement format (RGL .bsdf, Zemax or LightTools BSDF text, MERL "
                     ".binary, CSV point cloud, goniometer table)",
-                    "none recognised (extension '" + ext + "')", "name the format with --format");
+                    "none recognised (extension '" + ext + "')", {},
+                    Remedy{RemedyKind::kNameFormat, path});
 }
 
 Measurement ImportFile(const std::string& path, ImportFormat format, const ImportOptions& options) {
@@ -133,13 +148,11 @@ Measurement ImportFile(const std::string& path, ImportFormat format, const Impor
       return LoadGonioTable(path);
     case ImportFormat::kRgl:
     case ImportFormat::kMerl:
-      // Hook for evaluable formats: a Measurement needs a virtual capture of
-      // OpenBrdfSource(path) at the instrument's geometry, which lives with the simulated
-      // device. Wire it here (or in the CLI) once both exist.
+      // Evaluable formats need a virtual capture (brdf/core/virtual_capture.h), which the
+      // caller chooses the geometry of.
       throw InvalidArgument(path + ": " + ImportFormatName(format) +
-                            " files are evaluable BRDFs, not point clouds: use `brdf capture "
-                            "--device sim --material " +
-                            path + "` to capture one");
+                                " files are evaluable BRDFs, not point clouds",
+                            Remedy{RemedyKind::kCaptureEvaluable, path});
     case ImportFormat::kAuto:
       break;
   }

@@ -283,9 +283,10 @@ Measurement LightToolsToMeasurement(const LightToolsBsdf& lt, const std::string&
                       "a front-side BRDF block",
                       std::to_string(btdf_front) + " front-side BTDF and " + std::to_string(back) +
                           " back-side blocks",
-                      btdf_front > 0 ? "allow BTDF import (--allow-btdf) to store the "
-                                       "transmission data mirrored into the reflection hemisphere"
-                                     : "");
+                      btdf_front > 0 ? "transmission data, stored mirrored into the reflection "
+                                       "hemisphere only on request"
+                                     : "",
+                      btdf_front > 0 ? Remedy{RemedyKind::kAllowBtdf, file} : Remedy{});
   }
   const std::size_t channels = ChannelCount(lt.spectral);
   // (AOI, POI) → the block of each channel.

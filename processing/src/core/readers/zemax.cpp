@@ -357,8 +357,9 @@ Measurement ZemaxToMeasurement(const ZemaxBsdf& z, const std::string& file,
   if (z.btdf && !options.allow_btdf) {
     throw FormatError(file, LinePosition(z.scatter_type_line),
                       "ScatterType BRDF (a reflection measurement)", "BTDF (transmission)",
-                      "allow BTDF import (--allow-btdf) to store it mirrored into the "
-                      "reflection hemisphere; `brdf info` reads it as it is");
+                      "transmission data, stored mirrored into the reflection hemisphere only on "
+                      "request",
+                      Remedy{RemedyKind::kAllowBtdf, file});
   }
   Measurement m;
   m.metadata.sample_name = file;

@@ -1,0 +1,155 @@
+// Opening any input of the toolchain with one call: the fitter, the previewer, the viewer and
+// every `brdf` command ask these functions, so they agree on what a file holds.
+//
+//  - OpenBrdf: any evaluable file as a BrdfSource (`brdf eval`, the viewer, comparisons).
+//  - LutFromInput: any input as the float LUT of docs/design.md §5 (`brdf convert`, `atlas`).
+//  - OpenExportedTexture: an exported LUT or atlas read back with its sidecar or manifest.
+//  - ChooseExtrapolation: the §6 parameters that apply to one input.
+//
+// One evaluation path. A capture (or an imported table) is evaluated by resampling it into the
+// float LUT exactly as `brdf convert` does (processing::BuildLut) and sampling that LUT exactly
+// as a GPU samples the exported texture (Lut::SampleAngles: centre-exact texel coordinates,
+// trilinear, clamp-to-edge). So `brdf eval CAPTURE` and `brdf eval` of its exported LUT differ
+// only by the RGB9E5 rounding of the texture, and between measured θin both interpolate
+// linearly in the specular frame (the same (θd, φd) in the two neighbouring slices).
+//
+// θin outside the measured range (one rule for captures, LUTs and eval): the value of the
+// nearest measured slice at the same specular-frame coordinates (θd, φd), as the GPU's
+// clamp-to-edge along w gives it. OpenedSource::BeyondMeasuredWarning says when a query is
+// answered that way.
+//
+// Every function throws brdf::Error subclasses whose message starts with the file's path; what
+// the user can do is in Error::remedy(). Nothing here prints.
+#pragma once
+
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "brdf/core/brdf_source.h"
+#include "brdf/core/lut.h"
+#include "brdf/core/measurement.h"
+#include "brdf/exporter/atlas.h"
+#include "brdf/exporter/sidecar.h"
+#include "brdf/exporter/texture_file.h"
+#include "brdf/processing/extrapolation.h"
+#include "brdf/processing/resample.h"
+#include "brdf/sources/detect.h"
+
+namespace brdf::sources {
+
+// The §6 extrapolation parameters for one input and where they came from. Precedence, most
+// specific first: "<stem>.extrapolate.json" beside the input; the input's own "extrapolate"
+// member (material files); `command_line`; the defaults p = 1, l = 0.5.
+struct ExtrapolationChoice {
+  processing::ExtrapolationParams params;
+  enum class Origin { kDefaults, kCommandLine, kBesideFile, kMaterialMember };
+  Origin origin = Origin::kDefaults;
+  std::string file;  // kBesideFile / kMaterialMember: the file read
+};
+// Throws FormatError / IoError for an unreadable or invalid per-material file.
+ExtrapolationChoice ChooseExtrapolation(
+    const std::string& input_path, FileKind kind,
+    const std::optional<processing::ExtrapolationParams>& command_line,
+    std::vector<std::string>* warnings);
+
+// A capture, material file or imported table opened as a measurement ready to resample.
+struct PreparedMeasurement {
+  Measurement measurement;
+  ExtrapolationChoice extrapolation;
+  std::vector<std::string> warnings;
+};
+// Captures follow the damaged-capture rule (capture.h); material files are captured noise-free
+// on the reference geometry (brdf/core/virtual_capture.h); third-party tables (Zemax,
+// LightTools, CSV, gonio) are imported (transmission tables only with `allow_btdf`), RGL and
+// MERL files captured noise-free. InvalidArgument for any other kind.
+PreparedMeasurement PrepareMeasurement(
+    const std::string& path, FileKind kind,
+    const std::optional<processing::ExtrapolationParams>& command_line, bool allow_btdf = false);
+
+// An exported LUT or atlas read back: the texture, and the sidecar or manifest that describes
+// it if there is one (given directly, embedded in the KTX2, or found beside a DDS).
+struct OpenedTexture {
+  exporter::LoadedTexture texture;
+  std::string texture_path;
+  std::optional<exporter::SidecarInfo> sidecar;     // a single LUT's
+  std::optional<exporter::AtlasManifest> manifest;  // an atlas's
+  std::string sidecar_path;  // the standalone sidecar or manifest read, if any
+  // The payload CRC-32 was compared with the one the metadata records (the readers throw on a
+  // mismatch, so this is false only when there was no metadata to compare with).
+  bool checksum_verified = false;
+  std::vector<std::string> warnings;
+};
+// `path` is a .ktx2, a .dds, a sidecar .json or an atlas manifest .json. A sidecar leads to the
+// texture it lists (the .ktx2 first, else the .dds) in its folder, a manifest to PREFIX.ktx2
+// (else PREFIX.dds) beside it; the size and checksum the JSON records are checked against
+// that texture. Throws IoError / FormatError / InvalidArgument (another kind of file).
+OpenedTexture OpenExportedTexture(const std::string& path);
+
+// A LUT sampled exactly as a GPU samples the 3D texture (Lut::SampleAngles). The light's
+// azimuth is folded into φout (isotropic LUT, light stored at φin = 0). Zero when either
+// direction is at or below the horizon (the BrdfSource contract).
+class LutBrdf final : public BrdfSource {
+ public:
+  LutBrdf(Lut lut, std::string name) : lut_(std::move(lut)), name_(std::move(name)) {}
+  Rgb Eval(const Vec3& wi, const Vec3& wo) const override;
+  std::string Name() const override { return name_; }
+  const Lut& lut() const { return lut_; }
+
+ private:
+  Lut lut_;
+  std::string name_;
+};
+
+struct OpenOptions {
+  // §6 parameters from the command line (captures and tables; ignored with a warning for
+  // exported LUTs, where the extrapolation is baked in).
+  std::optional<processing::ExtrapolationParams> extrapolation;
+  // How captures are resampled (the same options `brdf convert` uses by default).
+  processing::ResampleOptions resample;
+};
+
+// How OpenBrdf evaluates the file.
+enum class Evaluation {
+  kAnalytic,      // a material file: the model's formula
+  kMeasuredDatabase,  // RGL / MERL: the database's own interpolation
+  kResampledLut,  // a capture or table, resampled into the float LUT (the convert path)
+  kExportedLut,   // an exported texture, RGB9E5 values as stored
+};
+
+struct OpenedSource {
+  std::unique_ptr<BrdfSource> brdf;
+  FileKind kind = FileKind::kUnknown;
+  Evaluation evaluation = Evaluation::kAnalytic;
+  // The measured θin, ascending, for kResampledLut and kExportedLut (the LUT's slices); empty
+  // when the source covers every θin itself.
+  std::vector<double> measured_theta_in_deg;
+  std::optional<ExtrapolationChoice> extrapolation;  // kResampledLut: what filled θout > θb
+  std::vector<std::string> warnings;  // full sentences starting with the path
+
+  // A warning sentence when a query with light polar angle `theta_in_deg` lies outside the
+  // measured θin range (answered from the nearest slice, clamp-to-edge), else nullopt.
+  std::optional<std::string> BeyondMeasuredWarning(double theta_in_deg,
+                                                   const std::string& path) const;
+};
+
+// Opens any evaluable file: material .json, .bpc capture, .ktx2 / .dds LUT or LUT sidecar,
+// RGL .bsdf, MERL .binary, Zemax / LightTools tables, CSV point clouds and goniometer tables
+// (tables evaluated like a capture; transmission tables mirrored, with a warning). Atlases are
+// refused (RemedyKind::kEvaluateSingleLut). Throws IoError / FormatError / InvalidArgument.
+OpenedSource OpenBrdf(const std::string& path, const OpenOptions& options = {});
+
+// A LUT ready to export or to place in an atlas, built from any input `brdf convert` or
+// `brdf atlas` accepts: captures and material files are resampled (processing::BuildLut with
+// the chosen extrapolation); exported LUTs (.ktx2, .dds, sidecar) are decoded as stored.
+struct InputLut {
+  Lut lut;
+  std::optional<exporter::ExtrapolationInfo> extrapolation;  // what filled θout > θb
+  std::vector<std::string> warnings;
+};
+InputLut LutFromInput(const std::string& path, FileKind kind,
+                      const std::optional<processing::ExtrapolationParams>& command_line,
+                      const processing::ResampleOptions& resample_options);
+
+}  // namespace brdf::sources

@@ -1,0 +1,321 @@
+#include "brdf/sources/open.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "brdf/core/error.h"
+#include "brdf/core/file_util.h"
+#include "brdf/core/merl.h"
+#include "brdf/core/rgl.h"
+#include "brdf/core/virtual_capture.h"
+#include "brdf/exporter/packed_volume.h"
+#include "brdf/sources/capture.h"
+#include "text.h"
+
+namespace brdf::sources {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr std::uint64_t kMaxJsonBytes = 16u << 20;
+
+using internal::Deg;
+using internal::DegList;
+
+std::string LowerExtension(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  for (char& c : ext)
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+  return ext;
+}
+
+std::string ExtrapolationIgnored(const std::string& path) {
+  return path + ": warning: the extrapolation given on the command line is ignored: it is baked "
+                "into an exported LUT";
+}
+
+// A noise-free capture of an evaluable file, named after it.
+Measurement CaptureFile(const BrdfSource& source, const std::string& path, FileKind kind) {
+  Measurement m = CaptureNoiseFree(source);
+  if (m.metadata.sample_name.empty()) m.metadata.sample_name = OutputNameOf(path);
+  m.metadata.extra["source_file"] = path;
+  if (kind == FileKind::kMaterial) {
+    m.metadata.extra["material_file"] = path;
+  } else if (const auto format = ImportFormatOf(kind)) {
+    m.metadata.extra["source_format"] = ImportFormatName(*format);
+  }
+  return m;
+}
+
+}  // namespace
+
+ExtrapolationChoice ChooseExtrapolation(
+    const std::string& input_path, FileKind kind,
+    const std::optional<processing::ExtrapolationParams>& command_line,
+    std::vector<std::string>* warnings) {
+  fs::path beside(input_path);
+  beside.replace_filename(OutputNameOf(input_path) + kExtrapolationSuffix);
+  std::optional<ExtrapolationChoice> own;
+  if (kind == FileKind::kMaterial) {
+    if (auto p =
+            processing::ExtrapolationFromJson(ReadFileText(input_path, kMaxJsonBytes), input_path))
+      own = ExtrapolationChoice{*p, ExtrapolationChoice::Origin::kMaterialMember, input_path};
+  }
+  std::error_code ec;
+  if (fs::is_regular_file(beside, ec)) {
+    ExtrapolationChoice choice{processing::LoadExtrapolationJson(beside.string()),
+                               ExtrapolationChoice::Origin::kBesideFile, beside.string()};
+    if (own && !(own->params == choice.params) && warnings)
+      warnings->push_back(input_path + ": warning: " + beside.string() +
+                          " (p,l = " + processing::FormatExtrapolation(choice.params) +
+                          ") overrides the material's own \"extrapolate\" (" +
+                          processing::FormatExtrapolation(own->params) + ")");
+    return choice;
+  }
+  if (own) return *own;
+  if (command_line) return {*command_line, ExtrapolationChoice::Origin::kCommandLine, {}};
+  return {processing::ExtrapolationParams{}, ExtrapolationChoice::Origin::kDefaults, {}};
+}
+
+PreparedMeasurement PrepareMeasurement(
+    const std::string& path, FileKind kind,
+    const std::optional<processing::ExtrapolationParams>& command_line, bool allow_btdf) {
+  PreparedMeasurement out;
+  switch (kind) {
+    case FileKind::kCapture:
+      out.measurement = LoadCaptureForLut(path, &out.warnings);
+      break;
+    case FileKind::kMaterial:
+    {
+      const Material material = LoadMaterialFile(path);
+      out.measurement = CaptureFile(AnalyticBrdf(material), path, kind);
+      out.measurement.metadata.extra["model"] = std::string(ModelName(material.model));
+      break;
+    }
+    case FileKind::kRgl:
+      out.measurement = CaptureFile(RglBrdf::Load(path), path, kind);
+      break;
+    case FileKind::kMerl:
+      out.measurement = CaptureFile(MerlBrdf::Load(path), path, kind);
+      break;
+    case FileKind::kZemax:
+    case FileKind::kLightTools:
+    case FileKind::kCsv:
+    case FileKind::kGonio: {
+      ImportOptions import_options;
+      import_options.allow_btdf = allow_btdf;
+      out.measurement = ImportFile(path, *ImportFormatOf(kind), import_options);
+      const auto it = out.measurement.metadata.extra.find("scatter_type");
+      if (it != out.measurement.metadata.extra.end() && it->second.rfind("BTDF", 0) == 0)
+        out.warnings.push_back(path +
+                               ": warning: transmission (BTDF) table, used mirrored into the "
+                               "reflection hemisphere");
+      break;
+    }
+    default:
+      throw InvalidArgument(path + ": expected a capture (.bpc), a material file or a measured "
+                                   "table, got a " +
+                            std::string(FileKindName(kind)));
+  }
+  out.extrapolation = ChooseExtrapolation(path, kind, command_line, &out.warnings);
+  return out;
+}
+
+OpenedTexture OpenExportedTexture(const std::string& path) {
+  OpenedTexture out;
+  const FileKind kind = DetectFileKind(path);
+  if (kind == FileKind::kSidecar || kind == FileKind::kAtlasManifest) {
+    out.sidecar_path = path;
+    const fs::path folder = fs::path(path).parent_path();
+    // What the JSON records about its texture, and where the texture may be.
+    int width = 0, height = 0, depth = 0;
+    std::uint64_t bytes = 0;
+    std::uint32_t crc = 0;
+    std::vector<double> theta_in_deg;
+    std::vector<std::string> candidates;
+    if (kind == FileKind::kSidecar) {
+      out.sidecar = exporter::ReadSidecar(path);
+      const exporter::SidecarInfo& s = *out.sidecar;
+      width = s.width, height = s.height, depth = s.slices;
+      bytes = s.payload_bytes, crc = s.payload_crc32, theta_in_deg = s.theta_in_deg;
+      for (const char* ext : {".ktx2", ".dds"})
+        for (const std::string& f : s.files)
+          if (LowerExtension(f) == ext) candidates.push_back((folder / f).string());
+    } else {
+      out.manifest = exporter::ParseAtlasManifest(ReadFileText(path, kMaxJsonBytes), path);
+      const exporter::AtlasManifest& m = *out.manifest;
+      width = m.texture_width, height = m.texture_height;
+      depth = static_cast<int>(m.theta_in_deg.size());
+      bytes = m.payload_bytes, crc = m.payload_crc32, theta_in_deg = m.theta_in_deg;
+      for (const char* ext : {".ktx2", ".dds"})
+        candidates.push_back((folder / (OutputNameOf(path) + ext)).string());
+    }
+    std::error_code ec;
+    for (const std::string& c : candidates) {
+      if (!fs::is_regular_file(c, ec)) continue;
+      out.texture_path = c;
+      break;
+    }
+    if (out.texture_path.empty()) {
+      std::string list;
+      for (const auto& c : candidates) list += (list.empty() ? "" : ", ") + c;
+      throw IoError(path + ": the texture it describes is missing (looked for " +
+                    (list.empty() ? std::string("a .ktx2 or .dds in its file list") : list) + ")");
+    }
+    out.texture = exporter::ReadTextureFile(out.texture_path);
+    const exporter::PackedVolume& v = out.texture.volume;
+    if (v.width != width || v.height != height || v.depth != depth)
+      throw FormatError(
+          path, "grid",
+          "the size of " + out.texture_path + " (" + std::to_string(v.width) + " × " +
+              std::to_string(v.height) + " × " + std::to_string(v.depth) + ")",
+          std::to_string(width) + " × " + std::to_string(height) + " × " + std::to_string(depth));
+    const std::uint32_t actual = v.Crc32();
+    if (bytes != v.ByteSize() || crc != actual) {
+      char want[64], got[64];
+      std::snprintf(want, sizeof want, "%llu bytes, CRC-32 0x%08x",
+                    static_cast<unsigned long long>(bytes), crc);
+      std::snprintf(got, sizeof got, "%zu bytes, CRC-32 0x%08x", v.ByteSize(), actual);
+      throw FormatError(out.texture_path, "payload",
+                        "the payload " + path + " records (" + want + ")", got,
+                        "the texture and its JSON do not belong together, or one is damaged");
+    }
+    if (!out.texture.theta_in_from_metadata) {
+      out.texture.theta_in_deg = theta_in_deg;
+      out.texture.theta_in_from_metadata = true;
+      exporter::FinishLoadedTexture(out.texture);  // decodes the LUT with this θin list
+    }
+    out.checksum_verified = true;
+    return out;
+  }
+  if (!IsTexture(kind))
+    throw InvalidArgument(path +
+                          ": expected a .ktx2 or .dds texture, a LUT sidecar or an atlas "
+                          "manifest, got a " +
+                          std::string(FileKindName(kind)));
+  out.texture_path = path;
+  out.texture = exporter::ReadTextureFile(path);
+  if (!out.texture.sidecar_json.empty()) {
+    out.sidecar = exporter::ParseSidecarJson(out.texture.sidecar_json, path + " (sidecar)");
+    out.checksum_verified = true;  // FinishLoadedTexture compared it
+  } else if (!out.texture.atlas_manifest_json.empty()) {
+    out.manifest =
+        exporter::ParseAtlasManifest(out.texture.atlas_manifest_json, path + " (manifest)");
+    out.checksum_verified = true;
+  } else {
+    out.warnings.push_back(path + ": warning: no sidecar recorded or found beside it: θin " +
+                           DegList(out.texture.theta_in_deg) +
+                           "° assumed (k·20°) and the checksum not verified");
+  }
+  return out;
+}
+
+Rgb LutBrdf::Eval(const Vec3& wi, const Vec3& wo) const {
+  if (!(wi.z > 0.0) || !(wo.z > 0.0)) return {0.0, 0.0, 0.0};
+  const double theta_in_deg = RadToDeg(ThetaOf(wi));
+  // Isotropic: only φout − φin matters, and the LUT stores the light at φin = 0.
+  const double phi_deg = std::hypot(wi.x, wi.y) > 0.0
+                             ? WrapDeg360(RadToDeg(PhiOf(wo)) - RadToDeg(PhiOf(wi)))
+                             : RadToDeg(PhiOf(wo));
+  const std::array<float, 3> f = lut_.SampleAngles(theta_in_deg, RadToDeg(ThetaOf(wo)), phi_deg);
+  return {f[0], f[1], f[2]};
+}
+
+std::optional<std::string> OpenedSource::BeyondMeasuredWarning(double theta_in_deg,
+                                                               const std::string& path) const {
+  if (measured_theta_in_deg.empty()) return std::nullopt;
+  const double lo = measured_theta_in_deg.front(), hi = measured_theta_in_deg.back();
+  constexpr double kTolDeg = 1e-6;
+  if (theta_in_deg >= lo - kTolDeg && theta_in_deg <= hi + kTolDeg) return std::nullopt;
+  const double nearest = theta_in_deg < lo ? lo : hi;
+  return path + ": warning: θin " + Deg(theta_in_deg) + "° is outside the measured range " +
+         Deg(lo) + "°–" + Deg(hi) + "°: the value is the θin " + Deg(nearest) +
+         "° slice's at the same specular-frame angles (clamped, not measured)";
+}
+
+OpenedSource OpenBrdf(const std::string& path, const OpenOptions& options) {
+  OpenedSource out;
+  out.kind = DetectFileKind(path);
+  switch (out.kind) {
+    case FileKind::kMaterial:
+      out.brdf = std::make_unique<AnalyticBrdf>(LoadMaterialFile(path));
+      out.evaluation = Evaluation::kAnalytic;
+      return out;
+    case FileKind::kRgl:
+      out.brdf = std::make_unique<RglBrdf>(RglBrdf::Load(path));
+      out.evaluation = Evaluation::kMeasuredDatabase;
+      return out;
+    case FileKind::kMerl:
+      out.brdf = std::make_unique<MerlBrdf>(MerlBrdf::Load(path));
+      out.evaluation = Evaluation::kMeasuredDatabase;
+      return out;
+    case FileKind::kCapture:
+    case FileKind::kZemax:
+    case FileKind::kLightTools:
+    case FileKind::kCsv:
+    case FileKind::kGonio: {
+      PreparedMeasurement p =
+          PrepareMeasurement(path, out.kind, options.extrapolation, /*allow_btdf=*/true);
+      out.warnings = std::move(p.warnings);
+      processing::ResampleOptions resample = options.resample;
+      resample.require_uniform_theta_in = false;  // tables measured at any θin evaluate too
+      Lut lut = processing::BuildLut(p.measurement, p.extrapolation.params, resample);
+      out.measured_theta_in_deg = lut.theta_in_deg;
+      out.extrapolation = p.extrapolation;
+      out.evaluation = Evaluation::kResampledLut;
+      out.brdf = std::make_unique<LutBrdf>(std::move(lut), OutputNameOf(path));
+      return out;
+    }
+    case FileKind::kKtx2:
+    case FileKind::kDds:
+    case FileKind::kSidecar:
+    case FileKind::kAtlasManifest: {
+      OpenedTexture t = OpenExportedTexture(path);
+      out.warnings = std::move(t.warnings);
+      if (!t.texture.IsSingleLut())
+        throw InvalidArgument(path + ": an atlas (" + std::to_string(t.texture.volume.width) +
+                                  " × " + std::to_string(t.texture.volume.height) +
+                                  " texels) holds many materials",
+                              Remedy{RemedyKind::kEvaluateSingleLut, path});
+      if (options.extrapolation) out.warnings.push_back(ExtrapolationIgnored(path));
+      out.measured_theta_in_deg = t.texture.lut.theta_in_deg;
+      out.evaluation = Evaluation::kExportedLut;
+      out.brdf = std::make_unique<LutBrdf>(std::move(t.texture.lut), OutputNameOf(path));
+      return out;
+    }
+    default:
+      throw InvalidArgument(path + ": cannot evaluate a " + std::string(FileKindName(out.kind)) +
+                            " (evaluable: material .json, .bpc capture, .ktx2 / .dds LUT, LUT "
+                            "sidecar .json, RGL .bsdf, MERL .binary, Zemax or LightTools BSDF "
+                            "table, CSV point cloud, goniometer table)");
+  }
+}
+
+InputLut LutFromInput(const std::string& path, FileKind kind,
+                      const std::optional<processing::ExtrapolationParams>& command_line,
+                      const processing::ResampleOptions& resample_options) {
+  InputLut out;
+  if (IsExportedLut(kind)) {
+    OpenedTexture t = OpenExportedTexture(path);
+    out.warnings = std::move(t.warnings);
+    if (!t.texture.IsSingleLut())
+      throw InvalidArgument(path + ": an atlas, not a single material's LUT");
+    if (command_line) out.warnings.push_back(ExtrapolationIgnored(path));
+    if (t.sidecar) out.extrapolation = t.sidecar->extrapolation;
+    out.lut = std::move(t.texture.lut);
+    return out;
+  }
+  PreparedMeasurement p = PrepareMeasurement(path, kind, command_line);
+  out.warnings = std::move(p.warnings);
+  processing::ResampleReport report;
+  out.lut = processing::BuildLut(p.measurement, p.extrapolation.params, resample_options, &report);
+  if (report.theta_b_deg < 90.0)
+    out.extrapolation = exporter::ExtrapolationInfo{p.extrapolation.params.p,
+                                                    p.extrapolation.params.l, report.theta_b_deg};
+  return out;
+}
+
+}  // namespace brdf::sources
