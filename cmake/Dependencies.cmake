@@ -10,7 +10,7 @@ pkg_check_modules(LIBUSB REQUIRED IMPORTED_TARGET libusb-1.0)
 pkg_check_modules(HIDAPI REQUIRED IMPORTED_TARGET hidapi-libusb)
 
 find_package(OpenImageIO REQUIRED)
-# OpenImageIO 2.4's config names /usr/include/opencv4, which Debian does not ship (DESIGN §3).
+# OpenImageIO 2.4's config names /usr/include/opencv4, which Debian does not ship (docs/design.md §3).
 foreach(oiio_target OpenImageIO::OpenImageIO OpenImageIO::OpenImageIO_Util)
   if(TARGET ${oiio_target})
     get_target_property(oiio_includes ${oiio_target} INTERFACE_INCLUDE_DIRECTORIES)

@@ -26,7 +26,8 @@ std::string SidecarJson(const PackedVolume& payload, const std::vector<double>& 
   if (metadata.extrapolation) {
     const ExtrapolationInfo& e = *metadata.extrapolation;
     j["extrapolation"] = {
-        {"method", "restricted quadratic Bezier beyond the last measured theta_out (DESIGN 6)"},
+        {"method",
+         "restricted quadratic Bezier beyond the last measured theta_out (docs/design.md §6)"},
         {"p", e.p},
         {"l", e.l},
         {"theta_b_deg", e.theta_b_deg}};

@@ -147,7 +147,7 @@ TEST(Gonio, SpecularPeakOfEachIncidenceLandsOnTheMirrorDirection) {
       if (smp.rgb[1] > peak->rgb[1]) peak = &smp;
     EXPECT_EQ(peak->theta_out_deg, static_cast<float>(s.theta_in_deg)) << s.theta_in_deg;
     EXPECT_EQ(peak->phi_out_deg, 180.0f) << s.theta_in_deg;
-    // The mirror direction of DESIGN §4: (θin, φin + 180°).
+    // The mirror direction of docs/design.md §4: (θin, φin + 180°).
     const Vec3 w = SphericalDirectionDeg(peak->theta_out_deg, peak->phi_out_deg);
     const Vec3 mirror = Reflect(SphericalDirectionDeg(s.theta_in_deg, 0.0));
     EXPECT_NEAR(Dot(w, mirror), 1.0, 1e-6);

@@ -1,5 +1,6 @@
 // LUTs for the exporter tests, built directly (no resampling): analytic materials evaluated in
-// the specular frame of DESIGN §5, and synthetic patterns whose every texel is identifiable.
+// the specular frame of docs/design.md §5, and synthetic patterns whose every texel is
+// identifiable.
 #pragma once
 
 #include <algorithm>
@@ -19,8 +20,8 @@
 namespace brdf::test {
 
 // Texel (i, j, k) holds f(θin,k, ω_out) with ω_out = S(θin,k)·ω(θd = j°, φd = i°); below the
-// horizon the value at θout = 90° with the same φout (DESIGN §5 edge extension), evaluated a
-// hair above the horizon so the analytic models stay finite.
+// horizon the value at θout = 90° with the same φout (docs/design.md §5 edge extension), evaluated
+// a hair above the horizon so the analytic models stay finite.
 inline Lut AnalyticLut(const Material& material, std::vector<double> theta_in_deg) {
   Lut lut;
   lut.Resize(theta_in_deg.size());

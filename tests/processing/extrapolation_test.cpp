@@ -1,5 +1,5 @@
-// DESIGN §6: the restricted quadratic Bézier b(x, l), the extrapolation factor and the ways a
-// user supplies p and l. Reference values come from a bisection on the curve written in
+// docs/design.md §6: the restricted quadratic Bézier b(x, l), the extrapolation factor and the ways
+// a user supplies p and l. Reference values come from a bisection on the curve written in
 // synthetic_capture.h, never from the closed-form root under test.
 #include "brdf/processing/extrapolation.h"
 

@@ -16,8 +16,7 @@ namespace {
 
 using Json = nlohmann::json;
 
-// 361 × 181 texels × K = 4 slices × 4 bytes. (DESIGN §5 prints 1,045,444 for this product; the
-// product is 1,045,456.)
+// 361 × 181 texels × K = 4 slices × 4 bytes = 1,045,456 (docs/design.md §5).
 constexpr std::size_t kPayloadBytesK4 = 361u * 181u * 4u * 4u;
 
 const std::vector<double> kThetaIn = {0, 20, 40, 60};
@@ -305,7 +304,7 @@ TEST_F(ConvertOptions, ExtrapolationComesFromTheMostSpecificSource) {
   EXPECT_FALSE(fs::exists(dir_ / "out" / "ggx.exr"));
 
   // The GGX LUT in the band beyond θb = 75°: f(75°, φ)·((1 − α) + α·p) with
-  // α = b(min((θ − 75°)/15°, 1), l), p = 0.2, l = 0.3 (DESIGN §6), at texel centres.
+  // α = b(min((θ − 75°)/15°, 1), l), p = 0.2, l = 0.3 (docs/design.md §6), at texel centres.
   const Analytic m = Ggx03();
   std::string pairs;
   std::vector<std::array<double, 3>> dirs;  // θin, θout, φout

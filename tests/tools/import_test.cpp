@@ -220,7 +220,7 @@ TEST_F(ImportCommand, GoniometerTableGivesReflectanceFactorOverPi) {
   EXPECT_EQ(samples, expected.size());
 }
 
-// A virtual capture at the reference geometry of DESIGN §1 (θin 0/20/40/60°, θout 0–75°,
+// A virtual capture at the reference geometry of docs/design.md §1 (θin 0/20/40/60°, θout 0–75°,
 // φout 0–359°, 1° steps): every grid point once, f_r equal to the source's own evaluation
 // (the reader's Eval, tested on its own in rgl_test / merl_test) as float, flagged invalid
 // exactly where `unmeasured` says so.
@@ -439,7 +439,7 @@ TEST_F(ImportCommand, WrongOrMissingArgumentsGiveOneClearLine) {
 
 class InfoCommand : public testing::ToolTest {};
 
-// DESIGN of the shared data (../shared/brdf-data/README.md): integrating the table should
+// The README of the third-party data set (BRDF_DATA_DIR/README.md): integrating the table should
 // land within 5–15% of the file's TIS lines; docs/formats/zemax.md gives the tolerance
 // |integrated − TIS| ≤ 15% and covered ≤ 1.01·TIS (a lower bound).
 TEST_F(InfoCommand, ShowsZemaxIntegratedTisNextToTheFilesOwn) {

@@ -1,5 +1,5 @@
-// `brdf atlas INPUT... --out PREFIX`: many materials in one texture (DESIGN §5) for deferred
-// renderers, with a manifest JSON.
+// `brdf atlas INPUT... --out PREFIX`: many materials in one texture (docs/design.md §5) for
+// deferred renderers, with a manifest JSON.
 //
 // Every input becomes a LUT exactly as `brdf convert` makes it (captures and material files
 // are resampled with their extrapolation; exported LUTs are used as stored), on --jobs worker

@@ -25,8 +25,8 @@ namespace brdf::cli {
 
 namespace {
 
-// The reference instrument's geometry (DESIGN §1): light at θin 0°, 20°, 40°, 60° (φin = 0),
-// detector at θout 0°–75° and φout 0°–359°, 1° steps.
+// The reference instrument's geometry (docs/design.md §1): light at θin 0°, 20°, 40°, 60° (φin =
+// 0), detector at θout 0°–75° and φout 0°–359°, 1° steps.
 constexpr double kReferenceThetaInDeg[] = {0, 20, 40, 60};
 constexpr int kReferenceThetaOutMaxDeg = 75;
 constexpr int kReferencePhiOutCount = 360;

@@ -73,7 +73,7 @@ int main(int argc, char** argv) {
   eval_out_opt->needs(eval_in_opt)->excludes(eval_pairs_opt);
   eval_cmd
       ->add_option("--extrapolate", eval.extrapolate,
-                   "Captures: grazing extrapolation P,L (DESIGN §6); default: the "
+                   "Captures: grazing extrapolation P,L (docs/design.md §6); default: the "
                    "per-material JSON beside the file, else 1,0.5")
       ->capture_default_str();
   eval_cmd->footer(
@@ -180,7 +180,7 @@ int main(int argc, char** argv) {
   convert_cmd->add_option("--out", convert.out, "Output folder (created if missing)")->required();
   convert_cmd
       ->add_option("--extrapolate", convert.extrapolate,
-                   "Grazing extrapolation P,L (DESIGN §6) for inputs without their own; "
+                   "Grazing extrapolation P,L (docs/design.md §6) for inputs without their own; "
                    "default 1,0.5 (clamping)")
       ->capture_default_str();
   convert_cmd->add_option("--formats", convert.formats, "Comma-separated outputs to write")
@@ -222,7 +222,7 @@ int main(int argc, char** argv) {
   brdf::cli::AtlasOptions atlas;
   auto* atlas_cmd = app.add_subcommand(
       "atlas",
-      "Pack many materials into one atlas texture (DESIGN §5): PREFIX.ktx2, .dds, .exr and "
+      "Pack many materials into one atlas texture (docs/design.md §5): PREFIX.ktx2, .dds, .exr and "
       "PREFIX.json (manifest naming every material's cell)");
   atlas_cmd
       ->add_option("inputs", atlas.inputs,

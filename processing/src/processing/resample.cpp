@@ -31,7 +31,7 @@ std::string Who(const Measurement& m) {
                                         : "measurement '" + m.metadata.sample_name + "'";
 }
 
-// Slice indices in ascending θin, checked against DESIGN §5's θin,k = k·Δin.
+// Slice indices in ascending θin, checked against docs/design.md §5's θin,k = k·Δin.
 std::vector<std::size_t> UniformThetaInOrder(const Measurement& m, double* delta_in) {
   if (m.slices.empty()) throw InvalidArgument(Who(m) + " has no slices; cannot build a LUT");
   std::vector<std::size_t> order(m.slices.size());
@@ -45,7 +45,7 @@ std::vector<std::size_t> UniformThetaInOrder(const Measurement& m, double* delta
   const auto fail = [&](const std::string& why) {
     throw InvalidArgument(Who(m) +
                           ": the LUT needs incidence angles θin,k = k·Δin starting at 0° "
-                          "(DESIGN §5), got θin = " +
+                          "(docs/design.md §5), got θin = " +
                           list + "°: " + why);
   };
   for (std::size_t k = 1; k < order.size(); ++k)
@@ -129,7 +129,7 @@ Lut BuildLut(const Measurement& measurement, const ExtrapolationParams& params,
   sin_t[0] = 0.0;
   sin_t[kH - 1] = 0.0;
 
-  // The texel's value from its outgoing direction (ω_out, θout, φout) per DESIGN §5 and §6.
+  // The texel's value from its outgoing direction (ω_out, θout, φout) per docs/design.md §5 and §6.
   const auto texel_value = [&](const internal::SliceInterpolator& slice, const Vec3& w_out,
                                double theta_out, double phi_out) {
     Rgb v;

@@ -1,4 +1,4 @@
-// EXR and PNG images of a LUT or an atlas, through OpenImageIO (DESIGN §5, §7).
+// EXR and PNG images of a LUT or an atlas, through OpenImageIO (docs/design.md §5, §7).
 //
 // The 3D texture is laid out flat: the K slices in a grid of C = ceil(√K) columns and
 // R = ceil(K/C) rows, row-major, ascending θin, top-left first (4 slices: 2 × 2, 722 × 362
@@ -54,7 +54,7 @@ struct FloatImage {
   }
 };
 
-// The DESIGN §5 composite of a LUT (722 × 362 for K = 4). Throws InvalidArgument for an
+// The docs/design.md §5 composite of a LUT (722 × 362 for K = 4). Throws InvalidArgument for an
 // unexportable LUT.
 FloatImage CompositeImage(const Lut& lut);
 // The inverse: the K slices back out of a composite image of the right size.

@@ -36,7 +36,7 @@ struct ImportOptions {
   bool allow_btdf = false;
 };
 
-// Reads `path` as a Measurement (f_r in 1/sr, linear Rec.709, our frame of DESIGN §4).
+// Reads `path` as a Measurement (f_r in 1/sr, linear Rec.709, our frame of docs/design.md §4).
 // kAuto detects the format with DetectImportFormat. For kRgl and kMerl it throws
 // InvalidArgument ("evaluable format: use `brdf capture --device sim --material FILE`"):
 // those need a virtual capture, wired where the capture code lives.
