@@ -6,12 +6,13 @@
 #include <algorithm>
 #include <sstream>
 
+#include "test_support.h"
 #include "tool_test_util.h"
 
 namespace brdf::tooltest {
 namespace {
 
-const fs::path kRglDir = fs::path(BRDF_SHARED_DATA_DIR) / "rgl";
+fs::path RglDir() { return brdf::test::DataPath("rgl"); }
 
 std::vector<std::array<double, 3>> ParseTriples(const std::string& text) {
   std::vector<std::array<double, 3>> out;
@@ -33,7 +34,7 @@ using RglCapture = ToolTest;
 
 TEST_F(RglCapture, EveryRglMaterialCapturedOnTheSimulatorConvertsToAMatchingLut) {
   std::vector<fs::path> bsdfs;
-  for (const auto& e : fs::directory_iterator(kRglDir))
+  for (const auto& e : fs::directory_iterator(RglDir()))
     if (e.path().extension() == ".bsdf") bsdfs.push_back(e.path());
   std::sort(bsdfs.begin(), bsdfs.end());
   ASSERT_EQ(bsdfs.size(), 18u) << "the shared data folder holds 18 RGL materials";
