@@ -16,9 +16,11 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <string_view>
+#include <vector>
 
 namespace brdf::test {
 
@@ -26,8 +28,8 @@ namespace brdf::test {
 // Throws std::runtime_error (which fails the calling test) when the folder does not exist.
 inline std::string DataDir() {
   const char* env = std::getenv("BRDF_DATA_DIR");
-  const std::string dir = (env != nullptr && *env != '\0') ? std::string(env)
-                                                           : std::string(BRDF_DATA_DIR_DEFAULT);
+  const std::string dir =
+      (env != nullptr && *env != '\0') ? std::string(env) : std::string(BRDF_DATA_DIR_DEFAULT);
   std::error_code ec;
   if (!std::filesystem::is_directory(dir, ec))
     throw std::runtime_error("third-party data folder '" + dir +
@@ -77,5 +79,13 @@ class ScopedTempDir {
  private:
   std::filesystem::path path_;
 };
+
+// A new private folder like ScopedTempDir, removed when the test program exits: for helpers
+// that hand out paths (a folder per call, never reused).
+inline std::filesystem::path NewTempDir(std::string_view tag) {
+  static std::vector<std::unique_ptr<ScopedTempDir>> dirs;
+  dirs.push_back(std::make_unique<ScopedTempDir>(tag));
+  return dirs.back()->path();
+}
 
 }  // namespace brdf::test

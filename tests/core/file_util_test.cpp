@@ -6,6 +6,7 @@
 #include <string>
 
 #include "brdf/core/error.h"
+#include "test_support.h"
 
 namespace brdf {
 namespace {
@@ -35,9 +36,7 @@ TEST(ByteReader, ReadsLittleEndianAndReportsOffsetsPastEnd) {
 }
 
 TEST(AtomicWrite, ReplacesWholeFileAndLeavesNoTemporary) {
-  const auto dir = std::filesystem::temp_directory_path() / "brdf_atomic_test";
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
+  const auto dir = brdf::test::NewTempDir("atomic");
   const std::string path = (dir / "out.bin").string();
   WriteFileAtomically(path, "first");
   WriteFileAtomically(path, "second!");

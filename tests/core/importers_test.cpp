@@ -23,11 +23,7 @@ std::string Zemax() {
 }
 std::string Gonio() { return brdf::test::DataPath("goniometer-csv/test_brdf_viewer_2D_data.csv"); }
 
-fs::path TempDir() {
-  const fs::path dir = fs::temp_directory_path() / "brdf_importers_test";
-  fs::create_directories(dir);
-  return dir;
-}
+fs::path TempDir() { return brdf::test::NewTempDir("importers"); }
 
 TEST(ImportFormat, NamesRoundTrip) {
   for (ImportFormat f :

@@ -32,11 +32,7 @@ namespace fs = std::filesystem;
 std::string ShaTable() { return brdf::test::DataPath("reference/merl_binary_sha256.tsv"); }
 const std::string kBrokenDir = std::string(BRDF_SOURCE_DIR) + "/tests/data/broken/merl/";
 
-fs::path TempDir() {
-  const fs::path dir = fs::temp_directory_path() / ("brdf_merl_test_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  return dir;
-}
+fs::path TempDir() { return brdf::test::NewTempDir("merl"); }
 
 // ---------------------------------------------------------------------------------------
 // SHA-256: the FIPS 180-2 appendix examples and the NIST short/long message values.

@@ -275,7 +275,7 @@ TEST(ZemaxReader, ErrorsNameFileLineExpectedAndFound) {
 
 TEST(ZemaxReader, RefusesFilesLargerThanItsCapBeforeReading) {
   // A sparse 65 MiB file: refused from its size alone, nothing is allocated or read.
-  const std::filesystem::path p = std::filesystem::temp_directory_path() / "brdf_zemax_huge.bsdf";
+  const std::filesystem::path p = brdf::test::NewTempDir("zemax") / "huge.bsdf";
   { std::ofstream(p.string()).put('#'); }
   std::filesystem::resize_file(p, 65ull << 20);
   try {

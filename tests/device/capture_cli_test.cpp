@@ -12,6 +12,7 @@
 #include "brdf/core/file_util.h"
 #include "commands.h"
 #include "device_test_support.h"
+#include "test_support.h"
 
 namespace brdf::device {
 namespace {
@@ -25,13 +26,7 @@ struct ToolRun {
 
 class CaptureCli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("brdf_capture_cli_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
+  void SetUp() override { dir_ = brdf::test::ScopedTempDir::MakeTempDir("capture-cli"); }
   void TearDown() override { fs::remove_all(dir_); }
 
   ToolRun Run(const std::string& args) const {

@@ -16,6 +16,7 @@
 #include "brdf/core/geometry.h"
 #include "brdf/core/lut.h"
 #include "brdf/core/models.h"
+#include "test_support.h"
 
 namespace brdf::test {
 
@@ -108,13 +109,9 @@ inline void SetLe32(std::vector<std::uint8_t>& b, std::size_t at, std::uint32_t 
   for (int i = 0; i < 4; ++i) b.at(at + i) = static_cast<std::uint8_t>(v >> (8 * i));
 }
 
-// A fresh empty folder under the build tree for one test.
+// A fresh private folder for one test (mkdtemp), removed when the test program exits.
 inline std::string TestDir(const std::string& name) {
-  const std::filesystem::path dir =
-      std::filesystem::path(BRDF_BINARY_DIR) / "test-output" / "export" / name;
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir.string();
+  return brdf::test::NewTempDir("export-" + name).string();
 }
 
 // Independent CRC-32 (IEEE 802.3, reflected 0xEDB88320), bit by bit as the standard defines it.

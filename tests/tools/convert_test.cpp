@@ -33,9 +33,7 @@ std::vector<Named> Materials() {
 class ConvertedMaterials : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    root_ = new fs::path(fs::temp_directory_path() /
-                         ("brdf_convert_test_" + std::to_string(::getpid())));
-    fs::remove_all(*root_);
+    root_ = new fs::path(brdf::test::ScopedTempDir::MakeTempDir("convert"));
     fs::create_directories(*root_ / "in");
     for (const Named& m : Materials())
       WriteText(*root_ / "in" / (m.name + ".json"), m.material.Json());

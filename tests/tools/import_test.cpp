@@ -23,15 +23,15 @@
 #include "brdf/core/models.h"
 #include "brdf/core/rgl.h"
 #include "test_support.h"
-#include "tool_runner.h"
+#include "tool_test_util.h"
 
 namespace brdf {
 namespace {
 
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
-using testing::Quote;
-using testing::ToolRun;
+using tooltest::Quote;
+using tooltest::ToolRun;
 
 constexpr double kPi = 3.14159265358979323846;
 
@@ -101,7 +101,7 @@ void ExpectSameValues(const Measurement& m, const Expected& expected) {
   EXPECT_EQ(samples, expected.size());
 }
 
-class ImportCommand : public testing::ToolTest {};
+class ImportCommand : public tooltest::ToolTest {};
 
 TEST_F(ImportCommand, CsvPointCloudKeepsEveryValue) {
   const Material mat = ColouredWard();
@@ -439,7 +439,7 @@ TEST_F(ImportCommand, WrongOrMissingArgumentsGiveOneClearLine) {
   }
 }
 
-class InfoCommand : public testing::ToolTest {};
+class InfoCommand : public tooltest::ToolTest {};
 
 // The README of the third-party data set (BRDF_DATA_DIR/README.md): integrating the table should
 // land within 5–15% of the file's TIS lines; docs/formats/zemax.md gives the tolerance

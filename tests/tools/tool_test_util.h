@@ -1,8 +1,9 @@
-// Helpers for the tests that run the built `brdf` tool as a user runs it: a scratch folder, a
-// process runner, and oracles written here from the specifications, independent of the code
-// under test: the analytic BRDFs of docs/design.md §9, the specular frame of docs/design.md §5, the
-// Bézier of docs/design.md §6 (by bisection), the RGB9E5 layout of EXT_texture_shared_exponent, and
-// minimal KTX2 / DDS / .bpc layout readers written from their specifications.
+// Helpers for the tests that run the built `brdf` tool as a user runs it (the one runner of
+// tests/tools): a private scratch folder per test, a process runner, and oracles written here from
+// the specifications, independent of the code under test: the analytic BRDFs of docs/design.md §9,
+// the specular frame of docs/design.md §5, the Bézier of docs/design.md §6 (by bisection), the
+// RGB9E5 layout of EXT_texture_shared_exponent, and minimal KTX2 / DDS / .bpc layout readers
+// written from their specifications.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -22,6 +23,7 @@
 
 #include "brdf/core/bpc.h"
 #include "brdf/core/measurement.h"
+#include "test_support.h"
 
 namespace brdf::tooltest {
 
@@ -32,6 +34,19 @@ inline constexpr double kPi = 3.14159265358979323846;
 struct ToolRun {
   int exit_code = -1;
   std::string out, err;
+
+  // stderr split into lines (without the newlines).
+  std::vector<std::string> ErrLines() const {
+    std::vector<std::string> lines;
+    std::size_t start = 0;
+    while (start < err.size()) {
+      const std::size_t end = err.find('\n', start);
+      lines.push_back(err.substr(start, end == std::string::npos ? end : end - start));
+      if (end == std::string::npos) break;
+      start = end + 1;
+    }
+    return lines;
+  }
 };
 
 inline std::string ReadAll(const fs::path& p) {
@@ -56,17 +71,14 @@ inline ToolRun RunTool(const std::string& args, const fs::path& dir) {
 
 inline std::string Quote(const fs::path& p) { return "'" + p.string() + "'"; }
 
-// A fresh folder per test, removed afterwards.
+// A fresh private folder per test (mkdtemp), removed afterwards.
 class ToolTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("brdf_tool_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+  void SetUp() override { dir_ = test::ScopedTempDir::MakeTempDir("tool"); }
+  void TearDown() override {
+    if (std::getenv("BRDF_KEEP_TEST_OUTPUT") == nullptr) fs::remove_all(dir_);
   }
-  void TearDown() override { fs::remove_all(dir_); }
+  ToolRun Run(const std::string& args) const { return RunTool(args, dir_); }
   fs::path dir_;
 };
 
