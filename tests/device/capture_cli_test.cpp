@@ -142,7 +142,7 @@ TEST_F(CaptureCli, InterruptedCaptureRecordsItsPlanSoConvertNamesTheMissingSlice
     ASSERT_EQ(info.exit_code, 0) << info.err;
     EXPECT_NE(info.out.find("\"theta_in_deg\": \"" + c.key + "\""), std::string::npos) << info.out;
 
-    const ToolRun convert = Run("convert " + out + " --out " + Path("lut") + " --quiet");
+    const ToolRun convert = Run("convert " + out + " --out " + Path("lut") + " --quiet --force");
     EXPECT_EQ(convert.exit_code, 1);
     EXPECT_NE(convert.out.find("converted 0 of 1"), std::string::npos) << convert.out;
     EXPECT_NE(convert.out.find(c.missing), std::string::npos) << convert.out;
@@ -153,7 +153,7 @@ TEST_F(CaptureCli, InterruptedCaptureRecordsItsPlanSoConvertNamesTheMissingSlice
     ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
     EXPECT_EQ(ReadBpc(out).measurement.metadata.extra.at("theta_in_deg"), c.key);
     const ToolRun done =
-        Run("convert " + out + " --out " + Path("lut") + " --formats ktx2 --quiet");
+        Run("convert " + out + " --out " + Path("lut") + " --formats ktx2 --quiet --force");
     EXPECT_EQ(done.exit_code, 0) << done.out << done.err;
   }
 }

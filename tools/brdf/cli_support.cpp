@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "brdf/core/error.h"
+#include "brdf/core/file_util.h"
 
 namespace brdf::cli {
 
@@ -59,8 +60,7 @@ void CheckOutputPath(const std::string& out, const std::string& input, const cha
   std::error_code ec;
   if (fs::equivalent(out, input, ec))
     throw InvalidArgument(std::string(option) + ": '" + out + "' is the input file itself");
-  if (fs::exists(out, ec) && !force)
-    throw InvalidArgument(out + " already exists: use --force to overwrite it");
+  CheckWritableOutput(out, force);
 }
 
 }  // namespace brdf::cli

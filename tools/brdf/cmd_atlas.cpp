@@ -13,6 +13,7 @@
 
 #include "batch.h"
 #include "brdf/core/error.h"
+#include "brdf/core/file_util.h"
 #include "brdf/exporter/atlas.h"
 #include "brdf/exporter/packed_volume.h"
 #include "commands.h"
@@ -49,6 +50,7 @@ int RunAtlas(const AtlasOptions& options) {
         throw InvalidArgument("--out " + options.out + ": the atlas file " + out +
                               " would overwrite an input; choose another prefix");
   }
+  CheckWritableOutputs(outputs, options.force);
   std::vector<BatchFailure> failures = found.failures;
   for (const BatchFailure& f : failures)
     std::fprintf(stderr, "%s: FAILED: %s\n", f.path.c_str(), f.reason.c_str());

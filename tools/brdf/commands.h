@@ -46,6 +46,7 @@ struct ConvertOptions {
   std::string exr_compression = "none";
   int jobs = DefaultJobs();
   bool quiet = false;  // no progress bar
+  bool force = false;  // overwrite existing outputs (brdf::CheckWritableOutputs)
 };
 int RunConvert(const ConvertOptions& options);
 
@@ -57,6 +58,7 @@ struct AtlasOptions {
   std::string exr_compression = "zip";
   int jobs = DefaultJobs();
   bool quiet = false;
+  bool force = false;  // overwrite existing PREFIX.* files
 };
 int RunAtlas(const AtlasOptions& options);
 

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "brdf/core/error.h"
+#include "brdf/core/file_util.h"
 #include "brdf/core/measurement.h"
 #include "commands.h"
 
@@ -202,6 +203,9 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   convert_cmd->add_flag("--quiet", convert.quiet, "No progress bar");
+  convert_cmd->add_flag("--force", convert.force,
+                        "Overwrite outputs that already exist in --out (without it nothing is "
+                        "converted when any output exists)");
   convert_cmd->footer(
       "Material files are first captured noise-free on the reference geometry (theta_in 0, 20, "
       "40, 60; theta_out 0-75; phi_out 0-359; 1 degree steps), then resampled like a capture.\n"
@@ -244,6 +248,8 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   atlas_cmd->add_flag("--quiet", atlas.quiet, "No progress bar");
+  atlas_cmd->add_flag("--force", atlas.force,
+                      "Overwrite PREFIX.ktx2, .dds, .exr, .json if any already exists");
   atlas_cmd->footer(
       "Materials are placed in input order (folders sorted by file name). All must share one "
       "theta_in list; materials with different sets are refused by name. Nothing is written "
@@ -300,6 +306,11 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "brdf: %s\nRun 'brdf --help' or 'brdf <command> --help' for usage.\n",
                  e.what());
     return 2;
+  } catch (const brdf::OutputExistsError& e) {
+    // The overwrite rule of every writing command (brdf/core/file_util.h), in our words.
+    std::fprintf(stderr, "brdf: error: %s; use --force to overwrite %s\n", e.what(),
+                 e.paths().size() == 1 ? "it" : "them");
+    return 1;
   } catch (const brdf::Error& e) {
     std::fprintf(stderr, "brdf: error: %s\n", e.what());
     return 1;

@@ -1,6 +1,7 @@
 #include "brdf/core/file_util.h"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <array>
@@ -27,7 +28,40 @@ void SyncPath(const std::string& path) {
   ::close(fd);
 }
 
+std::string ExistsMessage(const std::vector<std::string>& paths) {
+  std::string m = paths.front() + ": already exists";
+  if (paths.size() > 1)
+    m += " (and " + std::to_string(paths.size() - 1) + " more output" +
+         (paths.size() == 2 ? "" : "s") + " of this run)";
+  return m;
+}
+
+// "a folder", "a FIFO", ... for a path that exists and is not a regular file; "" otherwise.
+std::string NonRegularKind(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0 || S_ISREG(st.st_mode)) return {};
+  if (S_ISDIR(st.st_mode)) return "a folder";
+  if (S_ISFIFO(st.st_mode)) return "a FIFO (named pipe)";
+  if (S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode)) return "a device";
+  if (S_ISSOCK(st.st_mode)) return "a socket";
+  return "not a regular file";
+}
+
 }  // namespace
+
+OutputExistsError::OutputExistsError(std::vector<std::string> paths)
+    : IoError(ExistsMessage(paths)), paths_(std::move(paths)) {}
+
+void CheckWritableOutputs(const std::vector<std::string>& paths, bool overwrite) {
+  std::vector<std::string> existing;
+  for (const std::string& p : paths) {
+    if (const std::string kind = NonRegularKind(p); !kind.empty())
+      throw IoError(p + ": exists and is " + kind + ", not a file; choose another output name");
+    std::error_code ec;
+    if (fs::exists(p, ec)) existing.push_back(p);
+  }
+  if (!existing.empty() && !overwrite) throw OutputExistsError(std::move(existing));
+}
 
 AtomicOutputPath::AtomicOutputPath(std::string final_path) : final_path_(std::move(final_path)) {
   static std::atomic<unsigned> counter{0};

@@ -13,7 +13,35 @@
 #include <string_view>
 #include <vector>
 
+#include "brdf/core/error.h"
+
 namespace brdf {
+
+// The one overwrite rule of every command that writes a file (capture, import, export-csv,
+// convert, atlas, fit, preview): an output that already exists is replaced only when the user
+// said so (the tools' --force); an existing path that is not a regular file (a folder, a FIFO,
+// a device) is never replaced. Call it for every output before any work is done.
+//
+// Thrown when an output exists and overwriting was not allowed. The remedy is structured: the
+// caller knows the user can allow it (brdf's --force) and says so in its own words.
+class OutputExistsError : public IoError {
+ public:
+  explicit OutputExistsError(std::vector<std::string> paths);
+  // Every existing output (at least one), in the order checked.
+  const std::vector<std::string>& paths() const { return paths_; }
+
+ private:
+  std::vector<std::string> paths_;
+};
+
+// Checks `paths` (all the outputs of one command): throws OutputExistsError listing those that
+// exist when !overwrite, and IoError "<path>: exists and is a folder (or FIFO, device, ...), not
+// a file" for an existing non-regular path whatever `overwrite` says. Symbolic links are
+// followed (a link to a regular file counts as that file).
+void CheckWritableOutputs(const std::vector<std::string>& paths, bool overwrite);
+inline void CheckWritableOutput(const std::string& path, bool overwrite) {
+  CheckWritableOutputs({path}, overwrite);
+}
 
 // A temporary sibling of `final_path` ("dir/.name.tmp-<pid>-<n>"); removed by the destructor
 // unless Commit() renamed it into place.
