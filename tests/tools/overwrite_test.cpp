@@ -3,6 +3,8 @@
 // changed, and --force replaces it; an output path that is a folder is refused even with
 // --force. The expected bytes come from the first run's files, compared before and after.
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <filesystem>
 #include <string>
@@ -80,6 +82,26 @@ TEST_F(Overwrite, AnOutputThatIsAFolderIsRefusedEvenWithForce) {
   }
   EXPECT_TRUE(fs::is_directory(dir_ / "luts" / "gold.ktx2"));
   EXPECT_FALSE(fs::exists(dir_ / "luts" / "gold.dds")) << "nothing may be written";
+}
+
+// A run killed before renaming its outputs leaves ".brdf-<pid>-<n>.tmp" files; the next run into
+// that folder removes them and says so in one note.
+TEST_F(Overwrite, ConvertRemovesAndReportsTemporariesOfAKilledRun) {
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  ::waitpid(child, nullptr, 0);  // `child` now names no running process
+  fs::create_directories(dir_ / "luts");
+  const fs::path stale = dir_ / "luts" / (".brdf-" + std::to_string(child) + "-0.tmp");
+  WriteText(stale, "half a texture");
+  const ToolRun r = Run("convert " + Quote(kGoldCapture) + " --quiet --formats ktx2 --out " +
+                        Quote(dir_ / "luts"));
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_FALSE(fs::exists(stale));
+  const std::vector<std::string> lines = r.ErrLines();
+  ASSERT_EQ(lines.size(), 1u) << r.err;
+  EXPECT_NE(lines[0].find("removed 1 temporary file left by an interrupted run: " + stale.string()),
+            std::string::npos)
+      << lines[0];
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 
@@ -60,7 +61,15 @@ void CheckOutputPath(const std::string& out, const std::string& input, const cha
   std::error_code ec;
   if (fs::equivalent(out, input, ec))
     throw InvalidArgument(std::string(option) + ": '" + out + "' is the input file itself");
-  CheckWritableOutput(out, force);
+  ReportRemovedTemporaries(CheckWritableOutput(out, force));
+}
+
+void ReportRemovedTemporaries(const std::vector<std::string>& removed) {
+  if (removed.empty()) return;
+  std::string list;
+  for (const std::string& r : removed) list += (list.empty() ? "" : ", ") + r;
+  std::fprintf(stderr, "note: removed %zu temporary file%s left by an interrupted run: %s\n",
+               removed.size(), removed.size() == 1 ? "" : "s", list.c_str());
 }
 
 }  // namespace brdf::cli

@@ -28,4 +28,8 @@ std::string LowerExtension(const std::string& path);
 void CheckOutputPath(const std::string& out, const std::string& input, const char* extension,
                      bool force, const char* option = "--out");
 
+// Prints one note on stderr naming the temporary files of killed runs that
+// brdf::CheckWritableOutputs removed (nothing when there were none).
+void ReportRemovedTemporaries(const std::vector<std::string>& removed);
+
 }  // namespace brdf::cli

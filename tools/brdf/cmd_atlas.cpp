@@ -16,6 +16,7 @@
 #include "brdf/core/file_util.h"
 #include "brdf/exporter/atlas.h"
 #include "brdf/exporter/packed_volume.h"
+#include "cli_support.h"
 #include "commands.h"
 #include "progress.h"
 #include "sources.h"
@@ -50,7 +51,7 @@ int RunAtlas(const AtlasOptions& options) {
         throw InvalidArgument("--out " + options.out + ": the atlas file " + out +
                               " would overwrite an input; choose another prefix");
   }
-  CheckWritableOutputs(outputs, options.force);
+  ReportRemovedTemporaries(CheckWritableOutputs(outputs, options.force));
   std::vector<BatchFailure> failures = found.failures;
   for (const BatchFailure& f : failures)
     std::fprintf(stderr, "%s: FAILED: %s\n", f.path.c_str(), f.reason.c_str());

@@ -16,6 +16,7 @@
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
 #include "brdf/exporter/lut_export.h"
+#include "cli_support.h"
 #include "commands.h"
 #include "progress.h"
 #include "sources.h"
@@ -118,7 +119,7 @@ int RunConvert(const ConvertOptions& options) {
     for (const BatchInput& in : found.inputs)
       for (std::string& p : OutputPaths(out_dir, in.name, export_options.formats))
         outputs.push_back(std::move(p));
-    CheckWritableOutputs(outputs, options.force);
+    ReportRemovedTemporaries(CheckWritableOutputs(outputs, options.force));
   }
 
   const std::size_t total = found.inputs.size() + found.failures.size();

@@ -1,6 +1,7 @@
 #include "brdf/core/file_util.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -10,6 +11,8 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <regex>
+#include <set>
 
 #include "brdf/core/error.h"
 
@@ -47,12 +50,44 @@ std::string NonRegularKind(const std::string& path) {
   return "not a regular file";
 }
 
+constexpr const char* kTempPrefix = ".brdf-";
+constexpr const char* kTempSuffix = ".tmp";
+
+// The writer's process id if `name` is a temporary file name of AtomicOutputPath (this version:
+// ".brdf-<pid>-<n>.tmp"; older ones: ".<final name>.tmp-<pid>-<n>"), else 0.
+long TemporaryOwner(const std::string& name) {
+  static const std::regex current(R"(^\.brdf-([0-9]{1,9})-[0-9]{1,20}\.tmp$)");
+  static const std::regex legacy(R"(^\..+\.tmp-([0-9]{1,9})-[0-9]{1,20}$)");
+  std::smatch m;
+  if (std::regex_match(name, m, current) || std::regex_match(name, m, legacy))
+    return std::stol(m[1].str());
+  return 0;
+}
+
+bool ProcessRuns(long pid) { return ::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM; }
+
 }  // namespace
+
+std::vector<std::string> RemoveStaleTemporaries(const std::string& dir) {
+  std::vector<std::string> removed;
+  std::error_code ec;
+  for (fs::directory_iterator it(dir.empty() ? "." : dir, ec), end; !ec && it != end;
+       it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    const long pid = TemporaryOwner(name);
+    if (pid <= 0 || pid == ::getpid() || ProcessRuns(pid)) continue;
+    std::error_code type_ec;
+    if (!it->is_regular_file(type_ec)) continue;
+    if (::unlink(it->path().c_str()) == 0) removed.push_back(it->path().string());
+  }
+  return removed;
+}
 
 OutputExistsError::OutputExistsError(std::vector<std::string> paths)
     : IoError(ExistsMessage(paths)), paths_(std::move(paths)) {}
 
-void CheckWritableOutputs(const std::vector<std::string>& paths, bool overwrite) {
+std::vector<std::string> CheckWritableOutputs(const std::vector<std::string>& paths,
+                                              bool overwrite) {
   std::vector<std::string> existing;
   for (const std::string& p : paths) {
     if (const std::string kind = NonRegularKind(p); !kind.empty())
@@ -61,14 +96,22 @@ void CheckWritableOutputs(const std::vector<std::string>& paths, bool overwrite)
     if (fs::exists(p, ec)) existing.push_back(p);
   }
   if (!existing.empty() && !overwrite) throw OutputExistsError(std::move(existing));
+  std::vector<std::string> removed;
+  std::set<std::string> folders;
+  for (const std::string& p : paths) {
+    const fs::path parent = fs::path(p).parent_path();
+    if (!folders.insert(parent.empty() ? "." : parent.string()).second) continue;
+    for (std::string& r : RemoveStaleTemporaries(parent.string())) removed.push_back(std::move(r));
+  }
+  return removed;
 }
 
 AtomicOutputPath::AtomicOutputPath(std::string final_path) : final_path_(std::move(final_path)) {
   static std::atomic<unsigned> counter{0};
   const fs::path p(final_path_);
   const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
-  temp_path_ = (dir / ("." + p.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
-                       std::to_string(counter++)))
+  temp_path_ = (dir / (std::string(kTempPrefix) + std::to_string(::getpid()) + "-" +
+                       std::to_string(counter++) + kTempSuffix))
                    .string();
 }
 

@@ -37,14 +37,26 @@ class OutputExistsError : public IoError {
 // Checks `paths` (all the outputs of one command): throws OutputExistsError listing those that
 // exist when !overwrite, and IoError "<path>: exists and is a folder (or FIFO, device, ...), not
 // a file" for an existing non-regular path whatever `overwrite` says. Symbolic links are
-// followed (a link to a regular file counts as that file).
-void CheckWritableOutputs(const std::vector<std::string>& paths, bool overwrite);
-inline void CheckWritableOutput(const std::string& path, bool overwrite) {
-  CheckWritableOutputs({path}, overwrite);
+// followed (a link to a regular file counts as that file). Then removes the temporary files
+// that killed runs left in the outputs' folders (RemoveStaleTemporaries) and returns their
+// paths, for the caller to report.
+std::vector<std::string> CheckWritableOutputs(const std::vector<std::string>& paths,
+                                              bool overwrite);
+inline std::vector<std::string> CheckWritableOutput(const std::string& path, bool overwrite) {
+  return CheckWritableOutputs({path}, overwrite);
 }
 
-// A temporary sibling of `final_path` ("dir/.name.tmp-<pid>-<n>"); removed by the destructor
-// unless Commit() renamed it into place.
+// Removes from `dir` the temporary files of AtomicOutputPath whose writing process no longer
+// runs (a run that was killed or lost power before renaming them into place), also those of
+// older versions of the toolchain (".<name>.tmp-<pid>-<n>"). Files of live processes, including
+// this one, are left alone. Returns the removed paths; errors are ignored (a file that cannot
+// be removed is simply not listed).
+std::vector<std::string> RemoveStaleTemporaries(const std::string& dir);
+
+// A temporary sibling of `final_path`, "dir/.brdf-<pid>-<n>.tmp": short whatever the final
+// name's length (a legal 255-byte file name must not fail for want of room), and naming the
+// writing process so the next run into the folder can remove it if the writer was killed
+// (RemoveStaleTemporaries). Removed by the destructor unless Commit() renamed it into place.
 class AtomicOutputPath {
  public:
   explicit AtomicOutputPath(std::string final_path);
