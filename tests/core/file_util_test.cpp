@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -129,6 +130,42 @@ TEST(OverwriteRule, RefusesExistingFilesAndNonRegularPaths) {
                                            ", not a file; choose another output name");
     }
   }
+}
+
+// Reading a FIFO that nobody writes to would block forever with a plain open(2).
+TEST(RegularFiles, FifosFoldersAndDevicesAreRefusedWithoutBlocking) {
+  const auto dir = brdf::test::NewTempDir("special");
+  const std::string fifo = (dir / "cap.bpc").string();
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  const std::string expected = fifo + ": is a FIFO (named pipe), not a file";
+  const auto message = [](const std::function<void()>& f) {
+    try {
+      f();
+    } catch (const IoError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_EQ(message([&] { ReadFileBytes(fifo, 100); }), expected);
+  EXPECT_EQ(message([&] { ReadFileHead(fifo, 100); }), expected);
+  EXPECT_EQ(message([&] { MappedFile(fifo, 100); }), expected);
+  EXPECT_EQ(message([&] { CheckRegularFile(fifo); }), expected);
+  EXPECT_EQ(message([&] { CheckRegularFile((dir / "none").string()); }),
+            (dir / "none").string() + ": no such file");
+  EXPECT_EQ(message([&] { ReadFileBytes(dir.string(), 100); }),
+            dir.string() + ": is a folder, not a file");
+  EXPECT_EQ(message([&] { ReadFileBytes("/dev/null", 100); }),
+            "/dev/null: is a device, not a file");
+}
+
+TEST(RegularFiles, MappedFileSeesTheBytesAndHonoursTheCap) {
+  const auto dir = brdf::test::NewTempDir("mapped");
+  const std::string path = (dir / "m.bin").string();
+  WriteFileAtomically(path, "abc");
+  const MappedFile m(path, 3);
+  ASSERT_EQ(m.size(), 3u);
+  EXPECT_EQ(std::string(reinterpret_cast<const char*>(m.data()), 3), "abc");
+  EXPECT_THROW(MappedFile(path, 2), FormatError);
 }
 
 }  // namespace

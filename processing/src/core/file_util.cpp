@@ -2,9 +2,11 @@
 
 #include <fcntl.h>
 #include <signal.h>
+#include <sys/mman.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cerrno>
@@ -39,15 +41,20 @@ std::string ExistsMessage(const std::vector<std::string>& paths) {
   return m;
 }
 
-// "a folder", "a FIFO", ... for a path that exists and is not a regular file; "" otherwise.
-std::string NonRegularKind(const std::string& path) {
-  struct stat st {};
-  if (::stat(path.c_str(), &st) != 0 || S_ISREG(st.st_mode)) return {};
+// "a folder", "a FIFO (named pipe)", ... for what `st` describes if it is not a regular file.
+std::string KindOf(const struct stat& st) {
   if (S_ISDIR(st.st_mode)) return "a folder";
   if (S_ISFIFO(st.st_mode)) return "a FIFO (named pipe)";
   if (S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode)) return "a device";
   if (S_ISSOCK(st.st_mode)) return "a socket";
-  return "not a regular file";
+  return "a special file";
+}
+
+// KindOf for a path that exists and is not a regular file; "" otherwise.
+std::string NonRegularKind(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0 || S_ISREG(st.st_mode)) return {};
+  return KindOf(st);
 }
 
 constexpr const char* kTempPrefix = ".brdf-";
@@ -141,29 +148,98 @@ void WriteFileAtomically(const std::string& path, std::string_view bytes) {
   out.Commit();
 }
 
-std::vector<std::uint8_t> ReadFileBytes(const std::string& path, std::uint64_t max_bytes) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (f == nullptr) throw IoError(path + ": cannot open: " + ErrnoText());
-  struct Closer {
-    std::FILE* f;
-    ~Closer() { std::fclose(f); }
-  } closer{f};
-  if (std::fseek(f, 0, SEEK_END) != 0) throw IoError(path + ": cannot seek: " + ErrnoText());
-  const long size = std::ftell(f);
-  if (size < 0) throw IoError(path + ": cannot tell size: " + ErrnoText());
-  if (static_cast<std::uint64_t>(size) > max_bytes)
+int OpenRegularFile(const std::string& path, std::uint64_t* size_bytes) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) throw IoError(path + ": cannot open: " + ErrnoText());
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) {
+    const std::string why = ErrnoText();
+    ::close(fd);
+    throw IoError(path + ": cannot read its size: " + why);
+  }
+  if (!S_ISREG(st.st_mode)) {
+    ::close(fd);
+    throw IoError(path + ": is " + KindOf(st) + ", not a file");
+  }
+  const int flags = ::fcntl(fd, F_GETFL);
+  if (flags >= 0) ::fcntl(fd, F_SETFL, flags & ~O_NONBLOCK);
+  *size_bytes = static_cast<std::uint64_t>(st.st_size);
+  return fd;
+}
+
+void CheckRegularFile(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) {
+    if (errno == ENOENT || errno == ENOTDIR) throw IoError(path + ": no such file");
+    throw IoError(path + ": cannot access: " + ErrnoText());
+  }
+  if (!S_ISREG(st.st_mode)) throw IoError(path + ": is " + KindOf(st) + ", not a file");
+}
+
+namespace {
+
+// Reads exactly n bytes (fewer only at end of file); returns the count read. Throws IoError.
+std::size_t ReadUpTo(int fd, std::uint8_t* out, std::size_t n, const std::string& path) {
+  std::size_t done = 0;
+  while (done < n) {
+    const ssize_t got = ::read(fd, out + done, n - done);
+    if (got < 0 && errno == EINTR) continue;
+    if (got < 0) throw IoError(path + ": read failed: " + ErrnoText());
+    if (got == 0) break;
+    done += static_cast<std::size_t>(got);
+  }
+  return done;
+}
+
+struct FdCloser {
+  int fd;
+  ~FdCloser() { ::close(fd); }
+};
+
+void CheckSize(const std::string& path, std::uint64_t size, std::uint64_t max_bytes) {
+  if (size > max_bytes)
     throw FormatError(path, "file size", "at most " + std::to_string(max_bytes) + " bytes",
                       std::to_string(size) + " bytes");
-  std::rewind(f);
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> ReadFileBytes(const std::string& path, std::uint64_t max_bytes) {
+  std::uint64_t size = 0;
+  const FdCloser fd{OpenRegularFile(path, &size)};
+  CheckSize(path, size, max_bytes);
   std::vector<std::uint8_t> data(static_cast<std::size_t>(size));
-  if (!data.empty() && std::fread(data.data(), 1, data.size(), f) != data.size())
-    throw IoError(path + ": read failed: " + ErrnoText());
+  if (ReadUpTo(fd.fd, data.data(), data.size(), path) != data.size())
+    throw IoError(path + ": read failed: the file became shorter while it was read");
   return data;
 }
 
 std::string ReadFileText(const std::string& path, std::uint64_t max_bytes) {
   const auto bytes = ReadFileBytes(path, max_bytes);
   return std::string(bytes.begin(), bytes.end());
+}
+
+std::string ReadFileHead(const std::string& path, std::size_t max_bytes) {
+  std::uint64_t size = 0;
+  const FdCloser fd{OpenRegularFile(path, &size)};
+  std::string head(static_cast<std::size_t>(std::min<std::uint64_t>(size, max_bytes)), '\0');
+  head.resize(ReadUpTo(fd.fd, reinterpret_cast<std::uint8_t*>(head.data()), head.size(), path));
+  return head;
+}
+
+MappedFile::MappedFile(const std::string& path, std::uint64_t max_bytes) {
+  std::uint64_t size = 0;
+  const FdCloser fd{OpenRegularFile(path, &size)};
+  CheckSize(path, size, max_bytes);
+  if (size == 0) return;
+  void* p = ::mmap(nullptr, static_cast<std::size_t>(size), PROT_READ, MAP_PRIVATE, fd.fd, 0);
+  if (p == MAP_FAILED) throw IoError(path + ": cannot map the file: " + ErrnoText());
+  data_ = static_cast<const std::uint8_t*>(p);
+  size_ = static_cast<std::size_t>(size);
+}
+
+MappedFile::~MappedFile() {
+  if (data_ != nullptr) ::munmap(const_cast<std::uint8_t*>(data_), size_);
 }
 
 void ByteReader::Need(std::size_t n, std::string_view what) const {

@@ -77,10 +77,42 @@ class AtomicOutputPath {
 // Writes `bytes` to `path` atomically (temporary sibling, fsync, rename). Throws IoError.
 void WriteFileAtomically(const std::string& path, std::string_view bytes);
 
-// Reads a whole file; throws IoError if it cannot be read and FormatError if it is larger
-// than `max_bytes` (checked before allocating).
+// Every read of a named file goes through OpenRegularFile: the path is opened without blocking
+// (O_NONBLOCK, so a FIFO with no writer or a device cannot hang the caller) and refused with
+// IoError "<path>: is a FIFO (named pipe), not a file" (or a folder, a device, a socket) unless
+// it is a regular file. Returns a descriptor in blocking mode; `size_bytes` receives the size.
+// The caller closes it.
+int OpenRegularFile(const std::string& path, std::uint64_t* size_bytes);
+
+// Checks, without opening (stat(2) never blocks), that `path` names a regular file: throws
+// IoError "<path>: no such file" or "<path>: is a FIFO (named pipe), not a file" (a folder, a
+// device, a socket). For front ends that classify a path before reading it.
+void CheckRegularFile(const std::string& path);
+
+// Reads a whole file; throws IoError if it cannot be read or is not a regular file, and
+// FormatError if it is larger than `max_bytes` (checked before allocating).
 std::vector<std::uint8_t> ReadFileBytes(const std::string& path, std::uint64_t max_bytes);
 std::string ReadFileText(const std::string& path, std::uint64_t max_bytes);
+
+// At most the first `max_bytes` of a file (fewer if it is shorter), for content detection.
+std::string ReadFileHead(const std::string& path, std::size_t max_bytes);
+
+// A regular file mapped read-only into memory. Pages are read from disk only when touched, so
+// a parser that stops at the first bad chunk of a huge (or sparse) file costs memory for what
+// it looked at, not for the file's size. Throws like ReadFileBytes (size cap included).
+class MappedFile {
+ public:
+  MappedFile(const std::string& path, std::uint64_t max_bytes);
+  MappedFile(const MappedFile&) = delete;
+  MappedFile& operator=(const MappedFile&) = delete;
+  ~MappedFile();
+  const std::uint8_t* data() const { return data_; }
+  std::size_t size() const { return size_; }
+
+ private:
+  const std::uint8_t* data_ = nullptr;
+  std::size_t size_ = 0;
+};
 
 // Little-endian cursor over a byte buffer that knows the file name and its position, so every
 // read past the end or unexpected value becomes a FormatError naming both.

@@ -7,6 +7,7 @@
 
 #include "brdf/core/csv.h"
 #include "brdf/core/error.h"
+#include "brdf/core/file_util.h"
 #include "brdf/core/gonio.h"
 #include "brdf/core/lighttools.h"
 #include "brdf/core/zemax.h"
@@ -75,12 +76,7 @@ ImportFormat ImportFormatFromName(std::string_view name) {
 }
 
 ImportFormat DetectImportFormat(const std::string& path) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (f == nullptr) throw IoError(path + ": cannot open: " + std::strerror(errno));
-  std::string head(64 * 1024, '\0');
-  const std::size_t got = std::fread(head.data(), 1, head.size(), f);
-  std::fclose(f);
-  head.resize(got);
+  const std::string head = ReadFileHead(path, 64 * 1024);  // refuses FIFOs, never blocks
   std::error_code ec;
   const std::uint64_t size = std::filesystem::file_size(path, ec);
   const std::string ext = Lower(std::filesystem::path(path).extension().string());
