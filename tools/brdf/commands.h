@@ -55,7 +55,7 @@ struct AtlasOptions {
   std::string out;                  // prefix: writes PREFIX.ktx2, .dds, .exr, .json
   std::string extrapolate;
   std::string exr_type = "float";
-  std::string exr_compression = "zip";
+  std::string exr_compression = "none";  // as convert's: one default for every EXR written
   int jobs = DefaultJobs();
   bool quiet = false;
   bool force = false;  // overwrite existing PREFIX.* files

@@ -39,12 +39,49 @@ CLI::Validator AnglePairValidator() {
       "THETA,PHI");
 }
 
+// A whole number of at least `min`, as typed: "0", "-1", "2.5", "abc" and "" are refused with
+// the value quoted (CLI::PositiveNumber printed its range as two 309-digit numbers).
+// Help texts of options that convert and atlas share, written once so they cannot drift.
+constexpr const char* kExrCompressionHelp =
+    "EXR compression: none or zip (zip: float EXRs of measured data about 20 % smaller, writing "
+    "takes about twice as long)";
+constexpr const char* kExrTypeHelp = "EXR pixel type: float, or half (faster to write, smaller)";
+
+CLI::Validator WholeNumberAtLeast(long long min) {
+  return CLI::Validator(
+      [min](std::string& text) -> std::string {
+        const std::string expected = "expected a whole number >= " + std::to_string(min);
+        try {
+          std::size_t used = 0;
+          const long long v = std::stoll(text, &used);
+          if (used == text.size() && v >= min) return {};
+        } catch (const std::exception&) {
+        }
+        return expected + ", got '" + text + "'";
+      },
+      "INT>=" + std::to_string(min));
+}
+
+// One line for every command-line error, like every other error of the tool: CLI11's message
+// (for "--jobs: ..." it already names the option) and where help is.
+std::string OneLineParseError(const CLI::App& app, const CLI::Error& e) {
+  std::string command = "brdf";
+  for (const CLI::App* sub : app.get_subcommands()) command += " " + sub->get_name();
+  std::string what = e.what();
+  for (char& c : what)
+    if (c == '\n') c = ' ';
+  return command + ": " + what + " (see '" + command + " --help')";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"brdf: measured reflectance to engine-ready lookup textures"};
   app.set_version_flag("--version", std::string("brdf-toolchain ") + brdf::SoftwareVersion());
   app.require_subcommand(1);
+  // Errors reported through app.exit() (none today: main prints them) look the same.
+  app.failure_message(
+      [](const CLI::App* a, const CLI::Error& e) { return OneLineParseError(*a, e) + "\n"; });
   int exit_code = 0;
 
   // brdf eval
@@ -186,22 +223,17 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   convert_cmd->add_option("--formats", convert.formats, "Comma-separated outputs to write")
       ->capture_default_str();
-  convert_cmd
-      ->add_option("--exr-type", convert.exr_type,
-                   "EXR pixel type: float, or half (faster to write, smaller)")
+  convert_cmd->add_option("--exr-type", convert.exr_type, kExrTypeHelp)
       ->capture_default_str()
       ->check(CLI::IsMember({"float", "half"}));
-  convert_cmd
-      ->add_option("--exr-compression", convert.exr_compression,
-                   "EXR compression: none, or zip (float EXRs of measured data: about 20 % "
-                   "smaller, and a conversion takes twice as long)")
+  convert_cmd->add_option("--exr-compression", convert.exr_compression, kExrCompressionHelp)
       ->capture_default_str()
       ->check(CLI::IsMember({"zip", "none"}));
   convert_cmd
       ->add_option("--jobs", convert.jobs,
                    "Inputs converted in parallel (default: hardware threads)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(WholeNumberAtLeast(1));
   convert_cmd->add_flag("--quiet", convert.quiet, "No progress bar");
   convert_cmd->add_flag("--force", convert.force,
                         "Overwrite outputs that already exist in --out (without it nothing is "
@@ -238,15 +270,15 @@ int main(int argc, char** argv) {
       ->add_option("--extrapolate", atlas.extrapolate,
                    "Grazing extrapolation P,L for inputs without their own; default 1,0.5")
       ->capture_default_str();
-  atlas_cmd->add_option("--exr-type", atlas.exr_type, "EXR pixel type: float or half")
+  atlas_cmd->add_option("--exr-type", atlas.exr_type, kExrTypeHelp)
       ->capture_default_str()
       ->check(CLI::IsMember({"float", "half"}));
-  atlas_cmd->add_option("--exr-compression", atlas.exr_compression, "EXR compression: zip or none")
+  atlas_cmd->add_option("--exr-compression", atlas.exr_compression, kExrCompressionHelp)
       ->capture_default_str()
       ->check(CLI::IsMember({"zip", "none"}));
   atlas_cmd->add_option("--jobs", atlas.jobs, "Inputs resampled in parallel")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(WholeNumberAtLeast(1));
   atlas_cmd->add_flag("--quiet", atlas.quiet, "No progress bar");
   atlas_cmd->add_flag("--force", atlas.force,
                       "Overwrite PREFIX.ktx2, .dds, .exr, .json if any already exists");
@@ -302,9 +334,7 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);
-    // One clear line, then where to look for help.
-    std::fprintf(stderr, "brdf: %s\nRun 'brdf --help' or 'brdf <command> --help' for usage.\n",
-                 e.what());
+    std::fprintf(stderr, "%s\n", OneLineParseError(app, e).c_str());
     return 2;
   } catch (const brdf::OutputExistsError& e) {
     // The overwrite rule of every writing command (brdf/core/file_util.h), in our words.
