@@ -19,12 +19,12 @@ TEST_F(CliErrors, EveryParseErrorIsOneShortLineNamingOptionAndValue) {
     std::vector<std::string> expected;
   };
   const std::vector<Case> cases = {
-      {"convert in --out o --jobs 0", {"brdf convert: --jobs", "whole number >= 1", "'0'"}},
+      {"convert in --out o --jobs 0", {"brdf: convert: --jobs", "whole number >= 1", "'0'"}},
       {"convert in --out o --jobs abc", {"--jobs", "'abc'"}},
       {"convert in --out o --jobs 2.5", {"--jobs", "'2.5'"}},
-      {"atlas in --out o --jobs -1", {"brdf atlas: --jobs", "'-1'"}},
+      {"atlas in --out o --jobs -1", {"brdf: atlas: --jobs", "'-1'"}},
       {"convert in --out o --exr-compression foo", {"--exr-compression", "foo"}},
-      {"eval", {"brdf eval", "file"}},
+      {"eval", {"brdf: eval: ", "file", "brdf eval --help"}},
       {"nonsense", {"brdf"}},
   };
   for (const Case& c : cases) {

@@ -65,12 +65,15 @@ CLI::Validator WholeNumberAtLeast(long long min) {
 // One line for every command-line error, like every other error of the tool: CLI11's message
 // (for "--jobs: ..." it already names the option) and where help is.
 std::string OneLineParseError(const CLI::App& app, const CLI::Error& e) {
-  std::string command = "brdf";
-  for (const CLI::App* sub : app.get_subcommands()) command += " " + sub->get_name();
+  std::string command = "brdf", where = "brdf: ";
+  for (const CLI::App* sub : app.get_subcommands()) {
+    command += " " + sub->get_name();
+    where += sub->get_name() + ": ";
+  }
   std::string what = e.what();
   for (char& c : what)
     if (c == '\n') c = ' ';
-  return command + ": " + what + " (see '" + command + " --help')";
+  return where + what + " (see '" + command + " --help')";
 }
 
 }  // namespace
