@@ -66,7 +66,7 @@ BENCHMARK_CAPTURE(BM_RglEval, paper_white, std::string("paper_white_rgb.bsdf"));
 BENCHMARK_CAPTURE(BM_RglEval, chm_mint, std::string("chm_mint_rgb.bsdf"));
 BENCHMARK_CAPTURE(BM_RglEval, cg_sunflower_64, std::string("cg_sunflower_rgb.bsdf"));
 
-// A virtual capture at the reference instrument's geometry (DESIGN §1): θin ∈ {0, 20, 40,
+// A virtual capture at the reference instrument's geometry (docs/design.md §1): θin ∈ {0, 20, 40,
 // 60}°, θout 0…75° and φout 0…359° at 1° steps: 4 × 76 × 360 = 109,440 evaluations.
 void BM_RglVirtualCapture(benchmark::State& state) {
   const RglBrdf brdf = RglBrdf::Load(kRglDir + "chm_mint_rgb.bsdf");

@@ -14,7 +14,7 @@ pkg_check_modules(HIDAPI REQUIRED IMPORTED_TARGET hidapi-libusb)
 find_package(OpenEXR 3 REQUIRED)
 find_package(PNG REQUIRED)
 find_package(OpenImageIO REQUIRED)
-# OpenImageIO 2.4's config names /usr/include/opencv4, which Debian does not ship (DESIGN §3).
+# OpenImageIO 2.4's config names /usr/include/opencv4, which Debian does not ship (docs/design.md §3).
 foreach(oiio_target OpenImageIO::OpenImageIO OpenImageIO::OpenImageIO_Util)
   if(TARGET ${oiio_target})
     get_target_property(oiio_includes ${oiio_target} INTERFACE_INCLUDE_DIRECTORIES)

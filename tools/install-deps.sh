@@ -20,6 +20,7 @@ packages=(
   clang libclang-rt-14-dev
   python3 python3-numpy python3-scipy
   nodejs
+  glslang-tools
 )
 
 # Debian's npm is a separate package; a Node.js that already ships npm (e.g. NodeSource's)

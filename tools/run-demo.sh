@@ -22,9 +22,9 @@ for material in $("$brdf" materials --json | /usr/bin/python3 -c 'import json,sy
     --out "$out/captures/$material.bpc" --seed 1 --force
 done
 echo "== converting captures to RGB9E5 lookup textures -> $out/luts"
-"$brdf" convert "$out/captures" --out "$out/luts"
+"$brdf" convert "$out/captures" --out "$out/luts" --force
 echo "== packing the library into one atlas -> $out/atlas"
 mkdir -p "$out/atlas"
-"$brdf" atlas "$out/captures" --out "$out/atlas/library"
+"$brdf" atlas "$out/captures" --out "$out/atlas/library" --force
 echo "== done: $(ls "$out/captures" | wc -l) captures in $out/captures, LUTs in $out/luts, atlas in $out/atlas"
 "$brdf" info "$out/luts/gold.ktx2"

@@ -12,19 +12,20 @@ namespace brdf::exporter::detail {
 
 ordered_json GridJson(const PackedVolume& payload, const std::vector<double>& theta_in_deg) {
   const double delta = theta_in_deg.size() >= 2 ? theta_in_deg[1] - theta_in_deg[0] : 0.0;
-  return ordered_json{{"frame",
-                       "specular frame of theta_in (DESIGN 5): omega_d = S(theta_in) omega_out, "
-                       "S = [[-cos, 0, -sin], [0, -1, 0], [-sin, 0, cos]]; phi_in = 0"},
-                      {"width", payload.width},
-                      {"height", payload.height},
-                      {"slices", payload.depth},
-                      {"phi_d_deg", {{"first", 0}, {"step", 1}, {"count", 361}}},
-                      {"theta_d_deg", {{"first", 0}, {"step", 1}, {"count", 181}}},
-                      {"delta_in_deg", delta},
-                      {"seam", "column 360 repeats column 0 (phi_d = 360 deg = 0 deg)"},
-                      {"below_horizon",
-                       "edge extension: theta_out > 90 deg holds the value at theta_out = 90 deg "
-                       "with the same phi_out"}};
+  return ordered_json{
+      {"frame",
+       "specular frame of theta_in (docs/design.md §5): omega_d = S(theta_in) omega_out, "
+       "S = [[-cos, 0, -sin], [0, -1, 0], [-sin, 0, cos]]; phi_in = 0"},
+      {"width", payload.width},
+      {"height", payload.height},
+      {"slices", payload.depth},
+      {"phi_d_deg", {{"first", 0}, {"step", 1}, {"count", 361}}},
+      {"theta_d_deg", {{"first", 0}, {"step", 1}, {"count", 181}}},
+      {"delta_in_deg", delta},
+      {"seam", "column 360 repeats column 0 (phi_d = 360 deg = 0 deg)"},
+      {"below_horizon",
+       "edge extension: theta_out > 90 deg holds the value at theta_out = 90 deg "
+       "with the same phi_out"}};
 }
 
 ordered_json TexelConventionJson(const std::vector<double>& theta_in_deg) {

@@ -47,6 +47,7 @@ std::string GlslFloat(double v) {
 std::string ShaderSnippetGlsl(double delta_in_deg, int slices) {
   return fmt::format(
       "// uniform sampler3D lut: RGB9E5, linear filtering, CLAMP_TO_EDGE on s, t and r\n"
+      "precision highp sampler3D;  // GLSL ES has no default precision for sampler3D\n"
       "// w_d: view direction in the specular frame of theta_in, w_d = S(theta_in) * w_out\n"
       "vec3 BrdfLut(sampler3D lut, float theta_in_deg, vec3 w_d) {{\n"
       "  float theta_d = degrees(acos(clamp(w_d.z, -1.0, 1.0)));\n"

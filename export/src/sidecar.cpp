@@ -1,5 +1,8 @@
 #include "brdf/exporter/sidecar.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include <fmt/format.h>
 
 #include <nlohmann/json.hpp>
@@ -26,7 +29,8 @@ std::string SidecarJson(const PackedVolume& payload, const std::vector<double>& 
   if (metadata.extrapolation) {
     const ExtrapolationInfo& e = *metadata.extrapolation;
     j["extrapolation"] = {
-        {"method", "restricted quadratic Bezier beyond the last measured theta_out (DESIGN 6)"},
+        {"method",
+         "restricted quadratic Bezier beyond the last measured theta_out (docs/design.md §6)"},
         {"p", e.p},
         {"l", e.l},
         {"theta_b_deg", e.theta_b_deg}};
@@ -68,6 +72,23 @@ SidecarInfo ParseSidecarJson(std::string_view json_text, const std::string& file
         file, "member 'grid.slices'",
         fmt::format("the number of theta_in_deg values ({})", info.theta_in_deg.size()),
         std::to_string(info.slices));
+  // θin must be k·Δin (docs/design.md §5): the shader addresses slice k as θin/Δin, so a list
+  // that is not 0, Δ, 2Δ, ... would put every value at the wrong incidence.
+  {
+    const std::vector<double>& t = info.theta_in_deg;
+    const double delta = t.size() >= 2 ? t[1] - t[0] : 0.0;
+    bool ok = !t.empty() && std::isfinite(delta) && (t.size() < 2 || delta > 0.0);
+    for (std::size_t k = 0; ok && k < t.size(); ++k)
+      ok = std::isfinite(t[k]) && std::abs(t[k] - static_cast<double>(k) * delta) <= 1e-3;
+    if (ok && grid.contains("delta_in_deg") && t.size() >= 2)
+      ok = std::abs(g.Number("delta_in_deg") - delta) <= 1e-3;
+    if (!ok) {
+      std::string got;
+      for (const double v : t) got += (got.empty() ? "" : ", ") + fmt::format("{:g}", v);
+      throw FormatError(file, "member 'theta_in_deg'",
+                        "k * delta_in_deg for k = 0, 1, ... (e.g. 0, 20, 40, 60)", "[" + got + "]");
+    }
+  }
   if (j.contains("extrapolation") && !j["extrapolation"].is_null()) {
     detail::JsonFields e(f.Object("extrapolation"), file, "extrapolation.");
     info.extrapolation = ExtrapolationInfo{e.Number("p"), e.Number("l"), e.Number("theta_b_deg")};
@@ -81,6 +102,14 @@ SidecarInfo ParseSidecarJson(std::string_view json_text, const std::string& file
   info.tool_version = t.String("version");
   detail::JsonFields p(f.Object("payload"), file, "payload.");
   info.payload_bytes = p.UInt64("bytes");
+  const std::uint64_t texels = static_cast<std::uint64_t>(std::max(info.width, 0)) *
+                               static_cast<std::uint64_t>(std::max(info.height, 0)) *
+                               static_cast<std::uint64_t>(std::max(info.slices, 0));
+  if (info.payload_bytes != texels * 4)
+    throw FormatError(file, "member 'payload.bytes'",
+                      fmt::format("width * height * slices * 4 = {} * {} * {} * 4 = {}", info.width,
+                                  info.height, info.slices, texels * 4),
+                      std::to_string(info.payload_bytes));
   detail::JsonFields c(p.Object("checksum"), file, "payload.checksum.");
   if (c.String("algorithm") != "crc32")
     throw FormatError(file, "member 'payload.checksum.algorithm'", "\"crc32\"",

@@ -51,7 +51,7 @@ void FinishLoadedTexture(LoadedTexture& t) {
     t.theta_in_deg = m.theta_in_deg;
     t.theta_in_from_metadata = true;
   } else if (t.theta_in_deg.size() != static_cast<std::size_t>(t.volume.depth)) {
-    // No metadata: DESIGN §5's reference spacing, θin,k = k·20°.
+    // No metadata: docs/design.md §5's reference spacing, θin,k = k·20°.
     t.theta_in_deg.clear();
     for (int k = 0; k < t.volume.depth; ++k) t.theta_in_deg.push_back(20.0 * k);
     t.theta_in_from_metadata = false;

@@ -14,6 +14,7 @@
 #include "brdf/core/bpc.h"
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
+#include "test_support.h"
 
 namespace brdf {
 namespace {
@@ -147,10 +148,7 @@ Json RunPythonReader(const std::vector<std::string>& paths) {
 }
 
 TEST(BpcPythonReader, AgreesWithTheCppReaderOnIntactCutAndDamagedFiles) {
-  const fs::path dir =
-      fs::temp_directory_path() / ("brdf_bpc_python_" + std::to_string(::getpid()));
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = brdf::test::ScopedTempDir::MakeTempDir("bpc-python");
   struct Cleanup {
     fs::path dir;
     ~Cleanup() { fs::remove_all(dir); }

@@ -15,6 +15,7 @@
 
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
+#include "test_support.h"
 
 namespace brdf {
 namespace {
@@ -135,11 +136,7 @@ void ExpectSameSlice(const Slice& want, const Slice& got) {
 class TempDir {
  public:
   explicit TempDir(const std::string& name)
-      : path_(fs::temp_directory_path() /
-              ("brdf_bpc_test_" + name + "_" + std::to_string(::getpid()))) {
-    fs::remove_all(path_);
-    fs::create_directories(path_);
-  }
+      : path_(brdf::test::ScopedTempDir::MakeTempDir("bpc-" + name)) {}
   ~TempDir() { fs::remove_all(path_); }
   std::string File(const std::string& name) const { return (path_ / name).string(); }
   std::vector<std::string> Entries() const {

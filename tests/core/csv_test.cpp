@@ -10,6 +10,7 @@
 #include "brdf/core/file_util.h"
 #include "brdf/core/geometry.h"
 #include "brdf/core/models.h"
+#include "test_support.h"
 
 namespace brdf {
 namespace {
@@ -58,9 +59,7 @@ Measurement WardCapture(bool with_sigma) {
 }
 
 TEST(Csv, RoundTripIsBitExact) {
-  const fs::path dir = fs::temp_directory_path() / "brdf_csv_test";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = brdf::test::NewTempDir("csv");
   for (bool with_sigma : {false, true}) {
     const Measurement m = WardCapture(with_sigma);
     const std::string path = (dir / "ward.csv").string();

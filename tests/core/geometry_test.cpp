@@ -32,8 +32,8 @@ TEST(SpecularFrame, IsItsOwnInverseAndOrthogonal) {
 }
 
 TEST(SpecularFrame, MatchesDesignMatrixEntries) {
-  // DESIGN §5: S(θm) = [[−cosθm, 0, −sinθm], [0, −1, 0], [−sinθm, 0, cosθm]], applied to the
-  // basis vectors gives its columns.
+  // docs/design.md §5: S(θm) = [[−cosθm, 0, −sinθm], [0, −1, 0], [−sinθm, 0, cosθm]], applied to
+  // the basis vectors gives its columns.
   const double tm = DegToRad(20.0);
   const auto frame = SpecularFrame::FromThetaInRad(tm);
   const Vec3 cx = frame.Apply({1, 0, 0}), cy = frame.Apply({0, 1, 0}), cz = frame.Apply({0, 0, 1});

@@ -12,12 +12,14 @@
 
 #include "brdf/core/error.h"
 #include "brdf/core/geometry.h"
+#include "test_support.h"
 
 namespace brdf {
 namespace {
 
-const std::string kSharedTable =
-    std::string(BRDF_SHARED_DATA_DIR) + "/goniometer-csv/test_brdf_viewer_2D_data.csv";
+std::string SharedTable() {
+  return brdf::test::DataPath("goniometer-csv/test_brdf_viewer_2D_data.csv");
+}
 
 // The shared table parsed here with getline/strtod, independently of the reader.
 struct RawRow {
@@ -25,7 +27,7 @@ struct RawRow {
   std::vector<double> values;
 };
 std::vector<RawRow> RawRows() {
-  std::ifstream in(kSharedTable);
+  std::ifstream in(SharedTable());
   std::string line;
   std::getline(in, line);  // header
   std::vector<RawRow> rows;
@@ -82,7 +84,7 @@ TEST(Cie, FlatSpectrumGivesExactlyNeutralRgb) {
 }
 
 TEST(Gonio, ReadsTheSharedTableWithItsOwnShape) {
-  const GonioTable t = ReadGonioTable(kSharedTable);
+  const GonioTable t = ReadGonioTable(SharedTable());
   ASSERT_EQ(t.wavelengths_nm.size(), 35u);
   EXPECT_EQ(t.wavelengths_nm.front(), 390.0);
   EXPECT_EQ(t.wavelengths_nm.back(), 730.0);
@@ -100,7 +102,7 @@ TEST(Gonio, ReadsTheSharedTableWithItsOwnShape) {
 // The file's numbers at its own angles: every sample's RGB is the file row's reflectance
 // factor / π taken through the documented colour conversion, recomputed here step by step.
 TEST(Gonio, InPlaneValuesReproduceTheFileAtItsOwnAngles) {
-  const Measurement m = LoadGonioTable(kSharedTable);
+  const Measurement m = LoadGonioTable(SharedTable());
   const std::vector<RawRow> raw = RawRows();
   std::vector<double> nm;
   for (int w = 390; w <= 730; w += 10) nm.push_back(w);
@@ -140,14 +142,14 @@ TEST(Gonio, InPlaneValuesReproduceTheFileAtItsOwnAngles) {
 }
 
 TEST(Gonio, SpecularPeakOfEachIncidenceLandsOnTheMirrorDirection) {
-  const Measurement m = LoadGonioTable(kSharedTable);
+  const Measurement m = LoadGonioTable(SharedTable());
   for (const Slice& s : m.slices) {
     const Sample* peak = &s.samples.front();
     for (const Sample& smp : s.samples)
       if (smp.rgb[1] > peak->rgb[1]) peak = &smp;
     EXPECT_EQ(peak->theta_out_deg, static_cast<float>(s.theta_in_deg)) << s.theta_in_deg;
     EXPECT_EQ(peak->phi_out_deg, 180.0f) << s.theta_in_deg;
-    // The mirror direction of DESIGN §4: (θin, φin + 180°).
+    // The mirror direction of docs/design.md §4: (θin, φin + 180°).
     const Vec3 w = SphericalDirectionDeg(peak->theta_out_deg, peak->phi_out_deg);
     const Vec3 mirror = Reflect(SphericalDirectionDeg(s.theta_in_deg, 0.0));
     EXPECT_NEAR(Dot(w, mirror), 1.0, 1e-6);
@@ -155,7 +157,7 @@ TEST(Gonio, SpecularPeakOfEachIncidenceLandsOnTheMirrorDirection) {
 }
 
 TEST(Gonio, RowsShadowedByTheSourceAreFlaggedInvalid) {
-  const Measurement m = LoadGonioTable(kSharedTable);
+  const Measurement m = LoadGonioTable(SharedTable());
   std::size_t zero_rows = 0;
   for (const RawRow& r : RawRows()) {
     bool all_zero = true;

@@ -11,21 +11,19 @@
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
 #include "brdf/core/lighttools.h"
+#include "test_support.h"
 
 namespace brdf {
 namespace {
 
 namespace fs = std::filesystem;
 
-const std::string kShared = BRDF_SHARED_DATA_DIR;
-const std::string kZemax = kShared + "/zemax-imaging-sphere/test_13_planesymmetric_btdf_zemax.bsdf";
-const std::string kGonio = kShared + "/goniometer-csv/test_brdf_viewer_2D_data.csv";
-
-fs::path TempDir() {
-  const fs::path dir = fs::temp_directory_path() / "brdf_importers_test";
-  fs::create_directories(dir);
-  return dir;
+std::string Zemax() {
+  return brdf::test::DataPath("zemax-imaging-sphere/test_13_planesymmetric_btdf_zemax.bsdf");
 }
+std::string Gonio() { return brdf::test::DataPath("goniometer-csv/test_brdf_viewer_2D_data.csv"); }
+
+fs::path TempDir() { return brdf::test::NewTempDir("importers"); }
 
 TEST(ImportFormat, NamesRoundTrip) {
   for (ImportFormat f :
@@ -39,9 +37,10 @@ TEST(ImportFormat, NamesRoundTrip) {
 
 TEST(DetectImportFormat, RecognisesEachFormatByContent) {
   const fs::path dir = TempDir();
-  EXPECT_EQ(DetectImportFormat(kZemax), ImportFormat::kZemax);
-  EXPECT_EQ(DetectImportFormat(kGonio), ImportFormat::kGonio);
-  EXPECT_EQ(DetectImportFormat(kShared + "/rgl/paper_white_rgb.bsdf"), ImportFormat::kRgl);
+  EXPECT_EQ(DetectImportFormat(Zemax()), ImportFormat::kZemax);
+  EXPECT_EQ(DetectImportFormat(Gonio()), ImportFormat::kGonio);
+  EXPECT_EQ(DetectImportFormat(brdf::test::DataPath("rgl/paper_white_rgb.bsdf")),
+            ImportFormat::kRgl);
 
   LightToolsBsdf lt;
   lt.scatter_azimuth_deg = {0};
@@ -74,17 +73,17 @@ TEST(DetectImportFormat, RecognisesEachFormatByContent) {
 }
 
 TEST(ImportFile, ReadsEachPointCloudFormat) {
-  const Measurement gonio = ImportFile(kGonio);
+  const Measurement gonio = ImportFile(Gonio());
   EXPECT_EQ(gonio.slices.size(), 5u);
   EXPECT_EQ(gonio.metadata.extra.at("source_format"), "gonio");
-  const Measurement zemax = ImportFile(kZemax, ImportFormat::kAuto, ImportOptions{true});
+  const Measurement zemax = ImportFile(Zemax(), ImportFormat::kAuto, ImportOptions{true});
   EXPECT_EQ(zemax.slices.size(), 13u);
-  EXPECT_THROW(ImportFile(kZemax), FormatError);  // BTDF without allow_btdf
+  EXPECT_THROW(ImportFile(Zemax()), FormatError);  // BTDF without allow_btdf
 }
 
 TEST(ImportFile, EvaluableFormatsPointToVirtualCapture) {
   try {
-    ImportFile(kShared + "/rgl/paper_white_rgb.bsdf");
+    ImportFile(brdf::test::DataPath("rgl/paper_white_rgb.bsdf"));
     FAIL();
   } catch (const InvalidArgument& e) {
     // What to do is a structured remedy the tool words; the library names no command line.

@@ -9,18 +9,14 @@
 #include "brdf/core/error.h"
 #include "brdf/core/geometry.h"
 #include "brdf/core/models.h"
+#include "test_support.h"
 
 namespace brdf {
 namespace {
 
 namespace fs = std::filesystem;
 
-fs::path TempDir(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / ("brdf_lighttools_test_" + name);
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  return dir;
-}
+fs::path TempDir(const std::string& name) { return brdf::test::NewTempDir("lighttools-" + name); }
 
 Material GgxMaterial() {
   Material mat;

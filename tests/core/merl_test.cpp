@@ -22,21 +22,17 @@
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
 #include "brdf/core/sha256.h"
+#include "test_support.h"
 
 namespace brdf {
 namespace {
 
 namespace fs = std::filesystem;
 
-const std::string kShaTable =
-    std::string(BRDF_SHARED_DATA_DIR) + "/reference/merl_binary_sha256.tsv";
+std::string ShaTable() { return brdf::test::DataPath("reference/merl_binary_sha256.tsv"); }
 const std::string kBrokenDir = std::string(BRDF_SOURCE_DIR) + "/tests/data/broken/merl/";
 
-fs::path TempDir() {
-  const fs::path dir = fs::temp_directory_path() / ("brdf_merl_test_" + std::to_string(::getpid()));
-  fs::create_directories(dir);
-  return dir;
-}
+fs::path TempDir() { return brdf::test::NewTempDir("merl"); }
 
 // ---------------------------------------------------------------------------------------
 // SHA-256: the FIPS 180-2 appendix examples and the NIST short/long message values.
@@ -440,7 +436,7 @@ TEST(MerlBrokenFiles, EachFailsWithAClearFormatError) {
 // Identification by SHA-256
 
 TEST(MerlDigests, ReadsThePublishedTable) {
-  const std::vector<MerlDigest> table = ReadMerlDigestTable(kShaTable);
+  const std::vector<MerlDigest> table = ReadMerlDigestTable(ShaTable());
   ASSERT_EQ(table.size(), 100u);
   EXPECT_EQ(table[0].material, "alum-bronze");
   EXPECT_EQ(table[0].size_bytes, kMerlFileBytes);
@@ -482,7 +478,7 @@ TEST(MerlDigests, IdentifiesAFileListedInTheTableAndNoOtherOne) {
   ASSERT_EQ(sha.size(), 64u);
   EXPECT_EQ(Sha256HexOfFile(merl), sha);
   // A synthetic file is none of the 100 published ones.
-  EXPECT_EQ(IdentifyMerlFile(merl, kShaTable), std::nullopt);
+  EXPECT_EQ(IdentifyMerlFile(merl, ShaTable()), std::nullopt);
   // Listed under a name, it is recognised; the table may come from the environment.
   const std::string table = (dir / "table.tsv").string();
   WriteFileAtomically(table, "# material\tsize_bytes\tsha256\nsynthetic-grey\t" +

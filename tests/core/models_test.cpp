@@ -1,4 +1,4 @@
-// Physics checks of the analytic models of DESIGN §9: reciprocity, energy conservation by
+// Physics checks of the analytic models of docs/design.md §9: reciprocity, energy conservation by
 // numerical integration, and values against formulas written out independently here.
 #include "brdf/core/models.h"
 
@@ -96,7 +96,7 @@ TEST(Models, LafortuneLobeIsNormalisedAtNormalIncidence) {
 }
 
 TEST(Models, GgxMatchesTheTanSquaredFormOfDesign) {
-  // DESIGN §9 written literally: D = α² / (π cos⁴θh (α² + tan²θh)²),
+  // docs/design.md §9 written literally: D = α² / (π cos⁴θh (α² + tan²θh)²),
   // G1 = 2 / (1 + √(1 + α² tan²θ)), F = f0 + (1 − f0)(1 − v·h)⁵.
   const double alpha = 0.3, f0 = 0.04, kd = 0.25;
   const Material m = Make(Model::kGgx, {kd, kd, kd}, {f0, f0, f0}, {alpha, alpha, alpha});

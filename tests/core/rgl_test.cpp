@@ -14,18 +14,19 @@
 #include "brdf/core/brdf_source.h"
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
+#include "test_support.h"
 
 namespace brdf {
 namespace {
 
 namespace fs = std::filesystem;
 
-const std::string kRglDir = std::string(BRDF_SHARED_DATA_DIR) + "/rgl/";
+std::string RglDir() { return brdf::test::DataPath("rgl") + "/"; }
 const std::string kBrokenDir = std::string(BRDF_SOURCE_DIR) + "/tests/data/broken/rgl/";
 
 std::vector<std::string> RglFiles() {
   std::vector<std::string> names;
-  for (const auto& e : fs::directory_iterator(kRglDir))
+  for (const auto& e : fs::directory_iterator(RglDir()))
     if (e.path().extension() == ".bsdf") names.push_back(e.path().filename().string());
   std::sort(names.begin(), names.end());
   return names;
@@ -145,7 +146,7 @@ TEST(TensorFile, RealFilesHaveTheFieldsTheReadmeDescribes) {
   ASSERT_EQ(files.size(), 18u);
   for (const std::string& name : files) {
     SCOPED_TRACE(name);
-    const TensorFile tf = TensorFile::Read(kRglDir + name);
+    const TensorFile tf = TensorFile::Read(RglDir() + name);
     EXPECT_EQ(tf.Require("phi_i").shape, (std::vector<std::uint64_t>{1}));
     EXPECT_EQ(tf.Require("theta_i").shape, (std::vector<std::uint64_t>{8}));
     EXPECT_EQ(tf.Require("sigma").shape, (std::vector<std::uint64_t>{2, 128}));
@@ -166,7 +167,7 @@ TEST(TensorFile, EncodingTheParsedFieldsReproducesEveryRealFileByteForByte) {
   // writes the same layout must reproduce them exactly (an outside check of both directions).
   for (const std::string& name : RglFiles()) {
     SCOPED_TRACE(name);
-    const std::vector<std::uint8_t> original = ReadFileBytes(kRglDir + name, kMaxRglFileBytes);
+    const std::vector<std::uint8_t> original = ReadFileBytes(RglDir() + name, kMaxRglFileBytes);
     const TensorFile tf = TensorFile::Parse(original, name);
     std::vector<TensorFieldData> fields;
     for (const TensorField& f : tf.fields()) {
@@ -304,7 +305,7 @@ TEST(RglBrdf, EvaluatesAnAnisotropicTableWithAbsoluteHalfVectorAzimuth) {
 }
 
 TEST(RglBrdf, IsZeroBelowTheHorizonAndForNonFiniteDirections) {
-  const RglBrdf brdf = RglBrdf::Load(kRglDir + "paper_white_rgb.bsdf");
+  const RglBrdf brdf = RglBrdf::Load(RglDir() + "paper_white_rgb.bsdf");
   const Vec3 up = SphericalDirectionDeg(30, 0);
   EXPECT_EQ(brdf.Eval(up, {0.3, 0.0, -0.95}), (Rgb{0, 0, 0}));
   EXPECT_EQ(brdf.Eval({0.3, 0.0, -0.95}, up), (Rgb{0, 0, 0}));
@@ -320,7 +321,7 @@ TEST(RglFiles, EveryFileLoadsWithItsOwnDescriptionAndGrids) {
   std::map<std::string, int> rgb_res;
   for (const std::string& name : RglFiles()) {
     SCOPED_TRACE(name);
-    const RglBrdf brdf = RglBrdf::Load(kRglDir + name);
+    const RglBrdf brdf = RglBrdf::Load(RglDir() + name);
     EXPECT_EQ(brdf.Name(), name);
     EXPECT_TRUE(brdf.info().isotropic);
     EXPECT_TRUE(brdf.info().jacobian);
@@ -328,7 +329,7 @@ TEST(RglFiles, EveryFileLoadsWithItsOwnDescriptionAndGrids) {
     EXPECT_FALSE(brdf.info().description.empty());
     rgb_res[name] = brdf.info().rgb_res;
   }
-  EXPECT_EQ(RglBrdf::Load(kRglDir + "paper_white_rgb.bsdf").info().description,
+  EXPECT_EQ(RglBrdf::Load(RglDir() + "paper_white_rgb.bsdf").info().description,
             "White A4 paper (160 gsm)");
   EXPECT_EQ(rgb_res["cg_sunflower_rgb.bsdf"], 64);
   EXPECT_EQ(rgb_res["irid_flake_paint1_fine_rgb.bsdf"], 48);
@@ -337,7 +338,7 @@ TEST(RglFiles, EveryFileLoadsWithItsOwnDescriptionAndGrids) {
 
 TEST(RglFiles, PaperIsNearlyLambertianWithAlbedoAroundNinetyPercent) {
   // White 160 gsm paper: f_r ≈ ρ/π with ρ ≈ 0.85–0.95 over moderate angles.
-  const RglBrdf brdf = RglBrdf::Load(kRglDir + "paper_white_rgb.bsdf");
+  const RglBrdf brdf = RglBrdf::Load(RglDir() + "paper_white_rgb.bsdf");
   for (const Vec3& wi : CosineDirections(30, 50, 7))
     for (const Vec3& wo : CosineDirections(30, 50, 8)) {
       const double f = Luminance(brdf.Eval(wi, wo));
@@ -348,7 +349,7 @@ TEST(RglFiles, PaperIsNearlyLambertianWithAlbedoAroundNinetyPercent) {
 
 TEST(RglFiles, ValuesDependOnlyOnRelativeAzimuth) {
   // Isotropic files: rotating both directions about the normal changes nothing.
-  const RglBrdf brdf = RglBrdf::Load(kRglDir + "chm_mint_rgb.bsdf");
+  const RglBrdf brdf = RglBrdf::Load(RglDir() + "chm_mint_rgb.bsdf");
   const auto wis = CosineDirections(200, 80, 9), wos = CosineDirections(200, 80, 10);
   for (std::size_t k = 0; k < wis.size(); ++k) {
     const double a = 0.1 + 0.03 * static_cast<double>(k);
@@ -362,7 +363,7 @@ TEST(RglFiles, ValuesDependOnlyOnRelativeAzimuth) {
 }
 
 TEST(RglFiles, EvalIsEvalCosineOverCosThetaOut) {
-  const RglBrdf brdf = RglBrdf::Load(kRglDir + "cc_ibiza_sunset_rgb.bsdf");
+  const RglBrdf brdf = RglBrdf::Load(RglDir() + "cc_ibiza_sunset_rgb.bsdf");
   const auto wis = CosineDirections(100, 85, 11), wos = CosineDirections(100, 85, 12);
   for (std::size_t k = 0; k < wis.size(); ++k) {
     const Rgb f = brdf.Eval(wis[k], wos[k]), fc = brdf.EvalCosine(wis[k], wos[k]);
@@ -383,7 +384,7 @@ TEST(RglFiles, AreReciprocalWithinTheDataAccuracy) {
   const auto as = CosineDirections(20000, 75, 13), bs = CosineDirections(20000, 75, 14);
   for (const std::string& name : RglFiles()) {
     SCOPED_TRACE(name);
-    const RglBrdf brdf = RglBrdf::Load(kRglDir + name);
+    const RglBrdf brdf = RglBrdf::Load(RglDir() + name);
     std::vector<double> rel;
     for (std::size_t k = 0; k < as.size(); ++k) {
       const double f = Luminance(brdf.Eval(as[k], bs[k])), g = Luminance(brdf.Eval(bs[k], as[k]));
@@ -437,7 +438,7 @@ TEST(RglFiles, AlbedoQuadratureIntegratesAConstantToTheHemisphereSolidAngle) {
 TEST(RglFiles, DirectionalAlbedoIsAtMostOneWithinTheDataAccuracy) {
   for (const std::string& name : RglFiles()) {
     SCOPED_TRACE(name);
-    const RglBrdf brdf = RglBrdf::Load(kRglDir + name);
+    const RglBrdf brdf = RglBrdf::Load(RglDir() + name);
     for (const double theta : {0.0, 15.0, 30.0, 45.0, 60.0, 75.0}) {
       const Rgb a = Albedo(brdf, theta, 160);
       for (int c = 0; c < 3; ++c) {
@@ -456,7 +457,7 @@ TEST(RglFiles, DirectionalAlbedoIsAtMostOneWithinTheDataAccuracy) {
 TEST(RglFiles, GlossyFilmsPeakAtTheMirrorDirection) {
   std::set<std::string> glossy;
   for (const std::string& name : RglFiles()) {
-    const TensorFile tf = TensorFile::Read(kRglDir + name);
+    const TensorFile tf = TensorFile::Read(RglDir() + name);
     const std::vector<float> ndf = tf.Float32(tf.Require("ndf"));
     if (*std::max_element(ndf.begin(), ndf.end()) > 100.0f) glossy.insert(name);
   }
@@ -468,7 +469,7 @@ TEST(RglFiles, GlossyFilmsPeakAtTheMirrorDirection) {
   const auto outs = CosineDirections(3000, 85, 15);
   for (const std::string& name : glossy) {
     SCOPED_TRACE(name);
-    const RglBrdf brdf = RglBrdf::Load(kRglDir + name);
+    const RglBrdf brdf = RglBrdf::Load(RglDir() + name);
     for (const double theta : {10.0, 30.0, 50.0, 70.0}) {
       const Vec3 wi = SphericalDirectionDeg(theta, 0), mirror = SphericalDirectionDeg(theta, 180);
       const double peak = Luminance(brdf.Eval(wi, mirror));
@@ -483,8 +484,8 @@ TEST(RglFiles, GlossyFilmsPeakAtTheMirrorDirection) {
 }
 
 TEST(RglFiles, OpenBrdfSourceDispatchesOnTheBsdfExtension) {
-  const std::unique_ptr<BrdfSource> source = OpenBrdfSource(kRglDir + "chm_orange_rgb.bsdf");
-  const RglBrdf direct = RglBrdf::Load(kRglDir + "chm_orange_rgb.bsdf");
+  const std::unique_ptr<BrdfSource> source = OpenBrdfSource(RglDir() + "chm_orange_rgb.bsdf");
+  const RglBrdf direct = RglBrdf::Load(RglDir() + "chm_orange_rgb.bsdf");
   EXPECT_EQ(source->Name(), "chm_orange_rgb.bsdf");
   const Vec3 wi = SphericalDirectionDeg(35, 10), wo = SphericalDirectionDeg(33, 188);
   EXPECT_EQ(source->Eval(wi, wo), direct.Eval(wi, wo));

@@ -12,6 +12,7 @@
 #include "brdf/core/file_util.h"
 #include "commands.h"
 #include "device_test_support.h"
+#include "test_support.h"
 
 namespace brdf::device {
 namespace {
@@ -25,13 +26,7 @@ struct ToolRun {
 
 class CaptureCli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("brdf_capture_cli_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
+  void SetUp() override { dir_ = brdf::test::ScopedTempDir::MakeTempDir("capture-cli"); }
   void TearDown() override { fs::remove_all(dir_); }
 
   ToolRun Run(const std::string& args) const {
@@ -148,7 +143,7 @@ TEST_F(CaptureCli, InterruptedCaptureRecordsItsPlanSoConvertNamesTheMissingSlice
     ASSERT_EQ(info.exit_code, 1) << info.err;
     EXPECT_NE(info.out.find("\"theta_in_deg\": \"" + c.key + "\""), std::string::npos) << info.out;
 
-    const ToolRun convert = Run("convert " + out + " --out " + Path("lut") + " --quiet");
+    const ToolRun convert = Run("convert " + out + " --out " + Path("lut") + " --quiet --force");
     EXPECT_EQ(convert.exit_code, 1);
     EXPECT_NE(convert.out.find("converted 0 of 1"), std::string::npos) << convert.out;
     EXPECT_NE(convert.out.find(c.missing), std::string::npos) << convert.out;
@@ -159,7 +154,7 @@ TEST_F(CaptureCli, InterruptedCaptureRecordsItsPlanSoConvertNamesTheMissingSlice
     ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
     EXPECT_EQ(ReadBpc(out).measurement.metadata.extra.at("theta_in_deg"), c.key);
     const ToolRun done =
-        Run("convert " + out + " --out " + Path("lut") + " --formats ktx2 --quiet");
+        Run("convert " + out + " --out " + Path("lut") + " --formats ktx2 --quiet --force");
     EXPECT_EQ(done.exit_code, 0) << done.out << done.err;
   }
 }

@@ -11,6 +11,7 @@
 #include "brdf/core/bpc.h"
 #include "brdf/core/error.h"
 #include "device_test_support.h"
+#include "test_support.h"
 
 namespace brdf::device {
 namespace {
@@ -21,13 +22,7 @@ using testing::LibraryMaterial;
 
 class CaptureFile : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("brdf_capture_file_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
+  void SetUp() override { dir_ = brdf::test::ScopedTempDir::MakeTempDir("capture-file"); }
   void TearDown() override { fs::remove_all(dir_); }
 
   // Captures `theta_in` into `path` (created, or resumed when `resume`), the way

@@ -94,7 +94,7 @@ TEST(SimulatedFirmware, ReportsTheReferenceInstrumentGeometry) {
   EXPECT_EQ(id.protocol_major, kProtocolMajor);
   host.Send(MessageType::kGetGeometry);
   const GeometryInfo g = DecodeGeometry(host.Expect(MessageType::kGeometry).payload);
-  // DESIGN §1: θin ∈ {0, 20, 40, 60}°, θout 0–75° and φout 0–359° at 1°.
+  // docs/design.md §1: θin ∈ {0, 20, 40, 60}°, θout 0–75° and φout 0–359° at 1°.
   EXPECT_EQ(g.theta_in_deg, (std::vector<float>{0, 20, 40, 60}));
   EXPECT_EQ(g.rows, 76);
   EXPECT_EQ(g.columns, 360);

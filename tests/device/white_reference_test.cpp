@@ -9,6 +9,7 @@
 #include <string>
 
 #include "brdf/core/models.h"
+#include "test_support.h"
 
 namespace brdf::device {
 namespace {
@@ -42,7 +43,7 @@ BandMean MeanOverBand(const std::string& path, double lo, double hi) {
 }
 
 TEST(SpectralonWhiteReference, IsTheBandMeanOfTheCertificate) {
-  const std::string path = std::string(BRDF_SHARED_DATA_DIR) + "/spectralon/Spectralon_Num4.txt";
+  const std::string path = brdf::test::DataPath("spectralon/Spectralon_Num4.txt");
   const double bands[3][2] = {{600, 700}, {500, 600}, {400, 500}};  // R, G, B
   const WhiteReference& w = SpectralonWhiteReference();
   for (int c = 0; c < 3; ++c) {

@@ -1,5 +1,6 @@
 // LUTs for the exporter tests, built directly (no resampling): analytic materials evaluated in
-// the specular frame of DESIGN §5, and synthetic patterns whose every texel is identifiable.
+// the specular frame of docs/design.md §5, and synthetic patterns whose every texel is
+// identifiable.
 #pragma once
 
 #include <algorithm>
@@ -15,12 +16,13 @@
 #include "brdf/core/geometry.h"
 #include "brdf/core/lut.h"
 #include "brdf/core/models.h"
+#include "test_support.h"
 
 namespace brdf::test {
 
 // Texel (i, j, k) holds f(θin,k, ω_out) with ω_out = S(θin,k)·ω(θd = j°, φd = i°); below the
-// horizon the value at θout = 90° with the same φout (DESIGN §5 edge extension), evaluated a
-// hair above the horizon so the analytic models stay finite.
+// horizon the value at θout = 90° with the same φout (docs/design.md §5 edge extension), evaluated
+// a hair above the horizon so the analytic models stay finite.
 inline Lut AnalyticLut(const Material& material, std::vector<double> theta_in_deg) {
   Lut lut;
   lut.Resize(theta_in_deg.size());
@@ -107,13 +109,9 @@ inline void SetLe32(std::vector<std::uint8_t>& b, std::size_t at, std::uint32_t 
   for (int i = 0; i < 4; ++i) b.at(at + i) = static_cast<std::uint8_t>(v >> (8 * i));
 }
 
-// A fresh empty folder under the build tree for one test.
+// A fresh private folder for one test (mkdtemp), removed when the test program exits.
 inline std::string TestDir(const std::string& name) {
-  const std::filesystem::path dir =
-      std::filesystem::path(BRDF_BINARY_DIR) / "test-output" / "export" / name;
-  std::filesystem::remove_all(dir);
-  std::filesystem::create_directories(dir);
-  return dir.string();
+  return brdf::test::NewTempDir("export-" + name).string();
 }
 
 // Independent CRC-32 (IEEE 802.3, reflected 0xEDB88320), bit by bit as the standard defines it.

@@ -238,9 +238,8 @@ TEST(Rgb9e5, QuantisationErrorIsAtMostHalfAStep) {
   }
 }
 
-// DESIGN §5 gives the per-material payload as "361·181·4 texels × 4 bytes (RGB9E5) =
-// 1,045,444 bytes", but the product it states is 361·181·4·4 = 1,045,456 (1,045,444 is not
-// even a multiple of 4 texels × 4 bytes). The test asserts the product of the stated sizes.
+// docs/design.md §5 gives the per-material payload as 361·181·4 texels × 4 bytes (RGB9E5) =
+// 1,045,456 bytes; the test asserts the product of the stated sizes.
 TEST(Rgb9e5, PackedLutOfFourSlicesIs361By181By4TexelsOfFourBytes) {
   const Lut lut = test::PatternLut({0, 20, 40, 60}, 1);
   const PackedVolume v = PackLut(lut);

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <functional>
+
 #include <regex>
 
 #include <nlohmann/json.hpp>
@@ -122,6 +124,47 @@ TEST(Sidecar, ParserNamesTheBadMember) {
     FAIL() << "accepted";
   } catch (const FormatError& e) {
     EXPECT_NE(std::string(e.what()).find("broken.json: byte"), std::string::npos) << e.what();
+  }
+}
+
+// A sidecar whose θin list is not k·Δin, disagrees with its grid, or whose payload size is not
+// 361·181·K·4 bytes is refused with one line naming the member (docs/design.md §5, §7).
+TEST(Sidecar, RefusesThetaInListsAndSizesThatDisagreeWithTheTexture) {
+  const Lut lut = test::PatternLut({0, 20, 40}, 4);
+  const auto good = nlohmann::json::parse(SidecarJson(PackLut(lut), lut.theta_in_deg, FullMeta()));
+  struct Case {
+    std::function<void(nlohmann::json&)> edit;
+    std::string member, got;
+  };
+  const std::vector<Case> cases = {
+      {[](auto& j) {
+         j["theta_in_deg"] = {0, 20, 45};
+       },
+       "member 'theta_in_deg'", "[0, 20, 45]"},
+      {[](auto& j) {
+         j["theta_in_deg"] = {10, 30, 50};
+       },
+       "member 'theta_in_deg'", "[10, 30, 50]"},
+      {[](auto& j) {
+         j["theta_in_deg"] = {0, 20};
+       },
+       "member 'grid.slices'", "got 3"},
+      {[](auto& j) { j["grid"]["delta_in_deg"] = 30; }, "member 'theta_in_deg'", "[0, 20, 40]"},
+      {[](auto& j) { j["payload"]["bytes"] = 1045456; }, "member 'payload.bytes'", "got 1045456"},
+      {[](auto& j) { j["grid"]["width"] = 360; }, "member 'payload.bytes'", "360 * 181 * 3 * 4"},
+  };
+  for (const Case& c : cases) {
+    auto j = good;
+    c.edit(j);
+    try {
+      ParseSidecarJson(j.dump(), "felt.json");
+      ADD_FAILURE() << "accepted " << j.dump();
+    } catch (const FormatError& e) {
+      const std::string what = e.what();
+      EXPECT_EQ(what.rfind("felt.json: " + c.member, 0), 0u) << what;
+      EXPECT_NE(what.find(c.got), std::string::npos) << what;
+      EXPECT_EQ(what.find('\n'), std::string::npos) << what;
+    }
   }
 }
 

@@ -3,20 +3,25 @@
 // texel values, checksum) against values written out here from the specifications:
 //   KTX 2.0 specification (Khronos), Khronos Data Format Specification 1.3, and the
 //   E5B9G9R9 descriptor libktx requires (KTX-Software lib/texture2.c).
-// Usage: node check_ktx2.mjs WRITER OUT_DIR  (WRITER = the write_ktx2_fixture executable)
+// Usage: node check_ktx2.mjs WRITER [OUT_DIR]  (WRITER = the write_ktx2_fixture executable;
+// without OUT_DIR the files go to a new private folder under the system's temporary folder)
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
-import { mkdirSync, readFileSync, rmSync } from 'node:fs';
+import { mkdirSync, mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
 import test from 'node:test';
 import { read, write } from 'ktx-parse';
 
-const [writer, outDir] = process.argv.slice(2);
-if (!writer || !outDir) {
-  console.error('usage: node check_ktx2.mjs WRITER OUT_DIR');
+const [writer, givenDir] = process.argv.slice(2);
+if (!writer) {
+  console.error('usage: node check_ktx2.mjs WRITER [OUT_DIR]');
   process.exit(2);
 }
-rmSync(outDir, { recursive: true, force: true });
+const outDir = givenDir ?? mkdtempSync(join(tmpdir(), 'brdf-ktx-parse-'));
+if (givenDir) rmSync(outDir, { recursive: true, force: true });
 mkdirSync(outDir, { recursive: true });
+if (!givenDir) process.on('exit', () => rmSync(outDir, { recursive: true, force: true }));
 execFileSync(writer, [outDir], { stdio: 'inherit' });
 
 const KHR_DF_SAMPLE_DATATYPE_EXPONENT = 0x20;

@@ -1,5 +1,5 @@
-// DESIGN §6: the restricted quadratic Bézier b(x, l), the extrapolation factor and the ways a
-// user supplies p and l. Reference values come from a bisection on the curve written in
+// docs/design.md §6: the restricted quadratic Bézier b(x, l), the extrapolation factor and the ways
+// a user supplies p and l. Reference values come from a bisection on the curve written in
 // synthetic_capture.h, never from the closed-form root under test.
 #include "brdf/processing/extrapolation.h"
 
@@ -15,6 +15,7 @@
 
 #include "brdf/core/error.h"
 #include "synthetic_capture.h"
+#include "test_support.h"
 
 namespace brdf::processing {
 namespace {
@@ -219,8 +220,7 @@ TEST(ExtrapolationJson, RejectsBadContentNamingIt) {
 class ExtrapolationFile : public ::testing::Test {
  protected:
   std::string Write(const std::string& name, const std::string& text) {
-    const auto dir = std::filesystem::path(::testing::TempDir()) / "extrapolation_test";
-    std::filesystem::create_directories(dir);
+    static const std::filesystem::path dir = brdf::test::NewTempDir("extrapolation");
     const auto path = (dir / name).string();
     std::ofstream(path) << text;
     return path;

@@ -1,6 +1,6 @@
-// BuildLut against DESIGN §5 and §6: noise-free captures of analytic materials must reproduce
-// the material texel by texel, the extrapolated band and the below-horizon region must follow
-// the formulas (computed here independently, synthetic_capture.h), and irregular captures
+// BuildLut against docs/design.md §5 and §6: noise-free captures of analytic materials must
+// reproduce the material texel by texel, the extrapolated band and the below-horizon region must
+// follow the formulas (computed here independently, synthetic_capture.h), and irregular captures
 // (random directions, a blind spot) must still give a complete, accurate LUT.
 #include "brdf/processing/resample.h"
 
@@ -21,7 +21,8 @@ using test::Dir;
 
 const std::vector<double> kThetaIn = {0, 20, 40, 60};
 
-// Largest θout among valid samples, computed here from the data (DESIGN §6: never hard-coded).
+// Largest θout among valid samples, computed here from the data (docs/design.md §6: never
+// hard-coded).
 double ThetaBOf(const Measurement& m) {
   double t = 0;
   for (const Slice& s : m.slices)
@@ -455,7 +456,7 @@ void ExpectInvalid(const Measurement& meas, const std::vector<std::string>& need
 
 TEST(BuildLut, RejectsThetaInThatIsNotKTimesDelta) {
   ExpectInvalid(test::GridCapture(test::Lambertian(), {0, 20, 45, 60}, 10),
-                {"DESIGN §5", "45", "not uniform"});
+                {"docs/design.md §5", "45", "not uniform"});
   ExpectInvalid(test::GridCapture(test::Lambertian(), {10, 30}, 10), {"first is not 0"});
   ExpectInvalid(test::GridCapture(test::Lambertian(), {0, 20, 20, 40}, 10), {"duplicate"});
   ExpectInvalid(test::GridCapture(test::Lambertian(), {0, 0}, 10), {"duplicate"});

@@ -1,8 +1,8 @@
 // Noise-free synthetic captures and independent reference formulas for the processing tests.
 //
-// Everything here is written from DESIGN §4–§6 directly, without calling the code under test
-// (brdf::processing): the specular frame matrix, the Bézier root by bisection, the extrapolation
-// factor. Only brdf::core's analytic models supply BRDF values.
+// Everything here is written from docs/design.md §4–§6 directly, without calling the code under
+// test (brdf::processing): the specular frame matrix, the Bézier root by bisection, the
+// extrapolation factor. Only brdf::core's analytic models supply BRDF values.
 #pragma once
 
 #include <algorithm>
@@ -45,7 +45,7 @@ inline double AngleBetweenDeg(const Dir& a, const Dir& b) {
   return Deg(std::acos(std::clamp(a.x * b.x + a.y * b.y + a.z * b.z, -1.0, 1.0)));
 }
 
-// ω_out of LUT texel (i, j) of the slice for θin, written out from DESIGN §5:
+// ω_out of LUT texel (i, j) of the slice for θin, written out from docs/design.md §5:
 // S(θm) = [[−cosθm, 0, −sinθm], [0, −1, 0], [−sinθm, 0, cosθm]], ω_out = S·ω_d (S = S⁻¹).
 // Rows 0 and 180 are single directions (θd = 0°, 180°).
 inline Dir TexelOutDirection(double theta_in_deg, int i, int j) {
@@ -56,9 +56,9 @@ inline Dir TexelOutDirection(double theta_in_deg, int i, int j) {
 }
 
 // b(x, l) by bisection on x(t) = 2(1−t)t·l + t² (monotone on [0, 1]), then y(t): the curve of
-// DESIGN §6 solved numerically, not with the closed-form root. The comparison uses the factored
-// forms x(t) = t·(2l + (1 − 2l)t) and 1 − x(t) = (1 − t)(1 + t − 2lt), each accurate to a few
-// ulp relative where it is used, so t is pinned down even where x'(t) = 0 (l = 1 at x = 1).
+// docs/design.md §6 solved numerically, not with the closed-form root. The comparison uses the
+// factored forms x(t) = t·(2l + (1 − 2l)t) and 1 − x(t) = (1 − t)(1 + t − 2lt), each accurate to a
+// few ulp relative where it is used, so t is pinned down even where x'(t) = 0 (l = 1 at x = 1).
 inline double BezierByBisection(double x, double l) {
   double lo = 0.0, hi = 1.0;
   for (int it = 0; it < 200 && hi - lo > 1e-17; ++it) {
@@ -71,7 +71,7 @@ inline double BezierByBisection(double x, double l) {
   return 2.0 * (1.0 - t) * t * (1.0 - l) + t * t;
 }
 
-// DESIGN §6 factor (1 − α) + α·p at θ (θ ≤ θb: 1; θ ≥ 90°: the horizon value).
+// docs/design.md §6 factor (1 − α) + α·p at θ (θ ≤ θb: 1; θ ≥ 90°: the horizon value).
 inline double FactorReference(double theta_deg, double theta_b_deg, double p, double l) {
   if (theta_deg <= theta_b_deg) return 1.0;
   const double x = std::min((std::min(theta_deg, 90.0) - theta_b_deg) / (90.0 - theta_b_deg), 1.0);
@@ -109,7 +109,8 @@ inline Sample MakeSample(double theta_in, double theta_out, double phi_out, cons
   return s;
 }
 
-// The reference instrument's grid (DESIGN §1), noise-free: θin list, θout 0…max, φout 0…359.
+// The reference instrument's grid (docs/design.md §1), noise-free: θin list, θout 0…max, φout
+// 0…359.
 inline Measurement GridCapture(const Material& m, std::vector<double> theta_in = {0, 20, 40, 60},
                                double theta_out_max = 75.0, double step_deg = 1.0) {
   Measurement meas;

@@ -15,7 +15,7 @@ Written from the published algorithm rather than from the C++ code:
     the ndf/sigma factor applied when the file's `jacobian` flag is set.
 Everything is float64 and vectorised over direction pairs.
 
-Run as a test:  rgl_oracle.py --driver PATH/rgl_eval_points --data-dir DIR [--pairs N]
+Run as a test:  rgl_oracle.py --driver PATH/rgl_eval_points --data-dir BRDF_DATA_DIR [--pairs N]
 The driver evaluates f_r with the C++ code for the same direction pairs; the script fails
 (exit 1) when any pair whose f_r is not tiny differs by more than --rtol.
 """
@@ -281,7 +281,8 @@ def synthetic_file(path, seed, anisotropic, jacobian):
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split('\n')[0])
     ap.add_argument('--driver', required=True)
-    ap.add_argument('--data-dir', required=True)
+    ap.add_argument('--data-dir', required=True,
+                    help='the brdf-data folder (its rgl/ is read); $BRDF_DATA_DIR overrides it')
     ap.add_argument('--files', nargs='*', default=[
         'paper_white_rgb.bsdf', 'chm_mint_rgb.bsdf', 'cg_sunflower_rgb.bsdf',
         'irid_flake_paint1_fine_rgb.bsdf', 'ilm_solo_m_68_rgb.bsdf', 'cc_ibiza_sunset_rgb.bsdf'])
@@ -291,7 +292,12 @@ def main():
     ap.add_argument('--tiny', type=float, default=1e-6)
     args = ap.parse_args()
     ok = True
-    paths = [os.path.join(args.data_dir, f) for f in args.files] + args.extra
+    data_dir = os.environ.get('BRDF_DATA_DIR') or args.data_dir
+    rgl_dir = os.path.join(data_dir, 'rgl')
+    if not os.path.isdir(rgl_dir):
+        sys.exit(f"third-party data folder '{rgl_dir}' not found: set BRDF_DATA_DIR to the "
+                 "brdf-data folder (see README.md, 'Test data')")
+    paths = [os.path.join(rgl_dir, f) for f in args.files] + args.extra
     with tempfile.TemporaryDirectory() as tmp:
         for name, aniso, jac in [('synthetic_anisotropic.bsdf', True, 1),
                                  ('synthetic_jacobian0.bsdf', False, 0)]:

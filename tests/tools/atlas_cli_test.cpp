@@ -1,6 +1,6 @@
 // `brdf atlas` run as a user runs it. Each material's cell of the atlas texture must hold
 // exactly the texels of that material's own LUT (both read back from their KTX2 files with the
-// layout reader of tool_test_util.h); the cell positions follow DESIGN §5, computed here.
+// layout reader of tool_test_util.h); the cell positions follow docs/design.md §5, computed here.
 #include <nlohmann/json.hpp>
 
 #include "tool_test_util.h"
@@ -47,8 +47,7 @@ TEST_F(AtlasCommand, EachCellEqualsThatMaterialsOwnLut) {
     SCOPED_TRACE(mats[m].first);
     EXPECT_EQ(manifest["materials"][m]["name"], mats[m].first);
     const Texture3d own = ReadKtx2Layout(dir_ / "own" / (mats[m].first + ".ktx2"));
-    // One material's payload: 361 · 181 · 4 texels · 4 bytes (DESIGN §5 prints 1,045,444; the
-    // product is 1,045,456).
+    // One material's payload: 361 · 181 · 4 texels · 4 bytes = 1,045,456 (docs/design.md §5).
     EXPECT_EQ(own.payload.size(), 1045456u);
     const std::size_t x0 = (m % 2) * 361, y0 = (m / 2) * 181;
     std::size_t differing = 0;

@@ -16,8 +16,7 @@ namespace {
 
 using Json = nlohmann::json;
 
-// 361 × 181 texels × K = 4 slices × 4 bytes. (DESIGN §5 prints 1,045,444 for this product; the
-// product is 1,045,456.)
+// 361 × 181 texels × K = 4 slices × 4 bytes = 1,045,456 (docs/design.md §5).
 constexpr std::size_t kPayloadBytesK4 = 361u * 181u * 4u * 4u;
 
 const std::vector<double> kThetaIn = {0, 20, 40, 60};
@@ -34,9 +33,7 @@ std::vector<Named> Materials() {
 class ConvertedMaterials : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
-    root_ = new fs::path(fs::temp_directory_path() /
-                         ("brdf_convert_test_" + std::to_string(::getpid())));
-    fs::remove_all(*root_);
+    root_ = new fs::path(brdf::test::ScopedTempDir::MakeTempDir("convert"));
     fs::create_directories(*root_ / "in");
     for (const Named& m : Materials())
       WriteText(*root_ / "in" / (m.name + ".json"), m.material.Json());
@@ -305,7 +302,7 @@ TEST_F(ConvertOptions, ExtrapolationComesFromTheMostSpecificSource) {
   EXPECT_FALSE(fs::exists(dir_ / "out" / "ggx.exr"));
 
   // The GGX LUT in the band beyond θb = 75°: f(75°, φ)·((1 − α) + α·p) with
-  // α = b(min((θ − 75°)/15°, 1), l), p = 0.2, l = 0.3 (DESIGN §6), at texel centres.
+  // α = b(min((θ − 75°)/15°, 1), l), p = 0.2, l = 0.3 (docs/design.md §6), at texel centres.
   const Analytic m = Ggx03();
   std::string pairs;
   std::vector<std::array<double, 3>> dirs;  // θin, θout, φout

@@ -14,14 +14,14 @@
 #include "brdf/core/file_util.h"
 #include "brdf/core/geometry.h"
 #include "brdf/core/models.h"
-#include "tool_runner.h"
+#include "tool_test_util.h"
 
 namespace brdf {
 namespace {
 
 namespace fs = std::filesystem;
-using testing::Quote;
-using testing::ToolRun;
+using tooltest::Quote;
+using tooltest::ToolRun;
 
 bool SameBits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
@@ -117,7 +117,7 @@ void ExpectSameMeasurement(const Measurement& got, const Measurement& want) {
   }
 }
 
-class ExportCsvCommand : public testing::ToolTest {};
+class ExportCsvCommand : public tooltest::ToolTest {};
 
 TEST_F(ExportCsvCommand, RoundTripIsBitExact) {
   const Measurement m = AwkwardCapture();

@@ -22,20 +22,22 @@
 #include "brdf/core/merl.h"
 #include "brdf/core/models.h"
 #include "brdf/core/rgl.h"
-#include "tool_runner.h"
+#include "test_support.h"
+#include "tool_test_util.h"
 
 namespace brdf {
 namespace {
 
 namespace fs = std::filesystem;
 using Json = nlohmann::json;
-using testing::Quote;
-using testing::ToolRun;
+using tooltest::Quote;
+using tooltest::ToolRun;
 
 constexpr double kPi = 3.14159265358979323846;
 
-const std::string kSharedZemax = std::string(BRDF_SHARED_DATA_DIR) +
-                                 "/zemax-imaging-sphere/test_13_planesymmetric_btdf_zemax.bsdf";
+std::string SharedZemax() {
+  return brdf::test::DataPath("zemax-imaging-sphere/test_13_planesymmetric_btdf_zemax.bsdf");
+}
 
 bool SameBits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 
@@ -99,7 +101,7 @@ void ExpectSameValues(const Measurement& m, const Expected& expected) {
   EXPECT_EQ(samples, expected.size());
 }
 
-class ImportCommand : public testing::ToolTest {};
+class ImportCommand : public tooltest::ToolTest {};
 
 TEST_F(ImportCommand, CsvPointCloudKeepsEveryValue) {
   const Material mat = ColouredWard();
@@ -220,7 +222,7 @@ TEST_F(ImportCommand, GoniometerTableGivesReflectanceFactorOverPi) {
   EXPECT_EQ(samples, expected.size());
 }
 
-// A virtual capture at the reference geometry of DESIGN §1 (θin 0/20/40/60°, θout 0–75°,
+// A virtual capture at the reference geometry of docs/design.md §1 (θin 0/20/40/60°, θout 0–75°,
 // φout 0–359°, 1° steps): every grid point once, f_r equal to the source's own evaluation
 // (the reader's Eval, tested on its own in rgl_test / merl_test) as float, flagged invalid
 // exactly where `unmeasured` says so.
@@ -253,7 +255,7 @@ void ExpectReferenceCapture(const Measurement& m, const BrdfSource& source, Unme
 }
 
 TEST_F(ImportCommand, RglMaterialBecomesANoiseFreeCaptureAtTheReferenceGeometry) {
-  const std::string file = std::string(BRDF_SHARED_DATA_DIR) + "/rgl/vch_silk_blue_rgb.bsdf";
+  const std::string file = brdf::test::DataPath("rgl/vch_silk_blue_rgb.bsdf");
   const ToolRun run = Run("import " + Quote(file) + " --out " + Quote(dir_ / "silk.bpc"));
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_NE(run.out.find("rgl"), std::string::npos) << run.out;
@@ -305,7 +307,7 @@ struct ZemaxScan {
 
 ZemaxScan ScanSharedZemax() {
   ZemaxScan z;
-  std::istringstream in(ReadFileText(kSharedZemax, 1 << 20));
+  std::istringstream in(ReadFileText(SharedZemax(), 1 << 20));
   std::string line;
   std::uint64_t n = 0;
   bool expect_aoi_list = false, expect_first_row = false;
@@ -338,11 +340,11 @@ ZemaxScan ScanSharedZemax() {
 TEST_F(ImportCommand, RefusesZemaxBtdfWithoutAllowBtdf) {
   const ZemaxScan z = ScanSharedZemax();
   ASSERT_GT(z.scatter_type_line, 0u);
-  const ToolRun run = Run("import " + Quote(kSharedZemax) + " --out " + Quote(dir_ / "z.bpc"));
+  const ToolRun run = Run("import " + Quote(SharedZemax()) + " --out " + Quote(dir_ / "z.bpc"));
   EXPECT_EQ(run.exit_code, 1);
   const auto lines = run.ErrLines();
   ASSERT_EQ(lines.size(), 1u) << run.err;
-  EXPECT_NE(lines[0].find(kSharedZemax), std::string::npos) << lines[0];
+  EXPECT_NE(lines[0].find(SharedZemax()), std::string::npos) << lines[0];
   EXPECT_NE(lines[0].find("line " + std::to_string(z.scatter_type_line)), std::string::npos)
       << lines[0];
   EXPECT_NE(lines[0].find("ScatterType"), std::string::npos) << lines[0];
@@ -355,7 +357,7 @@ TEST_F(ImportCommand, ImportsZemaxBtdfWithAllowBtdfMirroredOntoTheSpecularDirect
   ASSERT_EQ(z.aoi_deg.size(), 13u);
   ASSERT_EQ(z.specular_value.size(), z.aoi_deg.size());
   const ToolRun run =
-      Run("import " + Quote(kSharedZemax) + " --out " + Quote(dir_ / "z.bpc") + " --allow-btdf");
+      Run("import " + Quote(SharedZemax()) + " --out " + Quote(dir_ / "z.bpc") + " --allow-btdf");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   const BpcReadResult back = ReadIntact(dir_ / "z.bpc");
   const Measurement& m = back.measurement;
@@ -437,15 +439,15 @@ TEST_F(ImportCommand, WrongOrMissingArgumentsGiveOneClearLine) {
   }
 }
 
-class InfoCommand : public testing::ToolTest {};
+class InfoCommand : public tooltest::ToolTest {};
 
-// DESIGN of the shared data (../shared/brdf-data/README.md): integrating the table should
+// The README of the third-party data set (BRDF_DATA_DIR/README.md): integrating the table should
 // land within 5–15% of the file's TIS lines; docs/formats/zemax.md gives the tolerance
 // |integrated − TIS| ≤ 15% and covered ≤ 1.01·TIS (a lower bound).
 TEST_F(InfoCommand, ShowsZemaxIntegratedTisNextToTheFilesOwn) {
   const ZemaxScan z = ScanSharedZemax();
   ASSERT_EQ(z.tis.size(), 13u);
-  const ToolRun json_run = Run("info --json " + Quote(kSharedZemax));
+  const ToolRun json_run = Run("info --json " + Quote(SharedZemax()));
   ASSERT_EQ(json_run.exit_code, 0) << json_run.err;
   const Json j = Json::parse(json_run.out);
   EXPECT_EQ(j["format"], "zemax");
@@ -461,7 +463,7 @@ TEST_F(InfoCommand, ShowsZemaxIntegratedTisNextToTheFilesOwn) {
   }
   EXPECT_EQ(j["slices"].size(), z.aoi_deg.size());
 
-  const ToolRun text_run = Run("info " + Quote(kSharedZemax));
+  const ToolRun text_run = Run("info " + Quote(SharedZemax()));
   ASSERT_EQ(text_run.exit_code, 0) << text_run.err;
   std::istringstream lines(text_run.out);
   std::string line;

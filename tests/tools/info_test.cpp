@@ -12,6 +12,7 @@
 
 #include "brdf/core/bpc.h"
 #include "brdf/core/file_util.h"
+#include "test_support.h"
 
 namespace brdf {
 namespace {
@@ -40,13 +41,7 @@ ToolRun RunTool(const std::string& args, const fs::path& dir) {
 
 class InfoTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("brdf_info_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
+  void SetUp() override { dir_ = brdf::test::ScopedTempDir::MakeTempDir("info"); }
   void TearDown() override { fs::remove_all(dir_); }
   fs::path dir_;
 };

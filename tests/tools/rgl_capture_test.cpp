@@ -1,17 +1,18 @@
 // Issue 4: every RGL material in the shared data folder, captured on the simulated instrument
 // (default noise), converts to a LUT whose values agree with the RGL file's own f_r. The
 // reference values come from the RGL files (`brdf eval FILE.bsdf`); the texel directions come
-// from the specular frame of DESIGN §5 written out in tool_test_util.h; the payload size from
-// the RGB9E5 layout (4 bytes per texel).
+// from the specular frame of docs/design.md §5 written out in tool_test_util.h; the payload size
+// from the RGB9E5 layout (4 bytes per texel).
 #include <algorithm>
 #include <sstream>
 
+#include "test_support.h"
 #include "tool_test_util.h"
 
 namespace brdf::tooltest {
 namespace {
 
-const fs::path kRglDir = fs::path(BRDF_SHARED_DATA_DIR) / "rgl";
+fs::path RglDir() { return brdf::test::DataPath("rgl"); }
 
 std::vector<std::array<double, 3>> ParseTriples(const std::string& text) {
   std::vector<std::array<double, 3>> out;
@@ -33,7 +34,7 @@ using RglCapture = ToolTest;
 
 TEST_F(RglCapture, EveryRglMaterialCapturedOnTheSimulatorConvertsToAMatchingLut) {
   std::vector<fs::path> bsdfs;
-  for (const auto& e : fs::directory_iterator(kRglDir))
+  for (const auto& e : fs::directory_iterator(RglDir()))
     if (e.path().extension() == ".bsdf") bsdfs.push_back(e.path());
   std::sort(bsdfs.begin(), bsdfs.end());
   ASSERT_EQ(bsdfs.size(), 18u) << "the shared data folder holds 18 RGL materials";
@@ -65,7 +66,7 @@ TEST_F(RglCapture, EveryRglMaterialCapturedOnTheSimulatorConvertsToAMatchingLut)
   ASSERT_EQ(c.exit_code, 0) << c.out << c.err;
   EXPECT_NE(c.out.find("converted 18 of 18"), std::string::npos) << c.out;
 
-  // Texel centres (DESIGN §5: texel (i, j) holds f at exactly φd = i°, θd = j°) on the four
+  // Texel centres (docs/design.md §5: texel (i, j) holds f at exactly φd = i°, θd = j°) on the four
   // slices, dense near the mirror direction (θd = 0) where glossy materials keep their energy,
   // kept where the view direction is inside the measured range (θout ≤ 74°, one degree inside
   // the instrument's 75°, so no extrapolated texel is compared).

@@ -1,8 +1,9 @@
-// Helpers for the tests that run the built `brdf` tool as a user runs it: a scratch folder, a
-// process runner, and oracles written here from the specifications, independent of the code
-// under test: the analytic BRDFs of DESIGN §9, the specular frame of DESIGN §5, the Bézier of
-// DESIGN §6 (by bisection), the RGB9E5 layout of EXT_texture_shared_exponent, and minimal
-// KTX2 / DDS / .bpc layout readers written from their specifications.
+// Helpers for the tests that run the built `brdf` tool as a user runs it (the one runner of
+// tests/tools): a private scratch folder per test, a process runner, and oracles written here from
+// the specifications, independent of the code under test: the analytic BRDFs of docs/design.md §9,
+// the specular frame of docs/design.md §5, the Bézier of docs/design.md §6 (by bisection), the
+// RGB9E5 layout of EXT_texture_shared_exponent, and minimal KTX2 / DDS / .bpc layout readers
+// written from their specifications.
 #pragma once
 
 #include <gtest/gtest.h>
@@ -22,6 +23,7 @@
 
 #include "brdf/core/bpc.h"
 #include "brdf/core/measurement.h"
+#include "test_support.h"
 
 namespace brdf::tooltest {
 
@@ -32,6 +34,19 @@ inline constexpr double kPi = 3.14159265358979323846;
 struct ToolRun {
   int exit_code = -1;
   std::string out, err;
+
+  // stderr split into lines (without the newlines).
+  std::vector<std::string> ErrLines() const {
+    std::vector<std::string> lines;
+    std::size_t start = 0;
+    while (start < err.size()) {
+      const std::size_t end = err.find('\n', start);
+      lines.push_back(err.substr(start, end == std::string::npos ? end : end - start));
+      if (end == std::string::npos) break;
+      start = end + 1;
+    }
+    return lines;
+  }
 };
 
 inline std::string ReadAll(const fs::path& p) {
@@ -56,17 +71,14 @@ inline ToolRun RunTool(const std::string& args, const fs::path& dir) {
 
 inline std::string Quote(const fs::path& p) { return "'" + p.string() + "'"; }
 
-// A fresh folder per test, removed afterwards.
+// A fresh private folder per test (mkdtemp), removed afterwards.
 class ToolTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("brdf_tool_test_" + std::to_string(::getpid()) + "_" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
+  void SetUp() override { dir_ = test::ScopedTempDir::MakeTempDir("tool"); }
+  void TearDown() override {
+    if (std::getenv("BRDF_KEEP_TEST_OUTPUT") == nullptr) fs::remove_all(dir_);
   }
-  void TearDown() override { fs::remove_all(dir_); }
+  ToolRun Run(const std::string& args) const { return RunTool(args, dir_); }
   fs::path dir_;
 };
 
@@ -74,7 +86,7 @@ inline void WriteText(const fs::path& p, const std::string& text) {
   std::ofstream(p, std::ios::binary) << text;
 }
 
-// ---- directions and analytic BRDFs (DESIGN §4, §9), written out independently ----
+// ---- directions and analytic BRDFs (docs/design.md §4, §9), written out independently ----
 
 struct V3 {
   double x, y, z;
@@ -110,7 +122,7 @@ struct Analytic {
                     kd[0], kd[1], kd[2], ks[0], ks[1], ks[2], shape, extra.c_str());
     return buf;
   }
-  // f_r (1/sr) for light l and view v, from the DESIGN §9 table.
+  // f_r (1/sr) for light l and view v, from the docs/design.md §9 table.
   std::array<double, 3> F(const V3& l, const V3& v) const {
     std::array<double, 3> f{};
     if (l.z <= 0 || v.z <= 0) return f;
@@ -145,7 +157,7 @@ inline Analytic Lambertian() { return {"lambert", {0.5, 0.4, 0.3}, {}, 0}; }
 inline Analytic Ggx03() { return {"ggx", {0.2, 0.1, 0.05}, {0.9, 0.6, 0.3}, 0.3}; }
 inline Analytic Lafortune20() { return {"lafortune", {0.3, 0.2, 0.1}, {0.5, 0.4, 0.2}, 20}; }
 
-// DESIGN §5: ω_out = S(θin)·ω_d with S(θm) = [[−cosθm, 0, −sinθm], [0, −1, 0],
+// docs/design.md §5: ω_out = S(θin)·ω_d with S(θm) = [[−cosθm, 0, −sinθm], [0, −1, 0],
 // [−sinθm, 0, cosθm]]; returns (θout, φout) in degrees, φout in [0, 360).
 inline std::array<double, 2> TexelDirection(double theta_in_deg, int i, int j) {
   const V3 d = Dir(j, i);
@@ -158,7 +170,8 @@ inline std::array<double, 2> TexelDirection(double theta_in_deg, int i, int j) {
   return {theta, phi};
 }
 
-// DESIGN §6 Bézier b(x, l), found by bisection on x(t) = 2(1−t)t·l + t² (not the closed form).
+// docs/design.md §6 Bézier b(x, l), found by bisection on x(t) = 2(1−t)t·l + t² (not the closed
+// form).
 inline double BezierByBisection(double x, double l) {
   double lo = 0, hi = 1;
   for (int it = 0; it < 200; ++it) {

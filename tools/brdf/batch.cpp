@@ -12,6 +12,7 @@
 
 #include "brdf/core/error.h"
 #include "cli_support.h"
+#include "brdf/core/file_util.h"
 
 namespace brdf::cli {
 
@@ -82,6 +83,13 @@ DiscoveredInputs DiscoverInputs(const std::vector<std::string>& arguments,
         else
           out.failures.push_back(
               {arg, "not an input: expected " + Accepted(kinds) + ", got a " + sources::FileKindName(kind)});
+      } catch (const Error& e) {
+        out.failures.push_back({arg, ReasonWithoutPath(arg, e.what())});
+      }
+    } else if (fs::exists(st)) {
+      // A FIFO, device or socket: say what it is (brdf::CheckRegularFile), never open it.
+      try {
+        CheckRegularFile(arg);
       } catch (const Error& e) {
         out.failures.push_back({arg, ReasonWithoutPath(arg, e.what())});
       }

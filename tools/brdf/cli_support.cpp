@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "brdf/core/error.h"
+#include "brdf/core/file_util.h"
 
 namespace brdf::cli {
 
@@ -121,8 +122,15 @@ void CheckOutputPath(const std::string& out, const std::string& input, const cha
   std::error_code ec;
   if (fs::equivalent(out, input, ec))
     throw InvalidArgument(std::string(option) + ": '" + out + "' is the input file itself");
-  if (fs::exists(out, ec) && !force)
-    throw InvalidArgument(out + " already exists: use --force to overwrite it");
+  ReportRemovedTemporaries(CheckWritableOutput(out, force));
+}
+
+void ReportRemovedTemporaries(const std::vector<std::string>& removed) {
+  if (removed.empty()) return;
+  std::string list;
+  for (const std::string& r : removed) list += (list.empty() ? "" : ", ") + r;
+  std::fprintf(stderr, "note: removed %zu temporary file%s left by an interrupted run: %s\n",
+               removed.size(), removed.size() == 1 ? "" : "s", list.c_str());
 }
 
 }  // namespace brdf::cli

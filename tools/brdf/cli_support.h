@@ -33,9 +33,14 @@ std::string LowerExtension(const std::string& path);
 
 // Checks an output path before any work is done: it must end in `extension` (".bpc"), must
 // not be the input file itself, and must not exist unless `force` (a .bpc or .csv in the way
-// may be a measurement nobody can repeat). `option` names the option in messages ("--out").
-// Throws InvalidArgument.
+// may be a measurement nobody can repeat; brdf::CheckWritableOutput, the rule of every
+// writing command). `option` names the option in messages ("--out"). Throws InvalidArgument,
+// OutputExistsError or IoError.
 void CheckOutputPath(const std::string& out, const std::string& input, const char* extension,
                      bool force, const char* option = "--out");
+
+// Prints one note on stderr naming the temporary files of killed runs that
+// brdf::CheckWritableOutputs removed (nothing when there were none).
+void ReportRemovedTemporaries(const std::vector<std::string>& removed);
 
 }  // namespace brdf::cli

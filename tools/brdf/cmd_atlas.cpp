@@ -1,5 +1,5 @@
-// `brdf atlas INPUT... --out PREFIX`: many materials in one texture (DESIGN §5) for deferred
-// renderers, with a manifest JSON.
+// `brdf atlas INPUT... --out PREFIX`: many materials in one texture (docs/design.md §5) for
+// deferred renderers, with a manifest JSON.
 //
 // Every input becomes a LUT exactly as `brdf convert` makes it (captures and material files
 // are resampled with their extrapolation; exported LUTs are used as stored), on --jobs worker
@@ -13,9 +13,11 @@
 
 #include "batch.h"
 #include "brdf/core/error.h"
+#include "brdf/core/file_util.h"
 #include "brdf/exporter/atlas.h"
 #include "brdf/exporter/packed_volume.h"
 #include "brdf/sources/open.h"
+#include "cli_support.h"
 #include "commands.h"
 #include "progress.h"
 
@@ -49,6 +51,7 @@ int RunAtlas(const AtlasOptions& options) {
         throw InvalidArgument("--out " + options.out + ": the atlas file " + out +
                               " would overwrite an input; choose another prefix");
   }
+  ReportRemovedTemporaries(CheckWritableOutputs(outputs, options.force));
   std::vector<BatchFailure> failures = found.failures;
   for (const BatchFailure& f : failures)
     std::fprintf(stderr, "%s: FAILED: %s\n", f.path.c_str(), f.reason.c_str());

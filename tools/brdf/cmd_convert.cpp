@@ -14,8 +14,10 @@
 
 #include "batch.h"
 #include "brdf/core/error.h"
+#include "brdf/core/file_util.h"
 #include "brdf/exporter/lut_export.h"
 #include "brdf/sources/open.h"
+#include "cli_support.h"
 #include "commands.h"
 #include "progress.h"
 
@@ -111,6 +113,14 @@ int RunConvert(const ConvertOptions& options) {
     throw IoError(options.out + ": cannot create the output folder" +
                   (ec ? ": " + ec.message() : std::string()));
   RefuseCollisions(out_dir, export_options.formats, found.inputs, found.failures);
+  {
+    // The overwrite rule, for every output of the run before any work is done.
+    std::vector<std::string> outputs;
+    for (const BatchInput& in : found.inputs)
+      for (std::string& p : OutputPaths(out_dir, in.name, export_options.formats))
+        outputs.push_back(std::move(p));
+    ReportRemovedTemporaries(CheckWritableOutputs(outputs, options.force));
+  }
 
   const std::size_t total = found.inputs.size() + found.failures.size();
   std::vector<BatchFailure> failures = found.failures;

@@ -48,6 +48,7 @@ struct ConvertOptions {
   std::string exr_compression = "none";
   int jobs = DefaultJobs();
   bool quiet = false;  // no progress bar
+  bool force = false;  // overwrite existing outputs (brdf::CheckWritableOutputs)
 };
 int RunConvert(const ConvertOptions& options);
 
@@ -56,9 +57,10 @@ struct AtlasOptions {
   std::string out;                  // prefix: writes PREFIX.ktx2, .dds, .exr, .json
   std::string extrapolate;
   std::string exr_type = "float";
-  std::string exr_compression = "zip";
+  std::string exr_compression = "none";  // as convert's: one default for every EXR written
   int jobs = DefaultJobs();
   bool quiet = false;
+  bool force = false;  // overwrite existing PREFIX.* files
 };
 int RunAtlas(const AtlasOptions& options);
 

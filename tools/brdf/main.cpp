@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "brdf/core/error.h"
+#include "brdf/core/file_util.h"
 #include "brdf/core/measurement.h"
 #include "cli_support.h"
 #include "commands.h"
@@ -39,12 +40,52 @@ CLI::Validator AnglePairValidator() {
       "THETA,PHI");
 }
 
+// A whole number of at least `min`, as typed: "0", "-1", "2.5", "abc" and "" are refused with
+// the value quoted (CLI::PositiveNumber printed its range as two 309-digit numbers).
+// Help texts of options that convert and atlas share, written once so they cannot drift.
+constexpr const char* kExrCompressionHelp =
+    "EXR compression: none or zip (zip: float EXRs of measured data about 20 % smaller, writing "
+    "takes about twice as long)";
+constexpr const char* kExrTypeHelp = "EXR pixel type: float, or half (faster to write, smaller)";
+
+CLI::Validator WholeNumberAtLeast(long long min) {
+  return CLI::Validator(
+      [min](std::string& text) -> std::string {
+        const std::string expected = "expected a whole number >= " + std::to_string(min);
+        try {
+          std::size_t used = 0;
+          const long long v = std::stoll(text, &used);
+          if (used == text.size() && v >= min) return {};
+        } catch (const std::exception&) {
+        }
+        return expected + ", got '" + text + "'";
+      },
+      "INT>=" + std::to_string(min));
+}
+
+// One line for every command-line error, like every other error of the tool: CLI11's message
+// (for "--jobs: ..." it already names the option) and where help is.
+std::string OneLineParseError(const CLI::App& app, const CLI::Error& e) {
+  std::string command = "brdf", where = "brdf: ";
+  for (const CLI::App* sub : app.get_subcommands()) {
+    command += " " + sub->get_name();
+    where += sub->get_name() + ": ";
+  }
+  std::string what = e.what();
+  for (char& c : what)
+    if (c == '\n') c = ' ';
+  return where + what + " (see '" + command + " --help')";
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"brdf: measured reflectance to engine-ready lookup textures"};
   app.set_version_flag("--version", std::string("brdf-toolchain ") + brdf::SoftwareVersion());
   app.require_subcommand(1);
+  // Errors reported through app.exit() (none today: main prints them) look the same.
+  app.failure_message(
+      [](const CLI::App* a, const CLI::Error& e) { return OneLineParseError(*a, e) + "\n"; });
   int exit_code = 0;
 
   // brdf eval
@@ -74,7 +115,7 @@ int main(int argc, char** argv) {
   eval_out_opt->needs(eval_in_opt)->excludes(eval_pairs_opt);
   eval_cmd
       ->add_option("--extrapolate", eval.extrapolate,
-                   "Captures: grazing extrapolation P,L (DESIGN §6); default: the "
+                   "Captures: grazing extrapolation P,L (docs/design.md §6); default: the "
                    "per-material JSON beside the file, else 1,0.5")
       ->capture_default_str();
   eval_cmd->footer(
@@ -181,28 +222,26 @@ int main(int argc, char** argv) {
   convert_cmd->add_option("--out", convert.out, "Output folder (created if missing)")->required();
   convert_cmd
       ->add_option("--extrapolate", convert.extrapolate,
-                   "Grazing extrapolation P,L (DESIGN §6) for inputs without their own; "
+                   "Grazing extrapolation P,L (docs/design.md §6) for inputs without their own; "
                    "default 1,0.5 (clamping)")
       ->capture_default_str();
   convert_cmd->add_option("--formats", convert.formats, "Comma-separated outputs to write")
       ->capture_default_str();
-  convert_cmd
-      ->add_option("--exr-type", convert.exr_type,
-                   "EXR pixel type: float, or half (faster to write, smaller)")
+  convert_cmd->add_option("--exr-type", convert.exr_type, kExrTypeHelp)
       ->capture_default_str()
       ->check(CLI::IsMember({"float", "half"}));
-  convert_cmd
-      ->add_option("--exr-compression", convert.exr_compression,
-                   "EXR compression: none, or zip (float EXRs of measured data: about 20 % "
-                   "smaller, and a conversion takes twice as long)")
+  convert_cmd->add_option("--exr-compression", convert.exr_compression, kExrCompressionHelp)
       ->capture_default_str()
       ->check(CLI::IsMember({"zip", "none"}));
   convert_cmd
       ->add_option("--jobs", convert.jobs,
                    "Inputs converted in parallel (default: hardware threads)")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(WholeNumberAtLeast(1));
   convert_cmd->add_flag("--quiet", convert.quiet, "No progress bar");
+  convert_cmd->add_flag("--force", convert.force,
+                        "Overwrite outputs that already exist in --out (without it nothing is "
+                        "converted when any output exists)");
   convert_cmd->footer(
       "Material files are first captured noise-free on the reference geometry (theta_in 0, 20, "
       "40, 60; theta_out 0-75; phi_out 0-359; 1 degree steps), then resampled like a capture.\n"
@@ -223,7 +262,7 @@ int main(int argc, char** argv) {
   brdf::cli::AtlasOptions atlas;
   auto* atlas_cmd = app.add_subcommand(
       "atlas",
-      "Pack many materials into one atlas texture (DESIGN §5): PREFIX.ktx2, .dds, .exr and "
+      "Pack many materials into one atlas texture (docs/design.md §5): PREFIX.ktx2, .dds, .exr and "
       "PREFIX.json (manifest naming every material's cell)");
   atlas_cmd
       ->add_option("inputs", atlas.inputs,
@@ -235,16 +274,18 @@ int main(int argc, char** argv) {
       ->add_option("--extrapolate", atlas.extrapolate,
                    "Grazing extrapolation P,L for inputs without their own; default 1,0.5")
       ->capture_default_str();
-  atlas_cmd->add_option("--exr-type", atlas.exr_type, "EXR pixel type: float or half")
+  atlas_cmd->add_option("--exr-type", atlas.exr_type, kExrTypeHelp)
       ->capture_default_str()
       ->check(CLI::IsMember({"float", "half"}));
-  atlas_cmd->add_option("--exr-compression", atlas.exr_compression, "EXR compression: zip or none")
+  atlas_cmd->add_option("--exr-compression", atlas.exr_compression, kExrCompressionHelp)
       ->capture_default_str()
       ->check(CLI::IsMember({"zip", "none"}));
   atlas_cmd->add_option("--jobs", atlas.jobs, "Inputs resampled in parallel")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(WholeNumberAtLeast(1));
   atlas_cmd->add_flag("--quiet", atlas.quiet, "No progress bar");
+  atlas_cmd->add_flag("--force", atlas.force,
+                      "Overwrite PREFIX.ktx2, .dds, .exr, .json if any already exists");
   atlas_cmd->footer(
       "Materials are placed in input order (folders sorted by file name). All must share one "
       "theta_in list; materials with different sets are refused by name. Nothing is written "
@@ -314,10 +355,13 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);
-    // One clear line, then where to look for help.
-    std::fprintf(stderr, "brdf: %s\nRun 'brdf --help' or 'brdf <command> --help' for usage.\n",
-                 e.what());
+    std::fprintf(stderr, "%s\n", OneLineParseError(app, e).c_str());
     return 2;
+  } catch (const brdf::OutputExistsError& e) {
+    // The overwrite rule of every writing command (brdf/core/file_util.h), in our words.
+    std::fprintf(stderr, "brdf: error: %s; use --force to overwrite %s\n", e.what(),
+                 e.paths().size() == 1 ? "it" : "them");
+    return 1;
   } catch (const brdf::Error& e) {
     const std::string command =
         app.get_subcommands().empty() ? std::string() : app.get_subcommands().front()->get_name();

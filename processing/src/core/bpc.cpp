@@ -660,20 +660,17 @@ std::optional<BpcReadResult> ReadIntactStreaming(int fd, std::uint64_t size,
 }  // namespace
 
 BpcReadResult ReadBpc(const std::string& path) {
-  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
-  if (fd < 0) throw IoError(path + ": cannot open: " + ErrnoText());
-  struct stat st {};
-  if (::fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
-    ::close(fd);
-    throw IoError(path + ": not a regular file");
-  }
+  // Never blocks on a FIFO or device; refuses anything but a regular file.
+  std::uint64_t size = 0;
+  const int fd = OpenRegularFile(path, &size);
   std::optional<BpcReadResult> fast;
-  if (static_cast<std::uint64_t>(st.st_size) <= kBpcMaxFileBytes)
-    fast = ReadIntactStreaming(fd, static_cast<std::uint64_t>(st.st_size), path);
+  if (size <= kBpcMaxFileBytes) fast = ReadIntactStreaming(fd, size, path);
   ::close(fd);
   if (fast) return std::move(*fast);
-  const std::vector<std::uint8_t> data = ReadFileBytes(path, kBpcMaxFileBytes);
-  return ParseBpc(data.data(), data.size(), path);
+  // Damaged or unusual: the parser needs random access. Mapped, not read, so a huge file
+  // (e.g. a small capture followed by gigabytes of holes) costs only the pages looked at.
+  const MappedFile mapped(path, kBpcMaxFileBytes);
+  return ParseBpc(mapped.data(), mapped.size(), path);
 }
 
 BpcReadResult ParseBpc(const std::uint8_t* data, std::size_t size, const std::string& file) {

@@ -1,14 +1,20 @@
 #include "brdf/core/file_util.h"
 
 #include <fcntl.h>
+#include <signal.h>
+#include <sys/mman.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
+#include <regex>
+#include <set>
 
 #include "brdf/core/error.h"
 
@@ -27,14 +33,92 @@ void SyncPath(const std::string& path) {
   ::close(fd);
 }
 
+std::string ExistsMessage(const std::vector<std::string>& paths) {
+  std::string m = paths.front() + ": already exists";
+  if (paths.size() > 1)
+    m += " (and " + std::to_string(paths.size() - 1) + " more output" +
+         (paths.size() == 2 ? "" : "s") + " of this run)";
+  return m;
+}
+
+// "a folder", "a FIFO (named pipe)", ... for what `st` describes if it is not a regular file.
+std::string KindOf(const struct stat& st) {
+  if (S_ISDIR(st.st_mode)) return "a folder";
+  if (S_ISFIFO(st.st_mode)) return "a FIFO (named pipe)";
+  if (S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode)) return "a device";
+  if (S_ISSOCK(st.st_mode)) return "a socket";
+  return "a special file";
+}
+
+// KindOf for a path that exists and is not a regular file; "" otherwise.
+std::string NonRegularKind(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0 || S_ISREG(st.st_mode)) return {};
+  return KindOf(st);
+}
+
+constexpr const char* kTempPrefix = ".brdf-";
+constexpr const char* kTempSuffix = ".tmp";
+
+// The writer's process id if `name` is a temporary file name of AtomicOutputPath (this version:
+// ".brdf-<pid>-<n>.tmp"; older ones: ".<final name>.tmp-<pid>-<n>"), else 0.
+long TemporaryOwner(const std::string& name) {
+  static const std::regex current(R"(^\.brdf-([0-9]{1,9})-[0-9]{1,20}\.tmp$)");
+  static const std::regex legacy(R"(^\..+\.tmp-([0-9]{1,9})-[0-9]{1,20}$)");
+  std::smatch m;
+  if (std::regex_match(name, m, current) || std::regex_match(name, m, legacy))
+    return std::stol(m[1].str());
+  return 0;
+}
+
+bool ProcessRuns(long pid) { return ::kill(static_cast<pid_t>(pid), 0) == 0 || errno == EPERM; }
+
 }  // namespace
+
+std::vector<std::string> RemoveStaleTemporaries(const std::string& dir) {
+  std::vector<std::string> removed;
+  std::error_code ec;
+  for (fs::directory_iterator it(dir.empty() ? "." : dir, ec), end; !ec && it != end;
+       it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    const long pid = TemporaryOwner(name);
+    if (pid <= 0 || pid == ::getpid() || ProcessRuns(pid)) continue;
+    std::error_code type_ec;
+    if (!it->is_regular_file(type_ec)) continue;
+    if (::unlink(it->path().c_str()) == 0) removed.push_back(it->path().string());
+  }
+  return removed;
+}
+
+OutputExistsError::OutputExistsError(std::vector<std::string> paths)
+    : IoError(ExistsMessage(paths)), paths_(std::move(paths)) {}
+
+std::vector<std::string> CheckWritableOutputs(const std::vector<std::string>& paths,
+                                              bool overwrite) {
+  std::vector<std::string> existing;
+  for (const std::string& p : paths) {
+    if (const std::string kind = NonRegularKind(p); !kind.empty())
+      throw IoError(p + ": exists and is " + kind + ", not a file; choose another output name");
+    std::error_code ec;
+    if (fs::exists(p, ec)) existing.push_back(p);
+  }
+  if (!existing.empty() && !overwrite) throw OutputExistsError(std::move(existing));
+  std::vector<std::string> removed;
+  std::set<std::string> folders;
+  for (const std::string& p : paths) {
+    const fs::path parent = fs::path(p).parent_path();
+    if (!folders.insert(parent.empty() ? "." : parent.string()).second) continue;
+    for (std::string& r : RemoveStaleTemporaries(parent.string())) removed.push_back(std::move(r));
+  }
+  return removed;
+}
 
 AtomicOutputPath::AtomicOutputPath(std::string final_path) : final_path_(std::move(final_path)) {
   static std::atomic<unsigned> counter{0};
   const fs::path p(final_path_);
   const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
-  temp_path_ = (dir / ("." + p.filename().string() + ".tmp-" + std::to_string(::getpid()) + "-" +
-                       std::to_string(counter++)))
+  temp_path_ = (dir / (std::string(kTempPrefix) + std::to_string(::getpid()) + "-" +
+                       std::to_string(counter++) + kTempSuffix))
                    .string();
 }
 
@@ -64,29 +148,98 @@ void WriteFileAtomically(const std::string& path, std::string_view bytes) {
   out.Commit();
 }
 
-std::vector<std::uint8_t> ReadFileBytes(const std::string& path, std::uint64_t max_bytes) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (f == nullptr) throw IoError(path + ": cannot open: " + ErrnoText());
-  struct Closer {
-    std::FILE* f;
-    ~Closer() { std::fclose(f); }
-  } closer{f};
-  if (std::fseek(f, 0, SEEK_END) != 0) throw IoError(path + ": cannot seek: " + ErrnoText());
-  const long size = std::ftell(f);
-  if (size < 0) throw IoError(path + ": cannot tell size: " + ErrnoText());
-  if (static_cast<std::uint64_t>(size) > max_bytes)
+int OpenRegularFile(const std::string& path, std::uint64_t* size_bytes) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC);
+  if (fd < 0) throw IoError(path + ": cannot open: " + ErrnoText());
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) {
+    const std::string why = ErrnoText();
+    ::close(fd);
+    throw IoError(path + ": cannot read its size: " + why);
+  }
+  if (!S_ISREG(st.st_mode)) {
+    ::close(fd);
+    throw IoError(path + ": is " + KindOf(st) + ", not a file");
+  }
+  const int flags = ::fcntl(fd, F_GETFL);
+  if (flags >= 0) ::fcntl(fd, F_SETFL, flags & ~O_NONBLOCK);
+  *size_bytes = static_cast<std::uint64_t>(st.st_size);
+  return fd;
+}
+
+void CheckRegularFile(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) {
+    if (errno == ENOENT || errno == ENOTDIR) throw IoError(path + ": no such file");
+    throw IoError(path + ": cannot access: " + ErrnoText());
+  }
+  if (!S_ISREG(st.st_mode)) throw IoError(path + ": is " + KindOf(st) + ", not a file");
+}
+
+namespace {
+
+// Reads exactly n bytes (fewer only at end of file); returns the count read. Throws IoError.
+std::size_t ReadUpTo(int fd, std::uint8_t* out, std::size_t n, const std::string& path) {
+  std::size_t done = 0;
+  while (done < n) {
+    const ssize_t got = ::read(fd, out + done, n - done);
+    if (got < 0 && errno == EINTR) continue;
+    if (got < 0) throw IoError(path + ": read failed: " + ErrnoText());
+    if (got == 0) break;
+    done += static_cast<std::size_t>(got);
+  }
+  return done;
+}
+
+struct FdCloser {
+  int fd;
+  ~FdCloser() { ::close(fd); }
+};
+
+void CheckSize(const std::string& path, std::uint64_t size, std::uint64_t max_bytes) {
+  if (size > max_bytes)
     throw FormatError(path, "file size", "at most " + std::to_string(max_bytes) + " bytes",
                       std::to_string(size) + " bytes");
-  std::rewind(f);
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> ReadFileBytes(const std::string& path, std::uint64_t max_bytes) {
+  std::uint64_t size = 0;
+  const FdCloser fd{OpenRegularFile(path, &size)};
+  CheckSize(path, size, max_bytes);
   std::vector<std::uint8_t> data(static_cast<std::size_t>(size));
-  if (!data.empty() && std::fread(data.data(), 1, data.size(), f) != data.size())
-    throw IoError(path + ": read failed: " + ErrnoText());
+  if (ReadUpTo(fd.fd, data.data(), data.size(), path) != data.size())
+    throw IoError(path + ": read failed: the file became shorter while it was read");
   return data;
 }
 
 std::string ReadFileText(const std::string& path, std::uint64_t max_bytes) {
   const auto bytes = ReadFileBytes(path, max_bytes);
   return std::string(bytes.begin(), bytes.end());
+}
+
+std::string ReadFileHead(const std::string& path, std::size_t max_bytes) {
+  std::uint64_t size = 0;
+  const FdCloser fd{OpenRegularFile(path, &size)};
+  std::string head(static_cast<std::size_t>(std::min<std::uint64_t>(size, max_bytes)), '\0');
+  head.resize(ReadUpTo(fd.fd, reinterpret_cast<std::uint8_t*>(head.data()), head.size(), path));
+  return head;
+}
+
+MappedFile::MappedFile(const std::string& path, std::uint64_t max_bytes) {
+  std::uint64_t size = 0;
+  const FdCloser fd{OpenRegularFile(path, &size)};
+  CheckSize(path, size, max_bytes);
+  if (size == 0) return;
+  void* p = ::mmap(nullptr, static_cast<std::size_t>(size), PROT_READ, MAP_PRIVATE, fd.fd, 0);
+  if (p == MAP_FAILED) throw IoError(path + ": cannot map the file: " + ErrnoText());
+  data_ = static_cast<const std::uint8_t*>(p);
+  size_ = static_cast<std::size_t>(size);
+}
+
+MappedFile::~MappedFile() {
+  if (data_ != nullptr) ::munmap(const_cast<std::uint8_t*>(data_), size_);
 }
 
 void ByteReader::Need(std::size_t n, std::string_view what) const {

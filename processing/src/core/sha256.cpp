@@ -1,6 +1,8 @@
 // SHA-256 as FIPS 180-4 §6.2 specifies it.
 #include "brdf/core/sha256.h"
 
+#include <unistd.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <cstdio>
@@ -8,6 +10,7 @@
 #include <vector>
 
 #include "brdf/core/error.h"
+#include "brdf/core/file_util.h"
 
 namespace brdf {
 namespace {
@@ -121,15 +124,20 @@ std::string Sha256Hex(const void* data, std::size_t size) {
 std::string Sha256Hex(std::string_view bytes) { return Sha256Hex(bytes.data(), bytes.size()); }
 
 std::string Sha256HexOfFile(const std::string& path) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (f == nullptr) throw IoError(path + ": cannot open: " + std::strerror(errno));
+  std::uint64_t size = 0;
+  const int fd = OpenRegularFile(path, &size);  // refuses FIFOs and devices, never blocks
   Sha256 sha;
   std::vector<char> chunk(1 << 20);
-  std::size_t n;
-  while ((n = std::fread(chunk.data(), 1, chunk.size(), f)) > 0) sha.Update(chunk.data(), n);
-  const bool failed = std::ferror(f) != 0;
-  std::fclose(f);
-  if (failed) throw IoError(path + ": read failed");
+  ssize_t n;
+  while ((n = ::read(fd, chunk.data(), chunk.size())) != 0) {
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) {
+      ::close(fd);
+      throw IoError(path + ": read failed: " + std::strerror(errno));
+    }
+    sha.Update(chunk.data(), static_cast<std::size_t>(n));
+  }
+  ::close(fd);
   return Hex(sha.Finish());
 }
 

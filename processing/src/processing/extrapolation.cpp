@@ -45,19 +45,21 @@ constexpr std::uint64_t kMaxJsonBytes = 1u << 20;
 void ExtrapolationParams::Validate() const {
   if (!(std::isfinite(p) && p >= 0.0))
     throw InvalidArgument(
-        "extrapolation parameter p must be a finite number >= 0 (DESIGN §6), got " + Num(p));
+        "extrapolation parameter p must be a finite number >= 0 (docs/design.md §6), got " +
+        Num(p));
   if (!(l >= 0.0 && l <= 1.0))
-    throw InvalidArgument("extrapolation parameter l must be in [0, 1] (DESIGN §6), got " + Num(l));
+    throw InvalidArgument("extrapolation parameter l must be in [0, 1] (docs/design.md §6), got " +
+                          Num(l));
 }
 
 double BezierB(double x, double l) {
   if (std::isnan(x)) throw InvalidArgument("BezierB: x must be a number in [0, 1], got NaN");
   if (!(l >= 0.0 && l <= 1.0))
-    throw InvalidArgument("BezierB: l must be in [0, 1] (DESIGN §6), got " + Num(l));
+    throw InvalidArgument("BezierB: l must be in [0, 1] (docs/design.md §6), got " + Num(l));
   x = std::clamp(x, 0.0, 1.0);
   if (x == 0.0) return 0.0;  // t = 0; also avoids 0/0 when l = 0
-  // Root of x(t) = (1 − 2l)t² + 2l·t in the conjugate form of DESIGN §6: well defined at l = ½
-  // where the quadratic degenerates, and l² + (1 − 2l)x ≥ min(l², (1 − l)²) ≥ 0 on [0, 1].
+  // Root of x(t) = (1 − 2l)t² + 2l·t in the conjugate form of docs/design.md §6: well defined at l
+  // = ½ where the quadratic degenerates, and l² + (1 − 2l)x ≥ min(l², (1 − l)²) ≥ 0 on [0, 1].
   const double t = std::clamp(x / (l + std::sqrt(l * l + (1.0 - 2.0 * l) * x)), 0.0, 1.0);
   return 2.0 * (1.0 - t) * t * (1.0 - l) + t * t;
 }

@@ -1,4 +1,4 @@
-# brdf::processing: resampling to the LUT grid (DESIGN §5), grazing extrapolation (DESIGN §6)
+# brdf::processing: resampling to the LUT grid (docs/design.md §5), grazing extrapolation (docs/design.md §6)
 # and the interpolated-capture BrdfSource. Fitting (Ceres) joins this target later.
 add_library(brdf_processing
   ${CMAKE_CURRENT_LIST_DIR}/extrapolation.cpp

@@ -46,7 +46,7 @@ std::vector<std::size_t> ThetaInOrder(const Measurement& m, bool uniform, double
   const auto fail = [&](const std::string& why) {
     throw InvalidArgument(Who(m) +
                           ": the LUT needs incidence angles θin,k = k·Δin starting at 0° "
-                          "(DESIGN §5), got θin = " +
+                          "(docs/design.md §5), got θin = " +
                           list + "°: " + why);
   };
   for (std::size_t k = 1; k < order.size(); ++k)
@@ -236,7 +236,7 @@ Lut BuildLut(const Measurement& measurement, const ExtrapolationParams& params,
   sin_t[0] = 0.0;
   sin_t[kH - 1] = 0.0;
 
-  // The texel's value from its outgoing direction (ω_out, θout, φout) per DESIGN §5 and §6.
+  // The texel's value from its outgoing direction (ω_out, θout, φout) per docs/design.md §5 and §6.
   const auto texel_value = [&](const internal::SliceInterpolator& slice, const Vec3& w_out,
                                double theta_out, double phi_out) {
     Rgb v;

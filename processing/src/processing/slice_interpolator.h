@@ -137,8 +137,8 @@ class SliceInterpolator {
   SliceResampleReport report_;
 };
 
-// Evaluates the DESIGN §6 model for one slice: interpolated inside [0, θb], extrapolated from
-// the horizon ring up to 90°, the 90° value beyond. `factor_90` is ExtrapolationFactor(90°).
+// Evaluates the docs/design.md §6 model for one slice: interpolated inside [0, θb], extrapolated
+// from the horizon ring up to 90°, the 90° value beyond. `factor_90` is ExtrapolationFactor(90°).
 inline Rgb SliceValue(const SliceInterpolator& slice, double theta_b_deg,
                       const ExtrapolationParams& params, double theta_out_deg, double phi_out_deg) {
   if (theta_out_deg <= theta_b_deg)

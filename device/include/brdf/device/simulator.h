@@ -69,7 +69,7 @@ struct InstrumentModel {
   double autorange_target_fraction = 0.8;  // of (full scale − dark)
 };
 
-// Every known model; the first is the reference instrument of DESIGN §1 (MiniDiff V2 class:
+// Every known model; the first is the reference instrument of docs/design.md §1 (MiniDiff V2 class:
 // θin ∈ {0, 20, 40, 60}°, θout 0–75°, φout 0–359° at 1°).
 std::span<const InstrumentModel> InstrumentModels();
 const InstrumentModel& ReferenceInstrument();

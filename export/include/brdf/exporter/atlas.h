@@ -1,4 +1,4 @@
-// Atlases: many materials in one texture for deferred renderers (DESIGN §5).
+// Atlases: many materials in one texture for deferred renderers (docs/design.md §5).
 //
 // Each θin slice of the atlas is a grid of Cm = ceil(√M) × Rm = ceil(M/Cm) cells of 361 × 181
 // texels; material m sits in column m mod Cm, row m div Cm, so its texel (i, j) of slice k is

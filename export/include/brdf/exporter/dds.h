@@ -1,4 +1,4 @@
-// DirectDraw Surface container for RGB9E5 LUTs and atlases (DESIGN §7).
+// DirectDraw Surface container for RGB9E5 LUTs and atlases (docs/design.md §7).
 //
 // Layout written (Microsoft "DDS" programming guide: DDS_HEADER, DDS_PIXELFORMAT,
 // DDS_HEADER_DXT10), all fields little-endian 32-bit:

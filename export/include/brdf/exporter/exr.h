@@ -50,7 +50,7 @@ struct ExrOptions {
 // Interleaved RGB floats, row-major, row 0 at the top.
 using FloatImage = image_io::RgbImage;
 
-// The DESIGN §5 composite of a LUT (722 × 362 for K = 4). Throws InvalidArgument for an
+// The docs/design.md §5 composite of a LUT (722 × 362 for K = 4). Throws InvalidArgument for an
 // unexportable LUT.
 FloatImage CompositeImage(const Lut& lut);
 // The inverse: the K slices back out of a composite image of the right size.

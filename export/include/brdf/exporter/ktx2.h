@@ -1,4 +1,4 @@
-// KTX 2.0 container for RGB9E5 LUTs and atlases (DESIGN §7).
+// KTX 2.0 container for RGB9E5 LUTs and atlases (docs/design.md §7).
 //
 // Layout written (KTX 2.0 specification, Khronos):
 //   identifier «KTX 20» (12 bytes), header (vkFormat 123 = VK_FORMAT_E5B9G9R9_UFLOAT_PACK32,

@@ -1,8 +1,8 @@
-// What an exported LUT says about itself, and the 2D layouts of DESIGN §5.
+// What an exported LUT says about itself, and the 2D layouts of docs/design.md §5.
 //
 // The same metadata goes into the JSON sidecar (sidecar.h), the KTX2 key/value data and the
-// EXR header attributes (DESIGN §7), so a texture found on its own still tells where it came
-// from, how to address it and whether its content is intact.
+// EXR header attributes (docs/design.md §7), so a texture found on its own still tells where it
+// came from, how to address it and whether its content is intact.
 #pragma once
 
 #include <optional>
@@ -11,7 +11,7 @@
 
 namespace brdf::exporter {
 
-// Grazing extrapolation parameters of DESIGN §6 used to fill θout between θb and 90°.
+// Grazing extrapolation parameters of docs/design.md §6 used to fill θout between θb and 90°.
 struct ExtrapolationInfo {
   double p = 1.0;           // value factor at 90° (1 = clamping)
   double l = 0.5;           // Bézier control abscissa in [0, 1] (0.5 = linear ramp)
@@ -24,7 +24,7 @@ struct TextureMetadata {
   // Absent when the values did not need extrapolating (an analytic material evaluated
   // everywhere).
   std::optional<ExtrapolationInfo> extrapolation;
-  // Fitted analytic models (DESIGN §9 material JSON objects, each a complete JSON text), if
+  // Fitted analytic models (docs/design.md §9 material JSON objects, each a complete JSON text), if
   // any. Written verbatim into the sidecar's "fitted_models" array; must be valid JSON.
   std::vector<std::string> fitted_models_json;
   // File names (no folder) of the other outputs of the same conversion ("gold.ktx2", ...),
@@ -47,14 +47,14 @@ struct GridLayout {
   int CellRow(int n) const { return n / columns; }
 };
 
-// C = ceil(√count) columns and R = ceil(count / C) rows (DESIGN §5: 4 slices → 2 × 2, 3 → 2 × 2,
-// 5 → 3 × 2). Computed in integers, so perfect squares are exact. Throws InvalidArgument for
+// C = ceil(√count) columns and R = ceil(count / C) rows (docs/design.md §5: 4 slices → 2 × 2, 3 → 2
+// × 2, 5 → 3 × 2). Computed in integers, so perfect squares are exact. Throws InvalidArgument for
 // count < 1.
 GridLayout SquareishGrid(int count);
 
-// The texel conventions of DESIGN §5, in words, for sidecars, manifests and shader snippets.
-// Centre-exact (ours): u = (φd/1° + 0.5)/361, v = (θd/1° + 0.5)/181, w = (θin/Δin + 0.5)/K
-// (with θin − θin,0 in place of θin when the first slice is not at 0°). In a shader
+// The texel conventions of docs/design.md §5, in words, for sidecars, manifests and shader
+// snippets. Centre-exact (ours): u = (φd/1° + 0.5)/361, v = (θd/1° + 0.5)/181, w = (θin/Δin +
+// 0.5)/K (with θin − θin,0 in place of θin when the first slice is not at 0°). In a shader
 // (ShaderSnippetGlsl), with ω_d = S(θin)·ω_out the view direction in the specular frame:
 //   float theta_d = degrees(acos(clamp(w_d.z, -1.0, 1.0)));
 //   float phi_d = degrees(atan(w_d.y, w_d.x)); if (phi_d < 0.0) phi_d += 360.0;

@@ -3,8 +3,8 @@
 // Texel (x, y, z) is words[(z·height + y)·width + x]; row y = 0 is the top row (θd = 0° for a
 // LUT), slice z = k is θin,k. This is the order both KTX2 (level 0 image) and DDS (volume
 // texture) store texels in, so the same bytes go into both files. For a single LUT
-// width = 361, height = 181, depth = K (DESIGN §5); an atlas of M materials has width Cm·361
-// and height Rm·181 (see atlas.h).
+// width = 361, height = 181, depth = K (docs/design.md §5); an atlas of M materials has width
+// Cm·361 and height Rm·181 (see atlas.h).
 #pragma once
 
 #include <cstddef>
@@ -28,7 +28,7 @@ struct PackedVolume {
   // The payload as stored in the files: each word little-endian, in Index order.
   std::string Bytes() const;
   // CRC-32 (IEEE 802.3, as zlib's crc32) of Bytes(): the content checksum written into the
-  // sidecar, the KTX2 metadata and the EXR header (DESIGN §7).
+  // sidecar, the KTX2 metadata and the EXR header (docs/design.md §7).
   std::uint32_t Crc32() const;
 };
 
@@ -41,7 +41,7 @@ PackedVolume PackLut(const Lut& lut);
 Lut UnpackLut(const PackedVolume& volume, std::vector<double> theta_in_deg);
 
 // Checks a LUT before export: K ≥ 1, texel array of K·181·361·3 floats, θin strictly
-// increasing and evenly spaced (the shader addresses slice k as θin/Δin, DESIGN §5).
+// increasing and evenly spaced (the shader addresses slice k as θin/Δin, docs/design.md §5).
 // Throws InvalidArgument saying what is wrong.
 void ValidateLutForExport(const Lut& lut);
 

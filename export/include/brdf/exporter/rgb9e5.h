@@ -1,4 +1,4 @@
-// RGB9E5: three 9-bit mantissas sharing one 5-bit exponent in 32 bits (DESIGN §7).
+// RGB9E5: three 9-bit mantissas sharing one 5-bit exponent in 32 bits (docs/design.md §7).
 //
 // This is the texel format of every exported LUT (KTX2 vkFormat 123
 // VK_FORMAT_E5B9G9R9_UFLOAT_PACK32, DXGI_FORMAT_R9G9B9E5_SHAREDEXP = 67), encoded exactly as

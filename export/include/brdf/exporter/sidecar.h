@@ -1,4 +1,4 @@
-// The JSON sidecar of an exported LUT (DESIGN §7).
+// The JSON sidecar of an exported LUT (docs/design.md §7).
 //
 // One small text file beside the textures that says what they hold: the source, the θin list,
 // the grid, both texel conventions (the centre-exact one we address texels with, and the
@@ -11,7 +11,7 @@
 // RGB9E5 payload bytes exactly as stored in the KTX2 level 0 image and the DDS data: 4 bytes
 // per texel, little-endian words, x fastest then y (rows, top first) then z (slices, θin
 // ascending). The payload size is recorded too: 361·181·K·4 bytes, 1,045,456 for K = 4
-// (DESIGN §5 prints 1,045,444, an arithmetic slip for the same product).
+// (docs/design.md §5).
 //
 // Example (abridged):
 //   { "kind": "brdf-lut-sidecar", "format_version": 1, "name": "gold", "source": "gold.bpc",

@@ -34,7 +34,7 @@ struct LoadedTexture {
   std::string sidecar_json;
   std::string atlas_manifest_json;
   // The θin list (degrees) from the embedded metadata or a sidecar found beside a DDS file;
-  // otherwise k·20° (DESIGN §5's Δin) with theta_in_from_metadata = false.
+  // otherwise k·20° (docs/design.md §5's Δin) with theta_in_from_metadata = false.
   std::vector<double> theta_in_deg;
   bool theta_in_from_metadata = false;
   // The decoded LUT when the texture is a single 361 × 181 × K LUT; empty (no slices) for an

@@ -5,7 +5,7 @@
 //   theta_in,phi_in,theta_out,phi_out,r,g,b,sigma_r,sigma_g,sigma_b,flags
 //   20,0,35,180,0.0912,0.0311,0.0208,0.0004,0.0002,0.0002,0
 //
-// Angles in degrees in our frame (DESIGN §4: z normal, directions away from the surface,
+// Angles in degrees in our frame (docs/design.md §4: z normal, directions away from the surface,
 // isotropic data with φin = 0); r, g, b are f_r in 1/sr, linear Rec.709, never multiplied by
 // cosθ. The header line is required; its columns may come in any order. Required columns:
 // theta_in, phi_in, theta_out, phi_out, r, g, b (the names may carry a "_deg" suffix:

@@ -13,10 +13,50 @@
 #include <string_view>
 #include <vector>
 
+#include "brdf/core/error.h"
+
 namespace brdf {
 
-// A temporary sibling of `final_path` ("dir/.name.tmp-<pid>-<n>"); removed by the destructor
-// unless Commit() renamed it into place.
+// The one overwrite rule of every command that writes a file (capture, import, export-csv,
+// convert, atlas, fit, preview): an output that already exists is replaced only when the user
+// said so (the tools' --force); an existing path that is not a regular file (a folder, a FIFO,
+// a device) is never replaced. Call it for every output before any work is done.
+//
+// Thrown when an output exists and overwriting was not allowed. The remedy is structured: the
+// caller knows the user can allow it (brdf's --force) and says so in its own words.
+class OutputExistsError : public IoError {
+ public:
+  explicit OutputExistsError(std::vector<std::string> paths);
+  // Every existing output (at least one), in the order checked.
+  const std::vector<std::string>& paths() const { return paths_; }
+
+ private:
+  std::vector<std::string> paths_;
+};
+
+// Checks `paths` (all the outputs of one command): throws OutputExistsError listing those that
+// exist when !overwrite, and IoError "<path>: exists and is a folder (or FIFO, device, ...), not
+// a file" for an existing non-regular path whatever `overwrite` says. Symbolic links are
+// followed (a link to a regular file counts as that file). Then removes the temporary files
+// that killed runs left in the outputs' folders (RemoveStaleTemporaries) and returns their
+// paths, for the caller to report.
+std::vector<std::string> CheckWritableOutputs(const std::vector<std::string>& paths,
+                                              bool overwrite);
+inline std::vector<std::string> CheckWritableOutput(const std::string& path, bool overwrite) {
+  return CheckWritableOutputs({path}, overwrite);
+}
+
+// Removes from `dir` the temporary files of AtomicOutputPath whose writing process no longer
+// runs (a run that was killed or lost power before renaming them into place), also those of
+// older versions of the toolchain (".<name>.tmp-<pid>-<n>"). Files of live processes, including
+// this one, are left alone. Returns the removed paths; errors are ignored (a file that cannot
+// be removed is simply not listed).
+std::vector<std::string> RemoveStaleTemporaries(const std::string& dir);
+
+// A temporary sibling of `final_path`, "dir/.brdf-<pid>-<n>.tmp": short whatever the final
+// name's length (a legal 255-byte file name must not fail for want of room), and naming the
+// writing process so the next run into the folder can remove it if the writer was killed
+// (RemoveStaleTemporaries). Removed by the destructor unless Commit() renamed it into place.
 class AtomicOutputPath {
  public:
   explicit AtomicOutputPath(std::string final_path);
@@ -37,10 +77,42 @@ class AtomicOutputPath {
 // Writes `bytes` to `path` atomically (temporary sibling, fsync, rename). Throws IoError.
 void WriteFileAtomically(const std::string& path, std::string_view bytes);
 
-// Reads a whole file; throws IoError if it cannot be read and FormatError if it is larger
-// than `max_bytes` (checked before allocating).
+// Every read of a named file goes through OpenRegularFile: the path is opened without blocking
+// (O_NONBLOCK, so a FIFO with no writer or a device cannot hang the caller) and refused with
+// IoError "<path>: is a FIFO (named pipe), not a file" (or a folder, a device, a socket) unless
+// it is a regular file. Returns a descriptor in blocking mode; `size_bytes` receives the size.
+// The caller closes it.
+int OpenRegularFile(const std::string& path, std::uint64_t* size_bytes);
+
+// Checks, without opening (stat(2) never blocks), that `path` names a regular file: throws
+// IoError "<path>: no such file" or "<path>: is a FIFO (named pipe), not a file" (a folder, a
+// device, a socket). For front ends that classify a path before reading it.
+void CheckRegularFile(const std::string& path);
+
+// Reads a whole file; throws IoError if it cannot be read or is not a regular file, and
+// FormatError if it is larger than `max_bytes` (checked before allocating).
 std::vector<std::uint8_t> ReadFileBytes(const std::string& path, std::uint64_t max_bytes);
 std::string ReadFileText(const std::string& path, std::uint64_t max_bytes);
+
+// At most the first `max_bytes` of a file (fewer if it is shorter), for content detection.
+std::string ReadFileHead(const std::string& path, std::size_t max_bytes);
+
+// A regular file mapped read-only into memory. Pages are read from disk only when touched, so
+// a parser that stops at the first bad chunk of a huge (or sparse) file costs memory for what
+// it looked at, not for the file's size. Throws like ReadFileBytes (size cap included).
+class MappedFile {
+ public:
+  MappedFile(const std::string& path, std::uint64_t max_bytes);
+  MappedFile(const MappedFile&) = delete;
+  MappedFile& operator=(const MappedFile&) = delete;
+  ~MappedFile();
+  const std::uint8_t* data() const { return data_; }
+  std::size_t size() const { return size_; }
+
+ private:
+  const std::uint8_t* data_ = nullptr;
+  std::size_t size_ = 0;
+};
 
 // Little-endian cursor over a byte buffer that knows the file name and its position, so every
 // read past the end or unexpected value becomes a FormatError naming both.

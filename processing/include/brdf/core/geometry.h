@@ -1,4 +1,4 @@
-// Local shading frame, directions and angles (DESIGN §4).
+// Local shading frame, directions and angles (docs/design.md §4).
 //
 // z is the surface normal; every direction points away from the surface; the spherical
 // direction is ω(θ, φ) = (sinθ cosφ, sinθ sinφ, cosθ). Functions here take and return radians
@@ -78,7 +78,7 @@ Vec3T<T> Reflect(const Vec3T<T>& l) {
   return {-l.x, -l.y, l.z};
 }
 
-// The specular frame of DESIGN §5: S(θm) = [[−cosθm, 0, −sinθm], [0, −1, 0],
+// The specular frame of docs/design.md §5: S(θm) = [[−cosθm, 0, −sinθm], [0, −1, 0],
 // [−sinθm, 0, cosθm]]. ω_d = S(θin)·ω_out maps the mirror direction (θin, φin + 180°) to the
 // pole. S is symmetric and orthogonal, so it is its own inverse: ω_out = S(θin)·ω_d.
 struct SpecularFrame {

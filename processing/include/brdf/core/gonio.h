@@ -4,10 +4,10 @@
 // The table (e.g. ../shared/brdf-data/goniometer-csv/test_brdf_viewer_2D_data.csv) is a CSV
 // with the header `Incident_angle,Measure_angle,<λ1>nm,...,<λn>nm` and one row per
 // (incidence, measurement angle). Values are a reflectance factor R = π·f_r (a perfect white
-// diffuser reads 1), so f_r = R/π in 1/sr (DESIGN §4).
+// diffuser reads 1), so f_r = R/π in 1/sr (docs/design.md §4).
 //
 // Geometry: the goniometer moves its detector in the plane of incidence. The incidence angle
-// is θin (light at φin = 0, DESIGN §4). The measurement angle a is the detector's polar
+// is θin (light at φin = 0, docs/design.md §4). The measurement angle a is the detector's polar
 // angle with a sign telling the side of the normal: a > 0 is the specular side (the
 // reflected beam leaves at a = +θin, and the real file's peaks sit exactly there), a < 0 is
 // the side of the light source. So θout = |a|, φout = 180° for a > 0 and 0° for a ≤ 0.

@@ -51,7 +51,7 @@ struct ImportOptions {
   bool allow_btdf = false;
 };
 
-// Reads `path` as a Measurement (f_r in 1/sr, linear Rec.709, our frame of DESIGN §4).
+// Reads `path` as a Measurement (f_r in 1/sr, linear Rec.709, our frame of docs/design.md §4).
 // kAuto detects the format with DetectImportFormat. For kRgl and kMerl it throws
 // InvalidArgument with RemedyKind::kCaptureEvaluable: those need a virtual capture
 // (CaptureNoiseFree in brdf/core/virtual_capture.h).

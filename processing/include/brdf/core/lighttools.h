@@ -80,7 +80,7 @@ struct LightToolsImportOptions {
 };
 
 // Front-side BRDF blocks become one slice per (AOI, POI), ascending AOI. With a single POI in
-// the file the data is stored isotropically: φin = 0 and φout = azimuth − POI (DESIGN §4);
+// the file the data is stored isotropically: φin = 0 and φout = azimuth − POI (docs/design.md §4);
 // with several, slice φin = POI and azimuths stay in the sample frame. PlaneSymmetrical files
 // get the mirror half (φ → 2·POI − φ) added. θout = radial; the θ = 0 sample appears once.
 // XYZ → linear Rec.709 (IEC 61966-2-1 matrix); Monochrome → grey. Back-side blocks are not

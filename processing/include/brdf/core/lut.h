@@ -1,4 +1,4 @@
-// The exported asset in memory: K slices of the specular-frame LUT of DESIGN §5.
+// The exported asset in memory: K slices of the specular-frame LUT of docs/design.md §5.
 //
 // Slice k holds f(θin,k, ω_out) sampled at texel centres (φd = i·1°, i = 0…360; θd = j·1°,
 // j = 0…180) of the specular frame S(θin,k); column 360 repeats column 0. Values are f_r in

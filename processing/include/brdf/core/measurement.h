@@ -4,7 +4,7 @@
 // captured with that light direction. Angles are stored in degrees exactly as the instrument
 // reports them (float32, so a .bpc round trip is bit-exact); values are f_r in 1/sr, linear
 // RGB, never multiplied by cosθ. Isotropic captures use φin = 0 (light in the +x half of the
-// xz-plane, DESIGN §4).
+// xz-plane, docs/design.md §4).
 #pragma once
 
 #include <array>

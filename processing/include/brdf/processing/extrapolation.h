@@ -1,4 +1,4 @@
-// Grazing-angle extrapolation: the restricted quadratic Bézier of DESIGN §6.
+// Grazing-angle extrapolation: the restricted quadratic Bézier of docs/design.md §6.
 //
 // A contact scatterometer measures outgoing polar angles only up to some θb (75° for the
 // reference instrument). The LUT needs values up to the horizon, so for every azimuth φout the
@@ -41,8 +41,9 @@ double BezierB(double x, double l);
 
 // The factor (1 − α) + α·p that multiplies f(θb) at outgoing polar angle `theta_out_deg`.
 // 1 for θout ≤ θb (inside the measured range); θout ≥ 90° gives the horizon factor p (below
-// the horizon the LUT repeats the horizon, DESIGN §5). If θb ≥ 90° nothing is extrapolated and
-// the factor is 1. Throws InvalidArgument for θb outside [0°, 90°], NaN θout, or invalid params.
+// the horizon the LUT repeats the horizon, docs/design.md §5). If θb ≥ 90° nothing is extrapolated
+// and the factor is 1. Throws InvalidArgument for θb outside [0°, 90°], NaN θout, or invalid
+// params.
 double ExtrapolationFactor(double theta_out_deg, double theta_b_deg,
                            const ExtrapolationParams& params);
 

@@ -4,7 +4,7 @@
 // the specular frame; this class still interpolates at fixed ω_out (see below).
 //
 // MeasurementBrdf interpolates the point cloud exactly as BuildLut (resample.h) does: within a
-// slice the same regular-grid or scattered interpolation over (θout, φout), the DESIGN §6
+// slice the same regular-grid or scattered interpolation over (θout, φout), the docs/design.md §6
 // extrapolation between θb and 90°. Across incidence angles it uses the slice whose θin equals
 // the light's polar angle (within 1e-6°), otherwise it interpolates linearly in θin between the
 // two neighbouring slices; outside the measured θin range it uses the nearest slice (no

@@ -1,4 +1,4 @@
-// Resampling a measurement point cloud into the exported LUT of DESIGN §5.
+// Resampling a measurement point cloud into the exported LUT of docs/design.md §5.
 //
 // BuildLut turns a Measurement (one slice of samples per incidence angle θin) into K
 // equirectangular slices of 361 × 181 texels in the specular frame of each θin. Texel (i, j)
@@ -6,7 +6,7 @@
 // (θd, φd) = (j·1°, i·1°); the outgoing direction is ω_out = S(θin,k)·ω_d (SpecularFrame in
 // brdf/core/geometry.h), with the light at (θin,k, φin = 0). Per texel:
 //   θout ≤ θb        interpolated from the slice's samples at (θout, φout);
-//   θb < θout ≤ 90°  DESIGN §6 extrapolation of the interpolated value at (θb, φout);
+//   θb < θout ≤ 90°  docs/design.md §6 extrapolation of the interpolated value at (θb, φout);
 //   θout > 90°       the value at θout = 90° with the same φout (edge extension); at the
 //                    nadir, where every φout meets, the mean of those values over φout.
 // θb is the largest θout among the valid samples of the whole measurement. Column 360 is a

@@ -7,6 +7,7 @@
 
 #include "brdf/core/csv.h"
 #include "brdf/core/error.h"
+#include "brdf/core/file_util.h"
 #include "brdf/core/gonio.h"
 #include "brdf/core/lighttools.h"
 #include "brdf/core/zemax.h"
@@ -110,15 +111,7 @@ ImportFormat DetectImportFormatFromHead(std::string_view head, std::uint64_t fil
 }
 
 std::string ReadDetectionHead(const std::string& path) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (f == nullptr) throw IoError(path + ": cannot open: " + std::strerror(errno));
-  std::string head(kImportDetectionBytes, '\0');
-  const std::size_t got = std::fread(head.data(), 1, head.size(), f);
-  const bool failed = std::ferror(f) != 0;
-  std::fclose(f);
-  if (failed) throw IoError(path + ": cannot read");
-  head.resize(got);
-  return head;
+  return ReadFileHead(path, kImportDetectionBytes);  // refuses FIFOs and folders, never blocks
 }
 
 ImportFormat DetectImportFormat(const std::string& path) {

@@ -2,7 +2,7 @@
 // goniometer tables). Private to brdf::core.
 //
 // Every failure is a FormatError naming the file, the 1-based line and what was expected and
-// found (DESIGN §4). Counts read from a file are bounded by what the rest of the file could
+// found (docs/design.md §4). Counts read from a file are bounded by what the rest of the file could
 // possibly hold, so a hostile "ScatterAzimuth 4000000000" is refused before anything is
 // allocated. Numbers must be finite; text that ends up in metadata must be valid UTF-8. Found
 // text is quoted through Printable() so a message never carries raw control bytes or broken

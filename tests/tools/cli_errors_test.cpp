@@ -1,0 +1,55 @@
+// Command-line mistakes give one line on stderr, like every other error, naming the option and
+// the value as typed, and exit code 2. The old messages were CLI11's: a second "Run ... --help"
+// line, and for --jobs 0 a range printed as two 309-digit numbers.
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "tool_test_util.h"
+
+namespace brdf::tooltest {
+namespace {
+
+class CliErrors : public ToolTest {};
+
+TEST_F(CliErrors, EveryParseErrorIsOneShortLineNamingOptionAndValue) {
+  struct Case {
+    std::string args;
+    std::vector<std::string> expected;
+  };
+  const std::vector<Case> cases = {
+      {"convert in --out o --jobs 0", {"brdf: convert: --jobs", "whole number >= 1", "'0'"}},
+      {"convert in --out o --jobs abc", {"--jobs", "'abc'"}},
+      {"convert in --out o --jobs 2.5", {"--jobs", "'2.5'"}},
+      {"atlas in --out o --jobs -1", {"brdf: atlas: --jobs", "'-1'"}},
+      {"convert in --out o --exr-compression foo", {"--exr-compression", "foo"}},
+      {"eval", {"brdf: eval: ", "file", "brdf eval --help"}},
+      {"nonsense", {"brdf"}},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.args);
+    const ToolRun r = Run(c.args);
+    EXPECT_EQ(r.exit_code, 2);
+    const std::vector<std::string> lines = r.ErrLines();
+    ASSERT_EQ(lines.size(), 1u) << r.err;
+    EXPECT_LT(lines[0].size(), 200u) << lines[0];
+    for (const std::string& e : c.expected)
+      EXPECT_NE(lines[0].find(e), std::string::npos) << lines[0] << " lacks " << e;
+  }
+}
+
+TEST_F(CliErrors, ConvertAndAtlasShareOneExrDefaultAndHelpText) {
+  const std::string convert = Run("convert --help").out, atlas = Run("atlas --help").out;
+  const auto line = [](const std::string& help) {
+    const std::size_t at = help.find("--exr-compression");
+    const std::size_t second = help.find('\n', help.find('\n', at) + 1);
+    return help.substr(at, second - at);  // the option line and its description
+  };
+  ASSERT_NE(convert.find("--exr-compression"), std::string::npos);
+  EXPECT_EQ(line(convert), line(atlas));
+  EXPECT_NE(line(convert).find("=none"), std::string::npos) << line(convert);
+}
+
+}  // namespace
+}  // namespace brdf::tooltest
