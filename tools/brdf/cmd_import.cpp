@@ -20,6 +20,7 @@
 #include "brdf/core/rgl.h"
 #include "cli_support.h"
 #include "commands.h"
+#include "evaluable_capture.h"
 
 namespace brdf::cli {
 
@@ -30,6 +31,8 @@ namespace {
 constexpr double kReferenceThetaInDeg[] = {0, 20, 40, 60};
 constexpr int kReferenceThetaOutMaxDeg = 75;
 constexpr int kReferencePhiOutCount = 360;
+
+}  // namespace
 
 // Evaluable formats (RGL, MERL) hold a BRDF, not samples: the .bpc is a virtual, noise-free
 // capture of it at the reference geometry, f_r = source.Eval(wi, wo) per sample (what
@@ -77,8 +80,6 @@ Measurement CaptureEvaluable(const std::string& path, ImportFormat format) {
   }
   return m;
 }
-
-}  // namespace
 
 int RunImport(const ImportOptions& options) {
   const ImportFormat requested = ImportFormatFromName(options.format);

@@ -10,3 +10,6 @@ target_sources(brdf PRIVATE
   brdf/sources.cpp
 )
 target_link_libraries(brdf PRIVATE brdf::processing brdf::exporter TBB::tbb Threads::Threads)
+# brdf fit (Ceres through brdf::fit only)
+target_sources(brdf PRIVATE brdf/cmd_fit.cpp)
+target_link_libraries(brdf PRIVATE brdf::fit)

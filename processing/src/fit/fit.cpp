@@ -544,6 +544,8 @@ std::string FitReportJson(const FitReport& report) {
                    {"theta_out", report.excluded_theta_out}};
   j["representable"] = report.representable;
   j["chromaticity_error"] = report.chromaticity_error;
+  j["hue_spread"] = report.hue_spread;
+  j["colour_shift"] = report.colour_shift;
   j["warnings"] = report.warnings;
   j["software_version"] = SoftwareVersion();
   return j.dump();

@@ -187,14 +187,52 @@ void FillErrors(const FitData& data, const Material& material, FitReport* report
     }
   }
   report->chromaticity_error = worst;
-  report->representable = worst <= 0.03;
-  if (!report->representable) {
+
+  // A hue that changes with angle beyond what a mix of two colours (a diffuse colour and a
+  // specular colour, the most any model here has) can make: the chromaticities of additive
+  // mixtures of two colours lie on one straight line, so the bins' measured chromaticities are
+  // fitted by a line (total least squares) and the largest distance from it is the spread.
+  std::vector<std::array<double, 3>> points;  // r, g chromaticity and luminance weight
+  for (std::size_t s = 0; s < n_slices; ++s) {
+    double slice_lum = 0;
+    for (const auto& b : bins[s]) slice_lum += luminance(b[0], b[1], b[2]);
+    if (!(slice_lum > 0)) continue;
+    for (const auto& b : bins[s]) {
+      const double lum = luminance(b[0], b[1], b[2]), sum = b[0] + b[1] + b[2];
+      if (lum >= 0.02 * slice_lum && sum > 0) points.push_back({b[0] / sum, b[1] / sum, 1.0});
+    }
+  }
+  double spread = 0;
+  if (points.size() >= 3) {
+    double mr = 0, mg = 0;
+    for (const auto& p : points) mr += p[0], mg += p[1];
+    mr /= static_cast<double>(points.size()), mg /= static_cast<double>(points.size());
+    double srr = 0, sgg = 0, srg = 0;
+    for (const auto& p : points) {
+      srr += (p[0] - mr) * (p[0] - mr), sgg += (p[1] - mg) * (p[1] - mg);
+      srg += (p[0] - mr) * (p[1] - mg);
+    }
+    const double angle = 0.5 * std::atan2(2 * srg, srr - sgg);  // principal direction
+    const double nx = -std::sin(angle), ny = std::cos(angle);   // its normal
+    for (const auto& p : points) spread = std::max(spread, std::fabs((p[0] - mr) * nx + (p[1] - mg) * ny));
+  }
+  report->hue_spread = spread;
+  report->colour_shift = spread > 0.02;
+  report->representable = !report->colour_shift && worst <= 0.05;
+  if (report->colour_shift) {
     char buf[400];
     std::snprintf(buf, sizeof buf,
-                  "the measured hue changes with angle in a way %s cannot follow (rg chromaticity "
-                  "differs by %.3f at %s): a colour-shifting finish (thin film, pearlescent or "
-                  "interference pigment)?",
-                  std::string(ModelName(material.model)).c_str(), worst, where.c_str());
+                  "the measured hue changes with angle beyond any mix of a diffuse and a specular "
+                  "colour (chromaticities up to %.3f off one line): a colour-shifting finish "
+                  "(thin film, interference or pearlescent pigment) that %s cannot represent",
+                  spread, std::string(ModelName(material.model)).c_str());
+    report->warnings.push_back(buf);
+  } else if (worst > 0.05) {
+    char buf[400];
+    std::snprintf(buf, sizeof buf,
+                  "the fit's hue differs from the measurement's by %.3f in rg chromaticity at %s: "
+                  "%s cannot follow how the colour changes with angle",
+                  worst, where.c_str(), std::string(ModelName(material.model)).c_str());
     report->warnings.push_back(buf);
   }
 }

@@ -93,9 +93,14 @@ struct FitReport {
   // False when the data has a feature the model cannot represent; `warnings` says which.
   bool representable = true;
   // Largest difference in rg chromaticity between measurement and fit over the (θin, θh)
-  // bins that carry at least 2 % of a slice's luminance: hue that changes with angle in a way
-  // the model cannot follow (colour-shifting films) makes this large. Warned above 0.03.
+  // bins (θh edges 0, 2, 5, 10, 20, 35, 60, 90°) that carry at least 2 % of a slice's
+  // luminance. Warned above 0.05.
   double chromaticity_error = 0;
+  // How far the measured chromaticities of those bins stray from one straight line in the rg
+  // plane (mixtures of two colours, a diffuse and a specular one, lie on a line). Above 0.02
+  // the hue changes with angle in a way no model here represents: colour_shift, warned.
+  double hue_spread = 0;
+  bool colour_shift = false;
   std::vector<std::string> warnings;
 };
 
