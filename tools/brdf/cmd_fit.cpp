@@ -19,6 +19,7 @@
 #include "cli_support.h"
 #include "commands.h"
 #include "evaluable_capture.h"
+#include "fit_support.h"
 #include "sources.h"
 
 namespace brdf::cli {
@@ -61,6 +62,13 @@ std::string SliceErrors(const processing::FitReport& r) {
 }
 
 }  // namespace
+
+std::optional<AutoExtrapolationChoice> AutoExtrapolationFor(const std::string& path, FileKind kind) {
+  if (kind != FileKind::kCapture && kind != FileKind::kMaterial) return std::nullopt;
+  const PreparedMeasurement p = PrepareMeasurement(path, kind, std::nullopt);
+  const processing::AutoExtrapolationResult r = processing::ChooseExtrapolationAuto(p.measurement);
+  return AutoExtrapolationChoice{r.params, processing::AutoExtrapolationJson(r)};
+}
 
 int RunFit(const FitCommandOptions& options) {
   if (options.out.empty()) throw InvalidArgument("--out: an output file or folder is required");

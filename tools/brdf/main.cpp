@@ -181,7 +181,8 @@ int main(int argc, char** argv) {
   convert_cmd
       ->add_option("--extrapolate", convert.extrapolate,
                    "Grazing extrapolation P,L (DESIGN §6) for inputs without their own; "
-                   "default 1,0.5 (clamping)")
+                   "default 1,0.5 (clamping); 'auto' fits GGX to each input and chooses P,L "
+                   "that follow its fall-off to 90 deg (recorded in the sidecar)")
       ->capture_default_str();
   convert_cmd->add_option("--formats", convert.formats, "Comma-separated outputs to write")
       ->capture_default_str();
@@ -232,7 +233,8 @@ int main(int argc, char** argv) {
   atlas_cmd->add_option("--out", atlas.out, "Output prefix (PREFIX.ktx2, ...)")->required();
   atlas_cmd
       ->add_option("--extrapolate", atlas.extrapolate,
-                   "Grazing extrapolation P,L for inputs without their own; default 1,0.5")
+                   "Grazing extrapolation P,L for inputs without their own; default 1,0.5; "
+                   "'auto' fits GGX to each input and chooses P,L that follow its fall-off")
       ->capture_default_str();
   atlas_cmd->add_option("--exr-type", atlas.exr_type, "EXR pixel type: float or half")
       ->capture_default_str()

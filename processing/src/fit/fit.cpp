@@ -355,9 +355,9 @@ Refinement Refine(const std::vector<FitSample>& samples, const Material& start,
   so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
   so.max_num_iterations = options.max_iterations;
   so.num_threads = options.threads;
-  so.function_tolerance = 1e-12;
-  so.parameter_tolerance = 1e-12;
-  so.gradient_tolerance = 1e-14;
+  so.function_tolerance = 1e-10;
+  so.parameter_tolerance = 1e-10;
+  so.gradient_tolerance = 1e-12;
   so.logging_type = ceres::SILENT;
   so.minimizer_progress_to_stdout = false;
   ceres::Solver::Summary summary;
