@@ -105,8 +105,8 @@ ZemaxBsdf LafortuneTable(const Material& mat, bool plane_symmetric) {
     for (std::size_t a = 0; a < z.scatter_azimuth_deg.size(); ++a) {
       for (double rho : z.scatter_radial_deg) {
         const double c = std::cos(DegToRad(rho));
-        z.values[0].push_back(mat.Parameter(0)[0] / kPi + mat.Parameter(1)[0] * (mat.Parameter(2)[0] + 2) / (2 * kPi) *
-                                                    std::pow(c, mat.Parameter(2)[0]));
+        const double kd = mat.Parameter(0)[0], ks = mat.Parameter(1)[0], n = mat.Parameter(2)[0];
+        z.values[0].push_back(kd / kPi + ks * (n + 2) / (2 * kPi) * std::pow(c, n));
       }
     }
   }

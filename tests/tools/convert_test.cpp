@@ -201,11 +201,11 @@ TEST_F(ConvertedMaterials, LambertianLutHoldsExactlyTheQuantisedAlbedo) {
   // Every texel, extrapolated and below-horizon ones included, is RGB9E5(ρ/π).
   const Texture3d ktx2 = ReadKtx2Layout(Out("lambert.ktx2"));
   const Analytic m = Lambertian();
-  const double step = Rgb9e5Step(m.Parameter(0)[0] / kPi);
+  const double step = Rgb9e5Step(m.kd[0] / kPi);
   const std::uint32_t first = ktx2.Word(0, 0, 0);
   const auto q = DecodeRgb9e5Word(first);
   for (int c = 0; c < 3; ++c) {
-    EXPECT_NEAR(q[c], m.Parameter(0)[c] / kPi, 0.5 * step);
+    EXPECT_NEAR(q[c], m.kd[c] / kPi, 0.5 * step);
     EXPECT_DOUBLE_EQ(std::round(q[c] / step), q[c] / step) << "not on the RGB9E5 grid";
   }
   std::size_t differing = 0;
