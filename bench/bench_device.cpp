@@ -21,9 +21,9 @@ using namespace brdf::device;
 Material Gold() {
   Material m;
   m.model = Model::kGgx;
-  m.kd = {0, 0, 0};
-  m.ks = {0.962585, 0.786916, 0.408220};
-  m.shape = {0.15, 0.15, 0.15};
+  m.SetParameter(0, {0, 0, 0});
+  m.SetParameter(1, {0.962585, 0.786916, 0.408220});
+  m.SetParameter(2, {0.15, 0.15, 0.15});
   m.name = "gold";
   return m;
 }

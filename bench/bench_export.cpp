@@ -27,9 +27,9 @@ const Lut& GgxLut() {
   static const Lut lut = [] {
     Material m;
     m.model = Model::kGgx;
-    m.kd = {0.2, 0.15, 0.1};
-    m.ks = {0.9, 0.6, 0.3};
-    m.shape = {0.3, 0.3, 0.3};
+    m.SetParameter(0, {0.2, 0.15, 0.1});
+    m.SetParameter(1, {0.9, 0.6, 0.3});
+    m.SetParameter(2, {0.3, 0.3, 0.3});
     Lut l;
     l.Resize(4);
     l.theta_in_deg = {0, 20, 40, 60};

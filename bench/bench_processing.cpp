@@ -22,9 +22,9 @@ using brdf::processing::ResampleOptions;
 brdf::Material Ggx() {
   brdf::Material m;
   m.model = brdf::Model::kGgx;
-  m.kd = {0.1, 0.15, 0.2};
-  m.ks = {0.9, 0.6, 0.3};
-  m.shape = {0.3, 0.3, 0.3};
+  m.SetParameter(0, {0.1, 0.15, 0.2});
+  m.SetParameter(1, {0.9, 0.6, 0.3});
+  m.SetParameter(2, {0.3, 0.3, 0.3});
   return m;
 }
 

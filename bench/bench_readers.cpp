@@ -27,9 +27,9 @@ const std::string kGonio = kShared + "/goniometer-csv/test_brdf_viewer_2D_data.c
 Material Ggx() {
   Material m;
   m.model = Model::kGgx;
-  m.kd = {0.3, 0.15, 0.05};
-  m.ks = {0.04, 0.04, 0.04};
-  m.shape = {0.2, 0.2, 0.2};
+  m.SetParameter(0, {0.3, 0.15, 0.05});
+  m.SetParameter(1, {0.04, 0.04, 0.04});
+  m.SetParameter(2, {0.2, 0.2, 0.2});
   return m;
 }
 

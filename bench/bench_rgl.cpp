@@ -92,9 +92,9 @@ const std::string& MerlFile() {
         (std::filesystem::temp_directory_path() / "bench_rgl_synthetic.binary").string();
     Material m;
     m.model = Model::kGgx;
-    m.kd = {0.1, 0.2, 0.3};
-    m.ks = {0.04, 0.04, 0.04};
-    m.shape = {0.2, 0.2, 0.2};
+    m.SetParameter(0, {0.1, 0.2, 0.3});
+    m.SetParameter(1, {0.04, 0.04, 0.04});
+    m.SetParameter(2, {0.2, 0.2, 0.2});
     WriteMerlBinary(p, AnalyticBrdf(m));
     return p;
   }();
@@ -123,9 +123,9 @@ BENCHMARK(BM_MerlEval);
 void BM_MerlWrite(benchmark::State& state) {
   Material m;
   m.model = Model::kGgx;
-  m.kd = {0.1, 0.2, 0.3};
-  m.ks = {0.04, 0.04, 0.04};
-  m.shape = {0.2, 0.2, 0.2};
+  m.SetParameter(0, {0.1, 0.2, 0.3});
+  m.SetParameter(1, {0.04, 0.04, 0.04});
+  m.SetParameter(2, {0.2, 0.2, 0.2});
   const AnalyticBrdf source(m);
   for (auto _ : state) benchmark::DoNotOptimize(EncodeMerlBinary(source));
 }

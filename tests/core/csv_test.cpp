@@ -24,9 +24,9 @@ bool SameBits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 Measurement WardCapture(bool with_sigma) {
   Material mat;
   mat.model = Model::kWard;
-  mat.kd = {0.25, 0.18, 0.08};
-  mat.ks = {0.05, 0.05, 0.05};
-  mat.shape = {0.15, 0.15, 0.15};
+  mat.SetParameter(0, {0.25, 0.18, 0.08});
+  mat.SetParameter(1, {0.05, 0.05, 0.05});
+  mat.SetParameter(2, {0.15, 0.15, 0.15});
   Measurement m;
   m.metadata.sample_name = "ward, painted";
   m.metadata.operator_notes = "line one\nline two with a backslash \\ and = sign";

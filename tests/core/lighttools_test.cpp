@@ -21,9 +21,9 @@ fs::path TempDir(const std::string& name) { return brdf::test::NewTempDir("light
 Material GgxMaterial() {
   Material mat;
   mat.model = Model::kGgx;
-  mat.kd = {0.30, 0.12, 0.05};
-  mat.ks = {0.04, 0.04, 0.04};
-  mat.shape = {0.25, 0.25, 0.25};
+  mat.SetParameter(0, {0.30, 0.12, 0.05});
+  mat.SetParameter(1, {0.04, 0.04, 0.04});
+  mat.SetParameter(2, {0.25, 0.25, 0.25});
   return mat;
 }
 
@@ -98,7 +98,7 @@ TEST(LightTools, RgbRoundTripReproducesTheAnalyticMaterial) {
 
 TEST(LightTools, PlaneSymmetricMonochromeFileGetsItsMirrorHalf) {
   Material mat = GgxMaterial();
-  mat.kd = {0.3, 0.3, 0.3};
+  mat.SetParameter(0, {0.3, 0.3, 0.3});
   const LightToolsBsdf written = AnalyticTable(mat, LightToolsSpectral::kMonochrome, true, 0.0);
   const Measurement m = LightToolsToMeasurement(
       ParseLightToolsBsdf(FormatLightToolsBsdf(written), "sym.bsdf"), "sym.bsdf");

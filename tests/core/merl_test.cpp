@@ -234,7 +234,7 @@ TEST(MerlBrdf, FlagsNegativeValuesAsNotMeasured) {
 Material Lambert(Rgb rho) {
   Material m;
   m.model = Model::kLambert;
-  m.kd = rho;
+  m.SetParameter(0, rho);
   m.name = "lambert";
   return m;
 }
@@ -292,9 +292,9 @@ TEST(MerlRoundTrip, ReproducesAConstantBrdfExactlyWhereverTheBinCentreIsVisible)
 TEST(MerlRoundTrip, ReturnsTheAnalyticValueAtTheBinCentreForAGlossyMaterial) {
   Material ggx;
   ggx.model = Model::kGgx;
-  ggx.kd = {0.05, 0.10, 0.20};
-  ggx.ks = {0.04, 0.5, 0.9};  // f0
-  ggx.shape = {0.15, 0.15, 0.3};
+  ggx.SetParameter(0, {0.05, 0.10, 0.20});
+  ggx.SetParameter(1, {0.04, 0.5, 0.9});  // f0
+  ggx.SetParameter(2, {0.15, 0.15, 0.3});
   const AnalyticBrdf source(ggx);
   const MerlBrdf merl = FromString(EncodeMerlBinary(source), "ggx.binary");
   double worst_relative = 0;

@@ -14,9 +14,9 @@ namespace {
 Material Make(Model model, Rgb kd, Rgb ks, Rgb shape) {
   Material m;
   m.model = model;
-  m.kd = kd;
-  m.ks = ks;
-  m.shape = shape;
+  const Rgb parameters[] = {kd, ks, shape};
+  for (std::size_t i = 0; i < DescribeModel(model).parameters.size(); ++i)
+    m.SetParameter(static_cast<int>(i), parameters[i]);
   return m;
 }
 
@@ -138,11 +138,11 @@ TEST(MaterialJson, RoundTripsAndAcceptsScalarsForRgb) {
   const Material m = ParseMaterialJson(
       R"({"name":"x","model":"ggx","kd":[0.1,0.2,0.3],"f0":0.04,"alpha":0.3,"fit":{"rmse":1}})");
   EXPECT_EQ(m.model, Model::kGgx);
-  EXPECT_DOUBLE_EQ(m.ks[2], 0.04);
-  EXPECT_DOUBLE_EQ(m.shape[1], 0.3);
+  EXPECT_DOUBLE_EQ(m.Parameter(1)[2], 0.04);
+  EXPECT_DOUBLE_EQ(m.Parameter(2)[1], 0.3);
   const Material again = ParseMaterialJson(MaterialToJson(m));
-  EXPECT_EQ(again.kd, m.kd);
-  EXPECT_EQ(again.ks, m.ks);
+  EXPECT_EQ(again.Parameter(0), m.Parameter(0));
+  EXPECT_EQ(again.Parameter(1), m.Parameter(1));
   EXPECT_NE(MaterialToJson(again).find("\"fit\""), std::string::npos);
 }
 

@@ -107,8 +107,8 @@ ZemaxBsdf LafortuneTable(const Material& mat, bool plane_symmetric) {
     for (std::size_t a = 0; a < z.scatter_azimuth_deg.size(); ++a) {
       for (double rho : z.scatter_radial_deg) {
         const double c = std::cos(DegToRad(rho));
-        z.values[0].push_back(mat.kd[0] / kPi + mat.ks[0] * (mat.shape[0] + 2) / (2 * kPi) *
-                                                    std::pow(c, mat.shape[0]));
+        const double kd = mat.Parameter(0)[0], ks = mat.Parameter(1)[0], n = mat.Parameter(2)[0];
+        z.values[0].push_back(kd / kPi + ks * (n + 2) / (2 * kPi) * std::pow(c, n));
       }
     }
   }
@@ -118,9 +118,9 @@ ZemaxBsdf LafortuneTable(const Material& mat, bool plane_symmetric) {
 TEST(ZemaxImport, TableValuesLandAtTheirDirectionsInOurFrame) {
   Material mat;
   mat.model = Model::kLafortune;
-  mat.kd = {0.2, 0.2, 0.2};
-  mat.ks = {0.5, 0.5, 0.5};
-  mat.shape = {12, 12, 12};
+  mat.SetParameter(0, {0.2, 0.2, 0.2});
+  mat.SetParameter(1, {0.5, 0.5, 0.5});
+  mat.SetParameter(2, {12, 12, 12});
   for (bool sym : {true, false}) {
     const ZemaxBsdf written = LafortuneTable(mat, sym);
     const ZemaxBsdf z = ParseZemaxBsdf(FormatZemaxBsdf(written), "lafortune.bsdf");

@@ -79,8 +79,8 @@ TEST(MaterialLibrary, MetalF0FollowsFromPublishedOpticalConstants) {
     for (int c = 0; c < 3; ++c) {
       const double n = metal.n[c], k = metal.k[c];
       const double f0 = ((n - 1) * (n - 1) + k * k) / ((n + 1) * (n + 1) + k * k);
-      EXPECT_NEAR(m.ks[c], f0, 5e-7) << metal.name << " channel " << c;
-      EXPECT_EQ(m.kd[c], 0.0) << metal.name;
+      EXPECT_NEAR(m.Parameter(1)[c], f0, 5e-7) << metal.name << " channel " << c;
+      EXPECT_EQ(m.Parameter(0)[c], 0.0) << metal.name;
       EXPECT_DOUBLE_EQ(extra.at("source").at("n").at(c).get<double>(), n) << metal.name;
       EXPECT_DOUBLE_EQ(extra.at("source").at("k").at(c).get<double>(), k) << metal.name;
     }
@@ -93,8 +93,8 @@ TEST(MaterialLibrary, DielectricsOnBlackHaveFresnelF0OfTheirIndex) {
     const Material& m = library.at(name);
     const double f0 = ((ior - 1) / (ior + 1)) * ((ior - 1) / (ior + 1));
     for (int c = 0; c < 3; ++c) {
-      EXPECT_NEAR(m.ks[c], f0, 5e-7) << name;
-      EXPECT_EQ(m.kd[c], 0.0) << name << ": the black backing reflects nothing";
+      EXPECT_NEAR(m.Parameter(1)[c], f0, 5e-7) << name;
+      EXPECT_EQ(m.Parameter(0)[c], 0.0) << name << ": the black backing reflects nothing";
     }
   }
 }

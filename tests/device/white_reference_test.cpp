@@ -59,7 +59,7 @@ TEST(SpectralonWhiteReference, LibraryWhiteReferenceMaterialCarriesTheSameReflec
   const Material m = LoadMaterialFile(std::string(BRDF_SOURCE_DIR) +
                                       "/data-samples/materials/white_reference.json");
   EXPECT_EQ(m.model, Model::kLambert);
-  for (int c = 0; c < 3; ++c) EXPECT_EQ(m.kd[c], SpectralonWhiteReference().rho[c]);
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(m.Parameter(0)[c], SpectralonWhiteReference().rho[c]);
 }
 
 }  // namespace

@@ -46,9 +46,9 @@ inline Lut AnalyticLut(const Material& material, std::vector<double> theta_in_de
 inline Material Ggx03() {
   Material m;
   m.model = Model::kGgx;
-  m.kd = {0.2, 0.15, 0.1};
-  m.ks = {0.9, 0.6, 0.3};  // f0
-  m.shape = {0.3, 0.3, 0.3};
+  m.SetParameter(0, {0.2, 0.15, 0.1});
+  m.SetParameter(1, {0.9, 0.6, 0.3});  // f0
+  m.SetParameter(2, {0.3, 0.3, 0.3});
   m.name = "ggx03";
   return m;
 }
@@ -56,9 +56,9 @@ inline Material Ggx03() {
 inline Material Lafortune20() {
   Material m;
   m.model = Model::kLafortune;
-  m.kd = {0.3, 0.3, 0.3};
-  m.ks = {0.5, 0.4, 0.2};
-  m.shape = {20, 20, 20};
+  m.SetParameter(0, {0.3, 0.3, 0.3});
+  m.SetParameter(1, {0.5, 0.4, 0.2});
+  m.SetParameter(2, {20, 20, 20});
   m.name = "lafortune20";
   return m;
 }
@@ -66,7 +66,7 @@ inline Material Lafortune20() {
 inline Material Lambert(double rho) {
   Material m;
   m.model = Model::kLambert;
-  m.kd = {rho, rho * 0.5, rho * 0.25};
+  m.SetParameter(0, {rho, rho * 0.5, rho * 0.25});
   m.name = "lambert";
   return m;
 }

@@ -82,9 +82,9 @@ inline double FactorReference(double theta_deg, double theta_b_deg, double p, do
 inline Material MakeMaterial(Model model, Rgb kd, Rgb ks, Rgb shape) {
   Material m;
   m.model = model;
-  m.kd = kd;
-  m.ks = ks;
-  m.shape = shape;
+  const Rgb parameters[] = {kd, ks, shape};
+  for (std::size_t i = 0; i < DescribeModel(model).parameters.size(); ++i)
+    m.SetParameter(static_cast<int>(i), parameters[i]);
   return m;
 }
 inline Material Lambertian() { return MakeMaterial(Model::kLambert, {0.8, 0.5, 0.2}, {}, {}); }

@@ -31,9 +31,9 @@ bool SameBits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 Measurement AwkwardCapture() {
   Material mat;
   mat.model = Model::kLafortune;
-  mat.kd = {0.21, 0.34, 0.12};
-  mat.ks = {0.4, 0.35, 0.3};
-  mat.shape = {18, 22, 30};
+  mat.SetParameter(0, {0.21, 0.34, 0.12});
+  mat.SetParameter(1, {0.4, 0.35, 0.3});
+  mat.SetParameter(2, {18, 22, 30});
   Measurement m;
   m.metadata.sample_name = "tile, \"awkward\"";
   m.metadata.instrument_model = "MiniDiff V2 (simulated)";

@@ -46,17 +46,17 @@ bool SameBits(float a, float b) { return std::memcmp(&a, &b, sizeof a) == 0; }
 Material ColouredWard() {
   Material m;
   m.model = Model::kWard;
-  m.kd = {0.31, 0.17, 0.06};
-  m.ks = {0.08, 0.07, 0.05};
-  m.shape = {0.12, 0.15, 0.2};
+  m.SetParameter(0, {0.31, 0.17, 0.06});
+  m.SetParameter(1, {0.08, 0.07, 0.05});
+  m.SetParameter(2, {0.12, 0.15, 0.2});
   return m;
 }
 Material GreyWard() {
   Material m;
   m.model = Model::kWard;
-  m.kd = {0.4, 0.4, 0.4};
-  m.ks = {0.1, 0.1, 0.1};
-  m.shape = {0.2, 0.2, 0.2};
+  m.SetParameter(0, {0.4, 0.4, 0.4});
+  m.SetParameter(1, {0.1, 0.1, 0.1});
+  m.SetParameter(2, {0.2, 0.2, 0.2});
   return m;
 }
 

@@ -3,8 +3,9 @@
 
 The libraries a process really maps come from the dynamic loader itself: with LD_DEBUG=libs it
 prints "calling init: <path>" for every shared object it initialises, including those opened
-later with dlopen. A command fails this test when any of them is OpenImageIO, VTK or Ceres (or
-the libraries only they bring: OpenVDB, GDAL, glog). The detector is checked on a positive
+later with dlopen. A command fails this test when any of them is OpenImageIO or VTK (or the
+libraries only they bring: OpenVDB, GDAL). Ceres is linked directly: measured, it adds about
+11 ms and 3 MiB to a start (docs/benchmarks.md, "Start-up cost"), inside the budget. The detector is checked on a positive
 control: a program that reads an image through brdf::image_io must show OpenImageIO.
 
 Peak RSS (GNU time's %M, the child's ru_maxrss) of each non-image command must stay
@@ -20,7 +21,7 @@ import subprocess
 import sys
 import tempfile
 
-FORBIDDEN = re.compile(r"lib(OpenImageIO|vtk|ceres|openvdb|gdal|glog)[^/\s]*\.so")
+FORBIDDEN = re.compile(r"lib(OpenImageIO|vtk|openvdb|gdal)[^/\s]*\.so")
 MAX_RSS_KIB = 30 * 1024
 
 

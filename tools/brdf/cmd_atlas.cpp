@@ -20,6 +20,7 @@
 #include "cli_support.h"
 #include "commands.h"
 #include "progress.h"
+#include "fit_support.h"
 
 namespace brdf::cli {
 
@@ -28,7 +29,8 @@ namespace fs = std::filesystem;
 int RunAtlas(const AtlasOptions& options) {
   if (options.out.empty()) throw InvalidArgument("--out: an output prefix is required");
   std::optional<processing::ExtrapolationParams> extrapolate;
-  if (!options.extrapolate.empty())
+  const bool auto_extrapolate = options.extrapolate == "auto";  // fitted per input (brdf fit)
+  if (!options.extrapolate.empty() && !auto_extrapolate)
     extrapolate = processing::ParseExtrapolation(options.extrapolate);
   const exporter::ExrOptions exr_options =
       ParseExrOptions(options.exr_type, options.exr_compression);
@@ -67,7 +69,10 @@ int RunAtlas(const AtlasOptions& options) {
       found.inputs.size(), options.jobs,
       [&](std::size_t i, JobResult& result) {
         const BatchInput& in = found.inputs[i];
-        sources::InputLut built = sources::LutFromInput(in.path, in.kind, extrapolate, resample);
+        std::optional<processing::ExtrapolationParams> chosen = extrapolate;
+        if (auto_extrapolate)
+          if (const auto automatic = AutoExtrapolationFor(in.path, in.kind)) chosen = automatic->params;
+        sources::InputLut built = sources::LutFromInput(in.path, in.kind, chosen, resample);
         exporter::ValidateLutForExport(built.lut);
         result.warnings = std::move(built.warnings);
         luts[i] = std::move(built.lut);

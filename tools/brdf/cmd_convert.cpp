@@ -13,6 +13,7 @@
 #include <set>
 
 #include "batch.h"
+#include "fit_support.h"
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
 #include "brdf/exporter/lut_export.h"
@@ -95,7 +96,8 @@ int RunConvert(const ConvertOptions& options) {
   export_options.formats = exporter::ParseExportFormats(options.formats);
   export_options.exr = ParseExrOptions(options.exr_type, options.exr_compression);
   std::optional<processing::ExtrapolationParams> extrapolate;
-  if (!options.extrapolate.empty())
+  const bool auto_extrapolate = options.extrapolate == "auto";  // fitted per input (brdf fit)
+  if (!options.extrapolate.empty() && !auto_extrapolate)
     extrapolate = processing::ParseExtrapolation(options.extrapolate);
   if (options.jobs < 1)
     throw InvalidArgument("--jobs: expected at least 1, got " + std::to_string(options.jobs));
@@ -145,9 +147,14 @@ int RunConvert(const ConvertOptions& options) {
       found.inputs.size(), options.jobs,
       [&](std::size_t i, JobResult& result) {
         const BatchInput& in = found.inputs[i];
-        sources::InputLut built = sources::LutFromInput(in.path, in.kind, extrapolate, resample);
+        std::optional<processing::ExtrapolationParams> chosen = extrapolate;
+        std::optional<AutoExtrapolationChoice> automatic;
+        if (auto_extrapolate) automatic = AutoExtrapolationFor(in.path, in.kind);
+        if (automatic) chosen = automatic->params;
+        sources::InputLut built = sources::LutFromInput(in.path, in.kind, chosen, resample);
         result.warnings = std::move(built.warnings);
         exporter::TextureMetadata metadata;
+        if (automatic) metadata.fitted_models_json.push_back(automatic->record_json);
         metadata.name = in.name;
         metadata.source = in.path;
         metadata.extrapolation = built.extrapolation;

@@ -161,15 +161,12 @@ Json DescribeMaterial(const std::string& path) {
   j["file"] = path;
   j["format"] = "material";
   j["model"] = std::string(ModelName(material.model));
-  // The canonical form names the parameters as DESIGN §9 spells them (grey ones as a scalar);
-  // they are listed here as RGB triples in that order.
-  static const std::set<std::string> kParameterNames = {"rho", "kd",    "ks",    "n",
-                                                        "f0",  "alpha", "rho_d", "rho_s"};
-  const Json canonical = Json::parse(MaterialToJson(material));
+  // The parameters in the model's order (brdf/core/models.h): RGB ones as triples, scalar
+  // ones (the engine models' sliders) as numbers.
   Json parameters = Json::object();
-  for (const auto& [key, value] : canonical.items()) {
-    if (kParameterNames.count(key) == 0) continue;
-    parameters[key] = value.is_number() ? Json{value, value, value} : value;
+  for (const ParameterInfo& p : DescribeModel(material.model).parameters) {
+    const Rgb v = material.Parameter(std::string_view(p.name));
+    parameters[std::string(p.name)] = p.rgb ? Json{v[0], v[1], v[2]} : Json(v[0]);
   }
   j["name"] = material.name;
   j["description"] = material.description;
@@ -501,7 +498,8 @@ void PrintMaterialText(const Json& j) {
   if (!j["description"].get<std::string>().empty())
     std::printf("  description  %s\n", j["description"].get<std::string>().c_str());
   for (const auto& [key, value] : j["parameters"].items())
-    std::printf("  %-12s %s\n", key.c_str(), TripleText(value).c_str());
+    std::printf("  %-12s %s\n", key.c_str(),
+                value.is_array() ? TripleText(value).c_str() : Fixed(value).c_str());
   for (const auto& p : j["physical_problems"])
     std::printf("  not physical: %s\n", p.get<std::string>().c_str());
 }

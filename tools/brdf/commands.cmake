@@ -12,3 +12,6 @@ target_sources(brdf PRIVATE
 target_link_libraries(brdf PRIVATE brdf::processing brdf::exporter TBB::tbb Threads::Threads)
 # The input rules (what a file is, damaged captures, opening any source): brdf::sources.
 target_link_libraries(brdf PRIVATE brdf::sources)
+# brdf fit (Ceres through brdf::fit only)
+target_sources(brdf PRIVATE brdf/cmd_fit.cpp)
+target_link_libraries(brdf PRIVATE brdf::fit)

@@ -121,5 +121,21 @@ struct RepairOptions {
   bool force = false;  // overwrite an existing --out
 };
 int RunRepair(const RepairOptions& options);
+// `brdf fit`: analytic materials fitted to captures, material files or measured BRDFs
+// (brdf/processing/fit.h). One input and one model: --out is the material file to write;
+// otherwise --out is a folder receiving <input>.<model>.json for every input and model.
+struct FitCommandOptions {
+  std::vector<std::string> inputs;  // files and folders
+  std::string model = "ggx";        // a model name or "all"
+  std::string out;
+  std::string loss = "ngan";  // ngan, log, cbrt
+  bool robust = false;
+  double max_theta_out_deg = 0;  // 0: everything measured
+  int starts = 2;
+  int jobs = 1;
+  bool force = false;  // overwrite existing outputs
+  bool quiet = false;  // no progress on stderr
+};
+int RunFit(const FitCommandOptions& options);
 
 }  // namespace brdf::cli

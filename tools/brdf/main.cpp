@@ -223,7 +223,8 @@ int main(int argc, char** argv) {
   convert_cmd
       ->add_option("--extrapolate", convert.extrapolate,
                    "Grazing extrapolation P,L (docs/design.md §6) for inputs without their own; "
-                   "default 1,0.5 (clamping)")
+                   "default 1,0.5 (clamping); 'auto' fits GGX to each input and chooses P,L "
+                   "that follow its fall-off to 90 deg (recorded in the sidecar)")
       ->capture_default_str();
   convert_cmd->add_option("--formats", convert.formats, "Comma-separated outputs to write")
       ->capture_default_str();
@@ -272,7 +273,8 @@ int main(int argc, char** argv) {
   atlas_cmd->add_option("--out", atlas.out, "Output prefix (PREFIX.ktx2, ...)")->required();
   atlas_cmd
       ->add_option("--extrapolate", atlas.extrapolate,
-                   "Grazing extrapolation P,L for inputs without their own; default 1,0.5")
+                   "Grazing extrapolation P,L for inputs without their own; default 1,0.5; "
+                   "'auto' fits GGX to each input and chooses P,L that follow its fall-off")
       ->capture_default_str();
   atlas_cmd->add_option("--exr-type", atlas.exr_type, kExrTypeHelp)
       ->capture_default_str()
@@ -350,6 +352,54 @@ int main(int argc, char** argv) {
       "has no end chunk: resume it with the 'brdf capture' command that made the original, "
       "with --out set to the new file and --resume, to capture the missing slices.");
   repair_cmd->callback([&] { exit_code = brdf::cli::RunRepair(repair); });
+  // brdf fit
+  brdf::cli::FitCommandOptions fit;
+  auto* fit_cmd = app.add_subcommand(
+      "fit",
+      "Fit analytic BRDF models (lafortune, ggx, blinn-phong, ward, lambert) and the engines' "
+      "shading models (unreal-defaultlit, unity-hdrp-lit[-specular], unity-urp-lit[-specular]) "
+      "to captures, material files or measured BRDFs; writes material files with the fit "
+      "report under \"fit\"");
+  fit_cmd
+      ->add_option("inputs", fit.inputs,
+                   "Captures (.bpc), material files (.json), RGL .bsdf or MERL .binary files, or "
+                   "folders of them")
+      ->required();
+  fit_cmd
+      ->add_option("--model", fit.model,
+                   "lambert, lafortune, ggx, blinn-phong, ward, unreal-defaultlit, unity-hdrp-lit, "
+                   "unity-hdrp-lit-specular, unity-urp-lit, unity-urp-lit-specular, or all")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"lambert", "lafortune", "ggx", "blinn-phong", "ward",
+                             "unreal-defaultlit", "unity-hdrp-lit", "unity-hdrp-lit-specular",
+                             "unity-urp-lit", "unity-urp-lit-specular", "all"}));
+  fit_cmd->add_option("--out", fit.out,
+                      "Output material file (.json) for one input and one model; otherwise a "
+                      "folder receiving INPUT.MODEL.json (or FIT.MODEL.json beside a .json name "
+                      "with --model all)")
+      ->required();
+  fit_cmd
+      ->add_option("--loss", fit.loss,
+                   "ngan (cos-weighted L2 with solid-angle weights), log (ln(1 + f cos)), cbrt "
+                   "(cube roots)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"ngan", "log", "cbrt"}));
+  fit_cmd->add_flag("--robust", fit.robust, "Cauchy loss against outliers");
+  fit_cmd
+      ->add_option("--max-theta-out", fit.max_theta_out_deg,
+                   "Leave out samples beyond this theta_out (degrees); default: all measured")
+      ->check(CLI::Range(0.001, 90.0));
+  fit_cmd->add_option("--starts", fit.starts, "Sweep candidates refined by Ceres")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 100));
+  fit_cmd
+      ->add_option("--jobs", fit.jobs,
+                   "Threads: inputs fitted in parallel, or Ceres threads for a single input")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 256));
+  fit_cmd->add_flag("--force", fit.force, "Overwrite existing output files");
+  fit_cmd->add_flag("--quiet", fit.quiet, "No progress on stderr");
+  fit_cmd->callback([&] { exit_code = brdf::cli::RunFit(fit); });
 
   try {
     app.parse(argc, argv);

@@ -1,0 +1,213 @@
+// `brdf fit INPUT... --model M|all --out OUT [--loss ...] [--robust] [--max-theta-out DEG]
+// [--starts N] [--jobs N]`: every input becomes a measurement (captures through the LUT rule
+// for damaged files, material files captured noise-free on the reference geometry, RGL and MERL
+// files captured virtually as `brdf import` does), processing::FitMaterial fits each model, and
+// the result is written as a material file with the report under "fit". A comparison table
+// (model, RMSE per θin slice and overall, median relative error, seconds, and for engine models
+// what to type where) goes to stdout; progress and skipped inputs to stderr.
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "batch.h"
+#include "brdf/core/error.h"
+#include "brdf/core/file_util.h"
+#include "brdf/core/importers.h"
+#include "brdf/processing/fit.h"
+#include "cli_support.h"
+#include "commands.h"
+#include "fit_support.h"
+#include "brdf/sources/detect.h"
+#include "brdf/sources/open.h"
+
+namespace brdf::cli {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct FitInput {
+  std::string path;
+  std::string name;
+};
+
+bool IsEvaluableFile(const std::string& path) {
+  const std::string ext = LowerExtension(path);
+  return ext == ".bsdf" || ext == ".binary";
+}
+
+Measurement OpenForFit(const std::string& path, std::vector<std::string>* warnings) {
+  const sources::FileKind kind = sources::DetectFileKind(path);
+  sources::PreparedMeasurement p = sources::PrepareMeasurement(path, kind, std::nullopt);
+  for (std::string& w : p.warnings) warnings->push_back(std::move(w));
+  return std::move(p.measurement);
+}
+
+std::string SliceErrors(const processing::FitReport& r) {
+  std::string out;
+  char buf[64];
+  for (const processing::SliceFitError& s : r.slices) {
+    std::snprintf(buf, sizeof buf, "%s%g:%.3g", out.empty() ? "" : " ", s.theta_in_deg, s.rmse);
+    out += buf;
+  }
+  return out;
+}
+
+}  // namespace
+
+std::optional<AutoExtrapolationChoice> AutoExtrapolationFor(const std::string& path, sources::FileKind kind) {
+  if (kind != sources::FileKind::kCapture && kind != sources::FileKind::kMaterial)
+    return std::nullopt;
+  const sources::PreparedMeasurement p = sources::PrepareMeasurement(path, kind, std::nullopt);
+  const processing::AutoExtrapolationResult r = processing::ChooseExtrapolationAuto(p.measurement);
+  return AutoExtrapolationChoice{r.params, processing::AutoExtrapolationJson(r)};
+}
+
+int RunFit(const FitCommandOptions& options) {
+  if (options.out.empty()) throw InvalidArgument("--out: an output file or folder is required");
+  if (options.jobs < 1)
+    throw InvalidArgument("--jobs: expected at least 1, got " + std::to_string(options.jobs));
+  if (options.starts < 1)
+    throw InvalidArgument("--starts: expected at least 1, got " + std::to_string(options.starts));
+  if (options.max_theta_out_deg < 0 || options.max_theta_out_deg > 90)
+    throw InvalidArgument("--max-theta-out: expected an angle in (0, 90] degrees, got " +
+                          std::to_string(options.max_theta_out_deg));
+  std::vector<Model> models;
+  if (options.model == "all") {
+    for (Model m : AllModels()) models.push_back(m);
+  } else {
+    models.push_back(ModelFromName(options.model));
+  }
+  processing::FitOptions fit;
+  fit.loss = processing::FitLossFromName(options.loss);
+  fit.robust = options.robust;
+  if (options.max_theta_out_deg > 0) fit.max_theta_out_deg = options.max_theta_out_deg;
+  fit.starts = options.starts;
+
+  // Inputs: measured BRDF files (.bsdf, .binary) directly or from folders, everything else
+  // through the convert rules (captures and material files).
+  std::vector<FitInput> inputs;
+  std::vector<BatchFailure> failures;
+  std::vector<std::string> rest;
+  for (const std::string& arg : options.inputs) {
+    std::error_code ec;
+    if (fs::is_directory(arg, ec)) {
+      std::vector<std::string> evaluable;
+      for (const auto& e : fs::directory_iterator(arg, ec))
+        if (e.is_regular_file() && IsEvaluableFile(e.path().string()))
+          evaluable.push_back(e.path().string());
+      std::sort(evaluable.begin(), evaluable.end());
+      for (const std::string& f : evaluable) inputs.push_back({f, OutputNameOf(f)});
+      rest.push_back(arg);
+    } else if (IsEvaluableFile(arg)) {
+      inputs.push_back({arg, OutputNameOf(arg)});
+    } else {
+      rest.push_back(arg);
+    }
+  }
+  if (!rest.empty()) {
+    DiscoveredInputs found = DiscoverInputs(rest);
+    for (const BatchInput& in : found.inputs) inputs.push_back({in.path, in.name});
+    for (const BatchFailure& f : found.failures) {
+      // A folder holding only measured BRDF files is not a failure here.
+      std::error_code ec;
+      if (!fs::is_directory(f.path, ec)) failures.push_back(f);
+    }
+  }
+  if (inputs.empty() && failures.empty())
+    throw InvalidArgument("no captures, material files or measured BRDF files found in the inputs");
+
+  // Output names: one input and one model write --out itself.
+  const bool single = inputs.size() == 1 && failures.empty() && models.size() == 1;
+  auto output_of = [&](const FitInput& in, Model m) {
+    if (single) return options.out;
+    if (inputs.size() == 1 && LowerExtension(options.out) == ".json") {
+      const fs::path p(options.out);
+      return (p.parent_path() / (p.stem().string() + "." + std::string(ModelName(m)) + ".json"))
+          .string();
+    }
+    return (fs::path(options.out) / (in.name + "." + std::string(ModelName(m)) + ".json")).string();
+  };
+  if (single) {
+    CheckOutputPath(options.out, inputs.front().path, ".json", options.force);
+  } else if (!(inputs.size() == 1 && LowerExtension(options.out) == ".json")) {
+    std::error_code ec;
+    fs::create_directories(options.out, ec);
+    if (!fs::is_directory(options.out))
+      throw IoError(options.out + ": cannot create the output folder" +
+                    (ec ? ": " + ec.message() : std::string()));
+  }
+  for (const FitInput& in : inputs)
+    for (Model m : models) {
+      const std::string out = output_of(in, m);
+      std::error_code ec;
+      if (!options.force && fs::exists(out, ec))
+        throw InvalidArgument(out + ": already exists; pass --force to overwrite it");
+    }
+
+  for (const BatchFailure& f : failures)
+    std::fprintf(stderr, "%s: FAILED: %s\n", f.path.c_str(), f.reason.c_str());
+  const bool progress = !options.quiet && (inputs.size() > 1 || models.size() > 1);
+  // Inputs in parallel when there are several; Ceres' threads for a single input.
+  fit.threads = inputs.size() == 1 ? options.jobs : 1;
+  std::vector<std::vector<processing::FitResult>> results(inputs.size());
+  const std::vector<JobResult> jobs = RunJobs(
+      inputs.size(), inputs.size() == 1 ? 1 : options.jobs,
+      [&](std::size_t i, JobResult& job) {
+        const Measurement meas = OpenForFit(inputs[i].path, &job.warnings);
+        for (Model m : models) {
+          processing::FitOptions o = fit;
+          o.model = m;
+          processing::FitResult r = processing::FitMaterial(meas, o);
+          r.material.name = inputs[i].name;
+          WriteFileAtomically(output_of(inputs[i], m), MaterialToJson(r.material));
+          if (progress)
+            std::fprintf(stderr, "%s: %s fitted in %.2f s (%s)\n", inputs[i].path.c_str(),
+                         std::string(ModelName(m)).c_str(), r.report.seconds,
+                         r.report.status.c_str());
+          results[i].push_back(std::move(r));
+        }
+      },
+      [&](std::size_t i, const JobResult& job) {
+        for (const std::string& w : job.warnings) std::fprintf(stderr, "%s\n", w.c_str());
+        if (!job.ok)
+          std::fprintf(stderr, "%s: FAILED: %s\n", inputs[i].path.c_str(),
+                       ReasonWithoutPath(inputs[i].path, job.error).c_str());
+      });
+
+  const std::size_t total = inputs.size() + failures.size();
+  std::size_t fitted = 0;
+  for (std::size_t i = 0; i < inputs.size(); ++i) {
+    if (!jobs[i].ok) {
+      failures.push_back({inputs[i].path, ReasonWithoutPath(inputs[i].path, jobs[i].error)});
+      continue;
+    }
+    ++fitted;
+    std::printf("%s\n", inputs[i].path.c_str());
+    std::printf("  %-24s %-15s %-40s %10s %8s %7s\n", "model", "status", "rmse per theta_in (1/sr)",
+                "rmse", "med.rel", "seconds");
+    for (const processing::FitResult& r : results[i]) {
+      std::printf("  %-24s %-15s %-40s %10.4g %8.4f %7.2f\n",
+                  std::string(ModelName(r.material.model)).c_str(), r.report.status.c_str(),
+                  SliceErrors(r.report).c_str(), r.report.rmse, r.report.median_relative_error,
+                  r.report.seconds);
+      const std::string engine = EngineInstructions(r.material);
+      if (!engine.empty())
+        std::printf("    %s: %s\n", std::string(DescribeModel(r.material.model).engine).c_str(),
+                    engine.c_str());
+      for (const std::string& w : r.report.warnings)
+        std::printf("    warning: %s\n", w.c_str());
+    }
+    std::printf("  written: ");
+    for (std::size_t k = 0; k < models.size(); ++k)
+      std::printf("%s%s", k ? ", " : "", output_of(inputs[i], models[k]).c_str());
+    std::printf("\n");
+  }
+  if (total > 1 || !failures.empty())
+    std::printf("%s\n", BatchSummary("fitted", fitted, total, failures).c_str());
+  return failures.empty() ? 0 : 1;
+}
+
+}  // namespace brdf::cli
