@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <tuple>
 
 #include "brdf/core/error.h"
 #include "brdf/device/white_reference.h"
@@ -71,6 +72,55 @@ class LambertianPanel final : public BrdfSource {
 };
 
 }  // namespace
+
+bool FaultPlan::Has(FaultType type, std::uint64_t at) const {
+  return std::any_of(faults.begin(), faults.end(),
+                     [&](const Fault& f) { return f.type == type && f.at == at; });
+}
+
+bool FaultPlan::HasFirmwareFaults() const {
+  return std::any_of(faults.begin(), faults.end(),
+                     [](const Fault& f) { return f.type != FaultType::kEndpointHalt; });
+}
+
+FaultPlan ParseFaultPlan(std::string_view spec) {
+  static constexpr std::pair<std::string_view, FaultType> kNames[] = {
+      {"disconnect", FaultType::kDisconnect}, {"stall", FaultType::kStall},
+      {"timeout", FaultType::kTimeout},       {"corrupt", FaultType::kCorrupt},
+      {"duplicate", FaultType::kDuplicate},   {"reorder", FaultType::kReorder},
+      {"lamp", FaultType::kLampFailure},      {"contact", FaultType::kSampleContact},
+      {"overtemp", FaultType::kOverTemperature}, {"halt", FaultType::kEndpointHalt}};
+  std::string names;
+  for (const auto& [name, type] : kNames) names += (names.empty() ? "" : ", ") + std::string(name);
+  FaultPlan plan;
+  std::size_t start = 0;
+  while (start <= spec.size() && !spec.empty()) {
+    std::size_t end = spec.find(',', start);
+    if (end == std::string_view::npos) end = spec.size();
+    const std::string item(spec.substr(start, end - start));
+    const std::size_t colon = item.find(':');
+    const std::string kind = item.substr(0, colon);
+    const std::string value = colon == std::string::npos ? "" : item.substr(colon + 1);
+    const auto it = std::find_if(std::begin(kNames), std::end(kNames),
+                                 [&](const auto& k) { return k.first == kind; });
+    if (it == std::end(kNames))
+      throw InvalidArgument("simulated fault '" + item + "': expected NAME:N with NAME one of " +
+                            names);
+    std::uint64_t n = 0;
+    bool digits = !value.empty() && value.size() <= 18;
+    for (char c : value) {
+      digits = digits && c >= '0' && c <= '9';
+      if (digits) n = n * 10 + static_cast<std::uint64_t>(c - '0');
+    }
+    if (!digits || n == 0)
+      throw InvalidArgument("simulated fault '" + item +
+                            "': expected a frame number ≥ 1 after the colon, got '" + value + "'");
+    plan.faults.push_back({it->second, n});
+    start = end + 1;
+    if (end == spec.size()) break;
+  }
+  return plan;
+}
 
 std::span<const InstrumentModel> InstrumentModels() { return ModelTable(); }
 
@@ -157,28 +207,63 @@ std::size_t SimulatedFirmware::Transmit(std::span<std::uint8_t> out) {
 }
 
 void SimulatedFirmware::Send(MessageType type, const std::vector<std::uint8_t>& payload) {
-  if (!link_up_ || stalled_) return;
+  if (!link_up_ || stalled_ || hung_) return;
   ++frames_sent_;
   const FaultPlan& f = config_.faults;
-  if (f.disconnect_after_frames != 0 && frames_sent_ > f.disconnect_after_frames) {
+  const std::uint64_t n = frames_sent_;
+  if (f.Has(FaultType::kDisconnect, n)) {
     link_up_ = false;
     streaming_ = false;
     return;
   }
-  if (f.stall_after_frames != 0 && frames_sent_ > f.stall_after_frames) {
+  if (f.Has(FaultType::kStall, n)) {
     stalled_ = true;
     streaming_ = false;
     return;
   }
+  if (f.Has(FaultType::kTimeout, n)) {
+    hung_ = true;
+    streaming_ = false;
+    return;
+  }
+  for (const auto& [fault, code, text] :
+       {std::tuple{FaultType::kLampFailure, ErrorCode::kLampFailure,
+                   "lamp failure: the light source did not reach its set point"},
+        std::tuple{FaultType::kSampleContact, ErrorCode::kSampleNotInContact,
+                   "sample not in contact with the measurement port"},
+        std::tuple{FaultType::kOverTemperature, ErrorCode::kOverTemperature,
+                   "detector over temperature"}}) {
+    if (f.Has(fault, n)) {
+      streaming_ = false;
+      std::vector<std::uint8_t> bytes;
+      AppendFrame(bytes, static_cast<std::uint8_t>(MessageType::kError), sequence_++,
+                  EncodeError({code, type == MessageType::kRowData ||
+                                             type == MessageType::kSliceEnd
+                                         ? static_cast<std::uint8_t>(MessageType::kMeasureSlice)
+                                         : static_cast<std::uint8_t>(0),
+                               text}));
+      output_.insert(output_.end(), bytes.begin(), bytes.end());
+      return;
+    }
+  }
   std::vector<std::uint8_t> bytes;
   AppendFrame(bytes, static_cast<std::uint8_t>(type), sequence_++, payload);
-  if (f.corrupt_frame == frames_sent_) {
+  if (f.Has(FaultType::kCorrupt, n)) {
     // One flipped bit in the payload (or in the CRC of an empty frame): line noise.
     const std::size_t at =
         payload.empty() ? bytes.size() - 1 : kFrameHeaderBytes + payload.size() / 2;
     bytes[at] ^= 0x10;
   }
+  if (f.Has(FaultType::kReorder, n)) {
+    held_frame_ = std::move(bytes);
+    return;
+  }
   output_.insert(output_.end(), bytes.begin(), bytes.end());
+  if (f.Has(FaultType::kDuplicate, n)) output_.insert(output_.end(), bytes.begin(), bytes.end());
+  if (!held_frame_.empty() && !f.Has(FaultType::kReorder, n)) {
+    output_.insert(output_.end(), held_frame_.begin(), held_frame_.end());
+    held_frame_.clear();
+  }
 }
 
 void SimulatedFirmware::SendError(ErrorCode code, std::uint8_t request_type,
@@ -193,6 +278,10 @@ bool SimulatedFirmware::FindThetaIn(float theta_in_deg) const {
 
 void SimulatedFirmware::Handle(const Frame& frame) {
   const auto type = static_cast<MessageType>(frame.type);
+  if (hung_) {
+    if (type != MessageType::kAbort) return;
+    hung_ = false;  // the host's ABORT wakes a hung firmware
+  }
   if (streaming_) {
     if (type == MessageType::kAbort) {
       streaming_ = false;

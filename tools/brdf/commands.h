@@ -99,10 +99,12 @@ struct CaptureOptions {
   std::string operator_notes;
   bool resume = false;
   bool force = false;  // overwrite an existing file instead of refusing
+  // On --resume: measure new dark and white references instead of reusing the file's.
+  bool calibrate = false;
   bool quiet = false;
   std::string exposure = "auto";  // "auto" (per θout row), "auto-slice", or fixed milliseconds
-  // Faults the simulated instrument injects, for testing the recovery path:
-  // "disconnect:N", "stall:N", "corrupt:N" (N counts the instrument's frames), comma separated.
+  // Faults the simulated instrument injects, for testing the recovery path: NAME:N items,
+  // comma separated, every one applied (brdf/device/simulator.h ParseFaultPlan).
   std::string sim_fault;
 };
 int RunCapture(const CaptureOptions& options);

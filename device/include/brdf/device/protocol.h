@@ -213,6 +213,10 @@ enum class ErrorCode : std::uint16_t {
   kBadArgument = 3,  // e.g. a θin the instrument cannot set
   kBusy = 4,         // a slice is streaming; only kAbort is accepted
   kBadFrame = 5,     // the instrument received a damaged frame
+  // Instrument states that stop a measurement; the host cannot retry them away.
+  kLampFailure = 6,         // the light source failed or did not reach its set point
+  kSampleNotInContact = 7,  // the sample port sensor sees no sample seated
+  kOverTemperature = 8,     // the detector is above its operating temperature
 };
 
 struct ErrorReply {

@@ -76,13 +76,38 @@ const InstrumentModel& ReferenceInstrument();
 // Throws InvalidArgument listing the known names.
 const InstrumentModel& FindInstrumentModel(std::string_view model);
 
-// Faults to inject, for tests of the host's error handling. Frames are counted from 1 in the
-// order the firmware sends them; 0 disables a fault.
-struct FaultPlan {
-  std::uint64_t disconnect_after_frames = 0;  // the link drops after this many frames
-  std::uint64_t stall_after_frames = 0;       // the firmware stops answering after this many
-  std::uint64_t corrupt_frame = 0;            // this frame is sent with one payload bit flipped
+// Faults to inject, for tests of the host's error handling and for demos. Frames are counted
+// from 1 in the order the firmware sends them (retransmissions included).
+enum class FaultType {
+  kDisconnect,       // the link drops instead of sending frame N (unplugged cable)
+  kStall,            // the firmware stops answering before frame N, for good
+  kTimeout,          // frame N is not sent and the firmware hangs until it receives ABORT
+  kCorrupt,          // frame N is sent with one payload bit flipped (CRC mismatch)
+  kDuplicate,        // frame N is sent twice
+  kReorder,          // frames N and N+1 are sent in swapped order
+  kLampFailure,      // instead of frame N: ERROR lamp failure, and the scan stops
+  kSampleContact,    // instead of frame N: ERROR sample not in contact, and the scan stops
+  kOverTemperature,  // instead of frame N: ERROR over-temperature, and the scan stops
+  kEndpointHalt,     // transport level: the Nth bulk/interrupt IN transfer stalls (USB, HID)
 };
+
+struct Fault {
+  FaultType type = FaultType::kCorrupt;
+  std::uint64_t at = 0;  // frame number N (kEndpointHalt: IN transfer number N), ≥ 1
+};
+
+struct FaultPlan {
+  std::vector<Fault> faults;  // every one applies; several of one type are fine
+  bool empty() const { return faults.empty(); }
+  bool Has(FaultType type, std::uint64_t at) const;
+  // Firmware faults only (everything but kEndpointHalt).
+  bool HasFirmwareFaults() const;
+};
+
+// "disconnect:50,corrupt:30" → the plan. Names: disconnect, stall, timeout, corrupt, duplicate,
+// reorder, lamp, contact, overtemp, halt. Throws InvalidArgument naming the item and what was
+// expected.
+FaultPlan ParseFaultPlan(std::string_view spec);
 
 struct SimulatorConfig {
   InstrumentModel model = ReferenceInstrument();  // copy: adjust the geometry freely
@@ -153,6 +178,8 @@ class SimulatedFirmware {
   std::uint8_t sequence_ = 0;
   bool link_up_ = true;
   bool stalled_ = false;
+  bool hung_ = false;  // kTimeout: silent until ABORT
+  std::vector<std::uint8_t> held_frame_;  // kReorder: frame N, sent after frame N+1
   ExposureSetting exposure_;
   std::mt19937_64 rng_;
   std::normal_distribution<double> normal_;
