@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <chrono>
+#include <thread>
 #include <tuple>
 
 #include "brdf/core/error.h"
@@ -489,6 +491,8 @@ SimulatedFirmware::Reading SimulatedFirmware::Read(const std::array<double, 3>& 
 }
 
 void SimulatedFirmware::PrepareRow(std::size_t row) {
+  if (config_.pace_ms_per_row > 0)
+    std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(config_.pace_ms_per_row));
   std::vector<std::array<double, 3>> rates;
   const std::array<double, 3> brightest = RowRates(row, &rates);
   row_exposure_ms_ = exposure_.mode == ExposureMode::kAutoPerRow ? AutoExposure(MaxOf(brightest))

@@ -5,6 +5,7 @@
 // umockdev is not active FAILS rather than skipping.
 #include <gtest/gtest.h>
 #include <stdlib.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <filesystem>
@@ -82,6 +83,59 @@ INSTANTIATE_TEST_SUITE_P(Transports, UsbCapture,
                            return param_info.param == UsbPersonality::kBulk ? "Libusb"
                                                                             : "Hidapi";
                          });
+
+// ---- The tool against an emulated instrument -------------------------------------------
+// The emulated device lives in this process; the brdf child process inherits umockdev's
+// environment (preload library and testbed), so it finds the device on "its" USB bus.
+
+std::string RunTool(const std::string& args, int* exit_code) {
+  std::string out;
+  std::FILE* pipe = ::popen((std::string(BRDF_TOOL) + " " + args + " 2>&1").c_str(), "r");
+  if (pipe == nullptr) return out;
+  char buf[4096];
+  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, pipe)) > 0;) out.append(buf, n);
+  const int status = ::pclose(pipe);
+  *exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return out;
+}
+
+TEST_P(UsbCapture, DevicesListsTheInstrumentAndCaptureOpensItByVidPidSerial) {
+  int code = -1;
+  EXPECT_NE(RunTool("devices", &code).find("no instruments found"), std::string::npos);
+  SimulatorConfig c = Config(LibraryMaterial("gold"), 1, 15, 15);
+  c.serial = "SN-4711";
+  EmulatedUsbInstrument emu(c, GetParam());
+  const bool usb = GetParam() == UsbPersonality::kBulk;
+  const std::string json = RunTool("devices --json", &code);
+  EXPECT_EQ(code, 0) << json;
+  EXPECT_NE(json.find(usb ? "\"interface\": \"usb\"" : "\"interface\": \"hid\""),
+            std::string::npos)
+      << json;
+  EXPECT_NE(json.find("\"serial\": \"SN-4711\""), std::string::npos) << json;
+  EXPECT_NE(json.find("\"firmware\": \"" + c.model.firmware_version + "\""),
+            std::string::npos)
+      << json;
+  const std::string text = RunTool("devices", &code);
+  EXPECT_NE(text.find(std::string(usb ? "usb" : "hid") + ":1209:" + (usb ? "b7d1" : "b7d2") +
+                      ":SN-4711"),
+            std::string::npos)
+      << text;
+
+  char tmpl[] = "/tmp/brdf_usb_cli_XXXXXX";
+  ASSERT_NE(::mkdtemp(tmpl), nullptr);
+  const std::string out = std::string(tmpl) + "/real.bpc";
+  const std::string spec = std::string(usb ? "usb" : "hid") + ":1209:" +
+                           (usb ? "b7d1" : "b7d2") + ":SN-4711";
+  const std::string wrong = RunTool("capture --device " + spec + "0 --sample s --out " + out, &code);
+  EXPECT_EQ(code, 1) << wrong;
+  EXPECT_NE(wrong.find("SN-47110"), std::string::npos) << wrong;
+  const std::string log = RunTool("capture --device " + spec + " --sample s --out " + out, &code);
+  EXPECT_EQ(code, 0) << log;
+  const Measurement m = LoadBpc(out);
+  EXPECT_EQ(m.metadata.instrument_serial, "SN-4711");
+  EXPECT_EQ(m.slices.size(), 4u);
+  std::filesystem::remove_all(tmpl);
+}
 
 // ---- Faults over every transport ---------------------------------------------------------
 

@@ -1,6 +1,9 @@
 // `brdf capture`: drives a scatterometer through a whole capture and appends each completed
 // slice to a .bpc file, so an interrupted capture keeps what it measured and can be resumed.
+#include <signal.h>
+
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -15,6 +18,8 @@
 #include "brdf/core/error.h"
 #include "brdf/device/capture_session.h"
 #include "brdf/device/driver.h"
+#include "brdf/device/emulated_usb.h"
+#include "brdf/device/usb_models.h"
 #include "brdf/device/simulator.h"
 #include "brdf/device/transport.h"
 #include "cli_support.h"
@@ -60,11 +65,6 @@ device::ExposureSetting ParseExposure(const std::string& text) {
 }
 
 void Validate(const CaptureOptions& o) {
-  if (o.device != "sim")
-    throw InvalidArgument(
-        "--device: only 'sim' (the simulated scatterometer) is available in "
-        "this build, got '" +
-        o.device + "'");
   if (o.sample.empty()) throw InvalidArgument("--sample: a sample name is required");
   if (o.out.empty()) throw InvalidArgument("--out: an output .bpc path is required");
   if (LowerExtension(o.out) != ".bpc")
@@ -121,6 +121,31 @@ std::string Eta(double seconds) {
   return buf;
 }
 
+// Ctrl-C and SIGTERM ask the session to abort the scan; a second signal is not special (the
+// abort itself is bounded by the reply timeout).
+std::atomic<bool> g_cancel{false};
+extern "C" void OnSignal(int) { g_cancel.store(true); }
+
+class SignalScope {
+ public:
+  SignalScope() {
+    struct sigaction sa {};
+    sa.sa_handler = OnSignal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, &old_int_);
+    sigaction(SIGTERM, &sa, &old_term_);
+  }
+  ~SignalScope() {
+    sigaction(SIGINT, &old_int_, nullptr);
+    sigaction(SIGTERM, &old_term_, nullptr);
+  }
+  SignalScope(const SignalScope&) = delete;
+  SignalScope& operator=(const SignalScope&) = delete;
+
+ private:
+  struct sigaction old_int_ {}, old_term_ {};
+};
+
 // The session's next step in this tool's words (options by their flag names).
 std::string Advice(const device::CaptureSessionResult& r, const std::string& out) {
   using device::NextStep;
@@ -163,6 +188,21 @@ std::string ProblemAdvice(device::InstrumentProblem p) {
 
 int RunCapture(const CaptureOptions& o) {
   Validate(o);
+  device::DeviceSpec spec;
+  device::SimLink sim_link = device::SimLink::kLoopback;
+  try {
+    spec = device::ParseDeviceSpec(o.device);
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument(std::string("--device: ") + e.what());
+  }
+  try {
+    sim_link = device::ParseSimLink(o.transport);
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument(std::string("--transport: ") + e.what());
+  }
+  const bool sim = spec.kind == device::DeviceSpec::Kind::kSim;
+  if (!sim && (o.transport != "loopback" || !o.sim_fault.empty()))
+    throw InvalidArgument("--transport and --sim-fault apply to --device sim only");
   device::FaultPlan faults;
   try {
     faults = device::ParseFaultPlan(o.sim_fault);
@@ -170,8 +210,11 @@ int RunCapture(const CaptureOptions& o) {
     throw InvalidArgument(std::string("--sim-fault: ") + e.what());
   }
   const device::ExposureSetting exposure = ParseExposure(o.exposure);
-  const std::string material_path = ResolveMaterial(o.material);
-  std::shared_ptr<const BrdfSource> source = OpenBrdfSource(material_path);
+  if (sim && o.material.empty())
+    throw InvalidArgument("--material: the simulated instrument needs a virtual sample");
+  const std::string material_path = sim ? ResolveMaterial(o.material) : std::string();
+  std::shared_ptr<const BrdfSource> source =
+      sim ? OpenBrdfSource(material_path) : std::shared_ptr<const BrdfSource>();
 
   // The simulated instrument: the reference model with the requested light-arm positions and
   // detector steps (a real instrument reports its own and refuses what it cannot do).
@@ -184,8 +227,9 @@ int RunCapture(const CaptureOptions& o) {
   config.model.theta_out_max_deg = static_cast<float>(o.theta_out_max_deg);
   config.model.theta_out_step_deg = static_cast<float>(o.theta_out_step_deg);
   config.model.phi_out_step_deg = static_cast<float>(o.phi_out_step_deg);
-  device::SimulatedFirmware firmware(config);
-  device::LoopbackTransport link(firmware);
+  config.pace_ms_per_row = o.sim_pace_ms;
+  const std::unique_ptr<device::InstrumentLink> link =
+      device::OpenInstrumentLink(spec, config, sim_link);
 
   device::CaptureRequest request;
   request.out_path = o.out;
@@ -193,8 +237,12 @@ int RunCapture(const CaptureOptions& o) {
   request.exposure = exposure;
   request.sample_name = o.sample;
   request.operator_notes = o.operator_notes;
-  request.settings = SettingsOf(o, source->Name());
-  request.notes["material_file"] = material_path;
+  if (sim) {
+    request.settings = SettingsOf(o, source->Name());
+    request.notes["material_file"] = material_path;
+  } else {
+    request.settings["device"] = o.device;
+  }
   request.resume = o.resume;
   request.force = o.force;
   request.calibrate = o.calibrate;
@@ -234,7 +282,12 @@ int RunCapture(const CaptureOptions& o) {
     std::fprintf(stderr, "%s\n", line.c_str());
   };
 
-  const device::CaptureSessionResult r = device::RunCaptureSession(request, link, events);
+  device::CaptureSessionResult r;
+  {
+    g_cancel.store(false);
+    SignalScope signals;
+    r = device::RunCaptureSession(request, link->transport(), events, &g_cancel);
+  }
   switch (r.outcome) {
     case device::CaptureOutcome::kFinished:
       if (!o.quiet)

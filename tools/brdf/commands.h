@@ -86,7 +86,12 @@ struct ExportCsvOptions {
 int RunExportCsv(const ExportCsvOptions& options);
 
 struct CaptureOptions {
+  // "sim", "usb[:VID:PID[:SERIAL]]" or "hid[:VID:PID[:SERIAL]]" (brdf/device/usb_models.h).
   std::string device = "sim";
+  // How --device sim is connected: "loopback" (in-process), "usb" or "hid" (the simulated
+  // firmware behind real libusb / hidapi through umockdev; run under umockdev-wrapper).
+  std::string transport = "loopback";
+  double sim_pace_ms = 0;  // testing: real time per θout row of the simulated firmware
   std::string material;  // library name or file
   std::string sample;    // sample name recorded in the metadata
   std::string out;       // .bpc path
@@ -108,5 +113,11 @@ struct CaptureOptions {
   std::string sim_fault;
 };
 int RunCapture(const CaptureOptions& options);
+
+// `brdf devices`: instruments found over USB and HID.
+struct DevicesOptions {
+  bool json = false;
+};
+int RunDevices(const DevicesOptions& options);
 
 }  // namespace brdf::cli

@@ -96,12 +96,21 @@ int main(int argc, char** argv) {
       "Capture a sample slice by slice with a scatterometer into a .bpc file (each completed "
       "slice is saved at once; --resume continues an interrupted capture)");
   capture_cmd
-      ->add_option("--device", capture.device, "Instrument: sim (the simulated scatterometer)")
+      ->add_option("--device", capture.device,
+                   "Instrument: sim (the simulated scatterometer), usb[:VID:PID[:SERIAL]] "
+                   "(vendor bulk interface, libusb) or hid[:VID:PID[:SERIAL]] (HID reports, "
+                   "hidapi); IDs in hexadecimal, the first instrument found when omitted")
+      ->capture_default_str();
+  capture_cmd
+      ->add_option("--transport", capture.transport,
+                   "How --device sim is connected: loopback (in-process), usb or hid (the "
+                   "simulated firmware behind real libusb or hidapi through umockdev; run "
+                   "under umockdev-wrapper)")
       ->capture_default_str();
   capture_cmd
       ->add_option("--material", capture.material,
-                   "Virtual sample: a library name ('brdf materials') or a material .json")
-      ->required();
+                   "Virtual sample of --device sim (required for it): a library name ('brdf "
+                   "materials') or a material .json");
   capture_cmd->add_option("--sample", capture.sample, "Sample name recorded in the file")
       ->required();
   capture_cmd->add_option("--out", capture.out, "Output .bpc file")->required();
@@ -162,7 +171,20 @@ int main(int argc, char** argv) {
                    "reorder (N and N+1 swapped), lamp, contact, overtemp (firmware error "
                    "codes); halt (the Nth USB/HID IN transfer stalls)")
       ->group("Testing");
+  capture_cmd
+      ->add_option("--sim-pace-ms", capture.sim_pace_ms,
+                   "Testing: real time the simulated firmware spends per detector row, ms")
+      ->group("Testing");
   capture_cmd->callback([&] { exit_code = brdf::cli::RunCapture(capture); });
+
+  // brdf devices
+  brdf::cli::DevicesOptions devices;
+  auto* devices_cmd = app.add_subcommand(
+      "devices",
+      "List the scatterometers connected over USB and HID (model, serial, firmware, bus "
+      "path, permission problems)");
+  devices_cmd->add_flag("--json", devices.json, "Machine-readable output");
+  devices_cmd->callback([&] { exit_code = brdf::cli::RunDevices(devices); });
 
   // brdf info
   brdf::cli::InfoOptions info;

@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "brdf/core/error.h"
+#include "brdf/device/usb_transport.h"
 
 namespace brdf::device {
 namespace {
@@ -451,5 +452,68 @@ std::uint64_t EmulatedUsbInstrument::in_transfers() const { return impl_->in_tra
 std::uint64_t EmulatedUsbInstrument::frames_sent() const { return impl_->frames_sent; }
 
 void EmulatedUsbInstrument::Unplug() { impl_->unplugged = true; }
+
+SimLink ParseSimLink(std::string_view text) {
+  if (text == "loopback") return SimLink::kLoopback;
+  if (text == "usb") return SimLink::kUsb;
+  if (text == "hid") return SimLink::kHid;
+  throw InvalidArgument("expected loopback, usb or hid, got '" + std::string(text) + "'");
+}
+
+namespace {
+
+class RealLink final : public InstrumentLink {
+ public:
+  explicit RealLink(std::unique_ptr<Transport> t) : transport_(std::move(t)) {}
+  Transport& transport() override { return *transport_; }
+
+ private:
+  std::unique_ptr<Transport> transport_;
+};
+
+class LoopbackLink final : public InstrumentLink {
+ public:
+  explicit LoopbackLink(const SimulatorConfig& c) : firmware_(c), loop_(firmware_) {}
+  Transport& transport() override { return loop_; }
+
+ private:
+  SimulatedFirmware firmware_;
+  LoopbackTransport loop_;
+};
+
+class EmulatedLink final : public InstrumentLink {
+ public:
+  EmulatedLink(const SimulatorConfig& c, UsbPersonality p) : emulated_(c, p) {
+    const DeviceSpec spec = emulated_.Spec();
+    transport_ = p == UsbPersonality::kBulk ? OpenUsbTransport(spec) : OpenHidTransport(spec);
+  }
+  Transport& transport() override { return *transport_; }
+
+ private:
+  EmulatedUsbInstrument emulated_;
+  std::unique_ptr<Transport> transport_;  // closed before the emulated device goes
+};
+
+}  // namespace
+
+std::unique_ptr<InstrumentLink> OpenInstrumentLink(const DeviceSpec& spec,
+                                                   const SimulatorConfig& sim, SimLink link) {
+  switch (spec.kind) {
+    case DeviceSpec::Kind::kUsb:
+      return std::make_unique<RealLink>(OpenUsbTransport(spec));
+    case DeviceSpec::Kind::kHid:
+      return std::make_unique<RealLink>(OpenHidTransport(spec));
+    case DeviceSpec::Kind::kSim:
+      break;
+  }
+  if (link == SimLink::kLoopback) {
+    for (const Fault& f : sim.faults.faults)
+      if (f.type == FaultType::kEndpointHalt)
+        throw InvalidArgument("an endpoint halt needs a USB or HID link, not the loopback");
+    return std::make_unique<LoopbackLink>(sim);
+  }
+  return std::make_unique<EmulatedLink>(
+      sim, link == SimLink::kUsb ? UsbPersonality::kBulk : UsbPersonality::kHid);
+}
 
 }  // namespace brdf::device

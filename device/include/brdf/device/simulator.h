@@ -119,6 +119,9 @@ struct SimulatorConfig {
   double noise_level = 1.0;  // s above: 1 = reference instrument, 0 = ideal detector
   std::uint64_t seed = 1;
   FaultPlan faults;
+  // Real time the firmware spends per θout row (sleeping), for demos and for tests that must
+  // interrupt a capture while it runs; 0 = as fast as the host reads (virtual time).
+  double pace_ms_per_row = 0;
 };
 
 // One raw reading that clipped, for tests only: real firmware reports clipping through the

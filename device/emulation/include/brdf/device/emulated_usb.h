@@ -24,8 +24,10 @@
 
 #include <cstdint>
 #include <memory>
+#include <string_view>
 
 #include "brdf/device/simulator.h"
+#include "brdf/device/transport.h"
 #include "brdf/device/usb_models.h"
 
 namespace brdf::device {
@@ -57,5 +59,25 @@ class EmulatedUsbInstrument {
 
 // True when umockdev's preload library is active in this process.
 bool UmockdevAvailable();
+
+// How the simulated instrument is connected: in-process, or behind real libusb or hidapi
+// through umockdev.
+enum class SimLink { kLoopback, kUsb, kHid };
+// "loopback", "usb", "hid"; throws InvalidArgument otherwise.
+SimLink ParseSimLink(std::string_view text);
+
+// An open connection to an instrument: the transport and whatever must live as long as it
+// (the simulated firmware, its emulated USB device).
+class InstrumentLink {
+ public:
+  virtual ~InstrumentLink() = default;
+  virtual Transport& transport() = 0;
+};
+
+// Opens what `spec` names: a real instrument over USB or HID, or (kSim) a simulated one built
+// from `sim` and connected over `link`. Throws DeviceError when no instrument answers to the
+// spec or umockdev is missing for an emulated link, InvalidArgument for a bad configuration.
+std::unique_ptr<InstrumentLink> OpenInstrumentLink(const DeviceSpec& spec,
+                                                   const SimulatorConfig& sim, SimLink link);
 
 }  // namespace brdf::device
