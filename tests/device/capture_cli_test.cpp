@@ -1,6 +1,7 @@
 // `brdf capture` run as a lab user runs it: the built tool against the simulated instrument.
 // Values are checked against models.h evaluated here, files with ReadBpc.
 #include <gtest/gtest.h>
+#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -261,6 +262,56 @@ TEST_F(CaptureCli, RefusesToOverwriteAnExistingFileWithoutForce) {
   EXPECT_TRUE(ReadBpc(out).finished);
 }
 
+// Ctrl-C and SIGTERM during a capture: the scan is aborted on the instrument, the completed
+// slices stay in a valid, unfinished file, and --resume completes it to the uninterrupted
+// result. The simulated firmware is paced (5 ms per row) so the signal lands mid-capture.
+TEST_F(CaptureCli, SignalAbortsTheScanAndLeavesAResumableFile) {
+  const std::string common =
+      " --material gold --sample g --seed 3" + kCoarse + " --sim-pace-ms 5";
+  const std::string whole = Path("whole.bpc");
+  ASSERT_EQ(Run("capture --quiet --out " + whole + common).exit_code, 0);
+  const Measurement expected = LoadBpc(whole);
+  for (int sig : {SIGINT, SIGTERM}) {
+    SCOPED_TRACE(sig);
+    const std::string out = Path("sig.bpc"), err = Path("sig.err");
+    fs::remove(out);
+    fs::remove(err);
+    const pid_t pid = ::fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      const std::string cmd =
+          std::string("exec ") + BRDF_TOOL + " capture --out " + out + common + " 2>" + err;
+      ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+      ::_exit(127);
+    }
+    // Wait for the first completed slice, then interrupt.
+    auto log_so_far = [&] { return fs::exists(err) ? ReadFileText(err, 1 << 16) : std::string(); };
+    for (int i = 0; i < 2000 && log_so_far().find("slice 1/4") == std::string::npos; ++i)
+      ::usleep(5000);
+    ASSERT_NE(log_so_far().find("slice 1/4"), std::string::npos);
+    ::kill(pid, sig);
+    int status = 0;
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 130);
+    const std::string log = ReadFileText(err, 1 << 16);
+    EXPECT_NE(log.find("cancelled"), std::string::npos) << log;
+    EXPECT_NE(log.find("--resume"), std::string::npos) << log;
+    const BpcReadResult partial = ReadBpc(out);
+    EXPECT_FALSE(partial.finished);
+    EXPECT_TRUE(partial.problems.empty());
+    EXPECT_GE(partial.measurement.slices.size(), 1u);
+    EXPECT_LT(partial.measurement.slices.size(), 4u);
+    const ToolRun resumed = Run("capture --quiet --resume --out " + out + common);
+    ASSERT_EQ(resumed.exit_code, 0) << resumed.err;
+    const Measurement got = LoadBpc(out);
+    ASSERT_EQ(got.slices.size(), 4u);
+    for (int k = 0; k < 4; ++k)
+      for (std::size_t i = 0; i < got.slices[k].samples.size(); ++i)
+        ASSERT_EQ(got.slices[k].samples[i].rgb, expected.slices[k].samples[i].rgb);
+  }
+}
+
 TEST_F(CaptureCli, WrongArgumentsGiveOneClearLineAndNonZeroExit) {
   const std::string out = " --out " + Path("bad.bpc");
   struct Case {
@@ -269,7 +320,10 @@ TEST_F(CaptureCli, WrongArgumentsGiveOneClearLineAndNonZeroExit) {
   for (const Case& k : std::vector<Case>{
            {"--material gold --sample g --noise -1" + out, "--noise"},
            {"--material no_such_material --sample g" + out, "library"},
-           {"--material gold --sample g --device usb" + out, "--device"},
+           {"--material gold --sample g --device usb:12" + out, "--device"},
+           {"--material gold --sample g --device serial" + out, "--device"},
+           {"--material gold --sample g --transport pigeon" + out, "--transport"},
+           {"--sample g" + out, "--material"},
            {"--material gold --sample g --theta-in 0,95" + out, "--theta-in"},
            {"--material gold --sample g --exposure fast" + out, "--exposure"},
            {"--material gold --sample g --sim-fault explode:3" + out, "--sim-fault"},
