@@ -115,6 +115,7 @@ bool RestoreFromMetadata(Driver& driver, const Metadata& recorded,
     WhiteCalibration w;
     w.theta_in_deg = t;
     w.exposure_ms = *exposure;
+    w.nd_transmittance = ParseNumber(x, key + "_nd_transmittance").value_or(1.0);
     w.counts = *counts;
     w.frames = static_cast<int>(*frames);
     w.time = Text(x, key + "_time");

@@ -181,6 +181,11 @@ const WhiteCalibration& Driver::MeasureWhite(double theta_in_deg) {
   WhiteCalibration w;
   w.theta_in_deg = r.theta_in_deg;
   w.exposure_ms = r.exposure_ms;
+  if (r.nd_index >= info_.geometry.nd_transmittance.size())
+    Fail(FaultKind::kProtocol, "WHITE names ND filter " + std::to_string(r.nd_index) +
+                                   ", the instrument has " +
+                                   std::to_string(info_.geometry.nd_transmittance.size()));
+  w.nd_transmittance = info_.geometry.nd_transmittance[r.nd_index];
   for (int c = 0; c < 3; ++c) {
     w.counts[c] = r.counts[c];
     if (!(w.counts[c] - dark_.mean_counts[c] > 0))
@@ -227,7 +232,8 @@ Slice Driver::MeasureSlice(double theta_in_deg, SliceReport* report) {
     var_w[c] = (read_var[c] + shot * w_signal[c]) / white->frames;
     var_dark[c] = read_var[c] / dark_.frames;
     floor[c] = options_.noise_floor_sigmas * sr / std::sqrt(frames);
-    scale[c] = options_.white.rho[c] * kInvPi * white->exposure_ms / w_signal[c];
+    scale[c] = options_.white.rho[c] * kInvPi * white->exposure_ms * white->nd_transmittance /
+               w_signal[c];
   }
 
   Slice slice;
@@ -270,7 +276,13 @@ Slice Driver::MeasureSlice(double theta_in_deg, SliceReport* report) {
       Fail(FaultKind::kProtocol, "ROW_DATA with exposure " +
                         Fmt("%g", row.exposure_ms) + " ms");
     const float theta_out = g.ThetaOutDeg(row.row);
-    const double t_s = row.exposure_ms;
+    if (row.nd_index >= g.nd_transmittance.size())
+      Fail(FaultKind::kProtocol, "ROW_DATA names ND filter " + std::to_string(row.nd_index) +
+                                     ", the instrument has " +
+                                     std::to_string(g.nd_transmittance.size()));
+    // The light integrated: exposure × filter transmittance (both float32 from the wire).
+    const double t_s = static_cast<double>(row.exposure_ms) *
+                       static_cast<double>(g.nd_transmittance[row.nd_index]);
     for (std::size_t i = 0; i < row.samples.size(); ++i) {
       const std::size_t column = row.first_column + i;
       const RowSample& rs = row.samples[i];
@@ -388,6 +400,7 @@ Metadata Driver::CalibrationMetadata() const {
     const std::string key = "white_theta_in_" + AngleText(wc.theta_in_deg);
     m.extra[key + "_counts"] = Triple(wc.counts);
     m.extra[key + "_exposure_ms"] = Fmt("%.9g", wc.exposure_ms);
+    if (wc.nd_transmittance != 1) m.extra[key + "_nd_transmittance"] = Fmt("%.9g", wc.nd_transmittance);
     m.extra[key + "_frames"] = std::to_string(wc.frames);
     m.extra[key + "_time"] = wc.time;
   }

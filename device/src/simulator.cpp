@@ -159,7 +159,11 @@ SimulatedFirmware::SimulatedFirmware(SimulatorConfig config) : config_(std::move
                           std::to_string(m.theta_out_step_deg) + ", φout " +
                           std::to_string(m.phi_out_step_deg));
   if (m.frames_per_reading < 1 || m.dark_frames < 2 || m.white_frames < 1 ||
-      !(m.min_exposure_ms > 0) || !(m.max_exposure_ms >= m.min_exposure_ms))
+      !(m.min_exposure_ms > 0) || !(m.max_exposure_ms >= m.min_exposure_ms) ||
+      m.nd_transmittance.empty() || m.nd_transmittance.size() > 255 ||
+      m.nd_transmittance[0] != 1.0f ||
+      !std::all_of(m.nd_transmittance.begin(), m.nd_transmittance.end(),
+                   [](float t) { return t > 0 && t <= 1; }))
     throw InvalidArgument("simulator: instrument model '" + m.model + "' has unusable constants");
 
   geometry_.theta_in_deg = m.theta_in_deg;
@@ -175,6 +179,9 @@ SimulatedFirmware::SimulatedFirmware(SimulatorConfig config) : config_(std::move
     throw InvalidArgument("simulator: geometry of " + std::to_string(rows) + " × " +
                           std::to_string(columns) + " samples exceeds 65535 per axis");
   geometry_.rows = static_cast<std::uint16_t>(rows);
+  geometry_.min_exposure_ms = static_cast<float>(m.min_exposure_ms);
+  geometry_.max_exposure_ms = static_cast<float>(m.max_exposure_ms);
+  geometry_.nd_transmittance = m.nd_transmittance;
   geometry_.columns = static_cast<std::uint16_t>(columns);
 
   white_ = config_.white_reference;
@@ -363,13 +370,14 @@ void SimulatedFirmware::Handle(const Frame& frame) {
         const Rgb f = white_->Eval(light, Vec3{0, 0, 1});
         std::array<double, 3> rate{};
         for (int c = 0; c < 3; ++c) rate[c] = m.responsivity_counts_per_ms[c] * f[c] * light.z;
-        const float t = AutoExposure(MaxOf(rate));
+        const Exposure t = AutoExposure(MaxOf(rate));
         Reseed(kSeedWhite, theta_in);
         const Reading r = Read(rate, t, m.white_frames);
         if (r.clipped != 0) clip_log_.push_back({theta_in, kWhiteRow, kWhiteRow, r.clipped});
         WhiteReading w;
         w.theta_in_deg = theta_in;
-        w.exposure_ms = t;
+        w.exposure_ms = t.ms;
+        w.nd_index = t.nd;
         w.counts = r.counts;
         w.clipped_channels = r.clipped;
         w.frames = static_cast<std::uint16_t>(m.white_frames);
@@ -414,12 +422,12 @@ void SimulatedFirmware::StartSlice(float theta_in_deg) {
   slice_samples_ = slice_clipped_ = 0;
   Reseed(kSeedSlice, theta_in_deg);
   if (exposure_.mode == ExposureMode::kFixed) {
-    slice_exposure_ms_ = exposure_.exposure_ms;
+    slice_exposure_ = {exposure_.exposure_ms, 0};
   } else if (exposure_.mode == ExposureMode::kAutoPerSlice) {
     double brightest = 0;
     for (std::size_t row = 0; row < geometry_.rows; ++row)
       brightest = std::max(brightest, MaxOf(RowRates(row, nullptr)));
-    slice_exposure_ms_ = AutoExposure(brightest);
+    slice_exposure_ = AutoExposure(brightest);
   }
   Send(MessageType::kSliceBegin,
        EncodeSliceBegin({theta_in_deg, geometry_.rows, geometry_.columns}));
@@ -444,24 +452,33 @@ std::array<double, 3> SimulatedFirmware::RowRates(std::size_t row,
   return brightest;
 }
 
-float SimulatedFirmware::AutoExposure(double brightest_rate) const {
+SimulatedFirmware::Exposure SimulatedFirmware::AutoExposure(double brightest_rate) const {
   const InstrumentModel& m = config_.model;
   const double dark = config_.noise_level * MaxOf(m.dark_offset_counts);
   double t = m.max_exposure_ms;
   if (brightest_rate > 0)
     t = m.autorange_target_fraction * std::max(0.0, m.adc_full_scale_counts - dark) /
         brightest_rate;
-  return static_cast<float>(std::clamp(t, m.min_exposure_ms, m.max_exposure_ms));
+  // The least attenuating filter that keeps the exposure at or above the minimum.
+  std::uint8_t nd = 0;
+  while (t / static_cast<double>(m.nd_transmittance[nd]) < m.min_exposure_ms &&
+         nd + 1u < m.nd_transmittance.size())
+    ++nd;
+  t /= static_cast<double>(m.nd_transmittance[nd]);
+  return {static_cast<float>(std::clamp(t, m.min_exposure_ms, m.max_exposure_ms)), nd};
 }
 
 SimulatedFirmware::Reading SimulatedFirmware::Read(const std::array<double, 3>& rate,
-                                                   float exposure_ms, int frames) {
+                                                   Exposure exposure, int frames) {
   const InstrumentModel& m = config_.model;
   const double s = config_.noise_level;
   const double full = m.adc_full_scale_counts;
   Reading r;
   for (int c = 0; c < 3; ++c) {
-    const double signal = static_cast<double>(exposure_ms) * rate[c];
+    // The light the detector integrates: exposure time × filter transmittance (the same
+    // float32 numbers the host multiplies).
+    const double signal = static_cast<double>(exposure.ms) *
+                          static_cast<double>(m.nd_transmittance[exposure.nd]) * rate[c];
     const double mean = signal + s * m.dark_offset_counts[c];
     if (s == 0) {  // ideal detector
       r.counts[c] = static_cast<float>(mean);
@@ -495,12 +512,12 @@ void SimulatedFirmware::PrepareRow(std::size_t row) {
     std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(config_.pace_ms_per_row));
   std::vector<std::array<double, 3>> rates;
   const std::array<double, 3> brightest = RowRates(row, &rates);
-  row_exposure_ms_ = exposure_.mode == ExposureMode::kAutoPerRow ? AutoExposure(MaxOf(brightest))
-                                                                 : slice_exposure_ms_;
+  row_exposure_ = exposure_.mode == ExposureMode::kAutoPerRow ? AutoExposure(MaxOf(brightest))
+                                                              : slice_exposure_;
   const int frames = config_.model.frames_per_reading;
   row_readings_.resize(rates.size());
   for (std::size_t col = 0; col < rates.size(); ++col) {
-    row_readings_[col] = Read(rates[col], row_exposure_ms_, frames);
+    row_readings_[col] = Read(rates[col], row_exposure_, frames);
     if (row_readings_[col].clipped != 0) {
       ++slice_clipped_;
       clip_log_.push_back({slice_theta_in_deg_, static_cast<std::uint16_t>(row),
@@ -521,7 +538,8 @@ void SimulatedFirmware::ProduceStreamFrame() {
   RowData data;
   data.row = static_cast<std::uint16_t>(next_row_);
   data.first_column = static_cast<std::uint16_t>(next_column_);
-  data.exposure_ms = row_exposure_ms_;
+  data.exposure_ms = row_exposure_.ms;
+  data.nd_index = row_exposure_.nd;
   data.samples.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     const Reading& r = row_readings_[next_column_ + i];

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <string>
 
@@ -309,6 +310,24 @@ TEST_F(CaptureCli, SignalAbortsTheScanAndLeavesAResumableFile) {
     for (int k = 0; k < 4; ++k)
       for (std::size_t i = 0; i < got.slices[k].samples.size(); ++i)
         ASSERT_EQ(got.slices[k].samples[i].rgb, expected.slices[k].samples[i].rgb);
+  }
+}
+
+// RGL paints whose specular peaks clipped at the 1 ms minimum exposure before the ND filter
+// stage (1,019 and 759 saturated samples at the reference geometry): now none clips.
+TEST_F(CaptureCli, RglPaintPeaksNoLongerClip) {
+  const char* env = std::getenv("BRDF_DATA_DIR");
+  const fs::path data = env ? fs::path(env) : fs::path(BRDF_SHARED_DATA_DIR);
+  ASSERT_TRUE(fs::is_directory(data / "rgl"))
+      << "third-party data not found: set BRDF_DATA_DIR (now " << data << ")";
+  for (const char* paint : {"chm_orange_rgb", "chm_light_blue_rgb"}) {
+    const std::string out = Path(std::string(paint) + ".bpc");
+    const ToolRun r = Run("capture --material " + (data / "rgl" / (std::string(paint) + ".bsdf")).string() +
+                          " --sample p --out " + out);
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    EXPECT_NE(r.err.find(", 0 saturated, "), std::string::npos) << r.err;
+    for (const Slice& s : LoadBpc(out).slices)
+      for (const Sample& x : s.samples) ASSERT_EQ(x.flags & kFlagSaturated, 0) << paint;
   }
 }
 

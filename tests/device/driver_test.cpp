@@ -122,11 +122,13 @@ TEST(Capture, SaturationFlagsAppearExactlyWhereTheRawSignalClipped) {
     const char* material;
     ExposureSetting exposure;
   };
-  // Diamond's specular peak clips even at the shortest exposure; a long fixed exposure makes
-  // a glossy plastic clip over a wide area.
+  // Without the ND filter stage, diamond's specular peak clips even at the shortest exposure;
+  // a long fixed exposure (no ND filter) makes a glossy plastic clip over a wide area.
   for (const Case& k :
        {Case{"diamond_on_black", {}}, Case{"plastic_glossy_yellow", {ExposureMode::kFixed, 300}}}) {
-    SimulatedFirmware fw(Config(LibraryMaterial(k.material), 1, 1, 2));
+    SimulatorConfig c = Config(LibraryMaterial(k.material), 1, 1, 2);
+    c.model.nd_transmittance = {1.0f};
+    SimulatedFirmware fw(c);
     testing::CaptureRun run;
     RunCapture(fw, &run, {0, 20, 40, 60}, k.exposure);
     const GeometryInfo& g = fw.geometry();
@@ -139,6 +141,32 @@ TEST(Capture, SaturationFlagsAppearExactlyWhereTheRawSignalClipped) {
       clipped.insert({r.theta_in_deg, std::size_t{r.row} * g.columns + r.column});
     EXPECT_FALSE(flagged.empty()) << k.material;
     EXPECT_EQ(flagged, clipped) << k.material;
+  }
+}
+
+// The ND filter stage: the sharpest peak of the library (diamond) is read through a dense
+// filter instead of clipping, and the host's calibration divides the filter out again: the
+// noise-free capture equals the analytic f_r at the peak rows too.
+TEST(Capture, NdFilterStageKeepsTheSharpestPeakUnclippedAndCalibrated) {
+  const Material m = LibraryMaterial("diamond_on_black");
+  for (double noise : {0.0, 1.0}) {
+    SimulatedFirmware fw(Config(m, noise, 1, 2));
+    testing::CaptureRun run;
+    RunCapture(fw, &run);
+    EXPECT_TRUE(fw.clip_log().empty()) << "noise " << noise;
+    double peak = 0;
+    for (const Slice& slice : run.slices)
+      for (const Sample& s : slice.samples) {
+        EXPECT_EQ(s.flags & kFlagSaturated, 0);
+        if (noise == 0) {
+          const Rgb t = testing::Truth(m, s);
+          for (int c = 0; c < 3; ++c) EXPECT_NEAR(s.rgb[c], t[c], 1e-5 * t[c] + 1e-30);
+          peak = std::max(peak, t[1]);
+        }
+      }
+    if (noise == 0) {
+      EXPECT_GT(peak, 100.0) << "the peak needs a filter: f_r far above the white's 0.3";
+    }
   }
 }
 
@@ -204,7 +232,7 @@ TEST(Capture, MetadataRecordsInstrumentCalibrationAndTimes) {
   EXPECT_EQ(md.instrument_model, ReferenceInstrument().model);
   EXPECT_EQ(md.instrument_serial, "SIM-000001");
   EXPECT_EQ(md.firmware_version, ReferenceInstrument().firmware_version);
-  EXPECT_EQ(md.protocol_version, "1.0");
+  EXPECT_EQ(md.protocol_version, "1.1");
   EXPECT_NE(md.calibration_reference.find("Spectralon"), std::string::npos);
   EXPECT_NE(md.calibration_reference.find("0.989747"), std::string::npos);
   EXPECT_TRUE(std::regex_match(md.calibration_time, iso)) << md.calibration_time;

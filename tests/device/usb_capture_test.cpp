@@ -272,7 +272,10 @@ TEST_P(FaultsOver, EveryFaultGivesItsOutcomeAndResumeGivesTheUninterruptedCaptur
         ASSERT_FALSE(retries.empty());
         EXPECT_NE(retries[0].find(k.message), std::string::npos) << retries[0];
       }
-      if (k.name == "duplicate") {
+      // A duplicated frame is dropped, not retried. (Over HID a retry can still happen on a
+      // loaded machine: hidapi keeps only 30 input reports and drops the oldest when the host
+      // falls behind, which the driver sees as a lost frame and measures again.)
+      if (k.name == "duplicate" && GetParam() != Link::kHidapi) {
         EXPECT_TRUE(retries.empty()) << retries[0];
       }
       if (k.name == "halt" && GetParam() == Link::kLibusb) {

@@ -24,8 +24,11 @@
 // Exposure is auto-ranged per θout row (default): the firmware finds the row's brightest
 // sample with a probe exposure (simulated as the noise-free maximum of the row) and sets t so
 // it reaches `autorange_target_fraction` of the range above dark, within
-// [min_exposure_ms, max_exposure_ms]. The white reference is always ranged this way. A peak too
-// bright even at the shortest exposure clips, and the sample carries clip bits per channel. Noise
+// [min_exposure_ms, max_exposure_ms]. A row too bright even at the shortest exposure is read
+// through the neutral-density filter stage (nd_transmittance: the least attenuating filter
+// that lets the exposure reach its target within the range; PROTOCOL.md, ND filters). The
+// white reference is always ranged this way. A peak too bright even at the shortest exposure
+// behind the densest filter clips, and the sample carries clip bits per channel. Noise
 // is drawn from a seeded generator restarted for every measurement from (seed, what is measured,
 // θin), so a slice is reproduced exactly whatever was measured before it (a resumed capture matches
 // an uninterrupted one).
@@ -65,6 +68,8 @@ struct InstrumentModel {
   // R_c: counts per ms per unit radiance (f_r · cosθi under unit irradiance).
   std::array<double, 3> responsivity_counts_per_ms{};
   double min_exposure_ms = 1;
+  // The ND filter wheel: transmittance of each position, [0] = open (1.0), then denser.
+  std::vector<float> nd_transmittance = {1.0f, 0.1f, 0.01f, 0.001f};
   double max_exposure_ms = 2000;
   double autorange_target_fraction = 0.8;  // of (full scale − dark)
 };
@@ -167,8 +172,12 @@ class SimulatedFirmware {
   void PrepareRow(std::size_t row);
   // Radiance L_c of the sample seen from (row, column) under the slice's light.
   std::array<double, 3> RowRates(std::size_t row, std::vector<std::array<double, 3>>* rates) const;
-  float AutoExposure(double brightest_rate) const;
-  Reading Read(const std::array<double, 3>& rate, float exposure_ms, int frames);
+  struct Exposure {
+    float ms = 0;
+    std::uint8_t nd = 0;  // ND filter position
+  };
+  Exposure AutoExposure(double brightest_rate) const;
+  Reading Read(const std::array<double, 3>& rate, Exposure exposure, int frames);
   void Reseed(std::uint64_t what, float theta_in_deg);
 
   SimulatorConfig config_;
@@ -192,10 +201,10 @@ class SimulatedFirmware {
   bool streaming_ = false;
   float slice_theta_in_deg_ = 0;
   Vec3 light_{};
-  float slice_exposure_ms_ = 0;  // kAutoPerSlice / kFixed
+  Exposure slice_exposure_;  // kAutoPerSlice / kFixed
   std::size_t next_row_ = 0, next_column_ = 0;
   std::vector<Reading> row_readings_;
-  float row_exposure_ms_ = 0;
+  Exposure row_exposure_;
   std::uint32_t slice_samples_ = 0, slice_clipped_ = 0;
 };
 
