@@ -183,6 +183,7 @@ DecodeResult DecodeFrame(std::span<const std::uint8_t> bytes) {
   }
   result.status = DecodeStatus::kComplete;
   result.consumed = total;
+  result.crc = stored;
   result.frame.type = bytes[2];
   result.frame.sequence = bytes[3];
   result.frame.payload.assign(
@@ -432,9 +433,16 @@ RowData DecodeRowData(std::span<const std::uint8_t> payload) {
       r.Fail("at most " + std::to_string(kMaxSamplesPerRowFrame) + " samples", std::to_string(n));
     row.exposure_ms = r.F32("exposure_ms");
     row.samples.resize(n);
+    // One bounds check for all samples (13 bytes each), then plain loads: this loop is most of
+    // the host's decoding work.
+    const std::uint8_t* p = r.Bytes(std::size_t{n} * 13, "samples (13 bytes each)");
     for (RowSample& s : row.samples) {
-      s.counts = ReadRgb(r, "sample counts");
-      s.clipped_channels = r.U8("sample clip bits");
+      for (float& c : s.counts) {
+        const std::uint32_t bits = LoadU32(p);
+        std::memcpy(&c, &bits, sizeof c);
+        p += 4;
+      }
+      s.clipped_channels = *p++;
     }
     if (r.remaining() > 0) row.nd_index = r.U8("nd_index");  // protocol 1.1
     return row;

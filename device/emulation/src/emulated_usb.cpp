@@ -28,6 +28,9 @@
 namespace brdf::device {
 namespace {
 
+// One interrupt IN report per millisecond (bInterval 1 at full speed; see the header).
+constexpr int kHidReportIntervalUs = 1000;
+
 constexpr std::uint8_t kDescDevice = 0x01, kDescConfig = 0x02, kDescString = 0x03,
                        kDescHidReport = 0x22;
 
@@ -72,7 +75,7 @@ std::vector<std::uint8_t> Descriptors(const UsbModel& m, UsbPersonality p,
     Put16(c, report);
     c.insert(c.end(), {7, 0x05, m.hid_in_endpoint, 0x03});
     Put16(c, m.hid_report_bytes);
-    c.push_back(1);
+    c.push_back(1);  // bInterval 1: every frame (1 ms at full speed)
     c.insert(c.end(), {7, 0x05, m.hid_out_endpoint, 0x03});
     Put16(c, m.hid_report_bytes);
     c.push_back(1);
@@ -198,7 +201,7 @@ struct EmulatedUsbInstrument::Impl {
     usbdevfs_urb* urb = u.urb();
     const bool hid = personality == UsbPersonality::kHid;
     const auto now = std::chrono::steady_clock::now();
-    if (hid && now - last_in < std::chrono::microseconds(125)) return false;
+    if (hid && now - last_in < std::chrono::microseconds(kHidReportIntervalUs)) return false;
     if (in_halted) {
       if (hid) in_halted = false;  // the interrupt endpoint recovers by itself (see header)
       urb->status = -EPIPE;

@@ -25,8 +25,8 @@
 // loses nothing the instrument cannot measure again, so Capture() aborts the scan and measures
 // that step again (up to DriverOptions::retries times); a disconnect, an instrument that stops
 // answering, or an error the instrument reports (lamp, sample contact, temperature) stops the
-// capture. A frame received twice with the same sequence number and bytes (a duplicated
-// transfer) is dropped. Capture() hands every completed slice to its callback before it
+// capture. A frame received twice (a duplicated transfer: same type, sequence number, length
+// and CRC-32) is dropped. Capture() hands every completed slice to its callback before it
 // returns or throws, so an interrupted capture loses only the slice in progress, which is
 // never handed out.
 #pragma once
@@ -175,7 +175,9 @@ class Driver {
   std::uint8_t host_sequence_ = 0;
   bool have_device_sequence_ = false;
   std::uint8_t device_sequence_ = 0;
-  std::vector<std::uint8_t> last_frame_bytes_;  // to recognise a duplicated frame
+  std::uint8_t last_frame_type_ = 0;  // the last frame, to recognise a duplicate of it
+  std::uint32_t last_frame_crc_ = 0;
+  std::size_t last_frame_size_ = 0;
   std::size_t duplicates_dropped_ = 0;
   const std::atomic<bool>* cancel_ = nullptr;
   std::string last_damage_;  // first damaged frame since the last good one, to explain a loss

@@ -98,6 +98,7 @@ struct DecodeResult {
   // least 1; up to the next possible sync byte). kNeedMore: 0.
   std::size_t consumed = 0;
   Frame frame;           // kComplete only
+  std::uint32_t crc = 0;  // kComplete only: the frame's CRC-32 (identifies a repeated frame)
   std::string reason;    // kInvalid only: "CRC-32: expected 0x…, got 0x…", "no sync bytes", …
   bool corrupt = false;  // kInvalid only: a frame header was found but its content is damaged
                          // (CRC mismatch), as opposed to bytes between frames

@@ -9,10 +9,13 @@
 // LD_PRELOAD=libumockdev-preload.so.0); the constructor throws DeviceError otherwise. This is
 // a test and demo facility: brdf links it for `capture --device sim --transport usb|hid`.
 //
-// Pacing: IN transfers of the HID personality complete at most once per 125 µs (a high-speed
-// interrupt endpoint with bInterval 1), as a real device's would; hidapi queues only 30
-// reports, so an unpaced device could overrun it. Bulk IN transfers complete as soon as the
-// firmware has bytes (a short packet ends each transfer).
+// Pacing: IN transfers of the HID personality complete at most once per millisecond (an
+// interrupt endpoint polled every full-speed frame, 64 KB/s), as a real device's would.
+// hidapi queues only 30 input reports and drops the oldest when the application falls
+// behind, so a faster device overruns a loaded host (measured: at one report per 125 µs, a
+// full capture on a machine with load 9 on 2 cores lost reports); at 1 ms the host has 30 ms
+// of slack. Bulk IN transfers complete as soon as the firmware has bytes (a short packet ends
+// each transfer).
 //
 // Faults: the firmware's FaultPlan applies as on the loopback; FaultType::kEndpointHalt N
 // makes the Nth IN transfer end with a stall (EPIPE). The bulk endpoint then stays halted
