@@ -50,6 +50,30 @@ def instrument_session():
     return stream(frames)
 
 
+def instrument_session_v1_1():
+    """Protocol 1.1 (device/PROTOCOL.md): GEOMETRY with the exposure range and ND filters,
+    WHITE and ROW_DATA with a trailing ND index, a duplicated ROW_DATA and a lamp error."""
+    rows, columns, theta_in = 2, 3, 40.0
+    nd = [1.0, 0.1, 0.01]
+    frames = [
+        (IDENTITY, string("BRDF-SIM MD2") + string("SIM-000002") + string("2.5.0-sim")
+         + struct.pack("<HHfHf", 1, 1, 65535.0, 16, 2.0)),
+        (GEOMETRY, struct.pack("<Bf", 1, theta_in) + struct.pack("<fffHH", 5, 5, 120, rows, columns)
+         + struct.pack("<ffB", 1.0, 2000.0, len(nd)) + b"".join(struct.pack("<f", t) for t in nd)),
+        (ACK, bytes([SET_EXPOSURE])),
+        (DARK, struct.pack("<6fH", 500, 500, 500, 6, 6, 6, 64)),
+        (WHITE, struct.pack("<ff3fBHB", theta_in, 80, 50000, 50000, 50000, 0, 64, 0)),
+        (SLICE_BEGIN, struct.pack("<fHH", theta_in, rows, columns)),
+    ]
+    for row in range(rows):
+        samples = b"".join(struct.pack("<3fB", 1000, 2000, 3000, 0) for _ in range(columns))
+        frames.append((ROW_DATA, struct.pack("<HHHf", row, 0, columns, 1.5) + samples + bytes([2])))
+    data = stream(frames)
+    data += data[-(len(frames[-1][1]) + 10):]  # the last ROW_DATA again: a duplicated transfer
+    data += frame(ERROR, len(frames), struct.pack("<HB", 6, MEASURE_SLICE) + string("lamp failure"))
+    return data
+
+
 def host_session():
     return stream([
         (IDENTIFY, b""),
@@ -70,6 +94,7 @@ def main():
     out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(os.path.dirname(__file__), "corpus", "protocol")
     os.makedirs(out, exist_ok=True)
     for name, data in [("instrument_session.bin", instrument_session()),
+                       ("instrument_session_v1_1.bin", instrument_session_v1_1()),
                        ("host_session.bin", host_session()),
                        ("error_reply.bin", error_reply())]:
         with open(os.path.join(out, name), "wb") as f:

@@ -29,25 +29,48 @@ std::string AngleText(double deg) { return Fmt("%g", deg); }
 Driver::Driver(Transport& transport, DriverOptions options)
     : transport_(transport), options_(std::move(options)) {}
 
+void Driver::Fail(FaultKind kind, const std::string& what) const {
+  throw DriverFault(kind, transport_.Description() + ": " + what);
+}
+
 void Driver::Send(MessageType type, const std::vector<std::uint8_t>& payload) {
   std::vector<std::uint8_t> bytes;
   AppendFrame(bytes, static_cast<std::uint8_t>(type), host_sequence_++, payload);
-  transport_.Write(bytes);
+  try {
+    transport_.Write(bytes);
+  } catch (const DriverFault&) {
+    throw;
+  } catch (const DeviceError& e) {
+    throw DriverFault(FaultKind::kDisconnected, e.what());
+  }
 }
 
-Frame Driver::NextFrame(std::string_view waiting_for) {
+Frame Driver::NextFrame(std::string_view waiting_for, bool check_sequence) {
   std::array<std::uint8_t, 4096> buffer{};
   for (;;) {
     DecodeResult r = reader_.Next();
     if (r.status == DecodeStatus::kComplete) {
+      // A duplicated transfer repeats a frame bit for bit, sequence number included: drop it.
+      // Same type, sequence, length and CRC-32 identify the repeat (a different frame with all
+      // four equal has a chance of 2^-32, and would be a lost frame the next sequence shows).
+      if (have_device_sequence_ && r.frame.sequence == device_sequence_ &&
+          r.frame.type == last_frame_type_ && r.crc == last_frame_crc_ &&
+          r.frame.payload.size() == last_frame_size_) {
+        ++duplicates_dropped_;
+        continue;
+      }
       const std::uint8_t expected = static_cast<std::uint8_t>(device_sequence_ + 1);
-      if (have_device_sequence_ && r.frame.sequence != expected)
-        throw DeviceError(transport_.Description() + ": frame lost while waiting for " +
-                          std::string(waiting_for) + ": expected sequence " +
-                          std::to_string(expected) + ", got " + std::to_string(r.frame.sequence) +
-                          (last_damage_.empty() ? "" : " (damaged frame: " + last_damage_ + ")"));
+      if (check_sequence && have_device_sequence_ && r.frame.sequence != expected)
+        Fail(FaultKind::kOutOfSequence,
+             "frame lost or out of order while waiting for " + std::string(waiting_for) +
+                 ": expected sequence " + std::to_string(expected) + ", got " +
+                 std::to_string(r.frame.sequence) +
+                 (last_damage_.empty() ? "" : " (damaged frame: " + last_damage_ + ")"));
       have_device_sequence_ = true;
       device_sequence_ = r.frame.sequence;
+      last_frame_type_ = r.frame.type;
+      last_frame_crc_ = r.crc;
+      last_frame_size_ = r.frame.payload.size();
       last_damage_.clear();
       return std::move(r.frame);
     }
@@ -59,12 +82,21 @@ Frame Driver::NextFrame(std::string_view waiting_for) {
       if (r.corrupt && last_damage_.empty()) last_damage_ = r.reason;
       continue;
     }
-    const std::size_t n = transport_.Read(buffer, options_.timeout_ms);
-    if (n == 0)
-      throw DeviceError(transport_.Description() + ": timeout: no answer within " +
-                        std::to_string(options_.timeout_ms) + " ms while waiting for " +
-                        std::string(waiting_for) +
-                        (last_damage_.empty() ? "" : " (damaged frame: " + last_damage_ + ")"));
+    std::size_t n = 0;
+    try {
+      n = transport_.Read(buffer, options_.timeout_ms);
+    } catch (const DriverFault&) {
+      throw;
+    } catch (const DeviceError& e) {
+      throw DriverFault(FaultKind::kDisconnected, e.what());
+    }
+    if (n == 0) {
+      if (!last_damage_.empty())
+        Fail(FaultKind::kDamagedFrame, "damaged frame while waiting for " +
+                                           std::string(waiting_for) + ": " + last_damage_);
+      Fail(FaultKind::kTimeout, "timeout: no answer within " + std::to_string(options_.timeout_ms) +
+                                    " ms while waiting for " + std::string(waiting_for));
+    }
     reader_.Append(std::span<const std::uint8_t>(buffer.data(), n));
   }
 }
@@ -73,11 +105,14 @@ void Driver::ThrowInstrumentError(const Frame& frame, MessageType request) const
   const std::string request_name = MessageTypeName(static_cast<std::uint8_t>(request));
   if (frame.type == static_cast<std::uint8_t>(MessageType::kError)) {
     const ErrorReply e = DecodeError(frame.payload);
-    throw DeviceError(transport_.Description() + ": the instrument refused " + request_name + ": " +
-                      e.message + " (error code " + std::to_string(static_cast<int>(e.code)) + ")");
+    throw DriverFault(FaultKind::kInstrumentError,
+                      transport_.Description() + ": the instrument refused " + request_name +
+                          ": " + e.message + " (error code " +
+                          std::to_string(static_cast<int>(e.code)) + ")",
+                      e.code);
   }
-  throw DeviceError(transport_.Description() + ": unexpected " + MessageTypeName(frame.type) +
-                    " in answer to " + request_name);
+  Fail(FaultKind::kProtocol,
+       "unexpected " + MessageTypeName(frame.type) + " in answer to " + request_name);
 }
 
 Frame Driver::Expect(MessageType request, MessageType reply) {
@@ -90,7 +125,7 @@ const InstrumentInfo& Driver::Connect() {
   Send(MessageType::kIdentify, {});
   info_.identity = DecodeIdentity(Expect(MessageType::kIdentify, MessageType::kIdentity).payload);
   if (info_.identity.protocol_major != kProtocolMajor)
-    throw DeviceError(transport_.Description() + ": instrument speaks protocol " +
+    Fail(FaultKind::kProtocol, "instrument speaks protocol " +
                       std::to_string(info_.identity.protocol_major) + "." +
                       std::to_string(info_.identity.protocol_minor) + ", this driver " +
                       std::to_string(kProtocolMajor) + ".x (update the toolchain or firmware)");
@@ -99,7 +134,7 @@ const InstrumentInfo& Driver::Connect() {
       DecodeGeometry(Expect(MessageType::kGetGeometry, MessageType::kGeometry).payload);
   const std::size_t per_slice = std::size_t{info_.geometry.rows} * info_.geometry.columns;
   if (per_slice == 0 || per_slice > kMaxSamplesPerSlice)
-    throw DeviceError(transport_.Description() + ": geometry of " +
+    Fail(FaultKind::kProtocol, "geometry of " +
                       std::to_string(info_.geometry.rows) + " × " +
                       std::to_string(info_.geometry.columns) +
                       " samples per slice is outside 1 … " + std::to_string(kMaxSamplesPerSlice));
@@ -114,7 +149,7 @@ void Driver::SetExposure(const ExposureSetting& setting) {
   const std::uint8_t acked =
       DecodeAck(Expect(MessageType::kSetExposure, MessageType::kAck).payload);
   if (acked != static_cast<std::uint8_t>(MessageType::kSetExposure))
-    throw DeviceError(transport_.Description() + ": SET_EXPOSURE acknowledged as " +
+    Fail(FaultKind::kProtocol, "SET_EXPOSURE acknowledged as " +
                       MessageTypeName(acked));
   exposure_ = setting;
 }
@@ -144,16 +179,21 @@ const WhiteCalibration& Driver::MeasureWhite(double theta_in_deg) {
   const WhiteReading r =
       DecodeWhite(Expect(MessageType::kMeasureWhite, MessageType::kWhite).payload);
   if (r.clipped_channels != 0)
-    throw DeviceError(transport_.Description() + ": white reference at θin " +
+    Fail(FaultKind::kInstrumentError, "white reference at θin " +
                       AngleText(theta_in_deg) + "° saturated (clip bits " +
                       std::to_string(r.clipped_channels) + "); cannot calibrate");
   WhiteCalibration w;
   w.theta_in_deg = r.theta_in_deg;
   w.exposure_ms = r.exposure_ms;
+  if (r.nd_index >= info_.geometry.nd_transmittance.size())
+    Fail(FaultKind::kProtocol, "WHITE names ND filter " + std::to_string(r.nd_index) +
+                                   ", the instrument has " +
+                                   std::to_string(info_.geometry.nd_transmittance.size()));
+  w.nd_transmittance = info_.geometry.nd_transmittance[r.nd_index];
   for (int c = 0; c < 3; ++c) {
     w.counts[c] = r.counts[c];
     if (!(w.counts[c] - dark_.mean_counts[c] > 0))
-      throw DeviceError(transport_.Description() + ": white reference at θin " +
+      Fail(FaultKind::kInstrumentError, "white reference at θin " +
                         AngleText(theta_in_deg) + "° gives no signal above dark in channel " +
                         std::to_string(c) + " (" + Fmt("%g", w.counts[c]) + " counts, dark " +
                         Fmt("%g", dark_.mean_counts[c]) + "); is the panel in place?");
@@ -181,7 +221,7 @@ Slice Driver::MeasureSlice(double theta_in_deg, SliceReport* report) {
   const SliceBegin begin =
       DecodeSliceBegin(Expect(MessageType::kMeasureSlice, MessageType::kSliceBegin).payload);
   if (begin.rows != g.rows || begin.columns != g.columns)
-    throw DeviceError(transport_.Description() + ": slice of " + std::to_string(begin.rows) +
+    Fail(FaultKind::kProtocol, "slice of " + std::to_string(begin.rows) +
                       " × " + std::to_string(begin.columns) + " samples announced, geometry says " +
                       std::to_string(g.rows) + " × " + std::to_string(g.columns));
 
@@ -196,7 +236,8 @@ Slice Driver::MeasureSlice(double theta_in_deg, SliceReport* report) {
     var_w[c] = (read_var[c] + shot * w_signal[c]) / white->frames;
     var_dark[c] = read_var[c] / dark_.frames;
     floor[c] = options_.noise_floor_sigmas * sr / std::sqrt(frames);
-    scale[c] = options_.white.rho[c] * kInvPi * white->exposure_ms / w_signal[c];
+    scale[c] = options_.white.rho[c] * kInvPi * white->exposure_ms * white->nd_transmittance /
+               w_signal[c];
   }
 
   Slice slice;
@@ -211,11 +252,16 @@ Slice Driver::MeasureSlice(double theta_in_deg, SliceReport* report) {
 
   std::size_t next_row = 0, next_column = 0, received = 0;
   for (;;) {
+    if (cancelled()) {
+      Abort();
+      Fail(FaultKind::kCancelled, "capture cancelled during the slice at θin " +
+                                      AngleText(theta_in_deg) + "°; the scan was stopped");
+    }
     const Frame f = NextFrame("ROW_DATA");
     if (f.type == static_cast<std::uint8_t>(MessageType::kSliceEnd)) {
       const SliceEnd end = DecodeSliceEnd(f.payload);
       if (received != total || end.samples != total)
-        throw DeviceError(transport_.Description() + ": slice θin " + AngleText(theta_in_deg) +
+        Fail(FaultKind::kOutOfSequence, "slice θin " + AngleText(theta_in_deg) +
                           "° ended after " + std::to_string(received) + " of " +
                           std::to_string(total) + " samples");
       break;
@@ -225,16 +271,22 @@ Slice Driver::MeasureSlice(double theta_in_deg, SliceReport* report) {
     const RowData row = DecodeRowData(f.payload);
     if (row.row != next_row || row.first_column != next_column ||
         next_column + row.samples.size() > g.columns || row.samples.empty())
-      throw DeviceError(transport_.Description() + ": ROW_DATA out of order: expected row " +
+      Fail(FaultKind::kOutOfSequence, "ROW_DATA out of order: expected row " +
                         std::to_string(next_row) + " column " + std::to_string(next_column) +
                         ", got row " + std::to_string(row.row) + " columns " +
                         std::to_string(row.first_column) + "+" +
                         std::to_string(row.samples.size()));
     if (!(row.exposure_ms > 0))
-      throw DeviceError(transport_.Description() + ": ROW_DATA with exposure " +
+      Fail(FaultKind::kProtocol, "ROW_DATA with exposure " +
                         Fmt("%g", row.exposure_ms) + " ms");
     const float theta_out = g.ThetaOutDeg(row.row);
-    const double t_s = row.exposure_ms;
+    if (row.nd_index >= g.nd_transmittance.size())
+      Fail(FaultKind::kProtocol, "ROW_DATA names ND filter " + std::to_string(row.nd_index) +
+                                     ", the instrument has " +
+                                     std::to_string(g.nd_transmittance.size()));
+    // The light integrated: exposure × filter transmittance (both float32 from the wire).
+    const double t_s = static_cast<double>(row.exposure_ms) *
+                       static_cast<double>(g.nd_transmittance[row.nd_index]);
     for (std::size_t i = 0; i < row.samples.size(); ++i) {
       const std::size_t column = row.first_column + i;
       const RowSample& rs = row.samples[i];
@@ -292,6 +344,38 @@ void Driver::Abort() {
   }
 }
 
+void Driver::Recover() {
+  // Whatever was in flight is suspect: forget the buffered bytes and the sequence, then wait
+  // for the acknowledgement of a fresh ABORT, skipping anything else (the tail of a stream, a
+  // late reply, an error about the damaged request).
+  reader_.Clear();
+  last_damage_.clear();
+  Send(MessageType::kAbort, {});
+  have_device_sequence_ = false;
+  for (;;) {
+    Frame f;
+    try {
+      f = NextFrame("ACK of ABORT", /*check_sequence=*/false);
+    } catch (const DriverFault& e) {
+      if (e.kind() == FaultKind::kTimeout || e.kind() == FaultKind::kDamagedFrame)
+        Fail(FaultKind::kNotAnswering,
+             "the instrument stopped answering (no acknowledgement of ABORT within " +
+                 std::to_string(options_.timeout_ms) + " ms)");
+      throw;
+    }
+    if (f.type == static_cast<std::uint8_t>(MessageType::kAck) && !f.payload.empty() &&
+        f.payload[0] == static_cast<std::uint8_t>(MessageType::kAbort))
+      return;
+  }
+}
+
+void Driver::RestoreCalibration(const DarkCalibration& dark, std::vector<WhiteCalibration> whites) {
+  if (!connected_) throw InvalidArgument("RestoreCalibration: connect to the instrument first");
+  dark_ = dark;
+  have_dark_ = true;
+  whites_ = std::move(whites);
+}
+
 Metadata Driver::CalibrationMetadata() const {
   Metadata m;
   const IdentityInfo& id = info_.identity;
@@ -313,19 +397,43 @@ Metadata Driver::CalibrationMetadata() const {
   if (have_dark_) {
     m.extra["dark_counts"] = Triple(dark_.mean_counts);
     m.extra["read_noise_counts"] = Triple(dark_.read_noise_counts);
+    m.extra["dark_frames"] = std::to_string(dark_.frames);
     m.extra["dark_time"] = dark_.time;
   }
   for (const WhiteCalibration& wc : whites_) {
     const std::string key = "white_theta_in_" + AngleText(wc.theta_in_deg);
     m.extra[key + "_counts"] = Triple(wc.counts);
     m.extra[key + "_exposure_ms"] = Fmt("%.9g", wc.exposure_ms);
+    if (wc.nd_transmittance != 1) m.extra[key + "_nd_transmittance"] = Fmt("%.9g", wc.nd_transmittance);
+    m.extra[key + "_frames"] = std::to_string(wc.frames);
+    m.extra[key + "_time"] = wc.time;
   }
   return m;
 }
 
+namespace {
+
+// Runs `step` until it succeeds, recovering and trying again after a retryable fault.
+template <class Step>
+auto WithRetries(Driver& driver, const CaptureCallbacks& callbacks, Step step) {
+  for (int attempt = 1;; ++attempt) {
+    try {
+      return step();
+    } catch (const DriverFault& e) {
+      if (!e.retryable() || attempt > driver.options().retries || driver.cancelled()) throw;
+      if (callbacks.on_retry) callbacks.on_retry(e, attempt);
+      driver.Recover();
+    }
+  }
+}
+
+}  // namespace
+
 Metadata Capture(Driver& driver, const CapturePlan& plan, const CaptureCallbacks& callbacks) {
   const std::string start = UtcNowIso8601();
-  const InstrumentInfo& info = driver.Connect();
+  const InstrumentInfo& info = WithRetries(driver, callbacks, [&]() -> const InstrumentInfo& {
+    return driver.Connect();
+  });
   if (plan.theta_in_deg.empty()) throw InvalidArgument("capture plan has no incidence angle");
   for (std::size_t i = 0; i < plan.theta_in_deg.size(); ++i) {
     const double t = plan.theta_in_deg[i];
@@ -342,9 +450,14 @@ Metadata Capture(Driver& driver, const CapturePlan& plan, const CaptureCallbacks
       if (std::fabs(plan.theta_in_deg[j] - t) <= kThetaMatchDeg)
         throw InvalidArgument("θin " + AngleText(t) + "° is listed twice");
   }
-  driver.SetExposure(plan.exposure);
-  driver.MeasureDark();
-  for (double t : plan.theta_in_deg) driver.MeasureWhite(t);
+  if (callbacks.on_connected) callbacks.on_connected(info);
+  WithRetries(driver, callbacks, [&] { driver.SetExposure(plan.exposure); });
+  const bool restored = callbacks.restore_calibration && callbacks.restore_calibration(driver);
+  if (!restored) {
+    WithRetries(driver, callbacks, [&] { driver.MeasureDark(); });
+    for (double t : plan.theta_in_deg)
+      WithRetries(driver, callbacks, [&] { driver.MeasureWhite(t); });
+  }
 
   auto merge = [&](Metadata m) {
     m.sample_name = plan.metadata.sample_name;
@@ -355,8 +468,11 @@ Metadata Capture(Driver& driver, const CapturePlan& plan, const CaptureCallbacks
   };
   if (callbacks.on_calibrated) callbacks.on_calibrated(merge(driver.CalibrationMetadata()));
   for (double t : plan.theta_in_deg) {
+    if (driver.cancelled())
+      throw DriverFault(FaultKind::kCancelled, "capture cancelled before the slice at θin " +
+                                                   AngleText(t) + "°");
     SliceReport report;
-    Slice slice = driver.MeasureSlice(t, &report);
+    Slice slice = WithRetries(driver, callbacks, [&] { return driver.MeasureSlice(t, &report); });
     if (callbacks.on_slice) callbacks.on_slice(slice, report);
   }
   Metadata final_metadata = merge(driver.CalibrationMetadata());

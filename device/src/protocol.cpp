@@ -183,6 +183,7 @@ DecodeResult DecodeFrame(std::span<const std::uint8_t> bytes) {
   }
   result.status = DecodeStatus::kComplete;
   result.consumed = total;
+  result.crc = stored;
   result.frame.type = bytes[2];
   result.frame.sequence = bytes[3];
   result.frame.payload.assign(
@@ -271,6 +272,10 @@ std::vector<std::uint8_t> EncodeGeometry(const GeometryInfo& info) {
   w.F32(info.phi_out_step_deg);
   w.U16(info.rows);
   w.U16(info.columns);
+  w.F32(info.min_exposure_ms);
+  w.F32(info.max_exposure_ms);
+  w.U8(static_cast<std::uint8_t>(info.nd_transmittance.size()));
+  for (float t : info.nd_transmittance) w.F32(t);
   return w.Take();
 }
 
@@ -287,6 +292,18 @@ GeometryInfo DecodeGeometry(std::span<const std::uint8_t> payload) {
     if (!(info.theta_out_step_deg > 0) || !(info.phi_out_step_deg > 0))
       r.Fail("positive angular steps", std::to_string(info.theta_out_step_deg) + ", " +
                                            std::to_string(info.phi_out_step_deg));
+    if (r.remaining() > 0) {  // protocol 1.1
+      info.min_exposure_ms = r.F32("min_exposure_ms");
+      info.max_exposure_ms = r.F32("max_exposure_ms");
+      const std::uint8_t nd = r.U8("nd filter count");
+      if (nd == 0) r.Fail("at least the open position in the ND filter list", "0 filters");
+      info.nd_transmittance.clear();
+      for (std::uint8_t i = 0; i < nd; ++i) {
+        const float t = r.F32("nd_transmittance");
+        if (!(t > 0 && t <= 1)) r.Fail("an ND transmittance in (0, 1]", std::to_string(t));
+        info.nd_transmittance.push_back(t);
+      }
+    }
     return info;
   });
 }
@@ -353,6 +370,7 @@ std::vector<std::uint8_t> EncodeWhite(const WhiteReading& reading) {
   WriteRgb(w, reading.counts);
   w.U8(reading.clipped_channels);
   w.U16(reading.frames);
+  w.U8(reading.nd_index);
   return w.Take();
 }
 
@@ -364,6 +382,7 @@ WhiteReading DecodeWhite(std::span<const std::uint8_t> payload) {
     wr.counts = ReadRgb(r, "counts");
     wr.clipped_channels = r.U8("clipped_channels");
     wr.frames = r.U16("frames");
+    if (r.remaining() > 0) wr.nd_index = r.U8("nd_index");  // protocol 1.1
     return wr;
   });
 }
@@ -400,6 +419,7 @@ std::vector<std::uint8_t> EncodeRowData(const RowData& row) {
     WriteRgb(w, s.counts);
     w.U8(s.clipped_channels);
   }
+  w.U8(row.nd_index);
   return w.Take();
 }
 
@@ -413,10 +433,18 @@ RowData DecodeRowData(std::span<const std::uint8_t> payload) {
       r.Fail("at most " + std::to_string(kMaxSamplesPerRowFrame) + " samples", std::to_string(n));
     row.exposure_ms = r.F32("exposure_ms");
     row.samples.resize(n);
+    // One bounds check for all samples (13 bytes each), then plain loads: this loop is most of
+    // the host's decoding work.
+    const std::uint8_t* p = r.Bytes(std::size_t{n} * 13, "samples (13 bytes each)");
     for (RowSample& s : row.samples) {
-      s.counts = ReadRgb(r, "sample counts");
-      s.clipped_channels = r.U8("sample clip bits");
+      for (float& c : s.counts) {
+        const std::uint32_t bits = LoadU32(p);
+        std::memcpy(&c, &bits, sizeof c);
+        p += 4;
+      }
+      s.clipped_channels = *p++;
     }
+    if (r.remaining() > 0) row.nd_index = r.U8("nd_index");  // protocol 1.1
     return row;
   });
 }

@@ -3,6 +3,9 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <chrono>
+#include <thread>
+#include <tuple>
 
 #include "brdf/core/error.h"
 #include "brdf/core/virtual_capture.h"
@@ -75,6 +78,55 @@ class LambertianPanel final : public BrdfSource {
 
 }  // namespace
 
+bool FaultPlan::Has(FaultType type, std::uint64_t at) const {
+  return std::any_of(faults.begin(), faults.end(),
+                     [&](const Fault& f) { return f.type == type && f.at == at; });
+}
+
+bool FaultPlan::HasFirmwareFaults() const {
+  return std::any_of(faults.begin(), faults.end(),
+                     [](const Fault& f) { return f.type != FaultType::kEndpointHalt; });
+}
+
+FaultPlan ParseFaultPlan(std::string_view spec) {
+  static constexpr std::pair<std::string_view, FaultType> kNames[] = {
+      {"disconnect", FaultType::kDisconnect}, {"stall", FaultType::kStall},
+      {"timeout", FaultType::kTimeout},       {"corrupt", FaultType::kCorrupt},
+      {"duplicate", FaultType::kDuplicate},   {"reorder", FaultType::kReorder},
+      {"lamp", FaultType::kLampFailure},      {"contact", FaultType::kSampleContact},
+      {"overtemp", FaultType::kOverTemperature}, {"halt", FaultType::kEndpointHalt}};
+  std::string names;
+  for (const auto& [name, type] : kNames) names += (names.empty() ? "" : ", ") + std::string(name);
+  FaultPlan plan;
+  std::size_t start = 0;
+  while (start <= spec.size() && !spec.empty()) {
+    std::size_t end = spec.find(',', start);
+    if (end == std::string_view::npos) end = spec.size();
+    const std::string item(spec.substr(start, end - start));
+    const std::size_t colon = item.find(':');
+    const std::string kind = item.substr(0, colon);
+    const std::string value = colon == std::string::npos ? "" : item.substr(colon + 1);
+    const auto it = std::find_if(std::begin(kNames), std::end(kNames),
+                                 [&](const auto& k) { return k.first == kind; });
+    if (it == std::end(kNames))
+      throw InvalidArgument("simulated fault '" + item + "': expected NAME:N with NAME one of " +
+                            names);
+    std::uint64_t n = 0;
+    bool digits = !value.empty() && value.size() <= 18;
+    for (char c : value) {
+      digits = digits && c >= '0' && c <= '9';
+      if (digits) n = n * 10 + static_cast<std::uint64_t>(c - '0');
+    }
+    if (!digits || n == 0)
+      throw InvalidArgument("simulated fault '" + item +
+                            "': expected a frame number ≥ 1 after the colon, got '" + value + "'");
+    plan.faults.push_back({it->second, n});
+    start = end + 1;
+    if (end == spec.size()) break;
+  }
+  return plan;
+}
+
 std::span<const InstrumentModel> InstrumentModels() { return ModelTable(); }
 
 const InstrumentModel& ReferenceInstrument() { return ModelTable().front(); }
@@ -110,7 +162,11 @@ SimulatedFirmware::SimulatedFirmware(SimulatorConfig config) : config_(std::move
                           std::to_string(m.theta_out_step_deg) + ", φout " +
                           std::to_string(m.phi_out_step_deg));
   if (m.frames_per_reading < 1 || m.dark_frames < 2 || m.white_frames < 1 ||
-      !(m.min_exposure_ms > 0) || !(m.max_exposure_ms >= m.min_exposure_ms))
+      !(m.min_exposure_ms > 0) || !(m.max_exposure_ms >= m.min_exposure_ms) ||
+      m.nd_transmittance.empty() || m.nd_transmittance.size() > 255 ||
+      m.nd_transmittance[0] != 1.0f ||
+      !std::all_of(m.nd_transmittance.begin(), m.nd_transmittance.end(),
+                   [](float t) { return t > 0 && t <= 1; }))
     throw InvalidArgument("simulator: instrument model '" + m.model + "' has unusable constants");
 
   geometry_.theta_in_deg = m.theta_in_deg;
@@ -126,6 +182,9 @@ SimulatedFirmware::SimulatedFirmware(SimulatorConfig config) : config_(std::move
     throw InvalidArgument("simulator: geometry of " + std::to_string(rows) + " × " +
                           std::to_string(columns) + " samples exceeds 65535 per axis");
   geometry_.rows = static_cast<std::uint16_t>(rows);
+  geometry_.min_exposure_ms = static_cast<float>(m.min_exposure_ms);
+  geometry_.max_exposure_ms = static_cast<float>(m.max_exposure_ms);
+  geometry_.nd_transmittance = m.nd_transmittance;
   geometry_.columns = static_cast<std::uint16_t>(columns);
 
   white_ = config_.white_reference;
@@ -160,28 +219,63 @@ std::size_t SimulatedFirmware::Transmit(std::span<std::uint8_t> out) {
 }
 
 void SimulatedFirmware::Send(MessageType type, const std::vector<std::uint8_t>& payload) {
-  if (!link_up_ || stalled_) return;
+  if (!link_up_ || stalled_ || hung_) return;
   ++frames_sent_;
   const FaultPlan& f = config_.faults;
-  if (f.disconnect_after_frames != 0 && frames_sent_ > f.disconnect_after_frames) {
+  const std::uint64_t n = frames_sent_;
+  if (f.Has(FaultType::kDisconnect, n)) {
     link_up_ = false;
     streaming_ = false;
     return;
   }
-  if (f.stall_after_frames != 0 && frames_sent_ > f.stall_after_frames) {
+  if (f.Has(FaultType::kStall, n)) {
     stalled_ = true;
     streaming_ = false;
     return;
   }
+  if (f.Has(FaultType::kTimeout, n)) {
+    hung_ = true;
+    streaming_ = false;
+    return;
+  }
+  for (const auto& [fault, code, text] :
+       {std::tuple{FaultType::kLampFailure, ErrorCode::kLampFailure,
+                   "lamp failure: the light source did not reach its set point"},
+        std::tuple{FaultType::kSampleContact, ErrorCode::kSampleNotInContact,
+                   "sample not in contact with the measurement port"},
+        std::tuple{FaultType::kOverTemperature, ErrorCode::kOverTemperature,
+                   "detector over temperature"}}) {
+    if (f.Has(fault, n)) {
+      streaming_ = false;
+      std::vector<std::uint8_t> bytes;
+      AppendFrame(bytes, static_cast<std::uint8_t>(MessageType::kError), sequence_++,
+                  EncodeError({code, type == MessageType::kRowData ||
+                                             type == MessageType::kSliceEnd
+                                         ? static_cast<std::uint8_t>(MessageType::kMeasureSlice)
+                                         : static_cast<std::uint8_t>(0),
+                               text}));
+      output_.insert(output_.end(), bytes.begin(), bytes.end());
+      return;
+    }
+  }
   std::vector<std::uint8_t> bytes;
   AppendFrame(bytes, static_cast<std::uint8_t>(type), sequence_++, payload);
-  if (f.corrupt_frame == frames_sent_) {
+  if (f.Has(FaultType::kCorrupt, n)) {
     // One flipped bit in the payload (or in the CRC of an empty frame): line noise.
     const std::size_t at =
         payload.empty() ? bytes.size() - 1 : kFrameHeaderBytes + payload.size() / 2;
     bytes[at] ^= 0x10;
   }
+  if (f.Has(FaultType::kReorder, n)) {
+    held_frame_ = std::move(bytes);
+    return;
+  }
   output_.insert(output_.end(), bytes.begin(), bytes.end());
+  if (f.Has(FaultType::kDuplicate, n)) output_.insert(output_.end(), bytes.begin(), bytes.end());
+  if (!held_frame_.empty() && !f.Has(FaultType::kReorder, n)) {
+    output_.insert(output_.end(), held_frame_.begin(), held_frame_.end());
+    held_frame_.clear();
+  }
 }
 
 void SimulatedFirmware::SendError(ErrorCode code, std::uint8_t request_type,
@@ -196,6 +290,10 @@ bool SimulatedFirmware::FindThetaIn(float theta_in_deg) const {
 
 void SimulatedFirmware::Handle(const Frame& frame) {
   const auto type = static_cast<MessageType>(frame.type);
+  if (hung_) {
+    if (type != MessageType::kAbort) return;
+    hung_ = false;  // the host's ABORT wakes a hung firmware
+  }
   if (streaming_) {
     if (type == MessageType::kAbort) {
       streaming_ = false;
@@ -275,13 +373,14 @@ void SimulatedFirmware::Handle(const Frame& frame) {
         const Rgb f = white_->Eval(light, Vec3{0, 0, 1});
         std::array<double, 3> rate{};
         for (int c = 0; c < 3; ++c) rate[c] = m.responsivity_counts_per_ms[c] * f[c] * light.z;
-        const float t = AutoExposure(MaxOf(rate));
+        const Exposure t = AutoExposure(MaxOf(rate));
         Reseed(kSeedWhite, theta_in);
         const Reading r = Read(rate, t, m.white_frames);
         if (r.clipped != 0) clip_log_.push_back({theta_in, kWhiteRow, kWhiteRow, r.clipped});
         WhiteReading w;
         w.theta_in_deg = theta_in;
-        w.exposure_ms = t;
+        w.exposure_ms = t.ms;
+        w.nd_index = t.nd;
         w.counts = r.counts;
         w.clipped_channels = r.clipped;
         w.frames = static_cast<std::uint16_t>(m.white_frames);
@@ -326,12 +425,12 @@ void SimulatedFirmware::StartSlice(float theta_in_deg) {
   slice_samples_ = slice_clipped_ = 0;
   Reseed(kSeedSlice, theta_in_deg);
   if (exposure_.mode == ExposureMode::kFixed) {
-    slice_exposure_ms_ = exposure_.exposure_ms;
+    slice_exposure_ = {exposure_.exposure_ms, 0};
   } else if (exposure_.mode == ExposureMode::kAutoPerSlice) {
     double brightest = 0;
     for (std::size_t row = 0; row < geometry_.rows; ++row)
       brightest = std::max(brightest, MaxOf(RowRates(row, nullptr)));
-    slice_exposure_ms_ = AutoExposure(brightest);
+    slice_exposure_ = AutoExposure(brightest);
   }
   Send(MessageType::kSliceBegin,
        EncodeSliceBegin({theta_in_deg, geometry_.rows, geometry_.columns}));
@@ -356,24 +455,33 @@ std::array<double, 3> SimulatedFirmware::RowRates(std::size_t row,
   return brightest;
 }
 
-float SimulatedFirmware::AutoExposure(double brightest_rate) const {
+SimulatedFirmware::Exposure SimulatedFirmware::AutoExposure(double brightest_rate) const {
   const InstrumentModel& m = config_.model;
   const double dark = config_.noise_level * MaxOf(m.dark_offset_counts);
   double t = m.max_exposure_ms;
   if (brightest_rate > 0)
     t = m.autorange_target_fraction * std::max(0.0, m.adc_full_scale_counts - dark) /
         brightest_rate;
-  return static_cast<float>(std::clamp(t, m.min_exposure_ms, m.max_exposure_ms));
+  // The least attenuating filter that keeps the exposure at or above the minimum.
+  std::uint8_t nd = 0;
+  while (t / static_cast<double>(m.nd_transmittance[nd]) < m.min_exposure_ms &&
+         nd + 1u < m.nd_transmittance.size())
+    ++nd;
+  t /= static_cast<double>(m.nd_transmittance[nd]);
+  return {static_cast<float>(std::clamp(t, m.min_exposure_ms, m.max_exposure_ms)), nd};
 }
 
 SimulatedFirmware::Reading SimulatedFirmware::Read(const std::array<double, 3>& rate,
-                                                   float exposure_ms, int frames) {
+                                                   Exposure exposure, int frames) {
   const InstrumentModel& m = config_.model;
   const double s = config_.noise_level;
   const double full = m.adc_full_scale_counts;
   Reading r;
   for (int c = 0; c < 3; ++c) {
-    const double signal = static_cast<double>(exposure_ms) * rate[c];
+    // The light the detector integrates: exposure time × filter transmittance (the same
+    // float32 numbers the host multiplies).
+    const double signal = static_cast<double>(exposure.ms) *
+                          static_cast<double>(m.nd_transmittance[exposure.nd]) * rate[c];
     const double mean = signal + s * m.dark_offset_counts[c];
     if (s == 0) {  // ideal detector
       r.counts[c] = static_cast<float>(mean);
@@ -403,14 +511,16 @@ SimulatedFirmware::Reading SimulatedFirmware::Read(const std::array<double, 3>& 
 }
 
 void SimulatedFirmware::PrepareRow(std::size_t row) {
+  if (config_.pace_ms_per_row > 0)
+    std::this_thread::sleep_for(std::chrono::duration<double, std::milli>(config_.pace_ms_per_row));
   std::vector<std::array<double, 3>> rates;
   const std::array<double, 3> brightest = RowRates(row, &rates);
-  row_exposure_ms_ = exposure_.mode == ExposureMode::kAutoPerRow ? AutoExposure(MaxOf(brightest))
-                                                                 : slice_exposure_ms_;
+  row_exposure_ = exposure_.mode == ExposureMode::kAutoPerRow ? AutoExposure(MaxOf(brightest))
+                                                              : slice_exposure_;
   const int frames = config_.model.frames_per_reading;
   row_readings_.resize(rates.size());
   for (std::size_t col = 0; col < rates.size(); ++col) {
-    row_readings_[col] = Read(rates[col], row_exposure_ms_, frames);
+    row_readings_[col] = Read(rates[col], row_exposure_, frames);
     if (row_readings_[col].clipped != 0) {
       ++slice_clipped_;
       clip_log_.push_back({slice_theta_in_deg_, static_cast<std::uint16_t>(row),
@@ -431,7 +541,8 @@ void SimulatedFirmware::ProduceStreamFrame() {
   RowData data;
   data.row = static_cast<std::uint16_t>(next_row_);
   data.first_column = static_cast<std::uint16_t>(next_column_);
-  data.exposure_ms = row_exposure_ms_;
+  data.exposure_ms = row_exposure_.ms;
+  data.nd_index = row_exposure_.nd;
   data.samples.resize(n);
   for (std::size_t i = 0; i < n; ++i) {
     const Reading& r = row_readings_[next_column_ + i];

@@ -72,7 +72,7 @@ TEST_F(CaptureFile, FaultMidCaptureKeepsCompletedSlicesAndResumeCompletesThem) {
     }
     SimulatorConfig faulty = Config(m, noise, 5, 5);
     // 8 set-up frames, 18 per slice of 16 × 72: the link drops inside the third slice.
-    faulty.faults.disconnect_after_frames = 8 + 2 * 18 + 7;
+    faulty.faults.faults.push_back({FaultType::kDisconnect, (8 + 2 * 18 + 7) + 1});
     {
       SimulatedFirmware fw(faulty);
       EXPECT_THROW(CaptureToFile(fw, cut, {0, 20, 40, 60}, false), DeviceError);

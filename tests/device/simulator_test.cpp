@@ -279,7 +279,7 @@ TEST(SimulatedFirmware, AnswersADamagedRequestWithBadFrame) {
 
 TEST(SimulatedFirmware, InjectedDisconnectDeliversTheFramesBeforeIt) {
   SimulatorConfig c = Config(LibraryMaterial("paper_white"), 1, 5, 5);
-  c.faults.disconnect_after_frames = 3;
+  c.faults.faults.push_back({FaultType::kDisconnect, (3) + 1});
   SimulatedFirmware fw(c);
   RawHost host(fw);
   host.Send(MessageType::kMeasureSlice, EncodeThetaIn(0));
@@ -293,7 +293,7 @@ TEST(SimulatedFirmware, InjectedDisconnectDeliversTheFramesBeforeIt) {
 
 TEST(SimulatedFirmware, InjectedStallGoesSilent) {
   SimulatorConfig c = Config(LibraryMaterial("paper_white"), 1, 5, 5);
-  c.faults.stall_after_frames = 1;
+  c.faults.faults.push_back({FaultType::kStall, (1) + 1});
   SimulatedFirmware fw(c);
   RawHost host(fw);
   host.Send(MessageType::kIdentify);
@@ -305,7 +305,7 @@ TEST(SimulatedFirmware, InjectedStallGoesSilent) {
 
 TEST(SimulatedFirmware, InjectedCorruptionFailsTheFrameCrc) {
   SimulatorConfig c = Config(LibraryMaterial("paper_white"), 1, 5, 5);
-  c.faults.corrupt_frame = 2;
+  c.faults.faults.push_back({FaultType::kCorrupt, 2});
   SimulatedFirmware fw(c);
   RawHost host(fw);
   host.Send(MessageType::kIdentify);

@@ -1,6 +1,9 @@
 // `brdf capture`: drives a scatterometer through a whole capture and appends each completed
 // slice to a .bpc file, so an interrupted capture keeps what it measured and can be resumed.
+#include <signal.h>
+
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -13,7 +16,10 @@
 #include "brdf/core/bpc.h"
 #include "brdf/core/brdf_source.h"
 #include "brdf/core/error.h"
+#include "brdf/device/capture_session.h"
 #include "brdf/device/driver.h"
+#include "brdf/device/emulated_usb.h"
+#include "brdf/device/usb_models.h"
 #include "brdf/device/simulator.h"
 #include "brdf/device/transport.h"
 #include "cli_support.h"
@@ -41,45 +47,6 @@ std::string Deg(double v) {
   return buf;
 }
 
-std::uint64_t ParseCount(const std::string& text, const std::string& what) {
-  std::size_t used = 0;
-  unsigned long long v = 0;
-  try {
-    v = std::stoull(text, &used);
-  } catch (const std::exception&) {
-    used = 0;
-  }
-  if (used == 0 || used != text.size() || v == 0)
-    throw InvalidArgument(what + ": expected a frame count ≥ 1, got '" + text + "'");
-  return v;
-}
-
-// "disconnect:N", "stall:N", "corrupt:N", comma separated.
-device::FaultPlan ParseFaults(const std::string& spec) {
-  device::FaultPlan plan;
-  std::size_t start = 0;
-  while (start < spec.size()) {
-    std::size_t end = spec.find(',', start);
-    if (end == std::string::npos) end = spec.size();
-    const std::string item = spec.substr(start, end - start);
-    const std::size_t colon = item.find(':');
-    const std::string kind = item.substr(0, colon);
-    const std::string value = colon == std::string::npos ? "" : item.substr(colon + 1);
-    const std::string what = "--sim-fault " + item;
-    if (kind == "disconnect")
-      plan.disconnect_after_frames = ParseCount(value, what);
-    else if (kind == "stall")
-      plan.stall_after_frames = ParseCount(value, what);
-    else if (kind == "corrupt")
-      plan.corrupt_frame = ParseCount(value, what);
-    else
-      throw InvalidArgument("--sim-fault: expected disconnect:N, stall:N or corrupt:N, got '" +
-                            item + "'");
-    start = end + 1;
-  }
-  return plan;
-}
-
 // "auto" / "auto-row", "auto-slice", or a fixed exposure in milliseconds.
 device::ExposureSetting ParseExposure(const std::string& text) {
   if (text == "auto" || text == "auto-row") return {device::ExposureMode::kAutoPerRow, 0};
@@ -98,13 +65,10 @@ device::ExposureSetting ParseExposure(const std::string& text) {
 }
 
 void Validate(const CaptureOptions& o) {
-  if (o.device != "sim")
-    throw InvalidArgument(
-        "--device: only 'sim' (the simulated scatterometer) is available in "
-        "this build, got '" +
-        o.device + "'");
   if (o.sample.empty()) throw InvalidArgument("--sample: a sample name is required");
   if (o.out.empty()) throw InvalidArgument("--out: an output .bpc path is required");
+  if (LowerExtension(o.out) != ".bpc")
+    throw InvalidArgument("--out: a capture is written as a .bpc file, got '" + o.out + "'");
   if (o.theta_in_deg.empty()) throw InvalidArgument("--theta-in: at least one angle is required");
   for (double t : o.theta_in_deg)
     if (!(t >= 0 && t < 90))
@@ -146,15 +110,111 @@ std::map<std::string, std::string> SettingsOf(const CaptureOptions& o,
           {"exposure", o.exposure}};
 }
 
+
+std::string Eta(double seconds) {
+  char buf[32];
+  if (seconds < 60)
+    std::snprintf(buf, sizeof buf, "%.0f s", seconds);
+  else
+    std::snprintf(buf, sizeof buf, "%.0f min %02.0f s", std::floor(seconds / 60),
+                  std::fmod(seconds, 60));
+  return buf;
+}
+
+// Ctrl-C and SIGTERM ask the session to abort the scan; a second signal is not special (the
+// abort itself is bounded by the reply timeout).
+std::atomic<bool> g_cancel{false};
+extern "C" void OnSignal(int) { g_cancel.store(true); }
+
+class SignalScope {
+ public:
+  SignalScope() {
+    struct sigaction sa {};
+    sa.sa_handler = OnSignal;
+    sigemptyset(&sa.sa_mask);
+    sigaction(SIGINT, &sa, &old_int_);
+    sigaction(SIGTERM, &sa, &old_term_);
+  }
+  ~SignalScope() {
+    sigaction(SIGINT, &old_int_, nullptr);
+    sigaction(SIGTERM, &old_term_, nullptr);
+  }
+  SignalScope(const SignalScope&) = delete;
+  SignalScope& operator=(const SignalScope&) = delete;
+
+ private:
+  struct sigaction old_int_ {}, old_term_ {};
+};
+
+// The session's next step in this tool's words (options by their flag names).
+std::string Advice(const device::CaptureSessionResult& r, const std::string& out) {
+  using device::NextStep;
+  switch (r.next) {
+    case NextStep::kNone:
+      return {};
+    case NextStep::kResume:
+      return std::to_string(r.slices_saved) + " of " + std::to_string(r.slices_planned) +
+             " slices are saved in " + out + "; run the same command with --resume to capture "
+             "the rest";
+    case NextStep::kRetry:
+      return "nothing was saved; check the instrument and run the command again";
+    case NextStep::kResumeOrOverwrite:
+      return "use --resume to continue an interrupted capture or --force to overwrite it";
+    case NextStep::kOverwrite:
+      return "start over with --force";
+    case NextStep::kAcceptInstrument:
+      return "connect the original instrument, or add --force to resume on this one";
+    case NextStep::kUseOriginalSettings:
+      return "rerun with the original settings";
+  }
+  return {};
+}
+
+std::string ProblemAdvice(device::InstrumentProblem p) {
+  switch (p) {
+    case device::InstrumentProblem::kNone:
+      return {};
+    case device::InstrumentProblem::kLampFailure:
+      return "check or replace the lamp, then ";
+    case device::InstrumentProblem::kSampleNotInContact:
+      return "seat the sample on the measurement port, then ";
+    case device::InstrumentProblem::kOverTemperature:
+      return "let the instrument cool down, then ";
+  }
+  return {};
+}
+
 }  // namespace
 
 int RunCapture(const CaptureOptions& o) {
   Validate(o);
-  const device::FaultPlan faults = ParseFaults(o.sim_fault);
+  device::DeviceSpec spec;
+  device::SimLink sim_link = device::SimLink::kLoopback;
+  try {
+    spec = device::ParseDeviceSpec(o.device);
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument(std::string("--device: ") + e.what());
+  }
+  try {
+    sim_link = device::ParseSimLink(o.transport);
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument(std::string("--transport: ") + e.what());
+  }
+  const bool sim = spec.kind == device::DeviceSpec::Kind::kSim;
+  if (!sim && (o.transport != "loopback" || !o.sim_fault.empty()))
+    throw InvalidArgument("--transport and --sim-fault apply to --device sim only");
+  device::FaultPlan faults;
+  try {
+    faults = device::ParseFaultPlan(o.sim_fault);
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument(std::string("--sim-fault: ") + e.what());
+  }
   const device::ExposureSetting exposure = ParseExposure(o.exposure);
-  const std::string material_path = ResolveMaterial(o.material);
-  std::shared_ptr<const BrdfSource> source = OpenBrdfSource(material_path);
-  const std::map<std::string, std::string> settings = SettingsOf(o, source->Name());
+  if (sim && o.material.empty())
+    throw InvalidArgument("--material: the simulated instrument needs a virtual sample");
+  const std::string material_path = sim ? ResolveMaterial(o.material) : std::string();
+  std::shared_ptr<const BrdfSource> source =
+      sim ? OpenBrdfSource(material_path) : std::shared_ptr<const BrdfSource>();
 
   // The simulated instrument: the reference model with the requested light-arm positions and
   // detector steps (a real instrument reports its own and refuses what it cannot do).
@@ -167,151 +227,90 @@ int RunCapture(const CaptureOptions& o) {
   config.model.theta_out_max_deg = static_cast<float>(o.theta_out_max_deg);
   config.model.theta_out_step_deg = static_cast<float>(o.theta_out_step_deg);
   config.model.phi_out_step_deg = static_cast<float>(o.phi_out_step_deg);
-  device::SimulatedFirmware firmware(config);
-  device::LoopbackTransport link(firmware);
-  device::Driver driver(link);
+  config.pace_ms_per_row = o.sim_pace_ms;
+  const std::unique_ptr<device::InstrumentLink> link =
+      device::OpenInstrumentLink(spec, config, sim_link);
 
-  // What is already on disk.
-  std::error_code ec;
-  const bool exists = fs::exists(o.out, ec);
-  std::vector<double> pending = o.theta_in_deg;
-  std::optional<BpcReadResult> existing;
-  if (exists && !o.resume && !o.force)
-    throw InvalidArgument(o.out +
-                          " already exists: use --resume to continue an interrupted "
-                          "capture or --force to overwrite it");
-  if (o.resume && exists) {
-    try {
-      existing = ReadBpc(o.out);
-    } catch (const FormatError& e) {
-      throw FormatError(e.file(), e.position(), e.expected(), e.got(),
-                        "nothing in it can be resumed; start over with --force");
-    }
-    const Metadata& old = existing->measurement.metadata;
-    if (existing->finished) {
-      if (!o.quiet)
-        std::fprintf(stderr, "%s is a finished capture (%zu slices); nothing to resume\n",
-                     o.out.c_str(), existing->measurement.slices.size());
-      return 0;
-    }
-    if (old.sample_name != o.sample)
-      throw InvalidArgument("--resume: " + o.out + " holds sample '" + old.sample_name +
-                            "', not '" + o.sample + "'");
-    for (const auto& [key, value] : settings) {
-      const auto it = old.extra.find(key);
-      if (it != old.extra.end() && it->second != value)
-        throw InvalidArgument("--resume: " + o.out + " was captured with " + key + " = " +
-                              it->second + ", this command has " + value +
-                              " (rerun with the original settings)");
-    }
-    for (const Slice& done : existing->measurement.slices) {
-      const auto it = std::find_if(pending.begin(), pending.end(), [&](double t) {
-        return std::fabs(t - done.theta_in_deg) <= 1e-6;
-      });
-      if (it == pending.end())
-        throw InvalidArgument("--resume: " + o.out + " holds a slice at θin " +
-                              Deg(done.theta_in_deg) + "° that --theta-in does not list");
-      pending.erase(it);
-    }
-  } else if (o.resume && !o.quiet) {
-    std::fprintf(stderr, "%s does not exist yet: starting a new capture\n", o.out.c_str());
+  device::CaptureRequest request;
+  request.out_path = o.out;
+  request.theta_in_deg = o.theta_in_deg;
+  request.exposure = exposure;
+  request.sample_name = o.sample;
+  request.operator_notes = o.operator_notes;
+  if (sim) {
+    request.settings = SettingsOf(o, source->Name());
+    request.notes["material_file"] = material_path;
+  } else {
+    request.settings["device"] = o.device;
   }
+  request.resume = o.resume;
+  request.force = o.force;
+  request.calibrate = o.calibrate;
 
-  const std::size_t total = o.theta_in_deg.size();
-  const std::size_t done_before = total - pending.size();
-  std::optional<BpcAppender> appender;
-  if (existing) {
-    appender.emplace(BpcAppender::Resume(o.out, nullptr));
-    if (!o.quiet)
+  device::SessionEvents events;
+  events.on_start = [&](const device::SessionStart& s) {
+    if (o.quiet) return;
+    if (o.resume && !s.resuming)
+      std::fprintf(stderr, "%s does not exist yet: starting a new capture\n", o.out.c_str());
+    if (s.resuming)
       std::fprintf(stderr, "resuming %s: %zu of %zu slices already captured\n", o.out.c_str(),
-                   done_before, total);
-  }
-
-  device::CapturePlan plan;
-  plan.theta_in_deg = pending;
-  plan.exposure = exposure;
-  plan.metadata.sample_name = o.sample;
-  plan.metadata.operator_notes = o.operator_notes;
-  plan.metadata.extra = settings;
-  plan.metadata.extra["material_file"] = material_path;
-
-  std::size_t slices_saved = done_before, samples = 0, saturated = 0, below = 0;
-  device::CaptureCallbacks callbacks;
-  callbacks.on_calibrated = [&](const Metadata& header) {
-    if (!appender) appender.emplace(BpcAppender::Create(o.out, header));
-    if (!o.quiet)
-      std::fprintf(stderr, "%s %s: dark and white reference measured at %zu θin\n",
-                   header.instrument_model.c_str(), header.instrument_serial.c_str(),
-                   pending.size());
+                   s.slices_done, s.slices_planned);
   };
-  callbacks.on_slice = [&](const Slice& slice, const device::SliceReport& report) {
-    appender->AppendSlice(slice);
-    ++slices_saved;
-    samples += report.samples;
-    saturated += report.saturated;
-    below += report.below_noise_floor;
-    if (!o.quiet) {
-      std::string line = "slice " + std::to_string(slices_saved) + "/" + std::to_string(total) +
-                         " θin=" + Deg(report.theta_in_deg) + "°: " + Thousands(report.samples) +
-                         " samples, ";
-      char secs[32];
-      std::snprintf(secs, sizeof secs, "%.1f s", report.seconds);
-      line += secs;
-      line += ", " + Thousands(report.saturated) + " saturated";
-      if (report.below_noise_floor > 0)
-        line += ", " + Thousands(report.below_noise_floor) + " below noise floor";
-      std::fprintf(stderr, "%s\n", line.c_str());
-    }
+  events.on_calibrated = [&](const Metadata& header, bool measured) {
+    if (o.quiet) return;
+    std::fprintf(stderr, "%s %s: %s\n", header.instrument_model.c_str(),
+                 header.instrument_serial.c_str(),
+                 measured ? "dark and white reference measured"
+                          : "dark and white reference of the interrupted capture reused");
+  };
+  events.on_retry = [&](const std::string& message) {
+    if (!o.quiet) std::fprintf(stderr, "brdf: warning: %s\n", message.c_str());
+  };
+  events.on_slice = [&](const device::SliceProgress& p) {
+    if (o.quiet) return;
+    const device::SliceReport& report = p.report;
+    std::string line = "slice " + std::to_string(p.index) + "/" + std::to_string(p.planned) +
+                       " θin=" + Deg(report.theta_in_deg) + "°: " + Thousands(report.samples) +
+                       " samples, ";
+    char secs[32];
+    std::snprintf(secs, sizeof secs, "%.1f s", report.seconds);
+    line += secs;
+    line += ", " + Thousands(report.saturated) + " saturated";
+    if (report.below_noise_floor > 0)
+      line += ", " + Thousands(report.below_noise_floor) + " below noise floor";
+    if (p.index < p.planned) line += ", ETA " + Eta(p.eta_seconds);
+    std::fprintf(stderr, "%s\n", line.c_str());
   };
 
-  Metadata final_metadata;
-  try {
-    if (!pending.empty()) final_metadata = device::Capture(driver, plan, callbacks);
-  } catch (const DeviceError& e) {
-    std::fprintf(stderr, "brdf: error: %s\n", e.what());
-    if (appender) {
-      std::fprintf(stderr,
-                   "brdf: %zu of %zu slices are saved in %s; run the same command with --resume "
-                   "to capture the rest\n",
-                   slices_saved, total, o.out.c_str());
-    } else {
-      std::fprintf(stderr,
-                   "brdf: nothing was saved; check the instrument and run the command "
-                   "again\n");
-    }
-    return 1;
+  device::CaptureSessionResult r;
+  {
+    g_cancel.store(false);
+    SignalScope signals;
+    r = device::RunCaptureSession(request, link->transport(), events, &g_cancel);
   }
-
-  if (existing) {
-    // The header keeps the original capture's start, calibration and notes; what the resumed
-    // part measured differently is added beside it.
-    Metadata merged = existing->measurement.metadata;
-    if (pending.empty()) {
-      final_metadata = merged;
-    } else {
-      for (const auto& [key, value] : final_metadata.extra) {
-        const auto it = merged.extra.find(key);
-        if (it == merged.extra.end())
-          merged.extra[key] = value;
-        else if (it->second != value)
-          merged.extra[key + "_resume"] = value;
-      }
-      merged.extra["calibration_time_resume"] = final_metadata.calibration_time;
-      merged.extra["capture_start_resume"] = final_metadata.capture_start;
-    }
-    std::string resumed;
-    for (double t : pending) resumed += (resumed.empty() ? "" : ",") + Deg(t);
-    merged.extra["resumed_theta_in_deg"] = resumed;
-    merged.capture_end = UtcNowIso8601();
-    final_metadata = merged;
+  switch (r.outcome) {
+    case device::CaptureOutcome::kFinished:
+      if (!o.quiet)
+        std::fprintf(stderr,
+                     "wrote %s: %zu slices, %s new samples, %s saturated, %s below noise floor\n",
+                     o.out.c_str(), r.slices_saved, Thousands(r.new_samples).c_str(),
+                     Thousands(r.saturated).c_str(), Thousands(r.below_noise_floor).c_str());
+      return 0;
+    case device::CaptureOutcome::kNothingToResume:
+      if (!o.quiet) std::fprintf(stderr, "%s\n", r.message.c_str());
+      return 0;
+    case device::CaptureOutcome::kRefused:
+      std::fprintf(stderr, "brdf: error: %s%s%s\n", r.message.c_str(),
+                   r.next == device::NextStep::kNone ? "" : ": ", Advice(r, o.out).c_str());
+      return 1;
+    case device::CaptureOutcome::kInterrupted:
+    case device::CaptureOutcome::kFailed:
+      std::fprintf(stderr, "brdf: error: %s\n", r.message.c_str());
+      std::fprintf(stderr, "brdf: %s%s\n", ProblemAdvice(r.problem).c_str(),
+                   Advice(r, o.out).c_str());
+      return r.outcome == device::CaptureOutcome::kInterrupted ? 130 : 1;
   }
-  appender->Finish(final_metadata);
-  if (!o.quiet)
-    std::fprintf(stderr,
-                 "wrote %s: %zu slices, %s new samples, %s saturated, %s below noise floor\n",
-                 o.out.c_str(), total, Thousands(samples).c_str(), Thousands(saturated).c_str(),
-                 Thousands(below).c_str());
-  return 0;
+  return 1;
 }
 
 }  // namespace brdf::cli

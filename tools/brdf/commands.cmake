@@ -1,8 +1,8 @@
 # Further command sources: target_sources(brdf PRIVATE ...) and their libraries.
 target_sources(brdf PRIVATE brdf/cmd_import.cpp brdf/cmd_export_csv.cpp)
 target_sources(brdf PRIVATE brdf/cmd_info.cpp)
-target_sources(brdf PRIVATE brdf/cmd_capture.cpp)
-target_link_libraries(brdf PRIVATE brdf::device)
+target_sources(brdf PRIVATE brdf/cmd_capture.cpp brdf/cmd_devices.cpp)
+target_link_libraries(brdf PRIVATE brdf::device brdf::device_emulation)
 target_sources(brdf PRIVATE
   brdf/cmd_convert.cpp
   brdf/cmd_atlas.cpp

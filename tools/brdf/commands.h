@@ -90,7 +90,12 @@ struct ExportCsvOptions {
 int RunExportCsv(const ExportCsvOptions& options);
 
 struct CaptureOptions {
+  // "sim", "usb[:VID:PID[:SERIAL]]" or "hid[:VID:PID[:SERIAL]]" (brdf/device/usb_models.h).
   std::string device = "sim";
+  // How --device sim is connected: "loopback" (in-process), "usb" or "hid" (the simulated
+  // firmware behind real libusb / hidapi through umockdev; run under umockdev-wrapper).
+  std::string transport = "loopback";
+  double sim_pace_ms = 0;  // testing: real time per θout row of the simulated firmware
   std::string material;  // library name or file
   std::string sample;    // sample name recorded in the metadata
   std::string out;       // .bpc path
@@ -104,10 +109,12 @@ struct CaptureOptions {
   std::string operator_notes;
   bool resume = false;
   bool force = false;  // overwrite an existing file instead of refusing
+  // On --resume: measure new dark and white references instead of reusing the file's.
+  bool calibrate = false;
   bool quiet = false;
   std::string exposure = "auto";  // "auto" (per θout row), "auto-slice", or fixed milliseconds
-  // Faults the simulated instrument injects, for testing the recovery path:
-  // "disconnect:N", "stall:N", "corrupt:N" (N counts the instrument's frames), comma separated.
+  // Faults the simulated instrument injects, for testing the recovery path: NAME:N items,
+  // comma separated, every one applied (brdf/device/simulator.h ParseFaultPlan).
   std::string sim_fault;
 };
 int RunCapture(const CaptureOptions& options);
@@ -137,5 +144,10 @@ struct FitCommandOptions {
   bool quiet = false;  // no progress on stderr
 };
 int RunFit(const FitCommandOptions& options);
+// `brdf devices`: instruments found over USB and HID.
+struct DevicesOptions {
+  bool json = false;
+};
+int RunDevices(const DevicesOptions& options);
 
 }  // namespace brdf::cli

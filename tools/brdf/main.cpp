@@ -138,12 +138,21 @@ int main(int argc, char** argv) {
       "Capture a sample slice by slice with a scatterometer into a .bpc file (each completed "
       "slice is saved at once; --resume continues an interrupted capture)");
   capture_cmd
-      ->add_option("--device", capture.device, "Instrument: sim (the simulated scatterometer)")
+      ->add_option("--device", capture.device,
+                   "Instrument: sim (the simulated scatterometer), usb[:VID:PID[:SERIAL]] "
+                   "(vendor bulk interface, libusb) or hid[:VID:PID[:SERIAL]] (HID reports, "
+                   "hidapi); IDs in hexadecimal, the first instrument found when omitted")
+      ->capture_default_str();
+  capture_cmd
+      ->add_option("--transport", capture.transport,
+                   "How --device sim is connected: loopback (in-process), usb or hid (the "
+                   "simulated firmware behind real libusb or hidapi through umockdev; run "
+                   "under umockdev-wrapper)")
       ->capture_default_str();
   capture_cmd
       ->add_option("--material", capture.material,
-                   "Virtual sample: a library name ('brdf materials') or a material .json")
-      ->required();
+                   "Virtual sample of --device sim (required for it): a library name ('brdf "
+                   "materials') or a material .json");
   capture_cmd->add_option("--sample", capture.sample, "Sample name recorded in the file")
       ->required();
   capture_cmd->add_option("--out", capture.out, "Output .bpc file")->required();
@@ -170,26 +179,54 @@ int main(int argc, char** argv) {
                    "(noise-free, unsaturated signal)")
       ->capture_default_str();
   capture_cmd->add_option("--seed", capture.seed, "Seed of the simulated detector noise")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            // CLI11 would wrap "-1" around to 2^64 − 1; a seed is typed as a whole number.
+            const bool digits = !text.empty() && text.size() <= 20 &&
+                                text.find_first_not_of("0123456789") == std::string::npos;
+            return digits ? std::string() : "expected a whole number ≥ 0, got '" + text + "'";
+          },
+          ""));
   capture_cmd
       ->add_option("--exposure", capture.exposure,
                    "Exposure: auto (ranged per θout row), auto-slice, or a fixed time in ms")
       ->capture_default_str();
   capture_cmd->add_option("--operator-notes", capture.operator_notes,
                           "Free text recorded in the file's metadata");
-  auto* resume_flag = capture_cmd->add_flag(
+  capture_cmd->add_flag(
       "--resume", capture.resume,
-      "Continue an interrupted capture in --out: keep its complete slices, measure the rest");
-  auto* force_flag =
-      capture_cmd->add_flag("--force", capture.force, "Overwrite --out if it already exists");
-  resume_flag->excludes(force_flag);
+      "Continue an interrupted capture in --out: re-identify the instrument, keep the complete "
+      "slices, measure the rest (with the file's dark and white references unless --calibrate)");
+  capture_cmd->add_flag("--force", capture.force,
+                        "Overwrite --out if it already exists; with --resume, accept an "
+                        "instrument whose serial number or geometry differs from the file's");
+  capture_cmd->add_flag("--calibrate", capture.calibrate,
+                        "Measure the dark and white references first also when resuming (a new "
+                        "capture always measures them)");
   capture_cmd->add_flag("--quiet", capture.quiet, "No progress on stderr");
   capture_cmd
       ->add_option("--sim-fault", capture.sim_fault,
-                   "Testing: make the simulated instrument fail: disconnect:N, stall:N or "
-                   "corrupt:N (N = instrument frames sent), comma separated")
+                   "Testing: faults of the simulated instrument, NAME:N comma separated, all "
+                   "applied (N = the instrument's Nth frame): disconnect, stall (stops "
+                   "answering), timeout (silent until ABORT), corrupt (bad CRC), duplicate, "
+                   "reorder (N and N+1 swapped), lamp, contact, overtemp (firmware error "
+                   "codes); halt (the Nth USB/HID IN transfer stalls)")
+      ->group("Testing");
+  capture_cmd
+      ->add_option("--sim-pace-ms", capture.sim_pace_ms,
+                   "Testing: real time the simulated firmware spends per detector row, ms")
       ->group("Testing");
   capture_cmd->callback([&] { exit_code = brdf::cli::RunCapture(capture); });
+
+  // brdf devices
+  brdf::cli::DevicesOptions devices;
+  auto* devices_cmd = app.add_subcommand(
+      "devices",
+      "List the scatterometers connected over USB and HID (model, serial, firmware, bus "
+      "path, permission problems)");
+  devices_cmd->add_flag("--json", devices.json, "Machine-readable output");
+  devices_cmd->callback([&] { exit_code = brdf::cli::RunDevices(devices); });
 
   // brdf info
   brdf::cli::InfoOptions info;

@@ -44,10 +44,10 @@ inline constexpr std::size_t kMaxFrameBytes = kFrameHeaderBytes + kMaxPayloadByt
 // The protocol version this code speaks. A host accepts an instrument with the same major
 // version; minor versions only add messages or trailing payload fields.
 inline constexpr std::uint16_t kProtocolMajor = 1;
-inline constexpr std::uint16_t kProtocolMinor = 0;
+inline constexpr std::uint16_t kProtocolMinor = 1;
 
 // Largest number of samples one kRowData frame carries; longer rows are split into segments.
-// 180 samples (one row at 2° azimuth steps, or half a row at 1°) are 2,356 payload bytes.
+// 180 samples (one row at 2° azimuth steps, or half a row at 1°) are 2,357 payload bytes (protocol 1.1).
 inline constexpr std::size_t kMaxSamplesPerRowFrame = 180;
 
 enum class MessageType : std::uint8_t {
@@ -98,6 +98,7 @@ struct DecodeResult {
   // least 1; up to the next possible sync byte). kNeedMore: 0.
   std::size_t consumed = 0;
   Frame frame;           // kComplete only
+  std::uint32_t crc = 0;  // kComplete only: the frame's CRC-32 (identifies a repeated frame)
   std::string reason;    // kInvalid only: "CRC-32: expected 0x…, got 0x…", "no sync bytes", …
   bool corrupt = false;  // kInvalid only: a frame header was found but its content is damaged
                          // (CRC mismatch), as opposed to bytes between frames
@@ -152,6 +153,12 @@ struct GeometryInfo {
   std::uint16_t rows = 0;     // θout rows: θout = row · step, row = 0 … rows − 1
   std::uint16_t columns = 0;  // φout columns: φout = column · step, column = 0 … columns − 1
 
+  // Protocol 1.1 (trailing fields; a 1.0 instrument omits them): the exposure range and the
+  // neutral-density filter stage. nd_transmittance[0] is the open position (1.0); a reading
+  // taken through filter k saw exposure_ms · nd_transmittance[k] worth of light.
+  float min_exposure_ms = 0, max_exposure_ms = 0;  // 0: not reported (1.0 instrument)
+  std::vector<float> nd_transmittance = {1.0f};
+
   // The angles of a row and a column exactly as both ends compute them (float32, so the
   // simulator's directions and the host's recorded angles agree bit for bit).
   float ThetaOutDeg(std::size_t row) const;
@@ -182,6 +189,7 @@ struct WhiteReading {
   std::array<float, 3> counts{};      // mean of `frames` frames, dark not subtracted
   std::uint8_t clipped_channels = 0;  // bit c set: some frame of channel c clipped
   std::uint16_t frames = 0;
+  std::uint8_t nd_index = 0;  // 1.1 trailing field: the ND filter of the reading (0 = open)
 };
 
 struct SliceBegin {
@@ -199,6 +207,7 @@ struct RowData {
   std::uint16_t first_column = 0;
   float exposure_ms = 0;
   std::vector<RowSample> samples;  // columns first_column … first_column + size − 1
+  std::uint8_t nd_index = 0;       // 1.1 trailing field: the ND filter of the row (0 = open)
 };
 
 struct SliceEnd {
@@ -213,6 +222,10 @@ enum class ErrorCode : std::uint16_t {
   kBadArgument = 3,  // e.g. a θin the instrument cannot set
   kBusy = 4,         // a slice is streaming; only kAbort is accepted
   kBadFrame = 5,     // the instrument received a damaged frame
+  // Instrument states that stop a measurement; the host cannot retry them away.
+  kLampFailure = 6,         // the light source failed or did not reach its set point
+  kSampleNotInContact = 7,  // the sample port sensor sees no sample seated
+  kOverTemperature = 8,     // the detector is above its operating temperature
 };
 
 struct ErrorReply {

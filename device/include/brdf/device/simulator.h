@@ -24,8 +24,11 @@
 // Exposure is auto-ranged per θout row (default): the firmware finds the row's brightest
 // sample with a probe exposure (simulated as the noise-free maximum of the row) and sets t so
 // it reaches `autorange_target_fraction` of the range above dark, within
-// [min_exposure_ms, max_exposure_ms]. The white reference is always ranged this way. A peak too
-// bright even at the shortest exposure clips, and the sample carries clip bits per channel. Noise
+// [min_exposure_ms, max_exposure_ms]. A row too bright even at the shortest exposure is read
+// through the neutral-density filter stage (nd_transmittance: the least attenuating filter
+// that lets the exposure reach its target within the range; PROTOCOL.md, ND filters). The
+// white reference is always ranged this way. A peak too bright even at the shortest exposure
+// behind the densest filter clips, and the sample carries clip bits per channel. Noise
 // is drawn from a seeded generator restarted for every measurement from (seed, what is measured,
 // θin), so a slice is reproduced exactly whatever was measured before it (a resumed capture matches
 // an uninterrupted one).
@@ -65,6 +68,8 @@ struct InstrumentModel {
   // R_c: counts per ms per unit radiance (f_r · cosθi under unit irradiance).
   std::array<double, 3> responsivity_counts_per_ms{};
   double min_exposure_ms = 1;
+  // The ND filter wheel: transmittance of each position, [0] = open (1.0), then denser.
+  std::vector<float> nd_transmittance = {1.0f, 0.1f, 0.01f, 0.001f};
   double max_exposure_ms = 2000;
   double autorange_target_fraction = 0.8;  // of (full scale − dark)
 };
@@ -76,13 +81,38 @@ const InstrumentModel& ReferenceInstrument();
 // Throws InvalidArgument listing the known names.
 const InstrumentModel& FindInstrumentModel(std::string_view model);
 
-// Faults to inject, for tests of the host's error handling. Frames are counted from 1 in the
-// order the firmware sends them; 0 disables a fault.
-struct FaultPlan {
-  std::uint64_t disconnect_after_frames = 0;  // the link drops after this many frames
-  std::uint64_t stall_after_frames = 0;       // the firmware stops answering after this many
-  std::uint64_t corrupt_frame = 0;            // this frame is sent with one payload bit flipped
+// Faults to inject, for tests of the host's error handling and for demos. Frames are counted
+// from 1 in the order the firmware sends them (retransmissions included).
+enum class FaultType {
+  kDisconnect,       // the link drops instead of sending frame N (unplugged cable)
+  kStall,            // the firmware stops answering before frame N, for good
+  kTimeout,          // frame N is not sent and the firmware hangs until it receives ABORT
+  kCorrupt,          // frame N is sent with one payload bit flipped (CRC mismatch)
+  kDuplicate,        // frame N is sent twice
+  kReorder,          // frames N and N+1 are sent in swapped order
+  kLampFailure,      // instead of frame N: ERROR lamp failure, and the scan stops
+  kSampleContact,    // instead of frame N: ERROR sample not in contact, and the scan stops
+  kOverTemperature,  // instead of frame N: ERROR over-temperature, and the scan stops
+  kEndpointHalt,     // transport level: the Nth bulk/interrupt IN transfer stalls (USB, HID)
 };
+
+struct Fault {
+  FaultType type = FaultType::kCorrupt;
+  std::uint64_t at = 0;  // frame number N (kEndpointHalt: IN transfer number N), ≥ 1
+};
+
+struct FaultPlan {
+  std::vector<Fault> faults;  // every one applies; several of one type are fine
+  bool empty() const { return faults.empty(); }
+  bool Has(FaultType type, std::uint64_t at) const;
+  // Firmware faults only (everything but kEndpointHalt).
+  bool HasFirmwareFaults() const;
+};
+
+// "disconnect:50,corrupt:30" → the plan. Names: disconnect, stall, timeout, corrupt, duplicate,
+// reorder, lamp, contact, overtemp, halt. Throws InvalidArgument naming the item and what was
+// expected.
+FaultPlan ParseFaultPlan(std::string_view spec);
 
 struct SimulatorConfig {
   InstrumentModel model = ReferenceInstrument();  // copy: adjust the geometry freely
@@ -94,6 +124,9 @@ struct SimulatorConfig {
   double noise_level = 1.0;  // s above: 1 = reference instrument, 0 = ideal detector
   std::uint64_t seed = 1;
   FaultPlan faults;
+  // Real time the firmware spends per θout row (sleeping), for demos and for tests that must
+  // interrupt a capture while it runs; 0 = as fast as the host reads (virtual time).
+  double pace_ms_per_row = 0;
 };
 
 // One raw reading that clipped, for tests only: real firmware reports clipping through the
@@ -139,8 +172,12 @@ class SimulatedFirmware {
   void PrepareRow(std::size_t row);
   // Radiance L_c of the sample seen from (row, column) under the slice's light.
   std::array<double, 3> RowRates(std::size_t row, std::vector<std::array<double, 3>>* rates) const;
-  float AutoExposure(double brightest_rate) const;
-  Reading Read(const std::array<double, 3>& rate, float exposure_ms, int frames);
+  struct Exposure {
+    float ms = 0;
+    std::uint8_t nd = 0;  // ND filter position
+  };
+  Exposure AutoExposure(double brightest_rate) const;
+  Reading Read(const std::array<double, 3>& rate, Exposure exposure, int frames);
   void Reseed(std::uint64_t what, float theta_in_deg);
 
   SimulatorConfig config_;
@@ -153,6 +190,8 @@ class SimulatedFirmware {
   std::uint8_t sequence_ = 0;
   bool link_up_ = true;
   bool stalled_ = false;
+  bool hung_ = false;  // kTimeout: silent until ABORT
+  std::vector<std::uint8_t> held_frame_;  // kReorder: frame N, sent after frame N+1
   ExposureSetting exposure_;
   std::mt19937_64 rng_;
   std::normal_distribution<double> normal_;
@@ -162,10 +201,10 @@ class SimulatedFirmware {
   bool streaming_ = false;
   float slice_theta_in_deg_ = 0;
   Vec3 light_{};
-  float slice_exposure_ms_ = 0;  // kAutoPerSlice / kFixed
+  Exposure slice_exposure_;  // kAutoPerSlice / kFixed
   std::size_t next_row_ = 0, next_column_ = 0;
   std::vector<Reading> row_readings_;
-  float row_exposure_ms_ = 0;
+  Exposure row_exposure_;
   std::uint32_t slice_samples_ = 0, slice_clipped_ = 0;
 };
 

@@ -1,0 +1,125 @@
+// One full reference capture (4 × 76 × 360 = 109,440 samples, GGX gold, noise on) over each
+// transport, against the firmware's own time to produce the same frames (no host at all), and
+// the frame decoder's throughput against a USB 2.0 high-speed link. libusb and hidapi run
+// through umockdev: start this program under umockdev-wrapper (it stops with a message
+// otherwise).
+#include <benchmark/benchmark.h>
+
+#include <cstdio>
+#include <memory>
+
+#include "brdf/core/brdf_source.h"
+#include "brdf/core/models.h"
+#include "brdf/device/driver.h"
+#include "brdf/device/emulated_usb.h"
+#include "brdf/device/protocol.h"
+#include "brdf/device/simulator.h"
+#include "brdf/device/usb_transport.h"
+
+namespace {
+
+using namespace brdf;
+using namespace brdf::device;
+
+SimulatorConfig GoldConfig() {
+  Material m;
+  m.model = Model::kGgx;
+  m.kd = {0, 0, 0};
+  m.ks = {0.962585, 0.786916, 0.408220};
+  m.shape = {0.15, 0.15, 0.15};
+  m.name = "gold";
+  SimulatorConfig c;
+  c.sample = std::make_shared<AnalyticBrdf>(m);
+  return c;
+}
+
+void RunCapture(Transport& link) {
+  Driver driver(link);
+  CapturePlan plan;
+  plan.theta_in_deg = {0, 20, 40, 60};
+  CaptureCallbacks callbacks;
+  callbacks.on_slice = [](const Slice& s, const SliceReport&) {
+    benchmark::DoNotOptimize(s.samples.data());
+  };
+  Capture(driver, plan, callbacks);
+}
+
+// The firmware's own scan: every frame of the same capture produced and encoded, drained by a
+// byte pump that decodes nothing.
+void BM_FirmwareOwnScan(benchmark::State& state) {
+  std::vector<std::uint8_t> buffer(64 * 1024);
+  for (auto _ : state) {
+    SimulatedFirmware fw(GoldConfig());
+    std::uint8_t seq = 0;
+    auto ask = [&](MessageType t, std::vector<std::uint8_t> payload) {
+      fw.Receive(EncodeFrame({static_cast<std::uint8_t>(t), seq++, std::move(payload)}));
+      for (std::size_t n; (n = fw.Transmit(buffer)) > 0;) benchmark::DoNotOptimize(buffer.data());
+    };
+    ask(MessageType::kIdentify, {});
+    ask(MessageType::kGetGeometry, {});
+    ask(MessageType::kSetExposure, EncodeExposure({}));
+    ask(MessageType::kMeasureDark, {});
+    for (float t : {0.f, 20.f, 40.f, 60.f}) ask(MessageType::kMeasureWhite, EncodeThetaIn(t));
+    for (float t : {0.f, 20.f, 40.f, 60.f}) ask(MessageType::kMeasureSlice, EncodeThetaIn(t));
+  }
+}
+BENCHMARK(BM_FirmwareOwnScan)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_CaptureLoopback(benchmark::State& state) {
+  for (auto _ : state) {
+    SimulatedFirmware fw(GoldConfig());
+    LoopbackTransport link(fw);
+    RunCapture(link);
+  }
+}
+BENCHMARK(BM_CaptureLoopback)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+void BM_CaptureOverUsb(benchmark::State& state) {
+  const auto personality = static_cast<UsbPersonality>(state.range(0));
+  if (!UmockdevAvailable()) {
+    state.SkipWithError("run under umockdev-wrapper");
+    return;
+  }
+  for (auto _ : state) {
+    EmulatedUsbInstrument emu(GoldConfig(), personality);
+    std::unique_ptr<Transport> link = personality == UsbPersonality::kBulk
+                                          ? OpenUsbTransport(emu.Spec())
+                                          : OpenHidTransport(emu.Spec());
+    RunCapture(*link);
+  }
+}
+// 0: libusb bulk, 1: hidapi reports.
+BENCHMARK(BM_CaptureOverUsb)->Arg(0)->Arg(1)->Iterations(3)->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// Frames of the whole capture, found and CRC-checked from one byte stream.
+void BM_DecodeCaptureStream(benchmark::State& state) {
+  std::vector<std::uint8_t> stream, buffer(64 * 1024);
+  {
+    SimulatedFirmware fw(GoldConfig());
+    std::uint8_t seq = 0;
+    for (float t : {0.f, 20.f, 40.f, 60.f}) {
+      fw.Receive(EncodeFrame({static_cast<std::uint8_t>(MessageType::kMeasureSlice), seq++,
+                              EncodeThetaIn(t)}));
+      for (std::size_t n; (n = fw.Transmit(buffer)) > 0;)
+        stream.insert(stream.end(), buffer.begin(), buffer.begin() + static_cast<std::ptrdiff_t>(n));
+    }
+  }
+  std::size_t frames = 0;
+  for (auto _ : state) {
+    FrameReader reader;
+    for (std::size_t at = 0; at < stream.size(); at += 16384) {
+      const std::size_t n = std::min<std::size_t>(16384, stream.size() - at);
+      reader.Append(std::span<const std::uint8_t>(stream.data() + at, n));
+      for (DecodeResult r = reader.Next(); r.status == DecodeStatus::kComplete; r = reader.Next())
+        ++frames;
+    }
+  }
+  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * stream.size()));
+  state.counters["stream_bytes"] = static_cast<double>(stream.size());
+  benchmark::DoNotOptimize(frames);
+}
+BENCHMARK(BM_DecodeCaptureStream)->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();

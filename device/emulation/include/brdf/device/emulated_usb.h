@@ -1,0 +1,86 @@
+// The simulated firmware behind real USB: a umockdev testbed that presents the instrument as
+// a USB device (vendor bulk interface or HID interface, usb_models.h) and answers the usbdevfs
+// ioctls libusb issues (submit, reap and discard URBs, clear halt, claim interface, control
+// requests for descriptors) with the bytes of a SimulatedFirmware. Real libusb, and hidapi's
+// libusb backend, then talk to the firmware exactly as to hardware: enumeration by VID:PID,
+// string descriptors, claiming, bulk/interrupt transfers, endpoint stalls, unplugging.
+//
+// Needs the process to run under umockdev's preload library (`umockdev-wrapper PROGRAM`, or
+// LD_PRELOAD=libumockdev-preload.so.0); the constructor throws DeviceError otherwise. This is
+// a test and demo facility: brdf links it for `capture --device sim --transport usb|hid`.
+//
+// Pacing: IN transfers of the HID personality complete at most once per millisecond (an
+// interrupt endpoint polled every full-speed frame, 64 KB/s), as a real device's would.
+// hidapi queues only 30 input reports and drops the oldest when the application falls
+// behind, so a faster device overruns a loaded host (measured: at one report per 125 µs, a
+// full capture on a machine with load 9 on 2 cores lost reports); at 1 ms the host has 30 ms
+// of slack. Bulk IN transfers complete as soon as the firmware has bytes (a short packet ends
+// each transfer).
+//
+// Faults: the firmware's FaultPlan applies as on the loopback; FaultType::kEndpointHalt N
+// makes the Nth IN transfer end with a stall (EPIPE). The bulk endpoint then stays halted
+// until the host sends CLEAR_HALT; the HID interrupt endpoint recovers by itself after one
+// stalled transfer (hidapi cannot clear a halt; its reader resubmits). When the firmware's link
+// drops (FaultType::kDisconnect) every URB fails with ENODEV/ESHUTDOWN, as for an unplugged
+// device.
+#pragma once
+
+#include <cstdint>
+#include <memory>
+#include <string_view>
+
+#include "brdf/device/simulator.h"
+#include "brdf/device/transport.h"
+#include "brdf/device/usb_models.h"
+
+namespace brdf::device {
+
+enum class UsbPersonality { kBulk, kHid };
+
+class EmulatedUsbInstrument {
+ public:
+  // `config.serial` becomes the USB serial-number string. Throws DeviceError when umockdev's
+  // preload library is not active, InvalidArgument for an unusable configuration.
+  EmulatedUsbInstrument(SimulatorConfig config, UsbPersonality personality,
+                        const UsbModel& model = UsbModels().front());
+  ~EmulatedUsbInstrument();
+  EmulatedUsbInstrument(const EmulatedUsbInstrument&) = delete;
+  EmulatedUsbInstrument& operator=(const EmulatedUsbInstrument&) = delete;
+
+  // The --device spec that opens this instrument (VID:PID:SERIAL).
+  DeviceSpec Spec() const;
+  std::uint64_t halts_cleared() const;    // CLEAR_HALT requests received
+  std::uint64_t in_transfers() const;     // IN URBs completed with data
+  std::uint64_t frames_sent() const;      // firmware frames
+  // Simulates pulling the cable: the device vanishes from the bus.
+  void Unplug();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+// True when umockdev's preload library is active in this process.
+bool UmockdevAvailable();
+
+// How the simulated instrument is connected: in-process, or behind real libusb or hidapi
+// through umockdev.
+enum class SimLink { kLoopback, kUsb, kHid };
+// "loopback", "usb", "hid"; throws InvalidArgument otherwise.
+SimLink ParseSimLink(std::string_view text);
+
+// An open connection to an instrument: the transport and whatever must live as long as it
+// (the simulated firmware, its emulated USB device).
+class InstrumentLink {
+ public:
+  virtual ~InstrumentLink() = default;
+  virtual Transport& transport() = 0;
+};
+
+// Opens what `spec` names: a real instrument over USB or HID, or (kSim) a simulated one built
+// from `sim` and connected over `link`. Throws DeviceError when no instrument answers to the
+// spec or umockdev is missing for an emulated link, InvalidArgument for a bad configuration.
+std::unique_ptr<InstrumentLink> OpenInstrumentLink(const DeviceSpec& spec,
+                                                   const SimulatorConfig& sim, SimLink link);
+
+}  // namespace brdf::device

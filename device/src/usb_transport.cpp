@@ -1,0 +1,461 @@
+// libusb and hidapi transports (usb_transport.h). The only translation unit that includes
+// libusb.h and hidapi.h.
+#include "brdf/device/usb_transport.h"
+
+#include <hidapi/hidapi.h>
+#include <libusb-1.0/libusb.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <cwchar>
+#include <mutex>
+
+#include "brdf/core/error.h"
+#include "brdf/device/driver.h"
+
+namespace brdf::device {
+namespace {
+
+std::string Hex4(std::uint16_t v) {
+  char buf[8];
+  std::snprintf(buf, sizeof buf, "%04x", v);
+  return buf;
+}
+
+std::string Narrow(const wchar_t* w) {
+  std::string s;
+  if (w == nullptr) return s;
+  for (; *w != 0; ++w) s += (*w >= 32 && *w < 127) ? static_cast<char>(*w) : '?';
+  return s;
+}
+
+std::string LookedFor(const DeviceSpec& spec, const char* kind) {
+  std::string s = std::string(kind) + " instrument";
+  if (spec.vendor_id) s += " " + Hex4(*spec.vendor_id) + ":" + Hex4(*spec.product_id);
+  if (!spec.serial.empty()) s += " with serial " + spec.serial;
+  return s;
+}
+
+bool Matches(const DeviceSpec& spec, std::uint16_t vid, std::uint16_t pid, bool hid) {
+  if (spec.vendor_id) return *spec.vendor_id == vid && *spec.product_id == pid;
+  const std::optional<UsbModel> m = FindUsbModel(vid, pid);
+  return m && (hid ? m->hid_product_id : m->bulk_product_id) == pid;
+}
+
+class CountingTransport : public Transport {
+ public:
+  TransportStats stats;
+};
+
+// ---- libusb ----------------------------------------------------------------------------
+
+struct LibusbContext {
+  libusb_context* ctx = nullptr;
+  LibusbContext() {
+    const int r = libusb_init(&ctx);
+    if (r != 0)
+      throw DeviceError(std::string("USB: cannot start libusb: ") + libusb_strerror(r));
+  }
+  ~LibusbContext() { libusb_exit(ctx); }
+  LibusbContext(const LibusbContext&) = delete;
+  LibusbContext& operator=(const LibusbContext&) = delete;
+};
+
+AccessProblem ProblemOf(int libusb_error) {
+  switch (libusb_error) {
+    case LIBUSB_ERROR_ACCESS:
+      return AccessProblem::kPermission;
+    case LIBUSB_ERROR_BUSY:
+      return AccessProblem::kBusy;
+    default:
+      return AccessProblem::kOther;
+  }
+}
+
+std::string AccessText(AccessProblem p, const std::string& detail) {
+  switch (p) {
+    case AccessProblem::kNone:
+      return detail;
+    case AccessProblem::kPermission:
+      return "permission denied (" + detail +
+             "): this user may not open the device; install the udev rule "
+             "70-brdf-scatterometer.rules";
+    case AccessProblem::kBusy:
+      return "the device is in use by another program (" + detail + ")";
+    case AccessProblem::kOther:
+      return detail;
+  }
+  return detail;
+}
+
+std::string SerialOf(libusb_device_handle* h, const libusb_device_descriptor& d) {
+  if (d.iSerialNumber == 0) return {};
+  unsigned char buf[128] = {};
+  const int n = libusb_get_string_descriptor_ascii(h, d.iSerialNumber, buf, sizeof buf - 1);
+  return n > 0 ? std::string(reinterpret_cast<char*>(buf), static_cast<std::size_t>(n))
+               : std::string();
+}
+
+class LibusbTransport final : public CountingTransport {
+ public:
+  LibusbTransport(std::unique_ptr<LibusbContext> ctx, libusb_device_handle* handle,
+                  UsbModel model, std::string description)
+      : ctx_(std::move(ctx)), handle_(handle), model_(model), description_(std::move(description)) {
+    inbox_.reserve(model_.bulk_read_bytes);
+  }
+  ~LibusbTransport() override {
+    libusb_release_interface(handle_, model_.interface_number);
+    libusb_close(handle_);
+  }
+
+  void Write(std::span<const std::uint8_t> bytes) override {
+    std::size_t done = 0;
+    int halts = 0;
+    while (done < bytes.size()) {
+      int sent = 0;
+      const int len = static_cast<int>(std::min<std::size_t>(bytes.size() - done, 1 << 16));
+      const int r = libusb_bulk_transfer(handle_, model_.bulk_out_endpoint,
+                                         const_cast<unsigned char*>(bytes.data() + done), len,
+                                         &sent, model_.reply_timeout_ms);
+      ++stats.transfers_out;
+      done += static_cast<std::size_t>(std::max(sent, 0));
+      if (r == 0 || (r == LIBUSB_ERROR_TIMEOUT && sent > 0)) continue;
+      if (r == LIBUSB_ERROR_PIPE && halts++ < kMaxHaltRetries) {
+        ClearHalt(model_.bulk_out_endpoint);
+        continue;
+      }
+      Throw(r, "write");
+    }
+  }
+
+  std::size_t Read(std::span<std::uint8_t> buffer, int timeout_ms) override {
+    if (inbox_start_ == inbox_.size()) {
+      inbox_.clear();
+      inbox_start_ = 0;
+      inbox_.resize(model_.bulk_read_bytes);
+      int got = 0, halts = 0;
+      for (;;) {
+        const int r = libusb_bulk_transfer(handle_, model_.bulk_in_endpoint, inbox_.data(),
+                                           static_cast<int>(inbox_.size()), &got, timeout_ms);
+        ++stats.transfers_in;
+        if (r == 0 || (r == LIBUSB_ERROR_TIMEOUT)) break;
+        if (r == LIBUSB_ERROR_PIPE && halts++ < kMaxHaltRetries) {
+          ClearHalt(model_.bulk_in_endpoint);
+          continue;
+        }
+        inbox_.clear();
+        Throw(r, "read");
+      }
+      inbox_.resize(static_cast<std::size_t>(std::max(got, 0)));
+      if (inbox_.empty()) return 0;
+    }
+    const std::size_t n = std::min(buffer.size(), inbox_.size() - inbox_start_);
+    std::memcpy(buffer.data(), inbox_.data() + inbox_start_, n);
+    inbox_start_ += n;
+    return n;
+  }
+
+  std::string Description() const override { return description_; }
+
+ private:
+  void ClearHalt(unsigned char endpoint) {
+    const int r = libusb_clear_halt(handle_, endpoint);
+    if (r != 0) Throw(r, "clear the halt of");
+    ++stats.halts_cleared;
+  }
+  [[noreturn]] void Throw(int r, const char* what) const {
+    if (r == LIBUSB_ERROR_NO_DEVICE)
+      throw DeviceError(description_ + ": the instrument disconnected (" + what + " failed)");
+    if (r == LIBUSB_ERROR_PIPE)
+      throw DeviceError(description_ + ": the endpoint stays stalled after " +
+                        std::to_string(kMaxHaltRetries) + " clear-halt attempts (" + what + ")");
+    throw DeviceError(description_ + ": USB " + what + " failed: " + libusb_strerror(r));
+  }
+
+  std::unique_ptr<LibusbContext> ctx_;
+  libusb_device_handle* handle_;
+  UsbModel model_;
+  std::string description_;
+  std::vector<std::uint8_t> inbox_;
+  std::size_t inbox_start_ = 0;
+};
+
+// ---- hidapi ----------------------------------------------------------------------------
+
+// hid_init/hid_exit are process wide; reference-count them.
+std::mutex g_hid_mutex;
+int g_hid_users = 0;
+
+struct HidLibrary {
+  HidLibrary() {
+    std::lock_guard lock(g_hid_mutex);
+    if (g_hid_users++ == 0 && hid_init() != 0) {
+      --g_hid_users;
+      throw DeviceError("HID: cannot start hidapi");
+    }
+  }
+  ~HidLibrary() {
+    std::lock_guard lock(g_hid_mutex);
+    if (--g_hid_users == 0) hid_exit();
+  }
+  HidLibrary(const HidLibrary&) = delete;
+  HidLibrary& operator=(const HidLibrary&) = delete;
+};
+
+class HidTransport final : public CountingTransport {
+ public:
+  HidTransport(std::unique_ptr<HidLibrary> lib, hid_device* dev, UsbModel model,
+               std::string description)
+      : lib_(std::move(lib)), dev_(dev), model_(model), description_(std::move(description)) {}
+  ~HidTransport() override { hid_close(dev_); }
+
+  // Each output report: a count byte, then up to report_bytes − 1 stream bytes (PROTOCOL.md).
+  void Write(std::span<const std::uint8_t> bytes) override {
+    const std::size_t per_report = model_.hid_report_bytes - 1;
+    std::vector<unsigned char> report(model_.hid_report_bytes + 1);
+    for (std::size_t done = 0; done < bytes.size();) {
+      const std::size_t n = std::min(per_report, bytes.size() - done);
+      std::fill(report.begin(), report.end(), 0);
+      report[0] = 0;  // no report IDs
+      report[1] = static_cast<unsigned char>(n);
+      std::memcpy(report.data() + 2, bytes.data() + done, n);
+      const int r = hid_write(dev_, report.data(), report.size());
+      ++stats.transfers_out;
+      if (r < 0)
+        throw DeviceError(description_ + ": the instrument disconnected (write failed: " +
+                          Narrow(hid_error(dev_)) + ")");
+      done += n;
+    }
+  }
+
+  std::size_t Read(std::span<std::uint8_t> buffer, int timeout_ms) override {
+    if (inbox_start_ == inbox_.size()) {
+      inbox_.clear();
+      inbox_start_ = 0;
+      std::vector<unsigned char> report(model_.hid_report_bytes);
+      const int r = hid_read_timeout(dev_, report.data(), report.size(), timeout_ms);
+      ++stats.transfers_in;
+      if (r < 0)
+        throw DeviceError(description_ + ": the instrument disconnected (read failed: " +
+                          Narrow(hid_error(dev_)) + ")");
+      if (r == 0) return 0;
+      const std::size_t count = report[0];
+      if (count > static_cast<std::size_t>(r) - 1)
+        throw DeviceError(description_ + ": HID report says " + std::to_string(count) +
+                          " stream bytes, the report holds " + std::to_string(r - 1));
+      inbox_.assign(report.begin() + 1, report.begin() + 1 + static_cast<std::ptrdiff_t>(count));
+      if (inbox_.empty()) return 0;
+    }
+    const std::size_t n = std::min(buffer.size(), inbox_.size() - inbox_start_);
+    std::memcpy(buffer.data(), inbox_.data() + inbox_start_, n);
+    inbox_start_ += n;
+    return n;
+  }
+
+  std::string Description() const override { return description_; }
+
+ private:
+  std::unique_ptr<HidLibrary> lib_;
+  hid_device* dev_;
+  UsbModel model_;
+  std::string description_;
+  std::vector<std::uint8_t> inbox_;
+  std::size_t inbox_start_ = 0;
+};
+
+struct HidCandidate {
+  std::string path, serial;
+  std::uint16_t vid = 0, pid = 0;
+};
+
+std::vector<HidCandidate> EnumerateHid(const DeviceSpec* spec) {
+  std::vector<HidCandidate> out;
+  hid_device_info* list = hid_enumerate(0, 0);
+  for (hid_device_info* d = list; d != nullptr; d = d->next) {
+    const bool match = spec ? Matches(*spec, d->vendor_id, d->product_id, true)
+                            : (FindUsbModel(d->vendor_id, d->product_id) &&
+                               FindUsbModel(d->vendor_id, d->product_id)->hid_product_id ==
+                                   d->product_id);
+    if (!match) continue;
+    HidCandidate c{d->path ? d->path : "", Narrow(d->serial_number), d->vendor_id,
+                   d->product_id};
+    if (spec && !spec->serial.empty() && c.serial != spec->serial) continue;
+    out.push_back(std::move(c));
+  }
+  hid_free_enumeration(list);
+  return out;
+}
+
+UsbModel ModelFor(std::uint16_t vid, std::uint16_t pid) {
+  const std::optional<UsbModel> m = FindUsbModel(vid, pid);
+  if (m) return *m;
+  UsbModel generic = UsbModels().front();  // an explicit VID:PID of an unlisted model
+  generic.vendor_id = vid;
+  generic.bulk_product_id = generic.hid_product_id = pid;
+  return generic;
+}
+
+}  // namespace
+
+std::unique_ptr<Transport> OpenUsbTransport(const DeviceSpec& spec) {
+  if (spec.kind != DeviceSpec::Kind::kUsb)
+    throw InvalidArgument("OpenUsbTransport: the device is not a USB instrument");
+  auto ctx = std::make_unique<LibusbContext>();
+  libusb_device** list = nullptr;
+  const ssize_t n = libusb_get_device_list(ctx->ctx, &list);
+  std::string problems;
+  std::unique_ptr<Transport> result;
+  for (ssize_t i = 0; i < n && !result; ++i) {
+    libusb_device_descriptor d{};
+    if (libusb_get_device_descriptor(list[i], &d) != 0) continue;
+    if (!Matches(spec, d.idVendor, d.idProduct, false)) continue;
+    const std::string where = "USB bus " + std::to_string(libusb_get_bus_number(list[i])) +
+                              " device " + std::to_string(libusb_get_device_address(list[i]));
+    libusb_device_handle* h = nullptr;
+    int r = libusb_open(list[i], &h);
+    if (r != 0) {
+      problems += "; " + where + ": " + AccessText(ProblemOf(r), libusb_strerror(r));
+      continue;
+    }
+    const std::string serial = SerialOf(h, d);
+    if (!spec.serial.empty() && serial != spec.serial) {
+      libusb_close(h);
+      continue;
+    }
+    const UsbModel model = ModelFor(d.idVendor, d.idProduct);
+    libusb_set_auto_detach_kernel_driver(h, 1);
+    r = libusb_claim_interface(h, model.interface_number);
+    if (r != 0) {
+      problems += "; " + where + ": " + AccessText(ProblemOf(r), libusb_strerror(r));
+      libusb_close(h);
+      continue;
+    }
+    result = std::make_unique<LibusbTransport>(
+        std::move(ctx), h, model,
+        "USB " + std::string(model.model) + " " + (serial.empty() ? "(no serial)" : serial) +
+            " (" + where + ")");
+  }
+  libusb_free_device_list(list, 1);
+  if (!result)
+    throw DeviceError("no " + LookedFor(spec, "USB") + " found" +
+                      (problems.empty() ? "" : problems));
+  return result;
+}
+
+std::unique_ptr<Transport> OpenHidTransport(const DeviceSpec& spec) {
+  if (spec.kind != DeviceSpec::Kind::kHid)
+    throw InvalidArgument("OpenHidTransport: the device is not a HID instrument");
+  auto lib = std::make_unique<HidLibrary>();
+  const std::vector<HidCandidate> found = EnumerateHid(&spec);
+  std::string problems;
+  for (const HidCandidate& c : found) {
+    hid_device* dev = hid_open_path(c.path.c_str());
+    if (dev == nullptr) {
+      problems += "; HID " + c.path + ": cannot open it (permission denied or in use; install "
+                  "the udev rule 70-brdf-scatterometer.rules)";
+      continue;
+    }
+    const UsbModel model = ModelFor(c.vid, c.pid);
+    return std::make_unique<HidTransport>(
+        std::move(lib), dev, model,
+        "HID " + std::string(model.model) + " " + (c.serial.empty() ? "(no serial)" : c.serial) +
+            " (" + c.path + ")");
+  }
+  throw DeviceError("no " + LookedFor(spec, "HID") + " found" + problems);
+}
+
+TransportStats StatsOf(const Transport& transport) {
+  const auto* counting = dynamic_cast<const CountingTransport*>(&transport);
+  return counting ? counting->stats : TransportStats{};
+}
+
+std::vector<FoundInstrument> ListInstruments(bool identify) {
+  std::vector<FoundInstrument> out;
+  auto ask_identity = [&](FoundInstrument& f, Transport& t) {
+    if (!identify) return;
+    try {
+      DriverOptions o;
+      o.timeout_ms = 1000;
+      Driver driver(t, o);
+      const InstrumentInfo& info = driver.Connect();
+      f.firmware_version = info.identity.firmware_version;
+      if (f.serial.empty()) f.serial = info.identity.serial;
+      f.model = info.identity.model;
+    } catch (const Error& e) {
+      f.problem = AccessProblem::kOther;
+      f.problem_detail = std::string("does not answer IDENTIFY: ") + e.what();
+    }
+  };
+  {
+    LibusbContext ctx;
+    libusb_device** list = nullptr;
+    const ssize_t n = libusb_get_device_list(ctx.ctx, &list);
+    for (ssize_t i = 0; i < n; ++i) {
+      libusb_device_descriptor d{};
+      if (libusb_get_device_descriptor(list[i], &d) != 0) continue;
+      const std::optional<UsbModel> m = FindUsbModel(d.idVendor, d.idProduct);
+      if (!m || m->bulk_product_id != d.idProduct) continue;
+      FoundInstrument f;
+      f.kind = DeviceSpec::Kind::kUsb;
+      f.vendor_id = d.idVendor;
+      f.product_id = d.idProduct;
+      f.model = std::string(m->model);
+      char where[64];
+      std::snprintf(where, sizeof where, "bus %03d device %03d", libusb_get_bus_number(list[i]),
+                    libusb_get_device_address(list[i]));
+      f.bus_path = where;
+      libusb_device_handle* h = nullptr;
+      const int r = libusb_open(list[i], &h);
+      if (r != 0) {
+        f.problem = ProblemOf(r);
+        f.problem_detail = libusb_strerror(r);
+      } else {
+        f.serial = SerialOf(h, d);
+        libusb_close(h);
+      }
+      out.push_back(f);
+    }
+    libusb_free_device_list(list, 1);
+  }
+  for (FoundInstrument& f : out) {
+    if (f.problem != AccessProblem::kNone || !identify) continue;
+    DeviceSpec spec;
+    spec.kind = DeviceSpec::Kind::kUsb;
+    spec.vendor_id = f.vendor_id;
+    spec.product_id = f.product_id;
+    spec.serial = f.serial;
+    try {
+      std::unique_ptr<Transport> t = OpenUsbTransport(spec);
+      ask_identity(f, *t);
+    } catch (const DeviceError& e) {
+      f.problem = AccessProblem::kBusy;
+      f.problem_detail = e.what();
+    }
+  }
+  HidLibrary lib;
+  for (const HidCandidate& c : EnumerateHid(nullptr)) {
+    FoundInstrument f;
+    f.kind = DeviceSpec::Kind::kHid;
+    f.vendor_id = c.vid;
+    f.product_id = c.pid;
+    f.model = std::string(ModelFor(c.vid, c.pid).model);
+    f.serial = c.serial;
+    f.bus_path = c.path;
+    hid_device* dev = hid_open_path(c.path.c_str());
+    if (dev == nullptr) {
+      f.problem = AccessProblem::kPermission;
+      f.problem_detail = "cannot open " + c.path;
+    } else if (identify) {
+      HidTransport t(std::make_unique<HidLibrary>(), dev, ModelFor(c.vid, c.pid),
+                     "HID " + c.path);
+      ask_identity(f, t);
+    } else {
+      hid_close(dev);
+    }
+    out.push_back(f);
+  }
+  return out;
+}
+
+}  // namespace brdf::device
