@@ -14,6 +14,7 @@
 
 #include "batch.h"
 #include "brdf/core/error.h"
+#include "brdf/engines/engine_export.h"
 #include "brdf/exporter/lut_export.h"
 #include "commands.h"
 #include "progress.h"
@@ -92,6 +93,7 @@ int RunConvert(const ConvertOptions& options) {
   exporter::LutExportOptions export_options;
   export_options.formats = exporter::ParseExportFormats(options.formats);
   export_options.exr = ParseExrOptions(options.exr_type, options.exr_compression);
+  const engines::EngineSet engine_set = engines::ParseEngines(options.engines);
   std::optional<processing::ExtrapolationParams> extrapolate;
   if (!options.extrapolate.empty())
     extrapolate = processing::ParseExtrapolation(options.extrapolate);
@@ -141,9 +143,14 @@ int RunConvert(const ConvertOptions& options) {
         metadata.name = in.name;
         metadata.source = in.path;
         metadata.extrapolation = built.extrapolation;
-        const OutputGuard guard(OutputPaths(out_dir, in.name, export_options.formats));
+        std::vector<std::string> outputs = OutputPaths(out_dir, in.name, export_options.formats);
+        for (std::string& p : engines::EngineOutputPaths(out_dir.string(), in.name,
+                                                         built.lut.theta_in_deg, engine_set))
+          outputs.push_back(std::move(p));
+        const OutputGuard guard(std::move(outputs));
         try {
-          exporter::ExportLut(out_dir.string(), built.lut, metadata, export_options);
+          engines::ExportLutWithEngines(out_dir.string(), built.lut, metadata, export_options,
+                                        engine_set);
         } catch (...) {
           // No partial set: remove what this conversion already renamed into place (the
           // writer that failed removed its own temporary file).

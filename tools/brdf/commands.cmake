@@ -10,3 +10,4 @@ target_sources(brdf PRIVATE
   brdf/sources.cpp
 )
 target_link_libraries(brdf PRIVATE brdf::processing brdf::exporter TBB::tbb Threads::Threads)
+target_link_libraries(brdf PRIVATE brdf::engines)  # --engine (convert, atlas)

@@ -46,6 +46,9 @@ struct ConvertOptions {
   std::string exr_compression = "none";
   int jobs = DefaultJobs();
   bool quiet = false;  // no progress bar
+  // Engine hand-off folders OUT/<engine>/: "unity,unreal,godot,web" (any subset) or "all";
+  // empty: none (brdf/engines/engine_export.h).
+  std::string engines;
 };
 int RunConvert(const ConvertOptions& options);
 
@@ -57,6 +60,7 @@ struct AtlasOptions {
   std::string exr_compression = "zip";
   int jobs = DefaultJobs();
   bool quiet = false;
+  std::string engines;  // as ConvertOptions::engines; folders beside the prefix
 };
 int RunAtlas(const AtlasOptions& options);
 
