@@ -17,6 +17,7 @@
 #include "brdf/exporter/rgb9e5.h"
 #include "brdf/exporter/shader_code.h"
 #include "brdf/exporter/sidecar.h"
+#include "brdf/exporter/texture_file.h"
 #include "engine_files.h"
 
 namespace brdf::engines {
@@ -337,6 +338,11 @@ std::vector<std::string> WriteEngineFolder(Engine e, const fs::path& dir, const 
       put(f.viewer, detail::WebViewerHtml(shader, h.name));
       put("index.html", detail::WebViewerHtml(shader, ""));
       put("package.json", detail::WebPackageJson());
+      // The same lookup as plain GLSL files for other WebGL 2 / OpenGL code.
+      put(detail::ShaderStem(h.layout) + ".es300.glsl",
+          exporter::MeasuredBrdfGlslFile(exporter::GlslVersion::kEs300, h.layout));
+      put(detail::ShaderStem(h.layout) + ".450.glsl",
+          exporter::MeasuredBrdfGlslFile(exporter::GlslVersion::k450, h.layout));
       break;
   }
   put(f.manifest, ManifestJson(e, h, f, shader));
@@ -479,8 +485,14 @@ EngineExportResult ExportLutWithEngines(const std::string& out_dir, const Lut& l
   h.cells = {{metadata.name, 0, 0}};
   h.composite = exporter::SquareishGrid(lut.slices());
   h.fitted_models_json = metadata.fitted_models_json;
-  const std::string ktx2 = exporter::EncodeKtx2(
-      packed, {{"brdf.sidecar", exporter::SidecarJson(packed, lut.theta_in_deg, metadata)}});
+  // The engine folders carry the same KTX2 bytes as OUT/NAME.ktx2 (its sidecar lists the
+  // companion files ExportLut wrote); without that file, one encoded from the metadata.
+  const std::string ktx2 =
+      options.formats.ktx2
+          ? ReadFileText((fs::path(out_dir) / (metadata.name + ".ktx2")).string(),
+                         exporter::kMaxTextureFileBytes)
+          : exporter::EncodeKtx2(packed, {{"brdf.sidecar", exporter::SidecarJson(
+                                                               packed, lut.theta_in_deg, metadata)}});
   exporter::FloatImage composite;
   if (engines.unreal || engines.godot) composite = exporter::CompositeImage(lut);
   result.written = WriteHandoff(fs::path(out_dir), h, ktx2, composite, engines);

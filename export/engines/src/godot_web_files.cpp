@@ -210,7 +210,7 @@ renderer.setSize(width, height);
 document.body.appendChild(renderer.domElement);
 const scene = new THREE.Scene();
 const camera = new THREE.PerspectiveCamera(30, width / height, 0.1, 100);
-camera.position.set(0, 0, 4);
+camera.position.set(0, 0, 5);
 camera.lookAt(0, 0, 0);
 const light = new THREE.Vector3(0.5, 0.6, 1.0).normalize();
 window.measuredBrdf = {{ renderer, scene, camera, light, THREE, ready: null }};

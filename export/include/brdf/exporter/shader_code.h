@@ -28,8 +28,8 @@
 // The result is f_r in 1/sr, linear RGB, NOT multiplied by cosθin: outgoing radiance from a
 // directional light of irradiance-at-normal-incidence E is f_r · E · max(n·l, 0).
 // Above the last measured θin (60° for the reference instrument) the clamp-to-edge w axis
-// returns the last slice unchanged (constant extension in θin); below the first slice, the
-// first. Light below the horizon (n·l ≤ 0) returns the value for θin = 90° clamped the same
+// selects the last slice, read at the ω_d of the actual θin (the lobe keeps following the
+// mirror direction; `brdf eval` of a LUT does the same); below the first slice, the first. Light below the horizon (n·l ≤ 0) returns the value for θin = 90° clamped the same
 // way; the caller's max(n·l, 0) makes it contribute nothing.
 //
 // Entry points in the generated code (same names and argument order in every language):

@@ -20,7 +20,8 @@
 //            NAME_slices.exr (+ .import)  the sliced-EXR route with its import settings
 //            measured_brdf*.gdshader  spatial shader with a light() function
 //   web/     NAME.ktx2, measured_brdf*.js (ES module: KTX2Loader, ShaderMaterial),
-//            index.html (viewer: ?material=NAME), NAME.html, package.json (three ≥ r180)
+//            index.html (viewer: ?material=NAME), NAME.html, package.json (three ≥ r180),
+//            MeasuredBrdf*.es300.glsl and MeasuredBrdf*.450.glsl (the lookup as GLSL files)
 //   each     NAME.manifest.json   axes and ranges, texel-centre mapping, units, colour space,
 //                                 orientation per import path, probe texels (index → RGB f_r)
 // Shader files carry the LUT layout in their constants; they are named MeasuredBrdf.* for the
