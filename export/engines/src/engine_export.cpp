@@ -3,11 +3,14 @@
 #include <algorithm>
 #include <bit>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <string>
 
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
+#include <unistd.h>
 
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
@@ -17,7 +20,6 @@
 #include "brdf/exporter/rgb9e5.h"
 #include "brdf/exporter/shader_code.h"
 #include "brdf/exporter/sidecar.h"
-#include "brdf/exporter/texture_file.h"
 #include "engine_files.h"
 
 namespace brdf::engines {
@@ -287,10 +289,39 @@ std::string ManifestJson(Engine e, const Handoff& h, const MaterialFiles& f,
   return j.dump(2) + "\n";
 }
 
-// Writes one engine folder; returns the paths written (shared files included).
+// The regular outputs an engine file can be a hard link to (empty when not written), and the
+// data to write instead when it is not there.
+struct Sources {
+  std::string ktx2_path, dds_path, exr_path;  // OUT/NAME.ktx2, .dds, .exr
+  std::function<std::string()> ktx2_bytes;
+  std::function<exporter::FloatImage()> composite;
+};
+
+// Places `path` as a hard link to `source` (same bytes, no second copy to write and flush):
+// linked under a temporary name, then renamed over `path`, so the final name appears whole.
+// The source is already durable; the folder is synced by the next atomic write into it.
+// Returns false when linking is impossible (no source, another file system), so the caller
+// writes the bytes instead.
+bool LinkAtomically(const std::string& source, const std::string& path) {
+  if (source.empty()) return false;
+  AtomicOutputPath out(path);
+  if (::link(source.c_str(), out.temp_path().c_str()) != 0) return false;
+  if (std::rename(out.temp_path().c_str(), path.c_str()) != 0) return false;
+  return true;  // the destructor's unlink of the (renamed) temporary name is a no-op
+}
+
+// Writes a file every material of a layout shares only when it is missing or different, so a
+// batch writes each once.
+bool SameContent(const std::string& path, std::string_view bytes) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec) || fs::file_size(path, ec) != bytes.size()) return false;
+  return ReadFileText(path, bytes.size()) == bytes;
+}
+
+// Writes one engine folder; returns the paths written or linked (shared files included when
+// they had to be written).
 std::vector<std::string> WriteEngineFolder(Engine e, const fs::path& dir, const Handoff& h,
-                                           const std::string& ktx2_bytes,
-                                           const exporter::FloatImage& composite) {
+                                           const Sources& src) {
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (!fs::is_directory(dir))
@@ -304,58 +335,76 @@ std::vector<std::string> WriteEngineFolder(Engine e, const fs::path& dir, const 
     WriteFileAtomically(path, bytes);
     written.push_back(path);
   };
-  const exporter::ExrOptions half_exr(exporter::ExrPixelType::kHalf, exporter::ExrCompression::kNone);
-  const exporter::StringAttributes exr_attributes = {
-      {"brdf:theta_in_deg", exporter::FormatThetaList(h.theta_in_deg)},
-      {"brdf:layout", fmt::format("{} x {} tiles of {} x {}, row-major, top-left first",
-                                  h.composite.columns, h.composite.rows, h.volume->width,
-                                  h.volume->height)},
-      {"brdf:texel_convention", exporter::TexelCentreFormula()}};
+  const auto shared = [&](const std::string& file, const std::string& bytes) {
+    if (!SameContent((dir / file).string(), bytes)) put(file, bytes);
+  };
+  const auto linked = [&](const std::string& file, const std::string& source,
+                          const std::function<std::string()>& bytes) {
+    const std::string path = (dir / file).string();
+    if (LinkAtomically(source, path))
+      written.push_back(path);
+    else
+      put(file, bytes());
+  };
+  // The tiled/sliced EXR: the regular composite EXR when there is one (same layout), else a
+  // half-float one written here.
+  const auto tiles = [&](const std::string& file) {
+    const std::string path = (dir / file).string();
+    if (LinkAtomically(src.exr_path, path)) {
+      written.push_back(path);
+      return;
+    }
+    exporter::WriteExr(
+        path, src.composite(),
+        exporter::ExrOptions(exporter::ExrPixelType::kHalf, exporter::ExrCompression::kNone),
+        {{"brdf:theta_in_deg", exporter::FormatThetaList(h.theta_in_deg)},
+         {"brdf:layout", fmt::format("{} x {} tiles of {} x {}, row-major, top-left first",
+                                     h.composite.columns, h.composite.rows, h.volume->width,
+                                     h.volume->height)},
+         {"brdf:texel_convention", exporter::TexelCentreFormula()}});
+    written.push_back(path);
+  };
   switch (e) {
     case Engine::kUnity:
-      put(f.texture, ktx2_bytes);
+      linked(f.texture, src.ktx2_path, src.ktx2_bytes);
       fs::create_directories(dir / "Editor", ec);
-      put("Editor/MeasuredBrdfImporter.cs", detail::UnityImporterCs());
-      put(shader, detail::UnityHlsl(h.layout));
+      shared("Editor/MeasuredBrdfImporter.cs", detail::UnityImporterCs());
+      shared(shader, detail::UnityHlsl(h.layout));
       break;
     case Engine::kUnreal:
+      tiles(f.tiles);
       put(f.texture, EncodeRgba16fDds(*h.volume));
-      exporter::WriteExr((dir / f.tiles).string(), composite, half_exr, exr_attributes);
-      written.push_back((dir / f.tiles).string());
-      put(shader, detail::UnrealUsh(h.layout));
-      put("import_measured_brdf.py", detail::UnrealImportPython());
+      shared(shader, detail::UnrealUsh(h.layout));
+      shared("import_measured_brdf.py", detail::UnrealImportPython());
       break;
     case Engine::kGodot:
-      put(f.texture, exporter::EncodeDds(*h.volume));
-      exporter::WriteExr((dir / f.tiles).string(), composite, half_exr, exr_attributes);
-      written.push_back((dir / f.tiles).string());
+      linked(f.texture, src.dds_path, [&] { return exporter::EncodeDds(*h.volume); });
+      tiles(f.tiles);
       put(f.tiles_import, detail::GodotSlicesImport(h, f.tiles));
-      put(shader, detail::GodotShader(h.layout));
+      shared(shader, detail::GodotShader(h.layout));
       break;
     case Engine::kWeb:
-      put(f.texture, ktx2_bytes);
-      put(shader, detail::WebModuleJs(h.layout));
+      linked(f.texture, src.ktx2_path, src.ktx2_bytes);
       put(f.viewer, detail::WebViewerHtml(shader, h.name));
-      put("index.html", detail::WebViewerHtml(shader, ""));
-      put("package.json", detail::WebPackageJson());
+      shared(shader, detail::WebModuleJs(h.layout));
+      shared("index.html", detail::WebViewerHtml(shader, ""));
+      shared("package.json", detail::WebPackageJson());
       // The same lookup as plain GLSL files for other WebGL 2 / OpenGL code.
-      put(detail::ShaderStem(h.layout) + ".es300.glsl",
-          exporter::MeasuredBrdfGlslFile(exporter::GlslVersion::kEs300, h.layout));
-      put(detail::ShaderStem(h.layout) + ".450.glsl",
-          exporter::MeasuredBrdfGlslFile(exporter::GlslVersion::k450, h.layout));
+      shared(detail::ShaderStem(h.layout) + ".es300.glsl",
+             exporter::MeasuredBrdfGlslFile(exporter::GlslVersion::kEs300, h.layout));
+      shared(detail::ShaderStem(h.layout) + ".450.glsl",
+             exporter::MeasuredBrdfGlslFile(exporter::GlslVersion::k450, h.layout));
       break;
   }
   put(f.manifest, ManifestJson(e, h, f, shader));
   return written;
 }
 
-std::vector<std::string> WriteHandoff(const fs::path& base, const Handoff& h,
-                                      const std::string& ktx2_bytes,
-                                      const exporter::FloatImage& composite,
+std::vector<std::string> WriteHandoff(const fs::path& base, const Handoff& h, const Sources& src,
                                       const EngineSet& engines) {
   std::vector<std::string> written;
   for (Engine e : Selected(engines)) {
-    const auto w = WriteEngineFolder(e, base / FolderOf(e), h, ktx2_bytes, composite);
+    const auto w = WriteEngineFolder(e, base / FolderOf(e), h, src);
     written.insert(written.end(), w.begin(), w.end());
   }
   return written;
@@ -485,17 +534,20 @@ EngineExportResult ExportLutWithEngines(const std::string& out_dir, const Lut& l
   h.cells = {{metadata.name, 0, 0}};
   h.composite = exporter::SquareishGrid(lut.slices());
   h.fitted_models_json = metadata.fitted_models_json;
-  // The engine folders carry the same KTX2 bytes as OUT/NAME.ktx2 (its sidecar lists the
-  // companion files ExportLut wrote); without that file, one encoded from the metadata.
-  const std::string ktx2 =
-      options.formats.ktx2
-          ? ReadFileText((fs::path(out_dir) / (metadata.name + ".ktx2")).string(),
-                         exporter::kMaxTextureFileBytes)
-          : exporter::EncodeKtx2(packed, {{"brdf.sidecar", exporter::SidecarJson(
-                                                               packed, lut.theta_in_deg, metadata)}});
-  exporter::FloatImage composite;
-  if (engines.unreal || engines.godot) composite = exporter::CompositeImage(lut);
-  result.written = WriteHandoff(fs::path(out_dir), h, ktx2, composite, engines);
+  const fs::path dir(out_dir);
+  const auto main_file = [&](bool written, const char* ext) {
+    return written ? (dir / (metadata.name + ext)).string() : std::string();
+  };
+  Sources src;
+  src.ktx2_path = main_file(options.formats.ktx2, ".ktx2");
+  src.dds_path = main_file(options.formats.dds, ".dds");
+  src.exr_path = main_file(options.formats.exr, ".exr");
+  src.ktx2_bytes = [&] {
+    return exporter::EncodeKtx2(
+        packed, {{"brdf.sidecar", exporter::SidecarJson(packed, lut.theta_in_deg, metadata)}});
+  };
+  src.composite = [&] { return exporter::CompositeImage(lut); };
+  result.written = WriteHandoff(dir, h, src, engines);
   return result;
 }
 
@@ -521,14 +573,19 @@ std::vector<std::string> WriteAtlasWithEngines(const std::string& prefix,
                        atlas.layout.cells.CellRow(m) * Lut::kHeight});
     h.source += (m ? ", " : "") + atlas.sources[m];
   }
-  const std::string ktx2 = exporter::EncodeKtx2(
-      atlas.volume,
-      {{"brdf.atlas", exporter::AtlasManifestJson(atlas, {h.name + ".ktx2", h.name + ".dds",
-                                                           h.name + ".exr", h.name + ".json"})}});
-  exporter::FloatImage composite;
-  if (engines.unreal || engines.godot) composite = exporter::AtlasImage(materials);
   const fs::path base = prefix_path.has_parent_path() ? prefix_path.parent_path() : fs::path(".");
-  const auto w = WriteHandoff(base, h, ktx2, composite, engines);
+  Sources src;  // WriteAtlas wrote all three
+  src.ktx2_path = prefix + ".ktx2";
+  src.dds_path = prefix + ".dds";
+  src.exr_path = prefix + ".exr";
+  src.ktx2_bytes = [&] {
+    return exporter::EncodeKtx2(
+        atlas.volume, {{"brdf.atlas", exporter::AtlasManifestJson(
+                                          atlas, {h.name + ".ktx2", h.name + ".dds",
+                                                  h.name + ".exr", h.name + ".json"})}});
+  };
+  src.composite = [&] { return exporter::AtlasImage(materials); };
+  const auto w = WriteHandoff(base, h, src, engines);
   written.insert(written.end(), w.begin(), w.end());
   return written;
 }
