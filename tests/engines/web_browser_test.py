@@ -86,6 +86,23 @@ def main():
                         os.path.join(web, "ggx_blue.manifest.json"), "--eval",
                         os.path.join(work, "eval.txt"), "--hlsl"], capture_output=True, text=True)
     print(r.stdout + r.stderr, end="")
+    # An atlas: the second material's cell (a Lambertian) through the viewer's ?cell= path.
+    lam = os.path.join(work, "lambert_orange.json")
+    with open(lam, "w") as f:
+        json.dump({"model": "lambert", "rho": [0.8, 0.5, 0.2]}, f)
+    run([tool, "atlas", mat, lam, "--out", os.path.join(work, "atlas", "set"), "--engine", "web",
+         "--quiet"])
+    atlas_web = os.path.join(work, "atlas", "web")
+    atlas_result = os.path.join(work, "atlas_result")
+    os.makedirs(atlas_result)
+    run(["node", os.path.join(source, "tests/node/render_web.mjs"), "--web", atlas_web,
+         "--material", "set", "--cell", "lambert_orange", "--out", atlas_result, "--size", "128"])
+    a = subprocess.run([sys.executable, check, "check", "--material", lam, "--result",
+                        atlas_result, "--ktx2", os.path.join(atlas_web, "set.ktx2"), "--manifest",
+                        os.path.join(atlas_web, "set.manifest.json")], capture_output=True, text=True)
+    print("atlas cell lambert_orange: " + (a.stdout + a.stderr).replace("\n", "\natlas: "), end="\n")
+    if a.returncode != 0:
+        r = a
     if r.returncode == 0:
         shutil.rmtree(work, ignore_errors=True)
     else:

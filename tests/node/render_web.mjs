@@ -12,7 +12,7 @@
 //   screenshot.png  the viewer as a person sees it (sRGB canvas), light moved once
 //   bench.json      with --bench: median frame time of a 1024² canvas
 // Usage: node render_web.mjs --web DIR --material NAME --out DIR [--size N] [--pairs FILE]
-//        [--hlsl-glsl FILE] [--bench] [--chromium PATH]
+//        [--hlsl-glsl FILE] [--cell NAME (an atlas material)] [--bench] [--chromium PATH]
 import { spawn } from 'node:child_process';
 import { createServer } from 'node:http';
 import { mkdtempSync, readFileSync, writeFileSync, existsSync, rmSync, statSync } from 'node:fs';
@@ -198,7 +198,8 @@ const fromBase64 = (s) => { const b = Buffer.from(s, 'base64'); return new Float
 
 try {
   const material = args.material;
-  const page = await openPage(`${base}/web/index.html?material=${encodeURIComponent(material)}&three=/three/&size=${size}`);
+  const cellParam = args.cell ? `&cell=${encodeURIComponent(args.cell)}` : '';
+  const page = await openPage(`${base}/web/index.html?material=${encodeURIComponent(material)}${cellParam}&three=/three/&size=${size}`);
   await page.eval(helpers);
   const light = [0.45, 0.55, 0.7];
   const info = await page.eval(`({ revision: window.measuredBrdf.THREE.REVISION,

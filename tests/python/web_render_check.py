@@ -59,6 +59,15 @@ def ggx(mat, wi, wo):
     return kd / math.pi + spec
 
 
+def material_f(mat, wi, wo):
+    """f_r of the docs/design.md §9 material (the models these tests render)."""
+    if mat["model"] == "ggx":
+        return ggx(mat, wi, wo)
+    if mat["model"] == "lambert":
+        return np.broadcast_to(np.asarray(mat["rho"], float) / math.pi, wi.shape).copy()
+    raise ValueError("web_render_check: no oracle for model " + mat["model"])
+
+
 def specular_matrix(theta_in):
     c, s = math.cos(theta_in), math.sin(theta_in)
     return np.array([[-c, 0.0, -s], [0.0, -1.0, 0.0], [-s, 0.0, c]])
@@ -75,7 +84,7 @@ def numpy_lut(mat, theta_in_deg, theta_b_deg=75.0):
         phi_o = np.arctan2(wo[..., 1], wo[..., 0])
         wo_c = spherical(np.minimum(theta_o, theta_b_deg * DEG), phi_o)
         wi = np.broadcast_to(np.array([math.sin(t * DEG), 0.0, math.cos(t * DEG)]), wo_c.shape)
-        out.append(ggx(mat, wi, wo_c))
+        out.append(material_f(mat, wi, wo_c))
     return np.stack(out)
 
 
@@ -210,6 +219,9 @@ def check(argv):
     mask = hit & (np.sum(n * v, -1) > 0.2) & (cos_l > 0.0)
     lut = numpy_lut(mat, theta)
     u, vv, w = lut_coords(n[mask], l[mask], v[mask], theta0, delta, k)
+    # An atlas cell samples the same texels as the material's own LUT (the cell is clamped to
+    # its outer texel centres), so the single-LUT reference applies; the cell offset is what
+    # the GPU must get right.
     ref = np.zeros_like(img)
     ref[mask] = trilinear(lut, u, vv, w) * cos_l[mask][:, None]
     peak = float(np.max(ref[mask]))
@@ -224,16 +236,18 @@ def check(argv):
     x = lt / np.linalg.norm(lt, axis=-1, keepdims=True)
     y = np.cross(nm, x)
     frame = lambda a: np.stack([np.sum(a * x, -1), np.sum(a * y, -1), np.sum(a * nm, -1)], -1)
-    analytic[mask] = ggx(mat, frame(lm), frame(vm)) * cos_l[mask][:, None]
+    analytic[mask] = material_f(mat, frame(lm), frame(vm)) * cos_l[mask][:, None]
     a_rms = float(np.sqrt(np.mean((img[mask] - analytic[mask]) ** 2)))
     print(f"image: {int(mask.sum())} sphere pixels of {size}x{size}; peak radiance {peak:.4g}; "
           f"vs LUT-scheme reference: RMS {rms:.3g} ({rms / peak:.3%} of peak), max {mx:.3g} "
           f"({mx / peak:.3%} of peak), 99th percentile relative {np.percentile(rel, 99):.3%}; "
           f"vs direct analytic shading: RMS {a_rms / peak:.3%} of peak")
-    # RGB9E5 rounds each texel by at most 2^-9 of its largest channel (0.2 %); the 1° capture's
-    # resampling and the GPU's filter weights add less on this lobe (measured: RMS 0.03 %,
-    # max 0.19 % of peak with SwiftShader). Allow 0.2 % of peak RMS and 1 % max.
-    if not (rms <= 0.002 * peak and mx <= 0.01 * peak):
+    # RGB9E5 rounds each texel by at most 2^-9 of its largest channel (0.2 %, RMS about a third
+    # of that); the 1° capture's resampling and the GPU's filter weights add less (measured with
+    # SwiftShader: RMS 0.034 % / 0.049 %, max 0.19 % / 0.22 % of peak for the GGX LUT and a
+    # Lambertian atlas cell). Allow 0.07 % RMS and 0.35 % max: a lookup half a texel off in θd
+    # alone gives 0.09 % and 0.45 %.
+    if not (rms <= 0.0007 * peak and mx <= 0.0035 * peak):
         print("FAIL image: the rendered sphere differs from the reference")
         ok = False
     np.save(f"{res}/reference.npy", ref)
