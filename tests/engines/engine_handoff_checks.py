@@ -192,6 +192,13 @@ def main():
     json.dump(MATERIAL, open(mat, "w"))
     out = os.path.join(work, "out")
     run([tool, "convert", mat, "--out", out, "--engine", "all", "--quiet", "--formats", "ktx2,json"])
+    # A misspelt engine: one line, exit 1, nothing written.
+    bad = subprocess.run([tool, "convert", mat, "--out", os.path.join(work, "bad"), "--engine",
+                          "unity,unrael"], capture_output=True, text=True)
+    expect(bad.returncode == 1 and bad.stderr.strip() ==
+           "brdf: error: unknown engine 'unrael' (known: unity, unreal, godot, web, all)"
+           and not os.path.exists(os.path.join(work, "bad")),
+           f"--engine unrael: exit {bad.returncode}, stderr {bad.stderr!r}")
     words, want = check_dds(out, "gold_like")
     check_unity(out, "gold_like", mcs, mono, work, words, want)
     check_unreal(out, work)
