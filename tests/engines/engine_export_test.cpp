@@ -104,10 +104,10 @@ TEST_F(EngineExport, WritesEveryEngineFolderWithTheContainersAsBytes) {
         "unreal/MeasuredBrdf.ush", "unreal/import_measured_brdf.py", "unreal/felt.manifest.json",
         "godot/felt.dds", "godot/felt_slices.exr", "godot/felt_slices.exr.import",
         "godot/measured_brdf.gdshader", "godot/felt.manifest.json", "web/felt.ktx2",
-        "web/measured_brdf.js", "web/index.html", "web/felt.html", "web/package.json",
+        "web/measured_brdf.js", "web/index.html", "web/package.json",
         "web/felt.manifest.json", "web/MeasuredBrdf.es300.glsl", "web/MeasuredBrdf.450.glsl"})
     EXPECT_TRUE(fs::is_regular_file(dir_ / f)) << f;
-  EXPECT_EQ(r.written.size(), 22u);
+  EXPECT_EQ(r.written.size(), 21u);
   const std::string ktx2 = Read(dir_ / "felt.ktx2");
   EXPECT_EQ(Read(dir_ / "unity/felt.brdf3d"), ktx2);
   EXPECT_EQ(Read(dir_ / "web/felt.ktx2"), ktx2);
@@ -115,7 +115,7 @@ TEST_F(EngineExport, WritesEveryEngineFolderWithTheContainersAsBytes) {
   // The paths a failed conversion must remove are the per-material ones.
   const auto paths = engines::EngineOutputPaths(dir_.string(), "felt", lut.theta_in_deg,
                                                 ParseEngines("all"));
-  EXPECT_EQ(paths.size(), 12u);
+  EXPECT_EQ(paths.size(), 11u);
   for (const std::string& p : paths) EXPECT_TRUE(fs::is_regular_file(p)) << p;
 }
 
@@ -128,7 +128,8 @@ TEST_F(EngineExport, ManifestProbesAreTheTexturesOwnTexels) {
   const std::size_t level = static_cast<std::size_t>(U32(ktx2, 80));  // level 0 byteOffset
   for (const char* engine : {"unity", "godot"}) {
     const auto j = nlohmann::json::parse(Read(dir_ / engine / "p.manifest.json"));
-    EXPECT_EQ(j["engine"], engine);
+    EXPECT_EQ(j["engines"][engine]["folder"], engine);
+    EXPECT_EQ(j["engines"].size(), 2u);
     EXPECT_EQ(j["texture"]["width"], 361);
     EXPECT_EQ(j["texture"]["depth"], 4);
     EXPECT_EQ(j["axes"]["w"]["range_deg"], nlohmann::json::array({0.0, 60.0}));
@@ -169,7 +170,7 @@ TEST_F(EngineExport, LayoutsOtherThanTheReferenceGetTheirOwnShaderFiles) {
   EXPECT_NE(other.find("MEASURED_BRDF_DELTA_IN_DEG = 15.0;"), std::string::npos);
   EXPECT_NE(other.find("MEASURED_BRDF_THETA_IN0_DEG = 10.0;"), std::string::npos);
   const auto j = nlohmann::json::parse(Read(dir_ / "unity/b.manifest.json"));
-  EXPECT_EQ(j["files"]["shader"], "MeasuredBrdf_3x15from10.hlsl");
+  EXPECT_EQ(j["engines"]["unity"]["files"]["shader"], "MeasuredBrdf_3x15from10.hlsl");
 }
 
 TEST_F(EngineExport, AtlasFoldersAddressEachMaterialsCell) {
@@ -188,7 +189,8 @@ TEST_F(EngineExport, AtlasFoldersAddressEachMaterialsCell) {
   EXPECT_EQ(j["cells"][1]["x0"], 361);
   EXPECT_EQ(j["cells"][2]["y0"], 181);
   EXPECT_EQ(j["texture"]["width"], 722);
-  const std::string shader = Read(dir_ / "web" / j["files"]["shader"].get<std::string>());
+  const std::string shader =
+      Read(dir_ / "web" / j["engines"]["web"]["files"]["shader"].get<std::string>());
   EXPECT_NE(shader.find("MEASURED_BRDF_TEXELS_U = 722.0;"), std::string::npos);
   EXPECT_NE(shader.find("MEASURED_BRDF_TEXELS_V = 362.0;"), std::string::npos);
 }

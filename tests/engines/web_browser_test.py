@@ -9,7 +9,7 @@ the code under test:
   - the manifest's probe texels with the KTX2 file and with what the GPU fetched,
   - the shipped GLSL and the shipped Unity HLSL (glslangValidator -D → SPIR-V → spirv-cross →
     GLSL ES, executed by the same WebGL context) with `brdf eval` of the LUT for 300 pairs.
-Usage: web_browser_test.py BRDF_TOOL SOURCE_DIR   (Debian /usr/bin/python3; fails when a tool
+Usage: web_browser_test.py BRDF_TOOL SOURCE_DIR [CHROMIUM]   (Debian /usr/bin/python3; fails when a tool
 is missing: install it with tools/install-deps.sh and tools/install-npm-deps.sh)
 """
 import json
@@ -52,6 +52,7 @@ def run(cmd, **kw):
 
 def main():
     tool, source = sys.argv[1], sys.argv[2]
+    chromium = sys.argv[3] if len(sys.argv) > 3 else "chromium"
     for exe in ("node", "chromium", "glslangValidator", "spirv-cross"):
         if shutil.which(exe) is None:
             print(f"FAILED: {exe} not found; run tools/install-deps.sh")
@@ -80,7 +81,7 @@ def main():
     os.makedirs(result)
     run(["node", os.path.join(source, "tests/node/render_web.mjs"), "--web", web,
          "--material", "ggx_blue", "--out", result, "--size", "256", "--pairs", nlv,
-         "--hlsl-glsl", es])
+         "--hlsl-glsl", es, "--chromium", chromium])
     r = subprocess.run([sys.executable, check, "check", "--material", mat, "--result", result,
                         "--ktx2", os.path.join(web, "ggx_blue.ktx2"), "--manifest",
                         os.path.join(web, "ggx_blue.manifest.json"), "--eval",
@@ -96,7 +97,8 @@ def main():
     atlas_result = os.path.join(work, "atlas_result")
     os.makedirs(atlas_result)
     run(["node", os.path.join(source, "tests/node/render_web.mjs"), "--web", atlas_web,
-         "--material", "set", "--cell", "lambert_orange", "--out", atlas_result, "--size", "128"])
+         "--material", "set", "--cell", "lambert_orange", "--out", atlas_result, "--size", "128",
+         "--chromium", chromium])
     a = subprocess.run([sys.executable, check, "check", "--material", lam, "--result",
                         atlas_result, "--ktx2", os.path.join(atlas_web, "set.ktx2"), "--manifest",
                         os.path.join(atlas_web, "set.manifest.json")], capture_output=True, text=True)

@@ -263,7 +263,7 @@ try {
       }`;
     const runPairs = async (source, lutName, pairsName) => fromBase64(await page.eval(`(async () => {
         const M = window.measuredBrdf;
-        const mod = await import('${base}/web/${manifest.files.shader}');
+        const mod = await import('${base}/web/${manifest.engines.web.files.shader}');
         const source = ${JSON.stringify(source)}.replace('@MEASURED_BRDF_GLSL@', mod.MEASURED_BRDF_GLSL);
         const t = M.dataTexture(new Float32Array(${JSON.stringify(Array.from(data))}), ${count}, 3);
         return M.toBase64(M.runFragment(source, { ${lutName}: { value: M.texture }, ${pairsName}: { value: t } }, ${count}, 1)); })()`));

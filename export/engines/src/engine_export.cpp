@@ -63,7 +63,7 @@ std::string NumberTag(double v) {
 
 // The per-material file names of one engine folder (shared files excluded).
 struct MaterialFiles {
-  std::string texture, manifest, tiles, tiles_import, viewer;
+  std::string texture, manifest, tiles, tiles_import;
 };
 
 MaterialFiles FilesOf(Engine e, const std::string& name) {
@@ -82,7 +82,6 @@ MaterialFiles FilesOf(Engine e, const std::string& name) {
       break;
     case Engine::kWeb:
       f.texture = name + ".ktx2";
-      f.viewer = name + ".html";
       break;
   }
   return f;
@@ -179,12 +178,13 @@ ordered_json FallbackMaterialJson(const std::vector<std::string>& fitted_models_
                       {"models", std::move(models)}};
 }
 
-std::string ManifestJson(Engine e, const Handoff& h, const MaterialFiles& f,
-                         const std::string& shader) {
+// What one engine's folder holds and how it imports (a member of "engines" in the manifest).
+ordered_json EngineSectionJson(Engine e, const Handoff& h) {
   const exporter::PackedVolume& vol = *h.volume;
-  ordered_json files = {{"texture", f.texture}, {"shader", shader}};
-  ordered_json texture = {{"width", vol.width}, {"height", vol.height}, {"depth", vol.depth},
-                          {"mip_levels", 1}};
+  const MaterialFiles f = FilesOf(e, h.name);
+  ordered_json files = {{"texture", f.texture}, {"shader", ShaderFile(e, h.layout)},
+                        {"manifest", f.manifest}};
+  ordered_json texture;
   ordered_json orientation, import;
   std::string versions;
   const std::string tiles = fmt::format(
@@ -222,8 +222,7 @@ std::string ManifestJson(Engine e, const Handoff& h, const MaterialFiles& f,
                 {"address_mode", "TA_Clamp"},
                 {"filter", "TF_Bilinear"},
                 {"tiles", {{"tile_width", vol.width}, {"tile_height", vol.height},
-                           {"columns", h.composite.columns}, {"rows", h.composite.rows},
-                           {"pixel_type", "half"}}}};
+                           {"columns", h.composite.columns}, {"rows", h.composite.rows}}}};
       break;
     case Engine::kGodot:
       versions = "Godot 4.2 to 4.5 (RGB9E5 3D DDS: 4.4 and later; sliced EXR: every 4.x)";
@@ -241,8 +240,7 @@ std::string ManifestJson(Engine e, const Handoff& h, const MaterialFiles& f,
     case Engine::kWeb:
       versions = fmt::format("three.js r{} (0.{}.0) or later, WebGL 2",
                              detail::kMinimumThreeRevision, detail::kMinimumThreeRevision);
-      files["viewer"] = f.viewer;
-      files["index"] = "index.html";
+      files["viewer"] = "index.html?material=" + h.name;
       texture["format"] = "KTX2 vkFormat 123 (VK_FORMAT_E5B9G9R9_UFLOAT_PACK32), uncompressed";
       orientation["ktx2loader"] =
           "KTX2 texel (x, y, z) = Data3DTexture texel (x, y, z) (KTXorientation rdi; three.js "
@@ -251,21 +249,36 @@ std::string ManifestJson(Engine e, const Handoff& h, const MaterialFiles& f,
                 {"wrap", "ClampToEdgeWrapping"}, {"color_space", "NoColorSpace"}};
       break;
   }
-  texture["colour_space"] = "linear Rec.709 RGB; sample without sRGB decode";
-  texture["sampler"] = "linear (trilinear), clamp-to-edge on u, v and w, no mipmaps";
+  return ordered_json{{"folder", FolderOf(e)},
+                      {"engine_versions", versions},
+                      {"files", files},
+                      {"texture_format", texture["format"]},
+                      {"orientation", orientation},
+                      {"import", import}};
+}
+
+// One manifest per material for every engine folder of the conversion (the same text in each,
+// hard-linked): the common description, then "engines" with one member per selected engine.
+std::string ManifestJson(const Handoff& h, const std::vector<Engine>& engines) {
+  const exporter::PackedVolume& vol = *h.volume;
   ordered_json cells = ordered_json::array();
   for (const HandoffCell& c : h.cells)
     cells.push_back({{"material", c.name}, {"x0", c.x0}, {"y0", c.y0}});
+  ordered_json sections = ordered_json::object();
+  for (Engine e : engines) sections[FolderOf(e)] = EngineSectionJson(e, h);
   ordered_json j = {
       {"kind", "brdf-engine-manifest"},
       {"format_version", 1},
-      {"engine", FolderOf(e)},
-      {"engine_versions", versions},
       {"name", h.name},
       {"source", h.source},
       {"atlas", h.atlas},
-      {"files", files},
-      {"texture", texture},
+      {"texture",
+       {{"width", vol.width},
+        {"height", vol.height},
+        {"depth", vol.depth},
+        {"mip_levels", 1},
+        {"colour_space", "linear Rec.709 RGB; sample without sRGB decode"},
+        {"sampler", "linear (trilinear), clamp-to-edge on u, v and w, no mipmaps"}}},
       {"theta_in_deg", h.theta_in_deg},
       {"axes", AxesJson(h)},
       {"texel_centre_mapping",
@@ -280,11 +293,10 @@ std::string ManifestJson(Engine e, const Handoff& h, const MaterialFiles& f,
        "MeasuredBrdf(n, l, v): unit vectors away from the surface in one frame; tangent frame "
        "from the light (x = l projected on the tangent plane, phi_in = 0); omega_d = "
        "S(theta_in) v; theta_d = atan2(|omega_d.xy|, omega_d.z)"},
-      {"orientation", orientation},
-      {"import", import},
       {"cells", cells},
       {"probe_texels", ProbeJson(h)},
       {"fallback_material", FallbackMaterialJson(h.fitted_models_json)},
+      {"engines", sections},
       {"tool", {{"name", "brdf-toolchain"}, {"version", exporter::BrdfToolVersion()}}}};
   return j.dump(2) + "\n";
 }
@@ -321,7 +333,8 @@ bool SameContent(const std::string& path, std::string_view bytes) {
 // Writes one engine folder; returns the paths written or linked (shared files included when
 // they had to be written).
 std::vector<std::string> WriteEngineFolder(Engine e, const fs::path& dir, const Handoff& h,
-                                           const Sources& src) {
+                                           const Sources& src, std::string& manifest_path,
+                                           const std::string& manifest) {
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (!fs::is_directory(dir))
@@ -385,7 +398,6 @@ std::vector<std::string> WriteEngineFolder(Engine e, const fs::path& dir, const 
       break;
     case Engine::kWeb:
       linked(f.texture, src.ktx2_path, src.ktx2_bytes);
-      put(f.viewer, detail::WebViewerHtml(shader, h.name));
       shared(shader, detail::WebModuleJs(h.layout));
       shared("index.html", detail::WebViewerHtml(shader, ""));
       shared("package.json", detail::WebPackageJson());
@@ -396,15 +408,21 @@ std::vector<std::string> WriteEngineFolder(Engine e, const fs::path& dir, const 
              exporter::MeasuredBrdfGlslFile(exporter::GlslVersion::k450, h.layout));
       break;
   }
-  put(f.manifest, ManifestJson(e, h, f, shader));
+  // The manifest: written into the first folder, hard-linked into the others.
+  if (!LinkAtomically(manifest_path, (dir / f.manifest).string())) put(f.manifest, manifest);
+  else written.push_back((dir / f.manifest).string());
+  if (manifest_path.empty()) manifest_path = (dir / f.manifest).string();
   return written;
 }
 
 std::vector<std::string> WriteHandoff(const fs::path& base, const Handoff& h, const Sources& src,
                                       const EngineSet& engines) {
   std::vector<std::string> written;
-  for (Engine e : Selected(engines)) {
-    const auto w = WriteEngineFolder(e, base / FolderOf(e), h, src);
+  const std::vector<Engine> selected = Selected(engines);
+  const std::string manifest = ManifestJson(h, selected);
+  std::string manifest_path;
+  for (Engine e : selected) {
+    const auto w = WriteEngineFolder(e, base / FolderOf(e), h, src, manifest_path, manifest);
     written.insert(written.end(), w.begin(), w.end());
   }
   return written;
@@ -511,7 +529,7 @@ std::vector<std::string> EngineOutputPaths(const std::string& out_dir, const std
   const fs::path base(out_dir);
   for (Engine e : Selected(engines)) {
     const MaterialFiles f = FilesOf(e, name);
-    for (const std::string* file : {&f.texture, &f.tiles, &f.tiles_import, &f.viewer, &f.manifest})
+    for (const std::string* file : {&f.texture, &f.tiles, &f.tiles_import, &f.manifest})
       if (!file->empty()) paths.push_back((base / FolderOf(e) / *file).string());
   }
   return paths;
@@ -522,9 +540,9 @@ EngineExportResult ExportLutWithEngines(const std::string& out_dir, const Lut& l
                                         const exporter::LutExportOptions& options,
                                         const EngineSet& engines) {
   EngineExportResult result;
-  result.lut = exporter::ExportLut(out_dir, lut, metadata, options);
-  if (!engines.Any()) return result;
   const exporter::PackedVolume packed = exporter::PackLut(lut);
+  result.lut = exporter::ExportLut(out_dir, lut, packed, metadata, options);
+  if (!engines.Any()) return result;
   Handoff h;
   h.name = metadata.name;
   h.source = metadata.source;

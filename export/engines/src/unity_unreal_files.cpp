@@ -288,9 +288,10 @@ def main(argv):
             continue
         with open(os.path.join(HERE, entry), encoding="utf-8") as f:
             manifest = json.load(f)
-        files = manifest["files"]
+        section = manifest["engines"]["unreal"]
+        files = section["files"]
         if tiles:
-            tile = manifest["import"]["tiles"]
+            tile = section["import"]["tiles"]
             imported.append(build_volume_from_tiles(os.path.join(HERE, files["tiles"]),
                                                     tile["tile_width"], tile["tile_height"]))
         else:

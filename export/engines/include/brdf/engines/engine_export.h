@@ -11,8 +11,8 @@
 //            MeasuredBrdf*.hlsl   Shader Graph Custom Function MeasuredBrdf_float (URP/HDRP)
 //                                 and the built-in pipeline lighting model MeasuredBrdf
 //   unreal/  NAME.dds             RGBA16F volume DDS (DXGI 10, one mip, depth K)
-//            NAME_tiles.exr       the K slices as 361 × 181 tiles (half, for the Volume
-//                                 Texture from a 2D texture route)
+//            NAME_tiles.exr       the K slices as 361 × 181 tiles (the composite EXR, for
+//                                 the Volume Texture from a 2D texture route)
 //            MeasuredBrdf*.ush    include for a Custom material node
 //            import_measured_brdf.py  editor script: imports the DDS (or builds the Volume
 //                                 Texture from the tiles), sRGB off, TC_HDR, clamp, no mips
@@ -20,14 +20,19 @@
 //            NAME_slices.exr (+ .import)  the sliced-EXR route with its import settings
 //            measured_brdf*.gdshader  spatial shader with a light() function
 //   web/     NAME.ktx2, measured_brdf*.js (ES module: KTX2Loader, ShaderMaterial),
-//            index.html (viewer: ?material=NAME), NAME.html, package.json (three ≥ r180),
+//            index.html (viewer: ?material=NAME), package.json (three ≥ r180),
 //            MeasuredBrdf*.es300.glsl and MeasuredBrdf*.450.glsl (the lookup as GLSL files)
 //   each     NAME.manifest.json   axes and ranges, texel-centre mapping, units, colour space,
-//                                 orientation per import path, probe texels (index → RGB f_r)
+//                                 probe texels (index → RGB f_r), and under "engines" each
+//                                 folder's files, texture format, orientation per import
+//                                 path and import settings (one text, hard-linked into every
+//                                 engine folder of the conversion)
 // Shader files carry the LUT layout in their constants; they are named MeasuredBrdf.* for the
 // reference layout (θin 0, 20, 40, 60, one material) and MeasuredBrdf_<tag>.* otherwise, so
 // materials of one layout share one file and different layouts never overwrite each other.
-// Shared files written by several conversions of one batch have identical bytes.
+// Shared files written by several conversions of one batch have identical bytes and are
+// written only when missing or different. The engine copies of OUT/NAME.ktx2, .dds and .exr are
+// hard links to them when they were written (else written in full: the EXR then in half).
 //
 // A fit (`brdf fit`, engine-model parameters) is carried as a fallback material when the
 // metadata has one: TextureMetadata::fitted_models_json entries go into every manifest's
