@@ -113,8 +113,7 @@ TEST_F(EngineExport, WritesEveryEngineFolderWithTheContainersAsBytes) {
   EXPECT_EQ(Read(dir_ / "web/felt.ktx2"), ktx2);
   EXPECT_EQ(Read(dir_ / "godot/felt.dds"), Read(dir_ / "felt.dds"));
   // The paths a failed conversion must remove are the per-material ones.
-  const auto paths = engines::EngineOutputPaths(dir_.string(), "felt", lut.theta_in_deg,
-                                                ParseEngines("all"));
+  const auto paths = engines::EngineOutputPaths(dir_.string(), "felt", ParseEngines("all"));
   EXPECT_EQ(paths.size(), 11u);
   for (const std::string& p : paths) EXPECT_TRUE(fs::is_regular_file(p)) << p;
 }

@@ -45,7 +45,7 @@ int RunAtlas(const AtlasOptions& options) {
     const fs::path prefix(options.out);
     for (std::string& p : engines::EngineOutputPaths(
              prefix.has_parent_path() ? prefix.parent_path().string() : std::string("."),
-             prefix.filename().string(), {}, engine_set))
+             prefix.filename().string(), engine_set))
       outputs.push_back(std::move(p));
   }
   {

@@ -144,8 +144,7 @@ int RunConvert(const ConvertOptions& options) {
         metadata.source = in.path;
         metadata.extrapolation = built.extrapolation;
         std::vector<std::string> outputs = OutputPaths(out_dir, in.name, export_options.formats);
-        for (std::string& p : engines::EngineOutputPaths(out_dir.string(), in.name,
-                                                         built.lut.theta_in_deg, engine_set))
+        for (std::string& p : engines::EngineOutputPaths(out_dir.string(), in.name, engine_set))
           outputs.push_back(std::move(p));
         const OutputGuard guard(std::move(outputs));
         try {

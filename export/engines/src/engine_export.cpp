@@ -523,7 +523,6 @@ std::string EncodeRgba16fDds(const exporter::PackedVolume& volume) {
 }
 
 std::vector<std::string> EngineOutputPaths(const std::string& out_dir, const std::string& name,
-                                           const std::vector<double>& /*theta_in_deg*/,
                                            const EngineSet& engines) {
   std::vector<std::string> paths;
   const fs::path base(out_dir);

@@ -79,7 +79,6 @@ EngineExportResult ExportLutWithEngines(const std::string& out_dir, const Lut& l
 
 // The files the engine folders would receive for `name` (for collision checks and cleanup).
 std::vector<std::string> EngineOutputPaths(const std::string& out_dir, const std::string& name,
-                                           const std::vector<double>& theta_in_deg,
                                            const EngineSet& engines);
 
 // The one call `brdf atlas` makes: exporter::WriteAtlas(prefix, ...), then the engine folders
