@@ -10,7 +10,8 @@
 //   pairs_hlsl.txt  the same through the shipped Unity HLSL cross-compiled to GLSL ES
 //                   (--hlsl-glsl, made by glslangValidator -D and spirv-cross)
 //   screenshot.png  the viewer as a person sees it (sRGB canvas), light moved once
-//   bench.json      with --bench: median frame time of a 1024² canvas
+//   bench.json      with --bench: frame times of a 1024² canvas, the measured material and
+//                   three's MeshStandardMaterial (the baseline) alternating
 // Usage: node render_web.mjs --web DIR --material NAME --out DIR [--size N] [--pairs FILE]
 //        [--hlsl-glsl FILE] [--cell NAME (an atlas material)] [--bench] [--chromium PATH]
 import { spawn } from 'node:child_process';
@@ -289,15 +290,28 @@ try {
 
   if (args.bench) {
     const bench = await openPage(`${base}/web/index.html?material=${encodeURIComponent(material)}&three=/three/&size=1024`);
+    // The measured material and, as the baseline in the same run, three's own
+    // MeshStandardMaterial under one DirectionalLight on the same sphere, alternating.
     const result = await bench.eval(`(() => {
-      const M = window.measuredBrdf, gl = M.renderer.getContext(), px = new Uint8Array(4);
-      const frame = () => { M.renderer.render(M.scene, M.camera); gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, px); };
-      for (let i = 0; i < 3; i++) frame();
-      const times = [];
-      for (let i = 0; i < 15; i++) { const t0 = performance.now(); frame(); times.push(performance.now() - t0); }
-      times.sort((a, b) => a - b);
-      return { canvas: [gl.drawingBufferWidth, gl.drawingBufferHeight], frames: times.length,
-               median_ms: times[times.length >> 1], min_ms: times[0], max_ms: times[times.length - 1] };
+      const M = window.measuredBrdf, THREE = M.THREE, gl = M.renderer.getContext(), px = new Uint8Array(4);
+      const standard = new THREE.MeshStandardMaterial({ color: 0x8090a0, roughness: 0.35, metalness: 0 });
+      const sun = new THREE.DirectionalLight(0xffffff, 3);
+      sun.position.copy(M.light);
+      const frame = (material) => {
+        M.sphere.material = material;
+        if (material === standard) M.scene.add(sun); else M.scene.remove(sun);
+        const t0 = performance.now();
+        M.renderer.render(M.scene, M.camera);
+        gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, px);
+        return performance.now() - t0;
+      };
+      for (let i = 0; i < 3; i++) { frame(M.shader); frame(standard); }
+      const measured = [], baseline = [];
+      for (let i = 0; i < 21; i++) { measured.push(frame(M.shader)); baseline.push(frame(standard)); }
+      M.sphere.material = M.shader; M.scene.remove(sun);
+      const stats = (t) => { t.sort((a, b) => a - b); return { median_ms: t[t.length >> 1], min_ms: t[0], max_ms: t[t.length - 1] }; };
+      return { canvas: [gl.drawingBufferWidth, gl.drawingBufferHeight], frames: measured.length,
+               measured_brdf: stats(measured), mesh_standard_material: stats(baseline) };
     })()`);
     writeFileSync(join(outDir, 'bench.json'), JSON.stringify(result, null, 2));
   }
