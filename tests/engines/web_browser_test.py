@@ -102,7 +102,7 @@ def main():
     a = subprocess.run([sys.executable, check, "check", "--material", lam, "--result",
                         atlas_result, "--ktx2", os.path.join(atlas_web, "set.ktx2"), "--manifest",
                         os.path.join(atlas_web, "set.manifest.json")], capture_output=True, text=True)
-    print("atlas cell lambert_orange: " + (a.stdout + a.stderr).replace("\n", "\natlas: "), end="\n")
+    print("atlas cell lambert_orange: " + (a.stdout + a.stderr).strip().replace("\n", "\natlas: "))
     if a.returncode != 0:
         r = a
     if r.returncode == 0:

@@ -271,6 +271,14 @@ try {
     const format = (out) => Array.from({ length: count }, (_, i) =>
       `${out[i * 4]} ${out[i * 4 + 1]} ${out[i * 4 + 2]}`).join('\n') + '\n';
     writeFileSync(join(outDir, 'pairs_glsl.txt'), format(await runPairs('@MEASURED_BRDF_GLSL@' + glslMain, 'lut', 'pairs')));
+    // The tangent-space entry point, with l and v expressed in an arbitrary tangent basis of n
+    // (not the light's): MeasuredBrdfTangent must find the light's frame itself.
+    const tangentMain = glslMain.replace('fragColor = vec4(MeasuredBrdfCell(lut, vec2(0.0), n, l, v), 1.0);', `
+        vec3 t = normalize(abs(n.z) < 0.9 ? cross(n, vec3(0.0, 0.0, 1.0)) : cross(n, vec3(1.0, 0.0, 0.0)));
+        vec3 b = cross(n, t);
+        vec3 l_ts = vec3(dot(l, t), dot(l, b), dot(l, n)), v_ts = vec3(dot(v, t), dot(v, b), dot(v, n));
+        fragColor = vec4(MeasuredBrdfTangent(lut, vec2(0.0), l_ts, v_ts), 1.0);`);
+    writeFileSync(join(outDir, 'pairs_tangent.txt'), format(await runPairs('@MEASURED_BRDF_GLSL@' + tangentMain, 'lut', 'pairs')));
     if (args['hlsl-glsl']) {
       // spirv-cross output: drop its #version line (three writes its own); find the combined
       // sampler names it made for lut/lut_sampler and for the pairs texture.

@@ -12,8 +12,9 @@ under test. Run with Debian's /usr/bin/python3 (numpy).
           precision and the capture-to-LUT resampling of a 1° capture.
   probes  Every manifest probe equals the RGB9E5 word of the KTX2 file at that index, decoded
           here from EXT_texture_shared_exponent, and what the GPU's texelFetch returned.
-  pairs   MeasuredBrdfCell on the GPU (GLSL, and the HLSL cross-compiled) against `brdf eval`
-          of the same LUT for the same direction pairs.
+  pairs   MeasuredBrdfCell on the GPU (GLSL, and the HLSL cross-compiled) and
+          MeasuredBrdfTangent (GLSL, an arbitrary tangent basis) against `brdf eval` of the
+          same LUT for the same direction pairs.
 
 Usage: web_render_check.py gen-pairs COUNT SEED ANGLES_OUT NLV_OUT
        web_render_check.py check --material M.json --result DIR --ktx2 F.ktx2
@@ -255,7 +256,7 @@ def check(argv):
     # Direction pairs.
     if "eval" in opts:
         cpu = np.loadtxt(opts["eval"], ndmin=2)
-        for lang in ["glsl"] + (["hlsl"] if "hlsl" in opts else []):
+        for lang in ["glsl", "tangent"] + (["hlsl"] if "hlsl" in opts else []):
             gpu = np.loadtxt(f"{res}/pairs_{lang}.txt", ndmin=2)
             if gpu.shape != cpu.shape:
                 print(f"FAIL pairs {lang}: {gpu.shape} values, brdf eval gave {cpu.shape}")
