@@ -20,7 +20,8 @@ packages=(
   clang libclang-rt-14-dev
   python3 python3-numpy python3-scipy
   nodejs
-  glslang-tools
+  # Engine hand-off tests (tests/engines): real clients for the shipped files.
+  chromium glslang-tools spirv-cross mono-mcs python3-openimageio
 )
 
 # Debian's npm is a separate package; a Node.js that already ships npm (e.g. NodeSource's)

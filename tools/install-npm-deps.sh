@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Installs the npm packages the tests use (ktx-parse, an independent KTX2 parser) into
+# Installs the npm packages the tests use (ktx-parse, an independent KTX2 parser; three, the
+# three.js the web hand-off is rendered with in Chromium; ws, the DevTools protocol client) into
 # tests/node/node_modules from the npm registry, exactly as tests/node/package-lock.json pins
 # them. Idempotent: when the pinned versions are already installed it does nothing.
 set -euo pipefail
@@ -18,8 +19,12 @@ wanted_version() {
   node -e "console.log(require('$dir/package-lock.json').packages['node_modules/$1'].version)"
 }
 
-if [ "$(installed_version ktx-parse)" = "$(wanted_version ktx-parse)" ]; then
-  echo "install-npm-deps: ktx-parse $(wanted_version ktx-parse) already installed"
+all_installed=1
+for package in ktx-parse three ws; do
+  if [ "$(installed_version "$package")" != "$(wanted_version "$package")" ]; then all_installed=0; fi
+done
+if [ "$all_installed" = 1 ]; then
+  echo "install-npm-deps: ktx-parse, three and ws already installed as pinned"
   exit 0
 fi
 echo "install-npm-deps: installing tests/node dependencies from package-lock.json"

@@ -32,22 +32,19 @@ std::string FourCcText(std::uint32_t v) {
 
 }  // namespace
 
-std::string EncodeDds(const PackedVolume& volume) {
-  if (volume.width < 1 || volume.height < 1 || volume.depth < 1 ||
-      volume.words.size() != static_cast<std::size_t>(volume.width) * volume.height * volume.depth)
-    throw InvalidArgument(fmt::format("DDS: inconsistent volume {} × {} × {} with {} texels",
-                                      volume.width, volume.height, volume.depth,
-                                      volume.words.size()));
+std::string DdsVolumeHeader(int width, int height, int depth, std::uint32_t dxgi_format,
+                            int bytes_per_texel) {
   std::string out;
-  out.reserve(kDdsDataOffset + volume.ByteSize());
+  out.reserve(kDdsDataOffset);
   AppendU32(out, kMagic);
   AppendU32(out, 124);  // dwSize
   AppendU32(out, kDdsdCaps | kDdsdHeight | kDdsdWidth | kDdsdPitch | kDdsdPixelFormat |
                      kDdsdMipMapCount | kDdsdDepth);
-  AppendU32(out, static_cast<std::uint32_t>(volume.height));
-  AppendU32(out, static_cast<std::uint32_t>(volume.width));
-  AppendU32(out, static_cast<std::uint32_t>(volume.width) * 4);  // row pitch in bytes
-  AppendU32(out, static_cast<std::uint32_t>(volume.depth));
+  AppendU32(out, static_cast<std::uint32_t>(height));
+  AppendU32(out, static_cast<std::uint32_t>(width));
+  AppendU32(out, static_cast<std::uint32_t>(width) *
+                     static_cast<std::uint32_t>(bytes_per_texel));  // row pitch in bytes
+  AppendU32(out, static_cast<std::uint32_t>(depth));
   AppendU32(out, 1);                               // dwMipMapCount
   for (int i = 0; i < 11; ++i) AppendU32(out, 0);  // dwReserved1
   AppendU32(out, 32);                              // DDS_PIXELFORMAT.dwSize
@@ -59,11 +56,22 @@ std::string EncodeDds(const PackedVolume& volume) {
   AppendU32(out, 0);  // dwCaps3
   AppendU32(out, 0);  // dwCaps4
   AppendU32(out, 0);  // dwReserved2
-  AppendU32(out, kDxgiFormatR9g9b9e5Sharedexp);
+  AppendU32(out, dxgi_format);
   AppendU32(out, kResourceDimensionTexture3d);
   AppendU32(out, 0);  // miscFlag
   AppendU32(out, 1);  // arraySize: 1 for a 3D texture
   AppendU32(out, 0);  // miscFlags2: DDS_ALPHA_MODE_UNKNOWN
+  return out;
+}
+
+std::string EncodeDds(const PackedVolume& volume) {
+  if (volume.width < 1 || volume.height < 1 || volume.depth < 1 ||
+      volume.words.size() != static_cast<std::size_t>(volume.width) * volume.height * volume.depth)
+    throw InvalidArgument(fmt::format("DDS: inconsistent volume {} × {} × {} with {} texels",
+                                      volume.width, volume.height, volume.depth,
+                                      volume.words.size()));
+  std::string out = DdsVolumeHeader(volume.width, volume.height, volume.depth,
+                                    kDxgiFormatR9g9b9e5Sharedexp, 4);
   out += volume.Bytes();
   return out;
 }

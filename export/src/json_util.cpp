@@ -29,10 +29,9 @@ ordered_json GridJson(const PackedVolume& payload, const std::vector<double>& th
 }
 
 ordered_json TexelConventionJson(const std::vector<double>& theta_in_deg) {
-  const double delta = theta_in_deg.size() >= 2 ? theta_in_deg[1] - theta_in_deg[0] : 0.0;
   return ordered_json{{"centre_exact", TexelCentreFormula()},
                       {"published", PublishedFormula()},
-                      {"glsl", ShaderSnippetGlsl(delta, static_cast<int>(theta_in_deg.size()))}};
+                      {"glsl", ShaderSnippetGlsl(theta_in_deg)}};
 }
 
 std::string Hex32(std::uint32_t v) { return fmt::format("0x{:08x}", v); }

@@ -39,12 +39,16 @@ LutExportFormats ParseExportFormats(std::string_view list) {
 
 LutExportResult ExportLut(const std::string& out_dir, const Lut& lut, TextureMetadata metadata,
                           const LutExportOptions& options) {
+  return ExportLut(out_dir, lut, PackLut(lut), std::move(metadata), options);
+}
+
+LutExportResult ExportLut(const std::string& out_dir, const Lut& lut, const PackedVolume& packed,
+                          TextureMetadata metadata, const LutExportOptions& options) {
   const std::string& name = metadata.name;
   if (name.empty() || name == "." || name == ".." ||
       name.find_first_of("/\\") != std::string::npos || name.find('\0') != std::string::npos)
     throw InvalidArgument("LUT export: the output name must be a plain file name, got '" + name +
                           "'");
-  const PackedVolume packed = PackLut(lut);
   const LutExportFormats& f = options.formats;
   metadata.companion_files.clear();
   if (f.ktx2) metadata.companion_files.push_back(name + ".ktx2");

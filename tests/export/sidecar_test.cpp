@@ -49,11 +49,13 @@ TEST(Sidecar, HoldsEveryFieldDesignSection7Names) {
   EXPECT_NE(published.find("u = phi_d/(2 pi)"), std::string::npos) << published;
   EXPECT_NE(published.find("v = theta_d/pi"), std::string::npos) << published;
   const std::string glsl = j["texel_convention"]["glsl"];
-  EXPECT_NE(glsl.find("(phi_d + 0.5) / 361.0"), std::string::npos) << glsl;
-  EXPECT_NE(glsl.find("(theta_d + 0.5) / 181.0"), std::string::npos) << glsl;
-  EXPECT_NE(glsl.find("(theta_in_deg / 20.0 + 0.5) / 4.0"), std::string::npos) << glsl;
-  EXPECT_NE(glsl.find("theta_in_deg / 60.0)"), std::string::npos)
-      << glsl;  // published: θin/θin,max
+  // The generated lookup (compiled by glslangValidator in tests/engines/shader_compile_test).
+  EXPECT_NE(glsl.find("MEASURED_BRDF_DELTA_IN_DEG = 20.0;"), std::string::npos) << glsl;
+  EXPECT_NE(glsl.find("MEASURED_BRDF_SLICES = 4.0;"), std::string::npos) << glsl;
+  EXPECT_NE(glsl.find("MEASURED_BRDF_TEXELS_U = 361.0;"), std::string::npos) << glsl;
+  EXPECT_NE(glsl.find("precision highp sampler3D;"), std::string::npos) << glsl;
+  EXPECT_NE(glsl.find("phi_d/360, theta_d/180"), std::string::npos)
+      << glsl;  // the published form is quoted
   EXPECT_EQ(j["extrapolation"]["p"], 0.2);
   EXPECT_EQ(j["extrapolation"]["l"], 0.3);
   EXPECT_EQ(j["extrapolation"]["theta_b_deg"], 75.0);

@@ -14,6 +14,7 @@
 #include "batch.h"
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
+#include "brdf/engines/engine_export.h"
 #include "brdf/exporter/atlas.h"
 #include "brdf/exporter/packed_volume.h"
 #include "brdf/sources/open.h"
@@ -34,6 +35,7 @@ int RunAtlas(const AtlasOptions& options) {
     extrapolate = processing::ParseExtrapolation(options.extrapolate);
   const exporter::ExrOptions exr_options =
       ParseExrOptions(options.exr_type, options.exr_compression);
+  const engines::EngineSet engine_set = engines::ParseEngines(options.engines);
   if (options.jobs < 1)
     throw InvalidArgument("--jobs: expected at least 1, got " + std::to_string(options.jobs));
 
@@ -41,8 +43,15 @@ int RunAtlas(const AtlasOptions& options) {
   if (found.inputs.empty() && found.failures.empty())
     throw InvalidArgument("no captures, material files or exported LUTs found in the inputs");
 
-  const std::vector<std::string> outputs = {options.out + ".ktx2", options.out + ".dds",
-                                            options.out + ".exr", options.out + ".json"};
+  std::vector<std::string> outputs = {options.out + ".ktx2", options.out + ".dds",
+                                      options.out + ".exr", options.out + ".json"};
+  {
+    const fs::path prefix(options.out);
+    for (std::string& p : engines::EngineOutputPaths(
+             prefix.has_parent_path() ? prefix.parent_path().string() : std::string("."),
+             prefix.filename().string(), engine_set))
+      outputs.push_back(std::move(p));
+  }
   {
     std::set<std::string> inputs;
     std::error_code ec;
@@ -112,7 +121,7 @@ int RunAtlas(const AtlasOptions& options) {
   std::vector<std::string> written;
   try {
     // BuildAtlas inside WriteAtlas refuses different θin sets, naming both materials.
-    written = exporter::WriteAtlas(options.out, materials, exr_options);
+    written = engines::WriteAtlasWithEngines(options.out, materials, exr_options, engine_set);
   } catch (...) {
     guard.RemoveNew();
     throw;

@@ -16,6 +16,7 @@
 #include "fit_support.h"
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
+#include "brdf/engines/engine_export.h"
 #include "brdf/exporter/lut_export.h"
 #include "brdf/sources/open.h"
 #include "cli_support.h"
@@ -95,6 +96,7 @@ int RunConvert(const ConvertOptions& options) {
   exporter::LutExportOptions export_options;
   export_options.formats = exporter::ParseExportFormats(options.formats);
   export_options.exr = ParseExrOptions(options.exr_type, options.exr_compression);
+  const engines::EngineSet engine_set = engines::ParseEngines(options.engines);
   std::optional<processing::ExtrapolationParams> extrapolate;
   const bool auto_extrapolate = options.extrapolate == "auto";  // fitted per input (brdf fit)
   if (!options.extrapolate.empty() && !auto_extrapolate)
@@ -158,9 +160,13 @@ int RunConvert(const ConvertOptions& options) {
         metadata.name = in.name;
         metadata.source = in.path;
         metadata.extrapolation = built.extrapolation;
-        const OutputGuard guard(OutputPaths(out_dir, in.name, export_options.formats));
+        std::vector<std::string> outputs = OutputPaths(out_dir, in.name, export_options.formats);
+        for (std::string& p : engines::EngineOutputPaths(out_dir.string(), in.name, engine_set))
+          outputs.push_back(std::move(p));
+        const OutputGuard guard(std::move(outputs));
         try {
-          exporter::ExportLut(out_dir.string(), built.lut, metadata, export_options);
+          engines::ExportLutWithEngines(out_dir.string(), built.lut, metadata, export_options,
+                                        engine_set);
         } catch (...) {
           // No partial set: remove what this conversion already renamed into place (the
           // writer that failed removed its own temporary file).

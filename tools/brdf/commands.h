@@ -49,6 +49,9 @@ struct ConvertOptions {
   int jobs = DefaultJobs();
   bool quiet = false;  // no progress bar
   bool force = false;  // overwrite existing outputs (brdf::CheckWritableOutputs)
+  // Engine hand-off folders OUT/<engine>/: "unity,unreal,godot,web" (any subset) or "all";
+  // empty: none (brdf/engines/engine_export.h).
+  std::string engines;
 };
 int RunConvert(const ConvertOptions& options);
 
@@ -61,6 +64,7 @@ struct AtlasOptions {
   int jobs = DefaultJobs();
   bool quiet = false;
   bool force = false;  // overwrite existing PREFIX.* files
+  std::string engines;  // as ConvertOptions::engines; folders beside the prefix
 };
 int RunAtlas(const AtlasOptions& options);
 

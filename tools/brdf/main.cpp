@@ -280,6 +280,10 @@ int main(int argc, char** argv) {
   convert_cmd->add_flag("--force", convert.force,
                         "Overwrite outputs that already exist in --out (without it nothing is "
                         "converted when any output exists)");
+  convert_cmd->add_option(
+      "--engine", convert.engines,
+      "Also write engine hand-off folders DIR/<engine>/ (importer, shader code, manifest, "
+      "texture in the engine's format): unity, unreal, godot, web (comma separated) or all");
   convert_cmd->footer(
       "Material files are first captured noise-free on the reference geometry (theta_in 0, 20, "
       "40, 60; theta_out 0-75; phi_out 0-359; 1 degree steps), then resampled like a capture.\n"
@@ -325,6 +329,9 @@ int main(int argc, char** argv) {
   atlas_cmd->add_flag("--quiet", atlas.quiet, "No progress bar");
   atlas_cmd->add_flag("--force", atlas.force,
                       "Overwrite PREFIX.ktx2, .dds, .exr, .json if any already exists");
+  atlas_cmd->add_option("--engine", atlas.engines,
+                        "Also write engine hand-off folders beside the prefix: unity, unreal, "
+                        "godot, web (comma separated) or all");
   atlas_cmd->footer(
       "Materials are placed in input order (folders sorted by file name). All must share one "
       "theta_in list; materials with different sets are refused by name. Nothing is written "

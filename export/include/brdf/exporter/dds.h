@@ -29,6 +29,12 @@ namespace brdf::exporter {
 inline constexpr std::uint32_t kDxgiFormatR9g9b9e5Sharedexp = 67;
 inline constexpr std::size_t kDdsDataOffset = 4 + 124 + 20;
 
+// The 148-byte header above for any single-mip 3D texture: `dxgi_format` and the row pitch
+// width · bytes_per_texel vary (e.g. DXGI_FORMAT_R16G16B16A16_FLOAT = 10, 8 bytes per texel,
+// for engines whose DDS importers do not take format 67). The caller appends the texels.
+std::string DdsVolumeHeader(int width, int height, int depth, std::uint32_t dxgi_format,
+                            int bytes_per_texel);
+
 // The whole file in memory. Throws InvalidArgument for an inconsistent volume.
 std::string EncodeDds(const PackedVolume& volume);
 

@@ -14,6 +14,7 @@
 #include "brdf/core/lut.h"
 #include "brdf/exporter/exr.h"
 #include "brdf/exporter/metadata.h"
+#include "brdf/exporter/packed_volume.h"
 
 namespace brdf::exporter {
 
@@ -41,5 +42,8 @@ struct LutExportResult {
 // Throws InvalidArgument (bad name, unexportable LUT) or IoError.
 LutExportResult ExportLut(const std::string& out_dir, const Lut& lut, TextureMetadata metadata,
                           const LutExportOptions& options = {});
+// The same with the LUT already packed (PackLut(lut)), for callers that need the words too.
+LutExportResult ExportLut(const std::string& out_dir, const Lut& lut, const PackedVolume& packed,
+                          TextureMetadata metadata, const LutExportOptions& options = {});
 
 }  // namespace brdf::exporter

@@ -1,0 +1,103 @@
+// Per-engine hand-off folders: the files a technical artist drops into Unity, Unreal Engine 5,
+// Godot 4 or a three.js page so the measured material imports and renders with no manual
+// steps beyond dropping them in (`brdf convert --engine ...`, `brdf atlas --engine ...`).
+//
+// Every engine folder sits beside the regular outputs (OUT/unity/, OUT/unreal/, OUT/godot/,
+// OUT/web/) and holds, for a material NAME:
+//   unity/   NAME.brdf3d          the KTX2 bytes under an extension no other importer claims
+//            Editor/MeasuredBrdfImporter.cs   ScriptedImporter → Texture3D
+//                                 (GraphicsFormat.E5B9G9R9_UFloatPack32, RGBAHalf fallback,
+//                                 linear, clamp, no mips); also offered for .ktx2 files
+//            MeasuredBrdf*.hlsl   Shader Graph Custom Function MeasuredBrdf_float (URP/HDRP)
+//                                 and the built-in pipeline lighting model MeasuredBrdf
+//   unreal/  NAME.dds             RGBA16F volume DDS (DXGI 10, one mip, depth K)
+//            NAME_tiles.exr       the K slices as 361 × 181 tiles (the composite EXR, for
+//                                 the Volume Texture from a 2D texture route)
+//            MeasuredBrdf*.ush    include for a Custom material node
+//            import_measured_brdf.py  editor script: imports the DDS (or builds the Volume
+//                                 Texture from the tiles), sRGB off, TC_HDR, clamp, no mips
+//   godot/   NAME.dds             the RGB9E5 3D DDS with one mip (byte-identical to OUT/NAME.dds)
+//            NAME_slices.exr (+ .import)  the sliced-EXR route with its import settings
+//            measured_brdf*.gdshader  spatial shader with a light() function
+//   web/     NAME.ktx2, measured_brdf*.js (ES module: KTX2Loader, ShaderMaterial),
+//            index.html (viewer: ?material=NAME), package.json (three ≥ r180),
+//            MeasuredBrdf*.es300.glsl and MeasuredBrdf*.450.glsl (the lookup as GLSL files)
+//   each     NAME.manifest.json   axes and ranges, texel-centre mapping, units, colour space,
+//                                 probe texels (index → RGB f_r), and under "engines" each
+//                                 folder's files, texture format, orientation per import
+//                                 path and import settings (one text, hard-linked into every
+//                                 engine folder of the conversion)
+// Shader files carry the LUT layout in their constants; they are named MeasuredBrdf.* for the
+// reference layout (θin 0, 20, 40, 60, one material) and MeasuredBrdf_<tag>.* otherwise, so
+// materials of one layout share one file and different layouts never overwrite each other.
+// Shared files written by several conversions of one batch have identical bytes and are
+// written only when missing or different. The engine copies of OUT/NAME.ktx2, .dds and .exr are
+// hard links to them when they were written (else written in full: the EXR then in half).
+//
+// A fit (`brdf fit`, engine-model parameters) is carried as a fallback material when the
+// metadata has one: TextureMetadata::fitted_models_json entries go into every manifest's
+// "fallback_material" member verbatim (see FallbackMaterialJson in engine_export.cpp).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "brdf/core/lut.h"
+#include "brdf/exporter/atlas.h"
+#include "brdf/exporter/lut_export.h"
+#include "brdf/exporter/metadata.h"
+#include "brdf/exporter/packed_volume.h"
+
+namespace brdf::engines {
+
+struct EngineSet {
+  bool unity = false, unreal = false, godot = false, web = false;
+  bool Any() const { return unity || unreal || godot || web; }
+};
+// "unity", "unreal", "godot", "web", comma separated, or "all"; "" or "none" selects nothing.
+// Throws InvalidArgument naming an unknown entry and the known ones.
+EngineSet ParseEngines(std::string_view list);
+
+// The folder names of the selected engines, in the order unity, unreal, godot, web.
+std::vector<std::string> EngineFolderNames(const EngineSet& engines);
+
+// What one conversion wrote.
+struct EngineExportResult {
+  exporter::LutExportResult lut;     // the regular outputs (ExportLut)
+  std::vector<std::string> written;  // engine files, in engine order
+};
+
+// The one call `brdf convert` makes per input: exporter::ExportLut into OUT_DIR, then the
+// engine folders OUT_DIR/<engine>/ for the selected engines (created when missing). Every file
+// is written atomically. Throws InvalidArgument / IoError.
+EngineExportResult ExportLutWithEngines(const std::string& out_dir, const Lut& lut,
+                                        exporter::TextureMetadata metadata,
+                                        const exporter::LutExportOptions& options,
+                                        const EngineSet& engines);
+
+// The files the engine folders would receive for `name` (for collision checks and cleanup).
+std::vector<std::string> EngineOutputPaths(const std::string& out_dir, const std::string& name,
+                                           const EngineSet& engines);
+
+// The one call `brdf atlas` makes: exporter::WriteAtlas(prefix, ...), then the engine folders
+// beside the prefix (<dir of prefix>/<engine>/<stem of prefix>.*), with shaders addressing
+// cells (MeasuredBrdfCell with the cell origin the manifest lists per material).
+// Returns every path written. Throws InvalidArgument / IoError.
+std::vector<std::string> WriteAtlasWithEngines(const std::string& prefix,
+                                               const std::vector<exporter::AtlasMaterial>& materials,
+                                               const exporter::ExrOptions& exr_options,
+                                               const EngineSet& engines);
+
+// The RGBA16F payload of the Unreal DDS: every RGB9E5 word decoded and converted to IEEE
+// half (exact: a decoded RGB9E5 value has at most 9 significant bits and is ≤ 65408, both
+// within half's range and precision), alpha = 1.0; 8 bytes per texel, little-endian, texels
+// in PackedVolume order.
+std::string Rgba16fBytes(const exporter::PackedVolume& volume);
+// The whole RGBA16F volume DDS (exporter::DdsVolumeHeader with DXGI format 10).
+std::string EncodeRgba16fDds(const exporter::PackedVolume& volume);
+// IEEE 754 binary16 from a float, round to nearest even (overflow → +inf, NaN kept).
+std::uint16_t FloatToHalf(float value);
+
+}  // namespace brdf::engines

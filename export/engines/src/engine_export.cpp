@@ -1,0 +1,610 @@
+#include "brdf/engines/engine_export.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <functional>
+#include <string>
+
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+#include <unistd.h>
+
+#include "brdf/core/error.h"
+#include "brdf/core/file_util.h"
+#include "brdf/exporter/dds.h"
+#include "brdf/exporter/exr.h"
+#include "brdf/exporter/ktx2.h"
+#include "brdf/exporter/rgb9e5.h"
+#include "brdf/exporter/shader_code.h"
+#include "brdf/exporter/sidecar.h"
+#include "engine_files.h"
+
+namespace brdf::engines {
+
+namespace fs = std::filesystem;
+using ordered_json = nlohmann::ordered_json;
+using detail::Handoff;
+using detail::HandoffCell;
+
+namespace {
+
+constexpr std::uint32_t kDxgiFormatR16g16b16a16Float = 10;
+
+enum class Engine { kUnity, kUnreal, kGodot, kWeb };
+
+const char* FolderOf(Engine e) {
+  switch (e) {
+    case Engine::kUnity: return "unity";
+    case Engine::kUnreal: return "unreal";
+    case Engine::kGodot: return "godot";
+    case Engine::kWeb: return "web";
+  }
+  return "";
+}
+
+std::vector<Engine> Selected(const EngineSet& s) {
+  std::vector<Engine> out;
+  if (s.unity) out.push_back(Engine::kUnity);
+  if (s.unreal) out.push_back(Engine::kUnreal);
+  if (s.godot) out.push_back(Engine::kGodot);
+  if (s.web) out.push_back(Engine::kWeb);
+  return out;
+}
+
+std::string NumberTag(double v) {
+  std::string s = fmt::format("{:g}", v);
+  std::replace(s.begin(), s.end(), '.', 'p');
+  std::replace(s.begin(), s.end(), '-', 'm');
+  return s;
+}
+
+// The per-material file names of one engine folder (shared files excluded).
+struct MaterialFiles {
+  std::string texture, manifest, tiles, tiles_import;
+};
+
+MaterialFiles FilesOf(Engine e, const std::string& name) {
+  MaterialFiles f;
+  f.manifest = name + ".manifest.json";
+  switch (e) {
+    case Engine::kUnity: f.texture = name + ".brdf3d"; break;
+    case Engine::kUnreal:
+      f.texture = name + ".dds";
+      f.tiles = name + "_tiles.exr";
+      break;
+    case Engine::kGodot:
+      f.texture = name + ".dds";
+      f.tiles = name + "_slices.exr";
+      f.tiles_import = name + "_slices.exr.import";
+      break;
+    case Engine::kWeb:
+      f.texture = name + ".ktx2";
+      break;
+  }
+  return f;
+}
+
+std::string ShaderFile(Engine e, const exporter::ShaderLutLayout& layout) {
+  const std::string stem = detail::ShaderStem(layout);
+  switch (e) {
+    case Engine::kUnity: return stem + ".hlsl";
+    case Engine::kUnreal: return stem + ".ush";
+    case Engine::kGodot: {
+      // Godot resource names are conventionally snake_case.
+      std::string s = "measured_brdf" + stem.substr(std::string("MeasuredBrdf").size());
+      return s + ".gdshader";
+    }
+    case Engine::kWeb: {
+      std::string s = "measured_brdf" + stem.substr(std::string("MeasuredBrdf").size());
+      return s + ".js";
+    }
+  }
+  return stem;
+}
+
+ordered_json AxesJson(const Handoff& h) {
+  const double last = h.layout.theta_in0_deg + h.layout.delta_in_deg * (h.layout.slices - 1);
+  return ordered_json{
+      {"u", {{"meaning", "phi_d: azimuth in the specular frame of theta_in (degrees)"},
+             {"range_deg", {0, 360}},
+             {"texels_per_cell", 361},
+             {"texel_centre_deg", "i * 1 deg, i = 0..360 (column 360 repeats column 0)"}}},
+      {"v", {{"meaning", "theta_d: polar angle from the mirror direction (degrees)"},
+             {"range_deg", {0, 180}},
+             {"texels_per_cell", 181},
+             {"texel_centre_deg", "j * 1 deg, j = 0..180 (row 0 = the mirror direction)"}}},
+      {"w", {{"meaning", "theta_in: incidence angle of the light (degrees)"},
+             {"range_deg", {h.layout.theta_in0_deg, last}},
+             {"texels", h.layout.slices},
+             {"texel_centre_deg", fmt::format("{:g} + k * {:g} deg, k = 0..{}", h.layout.theta_in0_deg,
+                                              h.layout.delta_in_deg, h.layout.slices - 1)},
+             {"beyond_range", "clamp-to-edge: the first or last slice (constant extension)"}}}};
+}
+
+ordered_json ProbeJson(const Handoff& h) {
+  const exporter::PackedVolume& vol = *h.volume;
+  ordered_json probes = ordered_json::array();
+  const bool few = h.cells.size() > 4;  // big atlases: three probes per cell and slice
+  for (const HandoffCell& cell : h.cells) {
+    for (int k = 0; k < vol.depth; ++k) {
+      std::vector<std::pair<int, int>> ij = {{0, 0}, {180, 90}};
+      if (!few) {
+        ij.push_back({90, 45});
+        ij.push_back({270, 135});
+        ij.push_back({360, 180});
+        ij.push_back({45, 10});
+      }
+      // The brightest texel of the slice (first one on ties): the peak of the lobe.
+      int best_i = 0, best_j = 0;
+      float best = -1;
+      for (int j = 0; j < 181; ++j)
+        for (int i = 0; i < 361; ++i) {
+          const auto c = exporter::DecodeRgb9e5(vol.words[vol.Index(cell.x0 + i, cell.y0 + j, k)]);
+          const float y = 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2];
+          if (y > best) best = y, best_i = i, best_j = j;
+        }
+      ij.push_back({best_i, best_j});
+      for (const auto& [i, j] : ij) {
+        const int x = cell.x0 + i, y = cell.y0 + j;
+        const auto c = exporter::DecodeRgb9e5(vol.words[vol.Index(x, y, k)]);
+        probes.push_back({{"material", cell.name},
+                          {"index", {x, y, k}},
+                          {"phi_d_deg", i},
+                          {"theta_d_deg", j},
+                          {"theta_in_deg", h.layout.theta_in0_deg + k * h.layout.delta_in_deg},
+                          {"uvw", {(x + 0.5) / vol.width, (y + 0.5) / vol.height,
+                                   (k + 0.5) / vol.depth}},
+                          {"rgb", {c[0], c[1], c[2]}}});
+      }
+    }
+  }
+  return probes;
+}
+
+// The hook for `brdf fit`: its engine-model parameters arrive as fitted material JSON objects
+// in TextureMetadata::fitted_models_json (docs/design.md §9 form, with the fit's own "fit"
+// diagnostics). They are carried verbatim so an engine can fall back to an analytic material
+// (e.g. glTF KHR_materials_* values or the Unity/Unreal parameters the fitter adds) with its
+// error; until a fit exists the member is null.
+ordered_json FallbackMaterialJson(const std::vector<std::string>& fitted_models_json) {
+  if (fitted_models_json.empty()) return nullptr;
+  ordered_json models = ordered_json::array();
+  for (const std::string& m : fitted_models_json) models.push_back(ordered_json::parse(m));
+  return ordered_json{{"note", "analytic fits of the same data, for engines or LODs that cannot "
+                               "sample the 3D LUT; see each model's \"fit\" member for its error"},
+                      {"models", std::move(models)}};
+}
+
+// What one engine's folder holds and how it imports (a member of "engines" in the manifest).
+ordered_json EngineSectionJson(Engine e, const Handoff& h) {
+  const exporter::PackedVolume& vol = *h.volume;
+  const MaterialFiles f = FilesOf(e, h.name);
+  ordered_json files = {{"texture", f.texture}, {"shader", ShaderFile(e, h.layout)},
+                        {"manifest", f.manifest}};
+  ordered_json texture;
+  ordered_json orientation, import;
+  std::string versions;
+  const std::string tiles = fmt::format(
+      "{} x {} tiles of {} x {} texels, row-major, top-left first, slice k in tile k",
+      h.composite.columns, h.composite.rows, vol.width, vol.height);
+  switch (e) {
+    case Engine::kUnity:
+      versions = "Unity 2021.3 LTS to Unity 6 (URP, HDRP Shader Graph; built-in pipeline)";
+      files["importer"] = "Editor/MeasuredBrdfImporter.cs";
+      texture["format"] = "GraphicsFormat.E5B9G9R9_UFloatPack32 (fallback R16G16B16A16_SFloat)";
+      orientation["scripted_importer"] =
+          "file texel (x, y, z) = Texture3D texel (x, y, z): rows uploaded in file order, row 0 "
+          "(theta_d = 0) at v = 0, slice 0 at w = 0; no flip";
+      orientation["flipbook_2d"] =
+          "the composite EXR (../" + h.name + ".exr) imported with Texture Shape 3D, Columns " +
+          std::to_string(h.composite.columns) + ", Rows " + std::to_string(h.composite.rows) +
+          ": " + tiles +
+          "; exact tiles, no gutters; Non-Power of 2 None, sRGB off, no mipmaps, clamp, bilinear; "
+          "check slice order against the probe texels";
+      import = {{"flipbook", {{"columns", h.composite.columns}, {"rows", h.composite.rows},
+                              {"npot_scale", "None"}, {"srgb", false}, {"mipmaps", false}}}};
+      break;
+    case Engine::kUnreal:
+      versions = "Unreal Engine 5.1 to 5.5";
+      files["import_script"] = "import_measured_brdf.py";
+      files["tiles"] = f.tiles;
+      texture["format"] = "DDS DXGI_FORMAT_R16G16B16A16_FLOAT (10), volume, one mip; alpha 1";
+      orientation["volume_dds"] =
+          "DDS texel (x, y, z) = Volume Texture texel (x, y, z); row 0 (theta_d = 0) first, at "
+          "v = 0; no flip";
+      orientation["tiles_2d"] = f.tiles + ": " + tiles + " (Source2DTileSizeX/Y)";
+      import = {{"srgb", false},
+                {"compression_settings", "TC_HDR"},
+                {"mip_gen_settings", "TMGS_NoMipmaps"},
+                {"address_mode", "TA_Clamp"},
+                {"filter", "TF_Bilinear"},
+                {"tiles", {{"tile_width", vol.width}, {"tile_height", vol.height},
+                           {"columns", h.composite.columns}, {"rows", h.composite.rows}}}};
+      break;
+    case Engine::kGodot:
+      versions = "Godot 4.2 to 4.5 (RGB9E5 3D DDS: 4.4 and later; sliced EXR: every 4.x)";
+      files["tiles"] = f.tiles;
+      files["tiles_import"] = f.tiles_import;
+      texture["format"] = "DDS DXGI_FORMAT_R9G9B9E5_SHAREDEXP (67), volume, one mip";
+      orientation["rgb9e5_dds"] =
+          "DDS texel (x, y, z) = Texture3D texel (x, y, z); row 0 (theta_d = 0) first, at v = 0; "
+          "no flip";
+      orientation["sliced_exr"] = f.tiles + ": " + tiles + " (slices/horizontal, slices/vertical)";
+      import = {{"slices_horizontal", h.composite.columns}, {"slices_vertical", h.composite.rows},
+                {"compress_mode", "VRAM Uncompressed"}, {"mipmaps", false},
+                {"sampler", "filter_linear, repeat_disable"}};
+      break;
+    case Engine::kWeb:
+      versions = fmt::format("three.js r{} (0.{}.0) or later, WebGL 2",
+                             detail::kMinimumThreeRevision, detail::kMinimumThreeRevision);
+      files["viewer"] = "index.html?material=" + h.name;
+      texture["format"] = "KTX2 vkFormat 123 (VK_FORMAT_E5B9G9R9_UFLOAT_PACK32), uncompressed";
+      orientation["ktx2loader"] =
+          "KTX2 texel (x, y, z) = Data3DTexture texel (x, y, z) (KTXorientation rdi; three.js "
+          "does not flip 3D textures); row 0 (theta_d = 0) at v = 0";
+      import = {{"min_filter", "LinearFilter"}, {"mag_filter", "LinearFilter"},
+                {"wrap", "ClampToEdgeWrapping"}, {"color_space", "NoColorSpace"}};
+      break;
+  }
+  return ordered_json{{"folder", FolderOf(e)},
+                      {"engine_versions", versions},
+                      {"files", files},
+                      {"texture_format", texture["format"]},
+                      {"orientation", orientation},
+                      {"import", import}};
+}
+
+// One manifest per material for every engine folder of the conversion (the same text in each,
+// hard-linked): the common description, then "engines" with one member per selected engine.
+std::string ManifestJson(const Handoff& h, const std::vector<Engine>& engines) {
+  const exporter::PackedVolume& vol = *h.volume;
+  ordered_json cells = ordered_json::array();
+  for (const HandoffCell& c : h.cells)
+    cells.push_back({{"material", c.name}, {"x0", c.x0}, {"y0", c.y0}});
+  ordered_json sections = ordered_json::object();
+  for (Engine e : engines) sections[FolderOf(e)] = EngineSectionJson(e, h);
+  ordered_json j = {
+      {"kind", "brdf-engine-manifest"},
+      {"format_version", 1},
+      {"name", h.name},
+      {"source", h.source},
+      {"atlas", h.atlas},
+      {"texture",
+       {{"width", vol.width},
+        {"height", vol.height},
+        {"depth", vol.depth},
+        {"mip_levels", 1},
+        {"colour_space", "linear Rec.709 RGB; sample without sRGB decode"},
+        {"sampler", "linear (trilinear), clamp-to-edge on u, v and w, no mipmaps"}}},
+      {"theta_in_deg", h.theta_in_deg},
+      {"axes", AxesJson(h)},
+      {"texel_centre_mapping",
+       {{"centre_exact", exporter::TexelCentreFormula()},
+        {"cell", fmt::format("u = (x0 + phi_d/1deg + 0.5)/{}, v = (y0 + theta_d/1deg + 0.5)/{}, "
+                             "clamped to the cell's outer texel centres",
+                             vol.width, vol.height)},
+        {"published", exporter::PublishedFormula()}}},
+      {"units", "f_r in 1/sr, linear Rec.709 RGB, not multiplied by cos(theta); radiance = f_r * "
+                "E * max(n.l, 0) for a directional light of irradiance E at normal incidence"},
+      {"shader_contract",
+       "MeasuredBrdf(n, l, v): unit vectors away from the surface in one frame; tangent frame "
+       "from the light (x = l projected on the tangent plane, phi_in = 0); omega_d = "
+       "S(theta_in) v; theta_d = atan2(|omega_d.xy|, omega_d.z)"},
+      {"cells", cells},
+      {"probe_texels", ProbeJson(h)},
+      {"fallback_material", FallbackMaterialJson(h.fitted_models_json)},
+      {"engines", sections},
+      {"tool", {{"name", "brdf-toolchain"}, {"version", exporter::BrdfToolVersion()}}}};
+  return j.dump(2) + "\n";
+}
+
+// The regular outputs an engine file can be a hard link to (empty when not written), and the
+// data to write instead when it is not there.
+struct Sources {
+  std::string ktx2_path, dds_path, exr_path;  // OUT/NAME.ktx2, .dds, .exr
+  std::function<std::string()> ktx2_bytes;
+  std::function<exporter::FloatImage()> composite;
+};
+
+// Places `path` as a hard link to `source` (same bytes, no second copy to write and flush):
+// linked under a temporary name, then renamed over `path`, so the final name appears whole.
+// The source is already durable; the folder is synced by the next atomic write into it.
+// Returns false when linking is impossible (no source, another file system), so the caller
+// writes the bytes instead.
+bool LinkAtomically(const std::string& source, const std::string& path) {
+  if (source.empty()) return false;
+  AtomicOutputPath out(path);
+  if (::link(source.c_str(), out.temp_path().c_str()) != 0) return false;
+  if (std::rename(out.temp_path().c_str(), path.c_str()) != 0) return false;
+  return true;  // the destructor's unlink of the (renamed) temporary name is a no-op
+}
+
+// Writes a file every material of a layout shares only when it is missing or different, so a
+// batch writes each once.
+bool SameContent(const std::string& path, std::string_view bytes) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec) || fs::file_size(path, ec) != bytes.size()) return false;
+  return ReadFileText(path, bytes.size()) == bytes;
+}
+
+// Writes one engine folder; returns the paths written or linked (shared files included when
+// they had to be written).
+std::vector<std::string> WriteEngineFolder(Engine e, const fs::path& dir, const Handoff& h,
+                                           const Sources& src, std::string& manifest_path,
+                                           const std::string& manifest) {
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (!fs::is_directory(dir))
+    throw IoError(dir.string() + ": cannot create the engine folder" +
+                  (ec ? ": " + ec.message() : std::string()));
+  const MaterialFiles f = FilesOf(e, h.name);
+  const std::string shader = ShaderFile(e, h.layout);
+  std::vector<std::string> written;
+  const auto put = [&](const std::string& file, std::string_view bytes) {
+    const std::string path = (dir / file).string();
+    WriteFileAtomically(path, bytes);
+    written.push_back(path);
+  };
+  const auto shared = [&](const std::string& file, const std::string& bytes) {
+    if (!SameContent((dir / file).string(), bytes)) put(file, bytes);
+  };
+  const auto linked = [&](const std::string& file, const std::string& source,
+                          const std::function<std::string()>& bytes) {
+    const std::string path = (dir / file).string();
+    if (LinkAtomically(source, path))
+      written.push_back(path);
+    else
+      put(file, bytes());
+  };
+  // The tiled/sliced EXR: the regular composite EXR when there is one (same layout), else a
+  // half-float one written here.
+  const auto tiles = [&](const std::string& file) {
+    const std::string path = (dir / file).string();
+    if (LinkAtomically(src.exr_path, path)) {
+      written.push_back(path);
+      return;
+    }
+    exporter::WriteExr(
+        path, src.composite(),
+        exporter::ExrOptions(exporter::ExrPixelType::kHalf, exporter::ExrCompression::kNone),
+        {{"brdf:theta_in_deg", exporter::FormatThetaList(h.theta_in_deg)},
+         {"brdf:layout", fmt::format("{} x {} tiles of {} x {}, row-major, top-left first",
+                                     h.composite.columns, h.composite.rows, h.volume->width,
+                                     h.volume->height)},
+         {"brdf:texel_convention", exporter::TexelCentreFormula()}});
+    written.push_back(path);
+  };
+  switch (e) {
+    case Engine::kUnity:
+      linked(f.texture, src.ktx2_path, src.ktx2_bytes);
+      fs::create_directories(dir / "Editor", ec);
+      shared("Editor/MeasuredBrdfImporter.cs", detail::UnityImporterCs());
+      shared(shader, detail::UnityHlsl(h.layout));
+      break;
+    case Engine::kUnreal:
+      tiles(f.tiles);
+      put(f.texture, EncodeRgba16fDds(*h.volume));
+      shared(shader, detail::UnrealUsh(h.layout));
+      shared("import_measured_brdf.py", detail::UnrealImportPython());
+      break;
+    case Engine::kGodot:
+      linked(f.texture, src.dds_path, [&] { return exporter::EncodeDds(*h.volume); });
+      tiles(f.tiles);
+      put(f.tiles_import, detail::GodotSlicesImport(h, f.tiles));
+      shared(shader, detail::GodotShader(h.layout));
+      break;
+    case Engine::kWeb:
+      linked(f.texture, src.ktx2_path, src.ktx2_bytes);
+      shared(shader, detail::WebModuleJs(h.layout));
+      shared("index.html", detail::WebViewerHtml(shader, ""));
+      shared("package.json", detail::WebPackageJson());
+      // The same lookup as plain GLSL files for other WebGL 2 / OpenGL code.
+      shared(detail::ShaderStem(h.layout) + ".es300.glsl",
+             exporter::MeasuredBrdfGlslFile(exporter::GlslVersion::kEs300, h.layout));
+      shared(detail::ShaderStem(h.layout) + ".450.glsl",
+             exporter::MeasuredBrdfGlslFile(exporter::GlslVersion::k450, h.layout));
+      break;
+  }
+  // The manifest: written into the first folder, hard-linked into the others.
+  if (!LinkAtomically(manifest_path, (dir / f.manifest).string())) put(f.manifest, manifest);
+  else written.push_back((dir / f.manifest).string());
+  if (manifest_path.empty()) manifest_path = (dir / f.manifest).string();
+  return written;
+}
+
+std::vector<std::string> WriteHandoff(const fs::path& base, const Handoff& h, const Sources& src,
+                                      const EngineSet& engines) {
+  std::vector<std::string> written;
+  const std::vector<Engine> selected = Selected(engines);
+  const std::string manifest = ManifestJson(h, selected);
+  std::string manifest_path;
+  for (Engine e : selected) {
+    const auto w = WriteEngineFolder(e, base / FolderOf(e), h, src, manifest_path, manifest);
+    written.insert(written.end(), w.begin(), w.end());
+  }
+  return written;
+}
+
+}  // namespace
+
+namespace detail {
+
+std::string ShaderStem(const exporter::ShaderLutLayout& l) {
+  const bool reference_slices = l.slices == 4 && l.delta_in_deg == 20 && l.theta_in0_deg == 0;
+  const bool single = l.texture_width == 361 && l.texture_height == 181;
+  if (reference_slices && single) return "MeasuredBrdf";
+  std::string s = fmt::format("MeasuredBrdf_{}x{}from{}", l.slices, NumberTag(l.delta_in_deg),
+                              NumberTag(l.theta_in0_deg));
+  if (!single) s += fmt::format("_{}x{}", l.texture_width, l.texture_height);
+  return s;
+}
+
+}  // namespace detail
+
+EngineSet ParseEngines(std::string_view list) {
+  EngineSet s;
+  if (list.empty() || list == "none") return s;
+  std::size_t start = 0;
+  while (start <= list.size()) {
+    const std::size_t comma = std::min(list.find(',', start), list.size());
+    const std::string_view item = list.substr(start, comma - start);
+    if (item == "unity") {
+      s.unity = true;
+    } else if (item == "unreal") {
+      s.unreal = true;
+    } else if (item == "godot") {
+      s.godot = true;
+    } else if (item == "web") {
+      s.web = true;
+    } else if (item == "all") {
+      s = {true, true, true, true};
+    } else {
+      throw InvalidArgument("unknown engine '" + std::string(item) +
+                            "' (known: unity, unreal, godot, web, all)");
+    }
+    start = comma + 1;
+  }
+  return s;
+}
+
+std::vector<std::string> EngineFolderNames(const EngineSet& engines) {
+  std::vector<std::string> out;
+  for (Engine e : Selected(engines)) out.push_back(FolderOf(e));
+  return out;
+}
+
+std::uint16_t FloatToHalf(float value) {
+  const std::uint32_t bits = std::bit_cast<std::uint32_t>(value);
+  const std::uint16_t sign = static_cast<std::uint16_t>((bits >> 16) & 0x8000u);
+  const std::uint32_t abs_bits = bits & 0x7fffffffu;
+  if (abs_bits >= 0x7f800000u)  // inf or NaN (keep a quiet NaN)
+    return sign | (abs_bits > 0x7f800000u ? 0x7e00u : 0x7c00u);
+  if (abs_bits >= 0x477ff000u) return sign | 0x7c00u;  // rounds to ≥ 65520: overflow to inf
+  const int exponent = static_cast<int>(abs_bits >> 23) - 127;
+  if (exponent < -25) return sign;  // below half the smallest subnormal: ±0
+  std::uint32_t mantissa = (abs_bits & 0x7fffffu) | 0x800000u;  // 24 significant bits
+  // Shift so the result has 10 fraction bits at the half exponent (or subnormal scale 2^-24).
+  const int shift = exponent < -14 ? (-14 - exponent) + 13 : 13;
+  const std::uint32_t kept = mantissa >> shift;
+  const std::uint32_t rest = mantissa & ((1u << shift) - 1u);
+  const std::uint32_t halfway = 1u << (shift - 1);
+  std::uint32_t rounded = kept + ((rest > halfway || (rest == halfway && (kept & 1u))) ? 1u : 0u);
+  if (exponent < -14) return sign | static_cast<std::uint16_t>(rounded);  // subnormal (may carry)
+  // Normal: kept holds the implicit bit at 2^10; a carry to 2^11 bumps the exponent.
+  const std::uint32_t half = (static_cast<std::uint32_t>(exponent + 15) << 10) + (rounded - 0x400u);
+  return sign | static_cast<std::uint16_t>(half);
+}
+
+std::string Rgba16fBytes(const exporter::PackedVolume& volume) {
+  std::string out(volume.words.size() * 8, '\0');
+  constexpr std::uint16_t kOne = 0x3c00;
+  for (std::size_t t = 0; t < volume.words.size(); ++t) {
+    const auto c = exporter::DecodeRgb9e5(volume.words[t]);
+    const std::uint16_t h[4] = {FloatToHalf(c[0]), FloatToHalf(c[1]), FloatToHalf(c[2]), kOne};
+    for (int i = 0; i < 4; ++i) {
+      out[t * 8 + 2 * i] = static_cast<char>(h[i] & 0xff);
+      out[t * 8 + 2 * i + 1] = static_cast<char>(h[i] >> 8);
+    }
+  }
+  return out;
+}
+
+std::string EncodeRgba16fDds(const exporter::PackedVolume& volume) {
+  if (volume.width < 1 || volume.height < 1 || volume.depth < 1 ||
+      volume.words.size() != static_cast<std::size_t>(volume.width) * volume.height * volume.depth)
+    throw InvalidArgument(fmt::format("RGBA16F DDS: inconsistent volume {} × {} × {}",
+                                      volume.width, volume.height, volume.depth));
+  return exporter::DdsVolumeHeader(volume.width, volume.height, volume.depth,
+                                   kDxgiFormatR16g16b16a16Float, 8) +
+         Rgba16fBytes(volume);
+}
+
+std::vector<std::string> EngineOutputPaths(const std::string& out_dir, const std::string& name,
+                                           const EngineSet& engines) {
+  std::vector<std::string> paths;
+  const fs::path base(out_dir);
+  for (Engine e : Selected(engines)) {
+    const MaterialFiles f = FilesOf(e, name);
+    for (const std::string* file : {&f.texture, &f.tiles, &f.tiles_import, &f.manifest})
+      if (!file->empty()) paths.push_back((base / FolderOf(e) / *file).string());
+  }
+  return paths;
+}
+
+EngineExportResult ExportLutWithEngines(const std::string& out_dir, const Lut& lut,
+                                        exporter::TextureMetadata metadata,
+                                        const exporter::LutExportOptions& options,
+                                        const EngineSet& engines) {
+  EngineExportResult result;
+  const exporter::PackedVolume packed = exporter::PackLut(lut);
+  result.lut = exporter::ExportLut(out_dir, lut, packed, metadata, options);
+  if (!engines.Any()) return result;
+  Handoff h;
+  h.name = metadata.name;
+  h.source = metadata.source;
+  h.volume = &packed;
+  h.theta_in_deg = lut.theta_in_deg;
+  h.layout = exporter::LutShaderLayout(lut.theta_in_deg);
+  h.cells = {{metadata.name, 0, 0}};
+  h.composite = exporter::SquareishGrid(lut.slices());
+  h.fitted_models_json = metadata.fitted_models_json;
+  const fs::path dir(out_dir);
+  const auto main_file = [&](bool written, const char* ext) {
+    return written ? (dir / (metadata.name + ext)).string() : std::string();
+  };
+  Sources src;
+  src.ktx2_path = main_file(options.formats.ktx2, ".ktx2");
+  src.dds_path = main_file(options.formats.dds, ".dds");
+  src.exr_path = main_file(options.formats.exr, ".exr");
+  src.ktx2_bytes = [&] {
+    return exporter::EncodeKtx2(
+        packed, {{"brdf.sidecar", exporter::SidecarJson(packed, lut.theta_in_deg, metadata)}});
+  };
+  src.composite = [&] { return exporter::CompositeImage(lut); };
+  result.written = WriteHandoff(dir, h, src, engines);
+  return result;
+}
+
+std::vector<std::string> WriteAtlasWithEngines(const std::string& prefix,
+                                               const std::vector<exporter::AtlasMaterial>& materials,
+                                               const exporter::ExrOptions& exr_options,
+                                               const EngineSet& engines) {
+  std::vector<std::string> written = exporter::WriteAtlas(prefix, materials, exr_options);
+  if (!engines.Any()) return written;
+  const exporter::Atlas atlas = exporter::BuildAtlas(materials);
+  const fs::path prefix_path(prefix);
+  Handoff h;
+  h.name = prefix_path.filename().string();
+  h.atlas = true;
+  h.volume = &atlas.volume;
+  h.theta_in_deg = atlas.theta_in_deg;
+  h.layout = exporter::LutShaderLayout(atlas.theta_in_deg);
+  h.layout.texture_width = atlas.layout.TextureWidth();
+  h.layout.texture_height = atlas.layout.TextureHeight();
+  h.composite = atlas.layout.composite;
+  for (int m = 0; m < atlas.layout.materials; ++m) {
+    h.cells.push_back({atlas.names[m], atlas.layout.cells.CellColumn(m) * Lut::kWidth,
+                       atlas.layout.cells.CellRow(m) * Lut::kHeight});
+    h.source += (m ? ", " : "") + atlas.sources[m];
+  }
+  const fs::path base = prefix_path.has_parent_path() ? prefix_path.parent_path() : fs::path(".");
+  Sources src;  // WriteAtlas wrote all three
+  src.ktx2_path = prefix + ".ktx2";
+  src.dds_path = prefix + ".dds";
+  src.exr_path = prefix + ".exr";
+  src.ktx2_bytes = [&] {
+    return exporter::EncodeKtx2(
+        atlas.volume, {{"brdf.atlas", exporter::AtlasManifestJson(
+                                          atlas, {h.name + ".ktx2", h.name + ".dds",
+                                                  h.name + ".exr", h.name + ".json"})}});
+  };
+  src.composite = [&] { return exporter::AtlasImage(materials); };
+  const auto w = WriteHandoff(base, h, src, engines);
+  written.insert(written.end(), w.begin(), w.end());
+  return written;
+}
+
+}  // namespace brdf::engines

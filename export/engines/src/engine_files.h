@@ -1,0 +1,53 @@
+// Private: the texts of the per-engine files (importers, shaders, viewer, import settings) and
+// what a hand-off describes. engine_export.cpp decides which files go where.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "brdf/exporter/exr.h"
+#include "brdf/exporter/packed_volume.h"
+#include "brdf/exporter/shader_code.h"
+
+namespace brdf::engines::detail {
+
+// One material's place in the texture (the whole texture for a single LUT).
+struct HandoffCell {
+  std::string name;
+  int x0 = 0, y0 = 0;  // texel origin of the cell
+};
+
+// What is handed off: one LUT (one cell at 0, 0) or an atlas.
+struct Handoff {
+  std::string name;    // file stem: the material, or the atlas prefix's stem
+  std::string source;  // where the values came from
+  bool atlas = false;
+  const exporter::PackedVolume* volume = nullptr;
+  std::vector<double> theta_in_deg;
+  exporter::ShaderLutLayout layout;
+  std::vector<HandoffCell> cells;
+  exporter::GridLayout composite;  // slice grid of the flat EXR image (C × R)
+  std::vector<std::string> fitted_models_json;
+};
+
+// "MeasuredBrdf" for the reference layout (θin 0, 20, 40, 60, a single 361 × 181 LUT), else
+// "MeasuredBrdf_<K>x<Δin>from<θin,0>" (+ "_<W>x<H>" for an atlas), with '.' in numbers as 'p'.
+std::string ShaderStem(const exporter::ShaderLutLayout& layout);
+
+// Unity (2021.3 LTS to Unity 6).
+std::string UnityImporterCs();
+std::string UnityHlsl(const exporter::ShaderLutLayout& layout);
+// Unreal Engine 5.
+std::string UnrealUsh(const exporter::ShaderLutLayout& layout);
+std::string UnrealImportPython();
+// Godot 4.
+std::string GodotShader(const exporter::ShaderLutLayout& layout);
+std::string GodotSlicesImport(const Handoff& handoff, const std::string& exr_file);
+// three.js (r180 or later).
+std::string WebModuleJs(const exporter::ShaderLutLayout& layout);
+std::string WebViewerHtml(const std::string& module_file, const std::string& default_material);
+std::string WebPackageJson();
+
+inline constexpr int kMinimumThreeRevision = 180;
+
+}  // namespace brdf::engines::detail

@@ -1,0 +1,214 @@
+"""Engine hand-off files checked where a Debian tool can check them (ctest: engine_handoff_checks).
+
+  - The Unreal RGBA16F volume DDS, parsed here from Microsoft's DDS_HEADER / DDS_HEADER_DXT10
+    layout (OpenImageIO 2.4 reads no DX10 DDS): DXGI 10, 3D, depth K, one mip; every half
+    equals the RGB9E5 decode (EXT_texture_shared_exponent, written here) of the KTX2 texel,
+    alpha 1. The Godot DDS is DXGI 67 with the KTX2's own payload bytes.
+  - The Unity ScriptedImporter compiled by mcs against stub UnityEngine/UnityEditor types and
+    run under mono on the shipped .brdf3d, once on the E5B9G9R9 path and once on the RGBAHalf
+    fallback: dimensions, format, clamp, filtering, no mips, and the texels it uploads.
+  - The Unreal editor script byte-compiled (py_compile) and run against a stub `unreal`
+    module: both import routes ask for sRGB off, TC_HDR, no mips, clamp, tiles 361 × 181.
+  - The Godot .import file: importer 3d_texture, 2 × 2 slices, no mipmaps.
+Usage: engine_handoff_checks.py BRDF_TOOL SOURCE_DIR MCS MONO   (Debian /usr/bin/python3)
+"""
+import configparser
+import json
+import os
+import py_compile
+import shutil
+import struct
+import subprocess
+import sys
+import tempfile
+
+import numpy as np
+
+MATERIAL = {"model": "ggx", "kd": [0.3, 0.2, 0.1], "f0": [0.9, 0.6, 0.3], "alpha": 0.2}
+FAILURES = []
+
+
+def expect(condition, message):
+    if not condition:
+        FAILURES.append(message)
+        print("FAIL " + message)
+
+
+def run(cmd, **kw):
+    r = subprocess.run(cmd, capture_output=True, text=True, **kw)
+    if r.returncode != 0:
+        print(f"FAILED ({r.returncode}): {' '.join(cmd)}\n{r.stdout}\n{r.stderr[-3000:]}")
+        sys.exit(1)
+    return r.stdout
+
+
+def decode_rgb9e5(words):
+    w = np.asarray(words, dtype=np.int64)
+    scale = np.exp2(((w >> 27) & 31).astype(float) - 24.0)
+    return np.stack([(w & 511) * scale, ((w >> 9) & 511) * scale, ((w >> 18) & 511) * scale], -1)
+
+
+def ktx2_payload(path):
+    data = open(path, "rb").read()
+    width, height, depth = struct.unpack_from("<3I", data, 20)
+    offset, length = struct.unpack_from("<QQ", data, 80)
+    return data[offset:offset + length], (depth, height, width)
+
+
+def parse_dds(path):
+    """DDS_HEADER + DDS_HEADER_DXT10 (Microsoft DDS programming guide)."""
+    data = open(path, "rb").read()
+    assert data[:4] == b"DDS ", f"{path}: magic {data[:4]!r}"
+    size, flags, height, width, pitch, depth, mips = struct.unpack_from("<7I", data, 4)
+    pf_size, pf_flags, fourcc = struct.unpack_from("<II4s", data, 76)
+    caps, caps2 = struct.unpack_from("<II", data, 108)
+    dxgi, dimension, misc, array_size, misc2 = struct.unpack_from("<5I", data, 128)
+    return dict(size=size, flags=flags, height=height, width=width, pitch=pitch, depth=depth,
+                mips=mips, pf_size=pf_size, pf_flags=pf_flags, fourcc=fourcc, caps=caps,
+                caps2=caps2, dxgi=dxgi, dimension=dimension, array_size=array_size,
+                data=data[148:])
+
+
+def check_dds(out, name):
+    payload, shape = ktx2_payload(os.path.join(out, name + ".ktx2"))
+    words = np.frombuffer(payload, dtype="<u4").reshape(shape)
+    want = decode_rgb9e5(words)
+    d = parse_dds(os.path.join(out, "unreal", name + ".dds"))
+    expect(d["size"] == 124 and d["fourcc"] == b"DX10" and d["dxgi"] == 10, f"unreal DDS header {d['fourcc']} dxgi {d['dxgi']}")
+    expect(d["dimension"] == 4 and d["array_size"] == 1, "unreal DDS is not a 3D texture")
+    expect(d["caps2"] & 0x200000 and d["flags"] & 0x800000, "unreal DDS lacks DDSCAPS2_VOLUME / DDSD_DEPTH")
+    expect((d["width"], d["height"], d["depth"], d["mips"]) == (361, 181, 4, 1),
+           f"unreal DDS size {d['width']}x{d['height']}x{d['depth']} mips {d['mips']}")
+    expect(d["pitch"] == 361 * 8, f"unreal DDS pitch {d['pitch']}")
+    halves = np.frombuffer(d["data"], dtype="<f2").reshape(4, 181, 361, 4).astype(np.float64)
+    diff = np.abs(halves[..., :3] - want)
+    expect(float(diff.max()) == 0.0, f"unreal DDS halves differ from the RGB9E5 decode by {diff.max()}")
+    expect(bool(np.all(halves[..., 3] == 1.0)), "unreal DDS alpha is not 1")
+    print(f"unreal DDS: DXGI 10 volume 361x181x4, 1 mip; {halves[..., :3].size} half values equal "
+          f"the RGB9E5 decode exactly (max |diff| {diff.max()}); peak {want.max():.4g}")
+    g = parse_dds(os.path.join(out, "godot", name + ".dds"))
+    expect(g["dxgi"] == 67 and g["depth"] == 4 and g["mips"] == 1 and g["data"] == payload,
+           "godot DDS is not the RGB9E5 volume with the KTX2's payload")
+    print("godot DDS: DXGI 67 volume, 1 mip, payload identical to the KTX2 level 0 image")
+    return words, want
+
+
+def check_unity(out, name, mcs, mono, work, words, want):
+    unity = os.path.join(out, "unity")
+    stubs = os.path.join(os.path.dirname(os.path.abspath(__file__)), "stubs")
+    exe = os.path.join(work, "driver.exe")
+    run([mcs, "-nologo", "-warnaserror+", "-out:" + exe,
+         os.path.join(unity, "Editor", "MeasuredBrdfImporter.cs"),
+         os.path.join(stubs, "UnityStubs.cs"), os.path.join(stubs, "ImporterDriver.cs")])
+    for mode in ("e5", "half"):
+        prefix = os.path.join(work, "unity_" + mode)
+        run([mono, exe, os.path.join(unity, name + ".brdf3d"), prefix] + (["half"] if mode == "half" else []))
+        info = json.load(open(prefix + ".json"))
+        expect(info["errors"] == [], f"unity importer errors: {info['errors']}")
+        expect(info["extensions"] == ["brdf3d"] and info["override_extensions"] == ["ktx2"],
+               f"unity importer extensions {info['extensions']} / {info['override_extensions']}")
+        expect((info["width"], info["height"], info["depth"]) == (361, 181, 4), f"unity size {info}")
+        expect(info["format"] == ("E5B9G9R9_UFloatPack32" if mode == "e5" else "R16G16B16A16_SFloat"),
+               f"unity format {info['format']}")
+        expect(info["wrap"] == "Clamp" and info["filter"] == "Bilinear" and info["aniso"] == 0,
+               f"unity sampler {info['wrap']} {info['filter']}")
+        expect(info["applied"] and not info["mipmaps_updated"], "unity texture mipmaps updated")
+        if mode == "e5":
+            got = np.fromfile(prefix + ".bin", dtype="<u4")
+            expect(np.array_equal(got, words.reshape(-1)), "unity uploads other words than the KTX2's")
+        else:
+            got = np.fromfile(prefix + ".bin", dtype="<f4").reshape(-1, 4).astype(np.float64)
+            expect(np.array_equal(got[:, :3], want.reshape(-1, 3)) and np.all(got[:, 3] == 1.0),
+                   "unity half fallback converts other values than the RGB9E5 decode")
+    print("unity importer: compiled by mcs (warnings as errors), run under mono: Texture3D 361x181x4 "
+          "E5B9G9R9_UFloatPack32 with the KTX2's words, RGBAHalf fallback with the exact RGB9E5 "
+          "decode; clamp, bilinear, no mips")
+    # A damaged file is refused with one line naming the byte.
+    bad = os.path.join(work, "bad.brdf3d")
+    data = bytearray(open(os.path.join(unity, name + ".brdf3d"), "rb").read())
+    data[12] = 97
+    open(bad, "wb").write(bytes(data))
+    run([mono, exe, bad, os.path.join(work, "unity_bad")])
+    info = json.load(open(os.path.join(work, "unity_bad.json")))
+    expect(len(info["errors"]) == 1 and "byte 12: expected vkFormat 123" in info["errors"][0]
+           and "got 97" in info["errors"][0], f"unity importer on a bad vkFormat: {info['errors']}")
+
+
+def check_unreal(out, work):
+    unreal = os.path.join(out, "unreal")
+    script = os.path.join(unreal, "import_measured_brdf.py")
+    py_compile.compile(script, doraise=True)
+    stubs = os.path.join(os.path.dirname(os.path.abspath(__file__)), "stubs")
+    for route in ([], ["--tiles"]):
+        log = os.path.join(work, "unreal%s.json" % ("_tiles" if route else ""))
+        env = dict(os.environ, PYTHONPATH=stubs, UNREAL_STUB_LOG=log)
+        run([sys.executable, script] + route, env=env)
+        record = json.load(open(log))
+        sets = {}
+        for r in record:
+            if "set" in r:
+                sets.setdefault(r["type"], {})[r["set"]] = r["value"]
+        imports = [r for r in record if "import" in r]
+        if not route:
+            expect(len(imports) == 1 and imports[0]["import"].endswith(".dds"), f"unreal imports {imports}")
+            vol = sets.get("VolumeTexture", {})
+        else:
+            expect(len(imports) == 1 and imports[0]["import"].endswith("_tiles.exr"), f"unreal imports {imports}")
+            vol = sets.get("VolumeTexture", {})
+            expect(vol.get("source2d_tile_size_x") == 361 and vol.get("source2d_tile_size_y") == 181,
+                   f"unreal tile size {vol}")
+            tex = sets.get("Texture2D", {})
+            expect(tex.get("srgb") is False and tex.get("compression_settings") == "TextureCompressionSettings.TC_HDR",
+                   f"unreal tiles texture settings {tex}")
+        expect(vol.get("srgb") is False, f"unreal sRGB {vol}")
+        expect(vol.get("compression_settings") == "TextureCompressionSettings.TC_HDR", f"unreal compression {vol}")
+        expect(vol.get("mip_gen_settings") == "TextureMipGenSettings.TMGS_NO_MIPMAPS", f"unreal mips {vol}")
+        expect(vol.get("address_mode") == "TextureAddress.TA_CLAMP", f"unreal address {vol}")
+    print("unreal script: py_compile ok; against the stub module both routes import (DDS; tiles "
+          "361x181 into a Volume Texture) with sRGB off, TC_HDR, no mips, clamp")
+
+
+def check_godot(out, name):
+    cp = configparser.ConfigParser()
+    text = open(os.path.join(out, "godot", name + "_slices.exr.import")).read()
+    cp.read_string("\n".join(l for l in text.splitlines() if not l.startswith(";")))
+    expect(cp["remap"]["importer"] == '"3d_texture"', f"godot importer {cp['remap']['importer']}")
+    expect(cp["params"]["slices/horizontal"] == "2" and cp["params"]["slices/vertical"] == "2",
+           "godot slices")
+    expect(cp["params"]["mipmaps/generate"] == "false", "godot mipmaps")
+    import OpenImageIO as oiio  # Debian python3-openimageio
+    inp = oiio.ImageInput.open(os.path.join(out, "godot", name + "_slices.exr"))
+    expect(inp is not None and (inp.spec().width, inp.spec().height) == (722, 362),
+           "godot sliced EXR is not 2 x 2 tiles of 361 x 181")
+    if inp:
+        inp.close()
+    print("godot: .import = 3d_texture, 2 x 2 slices, no mipmaps; sliced EXR 722 x 362 (OpenImageIO)")
+
+
+def main():
+    tool, source, mcs, mono = sys.argv[1:5]
+    work = tempfile.mkdtemp(prefix="brdf_engine_checks_")
+    mat = os.path.join(work, "gold_like.json")
+    json.dump(MATERIAL, open(mat, "w"))
+    out = os.path.join(work, "out")
+    run([tool, "convert", mat, "--out", out, "--engine", "all", "--quiet", "--formats", "ktx2,json"])
+    # A misspelt engine: one line, exit 1, nothing written.
+    bad = subprocess.run([tool, "convert", mat, "--out", os.path.join(work, "bad"), "--engine",
+                          "unity,unrael"], capture_output=True, text=True)
+    expect(bad.returncode == 1 and bad.stderr.strip() ==
+           "brdf: error: unknown engine 'unrael' (known: unity, unreal, godot, web, all)"
+           and not os.path.exists(os.path.join(work, "bad")),
+           f"--engine unrael: exit {bad.returncode}, stderr {bad.stderr!r}")
+    words, want = check_dds(out, "gold_like")
+    check_unity(out, "gold_like", mcs, mono, work, words, want)
+    check_unreal(out, work)
+    check_godot(out, "gold_like")
+    if FAILURES:
+        print(f"{len(FAILURES)} check(s) failed; kept {work}")
+        return 1
+    shutil.rmtree(work, ignore_errors=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,332 @@
+// Drives the exported web hand-off (OUT/web/) in real headless Chromium (WebGL 2 on
+// SwiftShader) through the DevTools protocol and writes what the GPU computed, for the
+// independent checks in tests/python/web_render_check.py:
+//   image.f32       the shipped viewer's sphere rendered into a float render target (RGBA32F,
+//                   rows top first), linear radiance, with image.json describing the camera
+//   probes.json     the manifest's probe texels read back with texelFetch and with a filtered
+//                   fetch at the texel centre
+//   pairs_glsl.txt  MeasuredBrdfCell (the shipped GLSL) for each line "nx ny nz lx ly lz vx vy vz"
+//                   of --pairs, one "r g b" line each
+//   pairs_hlsl.txt  the same through the shipped Unity HLSL cross-compiled to GLSL ES
+//                   (--hlsl-glsl, made by glslangValidator -D and spirv-cross)
+//   screenshot.png  the viewer as a person sees it (sRGB canvas), light moved once
+//   bench.json      with --bench: frame times of a 1024² canvas, the measured material and
+//                   three's MeshStandardMaterial (the baseline) alternating
+// Usage: node render_web.mjs --web DIR --material NAME --out DIR [--size N] [--pairs FILE]
+//        [--hlsl-glsl FILE] [--cell NAME (an atlas material)] [--bench] [--chromium PATH]
+import { spawn } from 'node:child_process';
+import { createServer } from 'node:http';
+import { mkdtempSync, readFileSync, writeFileSync, existsSync, rmSync, statSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join, extname, resolve, dirname } from 'node:path';
+import { fileURLToPath } from 'node:url';
+import WebSocket from 'ws';
+
+const here = dirname(fileURLToPath(import.meta.url));
+const args = {};
+for (let i = 2; i < process.argv.length; i++) {
+  const a = process.argv[i];
+  if (!a.startsWith('--')) throw new Error(`unexpected argument ${a}`);
+  const next = process.argv[i + 1];
+  if (next === undefined || next.startsWith('--')) args[a.slice(2)] = true;
+  else { args[a.slice(2)] = next; i++; }
+}
+for (const required of ['web', 'material', 'out'])
+  if (!args[required]) { console.error(`render_web: --${required} is required`); process.exit(2); }
+const webDir = resolve(args.web), outDir = resolve(args.out);
+const threeDir = resolve(here, 'node_modules/three');
+if (!existsSync(join(threeDir, 'build/three.module.js'))) {
+  console.error('render_web: three is not installed in tests/node; run tools/install-npm-deps.sh');
+  process.exit(1);
+}
+const size = parseInt(args.size || '256', 10);
+const chromium = args.chromium || 'chromium';
+const deadline = Date.now() + 240000;
+
+// A static server for /web/ (the exported folder) and /three/ (the npm package).
+const types = { '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/javascript',
+                '.json': 'application/json', '.ktx2': 'application/octet-stream' };
+const server = createServer((req, res) => {
+  const url = new URL(req.url, 'http://127.0.0.1');
+  const route = url.pathname.startsWith('/web/') ? [webDir, url.pathname.slice(5)]
+              : url.pathname.startsWith('/three/') ? [threeDir, url.pathname.slice(7)] : null;
+  const file = route && resolve(route[0], decodeURIComponent(route[1]));
+  if (!file || !file.startsWith(route[0]) || !existsSync(file) || !statSync(file).isFile()) {
+    res.writeHead(404); res.end('not found'); return;
+  }
+  res.writeHead(200, { 'Content-Type': types[extname(file)] || 'application/octet-stream' });
+  res.end(readFileSync(file));
+});
+await new Promise((ok) => server.listen(0, '127.0.0.1', ok));
+const base = `http://127.0.0.1:${server.address().port}`;
+
+const profile = mkdtempSync(join(tmpdir(), 'brdf-chromium-'));
+const browser = spawn(chromium, [
+  '--headless', '--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
+  '--disable-gpu-sandbox', '--disable-background-networking', '--disable-component-update',
+  '--disable-sync', '--no-first-run', '--no-default-browser-check', '--mute-audio',
+  `--user-data-dir=${profile}`, '--remote-debugging-port=0', '--window-size=1100,1100',
+  'about:blank'], { stdio: ['ignore', 'ignore', 'pipe'] });
+let browserLog = '';
+browser.stderr.on('data', (d) => { browserLog += d; });
+const cleanup = () => {
+  try { browser.kill('SIGKILL'); } catch { /* already gone */ }
+  server.close();
+  try { rmSync(profile, { recursive: true, force: true }); } catch { /* best effort */ }
+};
+const fail = (message) => {
+  console.error(`render_web: ${message}`);
+  if (browserLog) console.error(browserLog.split('\n').slice(-15).join('\n'));
+  cleanup();
+  process.exit(1);
+};
+const timer = setTimeout(() => fail('timed out after 240 s'), deadline - Date.now());
+
+const sleep = (ms) => new Promise((ok) => setTimeout(ok, ms));
+let endpoint = null;
+while (!endpoint) {
+  if (Date.now() > deadline) fail('chromium did not open its DevTools port');
+  if (browser.exitCode !== null) fail(`chromium exited with code ${browser.exitCode}`);
+  const portFile = join(profile, 'DevToolsActivePort');
+  if (existsSync(portFile)) {
+    const [port, path] = readFileSync(portFile, 'utf8').split('\n');
+    if (port && path) endpoint = `ws://127.0.0.1:${port}${path}`;
+  }
+  if (!endpoint) await sleep(100);
+}
+
+const ws = new WebSocket(endpoint, { perMessageDeflate: false, maxPayload: 1 << 30 });
+await new Promise((ok, bad) => { ws.once('open', ok); ws.once('error', bad); });
+let nextId = 1;
+const pending = new Map();
+const consoleLines = [];
+ws.on('message', (data) => {
+  const msg = JSON.parse(data.toString());
+  if (msg.id && pending.has(msg.id)) {
+    const { ok, bad } = pending.get(msg.id);
+    pending.delete(msg.id);
+    if (msg.error) bad(new Error(JSON.stringify(msg.error))); else ok(msg.result);
+  } else if (msg.method === 'Runtime.consoleAPICalled') {
+    consoleLines.push(msg.params.args.map((a) => a.value ?? a.description).join(' '));
+  } else if (msg.method === 'Runtime.exceptionThrown') {
+    consoleLines.push('exception: ' + msg.params.exceptionDetails.exception?.description);
+  }
+});
+const send = (method, params = {}, sessionId) => new Promise((ok, bad) => {
+  const id = nextId++;
+  pending.set(id, { ok, bad });
+  ws.send(JSON.stringify({ id, method, params, ...(sessionId ? { sessionId } : {}) }));
+});
+
+async function openPage(url) {
+  const { targetId } = await send('Target.createTarget', { url: 'about:blank' });
+  const { sessionId } = await send('Target.attachToTarget', { targetId, flatten: true });
+  await send('Runtime.enable', {}, sessionId);
+  await send('Page.enable', {}, sessionId);
+  await send('Page.navigate', { url }, sessionId);
+  const page = {
+    sessionId,
+    async eval(expression) {
+      const r = await send('Runtime.evaluate',
+        { expression, awaitPromise: true, returnByValue: true }, sessionId);
+      if (r.exceptionDetails)
+        throw new Error(`${r.exceptionDetails.exception?.description || r.exceptionDetails.text}\n` +
+                        consoleLines.join('\n'));
+      return r.result.value;
+    },
+  };
+  for (;;) {
+    if (Date.now() > deadline) fail(`page ${url} never became ready\n${consoleLines.join('\n')}`);
+    const state = await page.eval('window.measuredBrdf && window.measuredBrdf.ready ? "ok" : "wait"');
+    if (state === 'ok') break;
+    await sleep(100);
+  }
+  await page.eval('window.measuredBrdf.ready');
+  return page;
+}
+
+// Code run inside the page: helpers on window.measuredBrdf.
+const helpers = `
+(() => {
+  const M = window.measuredBrdf, THREE = M.THREE;
+  const toBase64 = (floats) => {
+    const bytes = new Uint8Array(floats.buffer);
+    let s = '';
+    for (let i = 0; i < bytes.length; i += 0x8000) s += String.fromCharCode.apply(null, bytes.subarray(i, i + 0x8000));
+    return btoa(s);
+  };
+  const floatTarget = (w, h) => new THREE.WebGLRenderTarget(w, h, { type: THREE.FloatType,
+      format: THREE.RGBAFormat, minFilter: THREE.NearestFilter, magFilter: THREE.NearestFilter });
+  const readTarget = (rt, w, h) => { const b = new Float32Array(w * h * 4); M.renderer.readRenderTargetPixels(rt, 0, 0, w, h, b); return b; };
+  // Renders a fragment shader over a w × h target and returns its RGBA floats (rows bottom first).
+  M.runFragment = (fragmentShader, uniforms, w, h) => {
+    const material = new THREE.ShaderMaterial({ glslVersion: THREE.GLSL3, uniforms, fragmentShader,
+      vertexShader: 'void main() { gl_Position = vec4(position.xy, 0.0, 1.0); }' });
+    const scene = new THREE.Scene();
+    scene.add(new THREE.Mesh(new THREE.PlaneGeometry(2, 2), material));
+    const rt = floatTarget(w, h);
+    M.renderer.setRenderTarget(rt);
+    M.renderer.render(scene, new THREE.Camera());
+    M.renderer.setRenderTarget(null);
+    const out = readTarget(rt, w, h);
+    rt.dispose(); material.dispose();
+    return out;
+  };
+  M.dataTexture = (floats, w, h) => {
+    const t = new THREE.DataTexture(floats, w, h, THREE.RGBAFormat, THREE.FloatType);
+    t.minFilter = THREE.NearestFilter; t.magFilter = THREE.NearestFilter; t.needsUpdate = true;
+    return t;
+  };
+  M.renderSphere = (size, light) => {
+    M.renderer.setSize(size, size);
+    M.camera.aspect = 1; M.camera.updateProjectionMatrix();
+    M.shader.uniforms.encodeSrgb.value = false;
+    M.shader.uniforms.lightDirection.value.set(light[0], light[1], light[2]).normalize();
+    const rt = floatTarget(size, size);
+    M.renderer.setRenderTarget(rt);
+    M.renderer.render(M.scene, M.camera);
+    M.renderer.setRenderTarget(null);
+    M.shader.uniforms.encodeSrgb.value = true;
+    const out = readTarget(rt, size, size);
+    rt.dispose();
+    return toBase64(out);
+  };
+  M.toBase64 = toBase64;
+  return true;
+})()`;
+
+const fromBase64 = (s) => { const b = Buffer.from(s, 'base64'); return new Float32Array(b.buffer, b.byteOffset, b.length / 4); };
+
+try {
+  const material = args.material;
+  const cellParam = args.cell ? `&cell=${encodeURIComponent(args.cell)}` : '';
+  const page = await openPage(`${base}/web/index.html?material=${encodeURIComponent(material)}${cellParam}&three=/three/&size=${size}`);
+  await page.eval(helpers);
+  const light = [0.45, 0.55, 0.7];
+  const info = await page.eval(`({ revision: window.measuredBrdf.THREE.REVISION,
+    isData3D: window.measuredBrdf.texture.isData3DTexture,
+    type: window.measuredBrdf.texture.type, format: window.measuredBrdf.texture.format,
+    minFilter: window.measuredBrdf.texture.minFilter, linear: window.measuredBrdf.THREE.LinearFilter,
+    size: [window.measuredBrdf.texture.image.width, window.measuredBrdf.texture.image.height, window.measuredBrdf.texture.image.depth],
+    webgl2: window.measuredBrdf.renderer.capabilities.isWebGL2 !== false,
+    renderer: (() => { const gl = window.measuredBrdf.renderer.getContext(); const e = gl.getExtension('WEBGL_debug_renderer_info'); return e ? gl.getParameter(e.UNMASKED_RENDERER_WEBGL) : gl.getParameter(gl.RENDERER); })() })`);
+  const image = fromBase64(await page.eval(`window.measuredBrdf.renderSphere(${size}, ${JSON.stringify(light)})`));
+  // Rows come bottom first from readPixels; store top first.
+  const flipped = new Float32Array(image.length);
+  for (let y = 0; y < size; y++) flipped.set(image.subarray((size - 1 - y) * size * 4, (size - y) * size * 4), y * size * 4);
+  writeFileSync(join(outDir, 'image.f32'), Buffer.from(flipped.buffer));
+  writeFileSync(join(outDir, 'image.json'), JSON.stringify({
+    width: size, height: size, channels: 4, rows: 'top first', light_direction: light,
+    light_color: [1, 1, 1], exposure: 1, camera: { fov_y_deg: 30, position: [0, 0, 5], target: [0, 0, 0] },
+    sphere: { radius: 1, centre: [0, 0, 0] }, three_revision: info.revision, texture: info }, null, 2));
+
+  // Probe texels: texelFetch and a filtered fetch at the texel centre.
+  const manifest = JSON.parse(readFileSync(join(webDir, `${material}.manifest.json`), 'utf8'));
+  const probes = manifest.probe_texels;
+  const n = probes.length;
+  const idx = new Float32Array(n * 4);
+  probes.forEach((p, i) => idx.set([p.index[0], p.index[1], p.index[2], 0], i * 4));
+  const probeShader = (filtered) => `
+    uniform highp sampler3D lut; uniform highp sampler2D indices;
+    layout(location = 0) out highp vec4 fragColor;
+    void main() {
+      ivec3 i = ivec3(texelFetch(indices, ivec2(int(gl_FragCoord.x), 0), 0).xyz + 0.25);
+      vec3 size = vec3(textureSize(lut, 0));
+      fragColor = vec4(${filtered ? 'textureLod(lut, (vec3(i) + 0.5) / size, 0.0).rgb' : 'texelFetch(lut, i, 0).rgb'}, 1.0);
+    }`;
+  const probeRun = async (filtered) => fromBase64(await page.eval(`(() => { const M = window.measuredBrdf;
+      const idx = new Float32Array(${JSON.stringify(Array.from(idx))});
+      const t = M.dataTexture(idx, ${n}, 1);
+      return M.toBase64(M.runFragment(${JSON.stringify(probeShader(filtered))}, { lut: { value: M.texture }, indices: { value: t } }, ${n}, 1)); })()`));
+  const fetched = await probeRun(false), filtered = await probeRun(true);
+  writeFileSync(join(outDir, 'probes.json'), JSON.stringify(probes.map((p, i) => ({
+    index: p.index, manifest: p.rgb,
+    texel_fetch: Array.from(fetched.subarray(i * 4, i * 4 + 3)),
+    filtered_at_centre: Array.from(filtered.subarray(i * 4, i * 4 + 3)) })), null, 1));
+
+  // Direction pairs through the shipped GLSL (and the HLSL cross-compiled to GLSL ES).
+  if (args.pairs) {
+    const rows = readFileSync(args.pairs, 'utf8').split('\n').map((l) => l.trim())
+      .filter((l) => l && !l.startsWith('#')).map((l) => l.split(/\s+/).map(Number));
+    const count = rows.length;
+    const data = new Float32Array(count * 3 * 4);
+    rows.forEach((r, i) => {
+      for (let k = 0; k < 3; k++) data.set([r[3 * k], r[3 * k + 1], r[3 * k + 2], 0], (k * count + i) * 4);
+    });
+    const glslMain = `
+      uniform highp sampler3D lut; uniform highp sampler2D pairs;
+      layout(location = 0) out highp vec4 fragColor;
+      void main() {
+        int x = int(gl_FragCoord.x);
+        vec3 n = texelFetch(pairs, ivec2(x, 0), 0).xyz, l = texelFetch(pairs, ivec2(x, 1), 0).xyz,
+             v = texelFetch(pairs, ivec2(x, 2), 0).xyz;
+        fragColor = vec4(MeasuredBrdfCell(lut, vec2(0.0), n, l, v), 1.0);
+      }`;
+    const runPairs = async (source, lutName, pairsName) => fromBase64(await page.eval(`(async () => {
+        const M = window.measuredBrdf;
+        const mod = await import('${base}/web/${manifest.engines.web.files.shader}');
+        const source = ${JSON.stringify(source)}.replace('@MEASURED_BRDF_GLSL@', mod.MEASURED_BRDF_GLSL);
+        const t = M.dataTexture(new Float32Array(${JSON.stringify(Array.from(data))}), ${count}, 3);
+        return M.toBase64(M.runFragment(source, { ${lutName}: { value: M.texture }, ${pairsName}: { value: t } }, ${count}, 1)); })()`));
+    const format = (out) => Array.from({ length: count }, (_, i) =>
+      `${out[i * 4]} ${out[i * 4 + 1]} ${out[i * 4 + 2]}`).join('\n') + '\n';
+    writeFileSync(join(outDir, 'pairs_glsl.txt'), format(await runPairs('@MEASURED_BRDF_GLSL@' + glslMain, 'lut', 'pairs')));
+    // The tangent-space entry point, with l and v expressed in an arbitrary tangent basis of n
+    // (not the light's): MeasuredBrdfTangent must find the light's frame itself.
+    const tangentMain = glslMain.replace('fragColor = vec4(MeasuredBrdfCell(lut, vec2(0.0), n, l, v), 1.0);', `
+        vec3 t = normalize(abs(n.z) < 0.9 ? cross(n, vec3(0.0, 0.0, 1.0)) : cross(n, vec3(1.0, 0.0, 0.0)));
+        vec3 b = cross(n, t);
+        vec3 l_ts = vec3(dot(l, t), dot(l, b), dot(l, n)), v_ts = vec3(dot(v, t), dot(v, b), dot(v, n));
+        fragColor = vec4(MeasuredBrdfTangent(lut, vec2(0.0), l_ts, v_ts), 1.0);`);
+    writeFileSync(join(outDir, 'pairs_tangent.txt'), format(await runPairs('@MEASURED_BRDF_GLSL@' + tangentMain, 'lut', 'pairs')));
+    if (args['hlsl-glsl']) {
+      // spirv-cross output: drop its #version line (three writes its own); find the combined
+      // sampler names it made for lut/lut_sampler and for the pairs texture.
+      let src = readFileSync(args['hlsl-glsl'], 'utf8').replace(/^#version.*\n/, '');
+      const s3 = src.match(/uniform\s+(?:highp\s+)?sampler3D\s+(\w+);/);
+      const s2 = src.match(/uniform\s+(?:highp\s+)?sampler2D\s+(\w+);/);
+      if (!s3 || !s2) throw new Error('cross-compiled HLSL has no sampler3D/sampler2D uniforms:\n' + src);
+      writeFileSync(join(outDir, 'pairs_hlsl.txt'), format(await runPairs(src, s3[1], s2[1])));
+    }
+  }
+
+  // What a person sees: the sRGB viewer, after moving the light once (as a drag would).
+  await page.eval(`(() => { const M = window.measuredBrdf; M.renderer.setSize(${size}, ${size});
+      M.light.set(-0.5, 0.4, 0.77).normalize(); M.draw(); return true; })()`);
+  const shot = await send('Page.captureScreenshot', { format: 'png', clip: { x: 0, y: 0, width: size, height: size, scale: 1 } }, page.sessionId);
+  writeFileSync(join(outDir, 'screenshot.png'), Buffer.from(shot.data, 'base64'));
+
+  if (args.bench) {
+    const bench = await openPage(`${base}/web/index.html?material=${encodeURIComponent(material)}&three=/three/&size=1024`);
+    // The measured material and, as the baseline in the same run, three's own
+    // MeshStandardMaterial under one DirectionalLight on the same sphere, alternating.
+    const result = await bench.eval(`(() => {
+      const M = window.measuredBrdf, THREE = M.THREE, gl = M.renderer.getContext(), px = new Uint8Array(4);
+      const standard = new THREE.MeshStandardMaterial({ color: 0x8090a0, roughness: 0.35, metalness: 0 });
+      const sun = new THREE.DirectionalLight(0xffffff, 3);
+      sun.position.copy(M.light);
+      const frame = (material) => {
+        M.sphere.material = material;
+        if (material === standard) M.scene.add(sun); else M.scene.remove(sun);
+        const t0 = performance.now();
+        M.renderer.render(M.scene, M.camera);
+        gl.readPixels(0, 0, 1, 1, gl.RGBA, gl.UNSIGNED_BYTE, px);
+        return performance.now() - t0;
+      };
+      for (let i = 0; i < 3; i++) { frame(M.shader); frame(standard); }
+      const measured = [], baseline = [];
+      for (let i = 0; i < 21; i++) { measured.push(frame(M.shader)); baseline.push(frame(standard)); }
+      M.sphere.material = M.shader; M.scene.remove(sun);
+      const stats = (t) => { t.sort((a, b) => a - b); return { median_ms: t[t.length >> 1], min_ms: t[0], max_ms: t[t.length - 1] }; };
+      return { canvas: [gl.drawingBufferWidth, gl.drawingBufferHeight], frames: measured.length,
+               measured_brdf: stats(measured), mesh_standard_material: stats(baseline) };
+    })()`);
+    writeFileSync(join(outDir, 'bench.json'), JSON.stringify(result, null, 2));
+  }
+  console.log(JSON.stringify({ ok: true, three: info.revision, renderer: info.renderer, probes: n }));
+  clearTimeout(timer);
+  ws.close();
+  cleanup();
+} catch (e) {
+  fail(`${e.stack || e}\n${consoleLines.join('\n')}`);
+}
