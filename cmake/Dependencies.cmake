@@ -9,6 +9,10 @@ find_package(PkgConfig REQUIRED)
 pkg_check_modules(LIBUSB REQUIRED IMPORTED_TARGET libusb-1.0)
 pkg_check_modules(HIDAPI REQUIRED IMPORTED_TARGET hidapi-libusb)
 
+# brdf::image_io writes and reads EXR and PNG itself; OpenImageIO is only linked by the module
+# that reads every other format (cmake/LazyModule.cmake).
+find_package(OpenEXR 3 REQUIRED)
+find_package(PNG REQUIRED)
 find_package(OpenImageIO REQUIRED)
 # OpenImageIO 2.4's config names /usr/include/opencv4, which Debian does not ship (DESIGN §3).
 foreach(oiio_target OpenImageIO::OpenImageIO OpenImageIO::OpenImageIO_Util)

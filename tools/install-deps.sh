@@ -9,6 +9,8 @@ packages=(
   build-essential cmake ninja-build pkg-config git
   libceres-dev libeigen3-dev
   libopenimageio-dev openimageio-tools libopenexr-dev
+  libimath-dev libpng-dev zlib1g-dev python3-openimageio  # brdf::image_io and its oracle
+  hyperfine time  # bench/startup.sh and the start-up test (GNU time's peak RSS)
   libvtk9-dev
   libusb-1.0-0-dev libhidapi-dev
   libcli11-dev nlohmann-json3-dev libfmt-dev libspdlog-dev libtbb-dev

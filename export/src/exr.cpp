@@ -4,34 +4,15 @@
 #include <array>
 #include <cmath>
 
-#include <OpenImageIO/imageio.h>
 #include <fmt/format.h>
 
 #include "brdf/core/error.h"
-#include "brdf/core/file_util.h"
 #include "brdf/exporter/atlas.h"
 #include "brdf/exporter/sidecar.h"
 #include "json_util.h"
 
 namespace brdf::exporter {
 namespace {
-
-// Writes through OIIO into the temporary sibling, then renames it into place.
-void WriteImageAtomically(const std::string& path, const char* format, const OIIO::ImageSpec& spec,
-                          OIIO::TypeDesc data_type, const void* data) {
-  AtomicOutputPath out_path(path);
-  auto out = OIIO::ImageOutput::create(format);
-  if (!out) throw IoError(path + ": OpenImageIO has no " + format + " writer: " + OIIO::geterror());
-  if (!out->open(out_path.temp_path(), spec))
-    throw IoError(path + ": cannot create " + format + " file: " + out->geterror());
-  const bool wrote = out->write_image(data_type, data);
-  const std::string write_error = wrote ? std::string() : out->geterror();
-  const bool closed = out->close();
-  if (!wrote) throw IoError(path + ": writing the image failed: " + write_error);
-  if (!closed) throw IoError(path + ": finishing the image failed: " + out->geterror());
-  out.reset();
-  out_path.Commit();
-}
 
 float SrgbEncode(float linear) {
   return linear <= 0.0031308f ? 12.92f * linear : 1.055f * std::pow(linear, 1.0f / 2.4f) - 0.055f;
@@ -97,14 +78,9 @@ void WriteExr(const std::string& path, const FloatImage& image, const ExrOptions
       image.rgb.size() != static_cast<std::size_t>(image.width) * image.height * 3)
     throw InvalidArgument(fmt::format("EXR: inconsistent image {} × {} with {} floats", image.width,
                                       image.height, image.rgb.size()));
-  OIIO::ImageSpec spec(
-      image.width, image.height, 3,
-      options.type == ExrPixelType::kHalf ? OIIO::TypeDesc::HALF : OIIO::TypeDesc::FLOAT);
-  spec.channelnames = {"R", "G", "B"};
-  spec.attribute("compression", options.compression == ExrCompression::kZip ? "zip" : "none");
-  spec.attribute("Software", BrdfToolWriter());
-  for (const auto& [name, value] : attributes) spec.attribute(name, value);
-  WriteImageAtomically(path, "exr", spec, OIIO::TypeDesc::FLOAT, image.rgb.data());
+  StringAttributes all = {{"Software", BrdfToolWriter()}};
+  all.insert(all.end(), attributes.begin(), attributes.end());
+  image_io::WriteExrImage(path, image, options.type, options.compression, all);
 }
 
 void WriteExrComposite(const std::string& path, const Lut& lut, const PackedVolume& packed,
@@ -152,57 +128,15 @@ std::vector<unsigned char> ToneMapForPng(const FloatImage& image) {
 }
 
 void WritePng(const std::string& path, const FloatImage& image) {
-  WritePngBytes(path, image.width, image.height, ToneMapForPng(image));
-}
-
-void WritePngBytes(const std::string& path, int width, int height,
-                   const std::vector<unsigned char>& pixels) {
-  if (width < 1 || height < 1 || pixels.size() != static_cast<std::size_t>(width) * height * 3)
-    throw InvalidArgument(fmt::format("PNG: inconsistent image {} × {} with {} bytes", width,
-                                      height, pixels.size()));
-  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
+  const std::vector<unsigned char> pixels = ToneMapForPng(image);
   // zlib level 3: half the encoding time of the default 6 for a file about 25 % larger.
-  spec.attribute("png:compressionLevel", 3);
-  spec.attribute("Software", BrdfToolWriter());
-  WriteImageAtomically(path, "png", spec, OIIO::TypeDesc::UINT8, pixels.data());
+  image_io::WritePng8(path, image.width, image.height, pixels, 3, {{"Software", BrdfToolWriter()}});
 }
 
 void WritePngComposite(const std::string& path, const Lut& lut) {
   WritePng(path, CompositeImage(lut));
 }
 
-std::string ExrFile::Attribute(const std::string& name) const {
-  for (const auto& [key, value] : attributes)
-    if (key == name) return value;
-  return {};
-}
-
-ExrFile ReadExr(const std::string& path) {
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) throw IoError(path + ": cannot open image: " + OIIO::geterror());
-  const OIIO::ImageSpec& spec = in->spec();
-  if (spec.nchannels < 3 || spec.channelnames.size() < 3 || spec.channelnames[0] != "R" ||
-      spec.channelnames[1] != "G" || spec.channelnames[2] != "B")
-    throw FormatError(
-        path, "channel list", "channels R, G, B",
-        fmt::format("{} channels ({})", spec.nchannels, fmt::join(spec.channelnames, ", ")));
-  if (spec.width < 1 || spec.height < 1 || spec.depth != 1 ||
-      static_cast<std::uint64_t>(spec.width) * spec.height > (1ull << 30))
-    throw FormatError(path, "data window", "a 2D image of at most 2^30 pixels",
-                      fmt::format("{} × {} × {}", spec.width, spec.height, spec.depth));
-  ExrFile file;
-  file.pixel_type =
-      spec.format == OIIO::TypeDesc::HALF ? ExrPixelType::kHalf : ExrPixelType::kFloat;
-  file.image.width = spec.width;
-  file.image.height = spec.height;
-  file.image.rgb.resize(static_cast<std::size_t>(spec.width) * spec.height * 3);
-  if (!in->read_image(0, 0, 0, 3, OIIO::TypeDesc::FLOAT, file.image.rgb.data()))
-    throw IoError(path + ": reading pixels failed: " + in->geterror());
-  for (const OIIO::ParamValue& p : spec.extra_attribs)
-    if (p.type() == OIIO::TypeDesc::STRING)
-      file.attributes.emplace_back(p.name().string(), p.get_string());
-  in->close();
-  return file;
-}
+ExrFile ReadExr(const std::string& path) { return image_io::ReadExrImage(path); }
 
 }  // namespace brdf::exporter

@@ -311,7 +311,7 @@ TEST(PreviewHighlight, SharpGgxHighlightSitsWhereMirrorReflectionPredicts) {
 TEST(PreviewOrientation, AxisCodedMapAppearsWhereTheDocumentedFrameSaysItIs) {
   const AnalyticBrdf white(MakeMaterial(Model::kLambert, {1, 1, 1}, {}, {}));
   const EnvironmentMap axes = EnvironmentMap::AxisCoded(512, 256);
-  const int size = 101;
+  const int size = 61;
   PreviewOptions o = SmallOptions(size, Estimator::kMis, 1024);
   o.camera.fill = 0.5;
   const PreviewImage image = RenderPreview(white, axes, o);

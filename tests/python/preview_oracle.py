@@ -76,7 +76,7 @@ def axes_map(w):
 def axes_lambert(n):
     n = np.asarray(n, float)
     n /= np.linalg.norm(n)
-    n_t, n_p = 1200, 2400
+    n_t, n_p = 600, 1200
     theta = (np.arange(n_t) + 0.5) / n_t * np.pi
     phi = (np.arange(n_p) + 0.5) / n_p * 2.0 * np.pi
     t_g, p_g = np.meshgrid(theta, phi, indexing="ij")

@@ -5,7 +5,8 @@
 #include <vector>
 
 #include "brdf/core/error.h"
-#include "brdf/exporter/exr.h"
+#include "brdf/core/measurement.h"
+#include "brdf/image_io/image_io.h"
 #include "brdf/processing/preview.h"
 #include "preview_internal.h"
 
@@ -114,18 +115,19 @@ void WritePreviewImage(const std::string& path, const PreviewImage& image, doubl
                        ToneMapCurve curve,
                        const std::vector<std::pair<std::string, std::string>>& attributes) {
   CheckImage(image, "written");
+  std::vector<std::pair<std::string, std::string>> attrs(attributes.begin(), attributes.end());
+  attrs.emplace_back("Software", std::string("brdf-toolchain ") + SoftwareVersion());
   if (EndsWith(path, ".png")) {
-    exporter::WritePngBytes(path, image.width, image.height, ToneMap(image, exposure_ev, curve));
+    image_io::WritePng8(path, image.width, image.height, ToneMap(image, exposure_ev, curve), 3,
+                        attrs);
   } else if (EndsWith(path, ".exr")) {
-    exporter::FloatImage f;
-    f.width = image.width;
-    f.height = image.height;
-    f.rgb = image.rgb;
-    exporter::StringAttributes attrs(attributes.begin(), attributes.end());
+    image_io::RgbImage rgb;
+    rgb.width = image.width;
+    rgb.height = image.height;
+    rgb.rgb = image.rgb;
     attrs.emplace_back("brdf:samples_per_pixel", std::to_string(image.samples_per_pixel));
-    exporter::WriteExr(path, f, exporter::ExrOptions(exporter::ExrPixelType::kFloat,
-                                                     exporter::ExrCompression::kZip),
-                       attrs);
+    image_io::WriteExrImage(path, rgb, image_io::ExrPixelType::kFloat,
+                            image_io::ExrCompression::kZip, attrs);
   } else {
     throw InvalidArgument(path + ": the preview is written as .exr (linear HDR) or .png " +
                           "(tone-mapped); the extension names which");
@@ -134,13 +136,13 @@ void WritePreviewImage(const std::string& path, const PreviewImage& image, doubl
 
 namespace detail {
 
-// Today through the exporter's OpenImageIO reader (which opens .hdr as well as .exr); the
-// image_io module replaces it when it lands.
+// Through brdf::image_io: .exr by OpenEXR, .hdr by the OpenImageIO module it loads on first use.
 RgbImage ReadEnvironmentImage(const std::string& path) {
   if (!EndsWith(path, ".exr") && !EndsWith(path, ".hdr"))
     throw InvalidArgument(path + ": an environment map must be an equirectangular .exr or .hdr");
-  exporter::ExrFile file = exporter::ReadExr(path);
-  return {file.image.width, file.image.height, std::move(file.image.rgb)};
+  image_io::RgbImage image = EndsWith(path, ".exr") ? image_io::ReadExrImage(path).image
+                                                    : image_io::ReadRgbImage(path);
+  return {image.width, image.height, std::move(image.rgb)};
 }
 
 }  // namespace detail

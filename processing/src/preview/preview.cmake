@@ -1,5 +1,5 @@
 # brdf::preview: environment-lit previews of any BrdfSource (preview.h). No VTK; images are
-# read and written through brdf::exporter (OpenImageIO stays behind it).
+# read and written through brdf::image_io (OpenImageIO only in its lazily loaded module).
 add_library(brdf_preview
   ${CMAKE_CURRENT_LIST_DIR}/environment_map.cpp
   ${CMAKE_CURRENT_LIST_DIR}/samplers.cpp
@@ -13,4 +13,4 @@ target_include_directories(brdf_preview PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/inclu
                                         PRIVATE ${CMAKE_CURRENT_LIST_DIR})
 target_link_libraries(brdf_preview
   PUBLIC brdf::core
-  PRIVATE brdf::warnings brdf::exporter Threads::Threads)
+  PRIVATE brdf::warnings brdf::image_io Threads::Threads)

@@ -7,6 +7,8 @@ add_library(brdf_processing
   ${CMAKE_CURRENT_LIST_DIR}/measurement_brdf.cpp
 )
 add_library(brdf::processing ALIAS brdf_processing)
+# Position-independent like brdf_core: the fitter's lazy module links it.
+set_target_properties(brdf_processing PROPERTIES POSITION_INDEPENDENT_CODE ON)
 target_include_directories(brdf_processing PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include
                                            PRIVATE ${CMAKE_CURRENT_LIST_DIR})
 target_link_libraries(brdf_processing

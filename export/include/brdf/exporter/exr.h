@@ -1,4 +1,5 @@
-// EXR and PNG images of a LUT or an atlas, through OpenImageIO (DESIGN §5, §7).
+// EXR and PNG images of a LUT or an atlas, written through OpenEXR and libpng (brdf::image_io,
+// never OpenImageIO; DESIGN §5, §7).
 //
 // The 3D texture is laid out flat: the K slices in a grid of C = ceil(√K) columns and
 // R = ceil(K/C) rows, row-major, ascending θin, top-left first (4 slices: 2 × 2, 722 × 362
@@ -11,7 +12,7 @@
 // as string header attributes: "brdf:sidecar" (the full sidecar JSON, or "brdf:atlas" for an atlas
 // manifest), "brdf:theta_in_deg" ("0, 20, 40, 60"), "brdf:layout" ("2 x 2 slices, row-major,
 // ascending theta_in, top-left first"), "brdf:texel_convention", "brdf:payload_crc32", and
-// "Software".
+// "Software". Nothing else (no date), so equal LUTs give byte-identical EXRs.
 //
 // PNG tone map (8-bit sRGB, for looking at, never for data): every channel value v is scaled
 // by s = 1 / L99, where L99 is the 99th percentile of the Rec.709 luminance
@@ -26,15 +27,16 @@
 #include <vector>
 
 #include "brdf/core/lut.h"
+#include "brdf/image_io/image_io.h"
 #include "brdf/exporter/metadata.h"
 #include "brdf/exporter/packed_volume.h"
 
 namespace brdf::exporter {
 
-enum class ExrPixelType { kHalf, kFloat };
+using image_io::ExrPixelType;
 // ZIP (deflate, 16 scanlines) shrinks a half composite about 7× and a float one about 1.5×
 // at two to three times the writing time (bench_export); kNone is the fastest.
-enum class ExrCompression { kZip, kNone };
+using image_io::ExrCompression;
 
 struct ExrOptions {
   // Implicit from a pixel type, so `WriteExr(path, image, ExrPixelType::kHalf, ...)` reads well.
@@ -46,13 +48,7 @@ struct ExrOptions {
 };
 
 // Interleaved RGB floats, row-major, row 0 at the top.
-struct FloatImage {
-  int width = 0, height = 0;
-  std::vector<float> rgb;  // width·height·3
-  const float* Pixel(int x, int y) const {
-    return &rgb[(static_cast<std::size_t>(y) * width + x) * 3];
-  }
-};
+using FloatImage = image_io::RgbImage;
 
 // The DESIGN §5 composite of a LUT (722 × 362 for K = 4). Throws InvalidArgument for an
 // unexportable LUT.
@@ -60,10 +56,10 @@ FloatImage CompositeImage(const Lut& lut);
 // The inverse: the K slices back out of a composite image of the right size.
 Lut LutFromComposite(const FloatImage& image, std::vector<double> theta_in_deg);
 
-using StringAttributes = std::vector<std::pair<std::string, std::string>>;
+using image_io::StringAttributes;
 
-// Writes an RGB EXR atomically (OIIO writes a temporary sibling that is renamed into place).
-// Throws IoError when OpenImageIO cannot create or write the file.
+// Writes an RGB EXR atomically (a temporary sibling renamed into place) with the "Software"
+// attribute and `attributes`. Throws IoError when the file cannot be created or written.
 void WriteExr(const std::string& path, const FloatImage& image, const ExrOptions& options,
               const StringAttributes& attributes);
 // The composite of a LUT with the sidecar's metadata in its header. `packed` is PackLut(lut)
@@ -75,21 +71,13 @@ void WriteExrComposite(const std::string& path, const Lut& lut, const TextureMet
 
 // The tone-mapped 8-bit sRGB PNG described above, written atomically.
 void WritePng(const std::string& path, const FloatImage& image);
-// An 8-bit RGB PNG of bytes already encoded (width·height·3, row 0 at the top), written
-// atomically: for callers with their own tone map (the preview's, processing/.../preview.h).
-void WritePngBytes(const std::string& path, int width, int height,
-                   const std::vector<unsigned char>& rgb);
 void WritePngComposite(const std::string& path, const Lut& lut);
 // The tone map alone (exposed for tests): 8-bit sRGB values, width·height·3.
 std::vector<unsigned char> ToneMapForPng(const FloatImage& image);
 
-struct ExrFile {
-  FloatImage image;             // R, G, B as float whatever the stored type
-  StringAttributes attributes;  // every string attribute of the header
-  ExrPixelType pixel_type = ExrPixelType::kFloat;
-  std::string Attribute(const std::string& name) const;  // "" when absent
-};
-// Reads an RGB EXR (the first three channels must be R, G, B). Throws IoError / FormatError.
+// image, attributes (every string attribute), pixel_type, compression, Attribute(name).
+using ExrFile = image_io::ExrImage;
+// Reads an RGB EXR (channels R, G, B) through OpenEXR. Throws IoError / FormatError.
 ExrFile ReadExr(const std::string& path);
 
 }  // namespace brdf::exporter
