@@ -26,5 +26,13 @@ echo "== converting captures to RGB9E5 lookup textures -> $out/luts"
 echo "== packing the library into one atlas -> $out/atlas"
 mkdir -p "$out/atlas"
 "$brdf" atlas "$out/captures" --out "$out/atlas/library" --force
-echo "== done: $(ls "$out/captures" | wc -l) captures in $out/captures, LUTs in $out/luts, atlas in $out/atlas"
+echo "== environment-lit previews (studio map) -> $out/previews"
+mkdir -p "$out/previews"
+for material in gold plastic_glossy_red wood_oak; do
+  "$brdf" preview "$root/data-samples/materials/$material.json" --size 384 --spp 64 --quiet \
+    --out "$out/previews/$material.png"
+done
+"$brdf" preview "$out/luts/gold.ktx2" --compare "$root/data-samples/materials/gold.json" \
+  --size 256 --spp 64 --quiet --out "$out/previews/gold_lut_vs_material.png"
+echo "== done: $(ls "$out/captures" | wc -l) captures in $out/captures, LUTs in $out/luts, atlas in $out/atlas, previews in $out/previews"
 "$brdf" info "$out/luts/gold.ktx2"
