@@ -19,6 +19,8 @@ packages=(
   python3 python3-numpy python3-scipy
   nodejs
 )
+# brdf-view: DejaVu Sans draws the Greek letters (θ, φ) in the window's labels.
+packages+=(fonts-dejavu-core)
 
 # Debian's npm is a separate package; a Node.js that already ships npm (e.g. NodeSource's)
 # conflicts with it, so npm is only requested when no npm command exists.

@@ -1,0 +1,164 @@
+// `brdf-view`: the VTK window onto a BRDF source (lobe, slice heat maps, environment-lit
+// preview). This is the only translation unit of brdf-view that sees CLI11; it parses the
+// options, makes sure there is an X display (re-running itself under xvfb-run for a
+// screenshot when there is none), opens the sources and hands them to brdf::viewer::RunViewer.
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <vector>
+
+#include "brdf/core/error.h"
+#include "brdf/core/measurement.h"
+#include "brdf/viewer/app.h"
+#include "open_source.h"
+
+namespace {
+
+constexpr const char* kXvfbGuard = "BRDF_VIEW_UNDER_XVFB";
+
+// "WxH" → width, height; an error text otherwise.
+std::string ParseSize(const std::string& text, int* width, int* height) {
+  const auto x = text.find_first_of("xX");
+  const std::string bad = "expected WIDTHxHEIGHT in pixels (e.g. 960x720), got '" + text + "'";
+  if (x == std::string::npos || x == 0 || x + 1 >= text.size()) return bad;
+  const std::string w = text.substr(0, x), h = text.substr(x + 1);
+  auto digits = [](const std::string& s) {
+    return s.size() <= 5 && std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
+  };
+  if (!digits(w) || !digits(h)) return bad;
+  *width = std::stoi(w);
+  *height = std::stoi(h);
+  if (*width < 64 || *height < 64 || *width > 8192 || *height > 8192) {
+    return "the size must be 64 to 8192 pixels each way, got '" + text + "'";
+  }
+  return {};
+}
+
+std::string FindOnPath(const std::string& program) {
+  const char* path = std::getenv("PATH");
+  std::string dirs = path ? path : "/usr/bin:/bin";
+  std::size_t start = 0;
+  while (start <= dirs.size()) {
+    const std::size_t end = std::min(dirs.find(':', start), dirs.size());
+    const std::string candidate = dirs.substr(start, end - start) + "/" + program;
+    if (end > start && access(candidate.c_str(), X_OK) == 0) return candidate;
+    start = end + 1;
+  }
+  return {};
+}
+
+// Replaces this process with `xvfb-run -a -s "-screen 0 WxHx24" <this program> <args>`.
+// Returns only if that fails.
+void ReexecUnderXvfb(const std::string& xvfb_run, int argc, char** argv, int width, int height) {
+  char self[4096];
+  const ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
+  if (n <= 0) return;
+  self[n] = '\0';
+  setenv(kXvfbGuard, "1", 1);
+  const std::string screen = "-screen 0 " + std::to_string(std::max(width, 1280)) + "x" +
+                             std::to_string(std::max(height, 1024)) + "x24";
+  std::vector<std::string> args = {xvfb_run, "-a", "-s", screen, self};
+  for (int i = 1; i < argc; ++i) args.emplace_back(argv[i]);
+  std::vector<char*> cargs;
+  for (std::string& a : args) cargs.push_back(a.data());
+  cargs.push_back(nullptr);
+  execv(xvfb_run.c_str(), cargs.data());
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{
+      "brdf-view: reflection lobes, LUT slice heat maps and environment-lit previews of any "
+      "BRDF the toolchain reads (capture, material, exported LUT, RGL, MERL, tables)"};
+  app.set_version_flag("--version", std::string("brdf-toolchain ") + brdf::SoftwareVersion());
+  std::string source, compare, mode_name = "lobe", screenshot, size_text = "960x720";
+  double theta_in_deg = 0;
+  app.add_option("source", source,
+                 "File to view (.bpc, material .json, .ktx2/.dds/sidecar, RGL .bsdf, MERL "
+                 ".binary, Zemax/LightTools/CSV table) or a library material name")
+      ->required();
+  app.add_option("--compare", compare,
+                 "Second source drawn over the first (e.g. a fit over its measurement)");
+  app.add_option("--mode", mode_name, "What to show")
+      ->check(CLI::IsMember({"lobe", "slices", "preview"}))
+      ->capture_default_str();
+  app.add_option("--theta-in", theta_in_deg,
+                 "Light polar angle in degrees; between measured slices the lobe is the LUT's "
+                 "interpolation")
+      ->check(CLI::Range(0.0, 89.0))
+      ->capture_default_str();
+  app.add_option("--screenshot", screenshot,
+                 "Render once to this PNG and exit (no window; uses xvfb-run when there is no "
+                 "X display). Also writes FILE.png.json with the camera");
+  app.add_option("--size", size_text, "Window or picture size in pixels, WIDTHxHEIGHT")
+      ->check(CLI::Validator(
+          [](std::string& text) {
+            int w = 0, h = 0;
+            return ParseSize(text, &w, &h);
+          },
+          "WxH"))
+      ->capture_default_str();
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);
+    std::fprintf(stderr, "brdf-view: %s\nRun 'brdf-view --help' for usage.\n", e.what());
+    return 2;
+  }
+
+  brdf::viewer::ViewerOptions options;
+  ParseSize(size_text, &options.width, &options.height);
+  options.mode = brdf::viewer::ModeFromName(mode_name);
+  options.theta_in_deg = theta_in_deg;
+  options.screenshot_path = screenshot;
+
+  const std::string display_problem = brdf::viewer::DisplayProblem();
+  if (!display_problem.empty()) {
+    if (screenshot.empty()) {
+      std::fprintf(stderr,
+                   "brdf-view: %s; the window needs an X display (use --screenshot FILE.png to "
+                   "render a picture without one)\n",
+                   display_problem.c_str());
+      return 1;
+    }
+    const std::string xvfb_run = FindOnPath("xvfb-run");
+    if (std::getenv(kXvfbGuard) == nullptr && !xvfb_run.empty()) {
+      ReexecUnderXvfb(xvfb_run, argc, argv, options.width, options.height);
+    }
+    if (xvfb_run.empty()) {
+      std::fprintf(stderr,
+                   "brdf-view: %s and xvfb-run is not installed: install the Debian packages "
+                   "xvfb and xauth (tools/install-deps.sh) or run inside an X session\n",
+                   display_problem.c_str());
+    } else {
+      std::fprintf(stderr, "brdf-view: %s, even under xvfb-run (%s)\n", display_problem.c_str(),
+                   xvfb_run.c_str());
+    }
+    return 1;
+  }
+
+  try {
+    brdf::viewer::LoadedSource primary = brdf::view_tool::OpenViewSource(source);
+    std::optional<brdf::viewer::LoadedSource> second;
+    if (!compare.empty()) second = brdf::view_tool::OpenViewSource(compare);
+    if (second && !second->error.empty()) {
+      std::fprintf(stderr, "brdf-view: error: --compare: %s\n", second->error.c_str());
+    }
+    const bool compare_failed = second && !second->error.empty();
+    const brdf::viewer::ViewerResult result =
+        brdf::viewer::RunViewer(options, std::move(primary), std::move(second));
+    if (!result.ok) {
+      if (!result.message.empty()) std::fprintf(stderr, "brdf-view: %s\n", result.message.c_str());
+      return 1;
+    }
+    return compare_failed && !screenshot.empty() ? 1 : 0;
+  } catch (const brdf::Error& e) {
+    std::fprintf(stderr, "brdf-view: error: %s\n", e.what());
+    return 1;
+  }
+}

@@ -1,0 +1,67 @@
+#include "open_source.h"
+
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <vector>
+
+#include "brdf/core/error.h"
+#include "brdf/processing/measurement_brdf.h"
+#include "cli_support.h"
+#include "sources.h"
+
+namespace brdf::view_tool {
+
+viewer::LoadedSource OpenViewSource(const std::string& path_or_name) {
+  viewer::LoadedSource out;
+  out.path = path_or_name;
+  try {
+    const std::string path = std::filesystem::exists(path_or_name)
+                                 ? path_or_name
+                                 : cli::ResolveMaterial(path_or_name);
+    const std::string name = cli::OutputNameOf(path);
+    std::vector<std::string> warnings;
+    const cli::FileKind kind = cli::ClassifyFile(path);
+    if (kind == cli::FileKind::kCapture || kind == cli::FileKind::kMaterial) {
+      // The measurement itself (not only an interpolated BRDF) so the lobe can show which
+      // directions were measured.
+      cli::PreparedMeasurement p = cli::PrepareMeasurement(path, kind, std::nullopt);
+      out.view = viewer::ViewSourceFromMeasurement(p.measurement, p.extrapolation.params, name);
+      if (kind == cli::FileKind::kCapture) {
+        out.brdf = std::make_shared<processing::MeasurementBrdf>(
+            p.measurement, p.extrapolation.params, processing::ResampleOptions{}, name);
+      } else {
+        out.brdf = cli::OpenEvalSource(path, std::nullopt, &warnings);
+      }
+      warnings.insert(warnings.end(), p.warnings.begin(), p.warnings.end());
+    } else if (kind == cli::FileKind::kTexture || kind == cli::FileKind::kSidecar) {
+      cli::OpenedTexture t = cli::OpenExportedTexture(path);
+      if (!t.texture.IsSingleLut()) {
+        throw InvalidArgument(path + ": an atlas holds many materials; open one material's LUT");
+      }
+      double theta_b = 90;
+      if (t.sidecar && t.sidecar->extrapolation) theta_b = t.sidecar->extrapolation->theta_b_deg;
+      out.brdf = std::make_shared<cli::LutBrdf>(t.texture.lut, name);
+      out.view = viewer::ViewSourceFromLut(std::move(t.texture.lut), name, theta_b);
+      warnings.insert(warnings.end(), t.warnings.begin(), t.warnings.end());
+    } else {
+      // Measured databases (RGL, MERL) and tables (Zemax, LightTools, CSV): whatever
+      // OpenEvalSource makes of the file, captured at the reference geometry.
+      std::shared_ptr<const BrdfSource> brdf = cli::OpenEvalSource(path, std::nullopt, &warnings);
+      out.view = viewer::ViewSourceFromBrdf(*brdf, name);
+      out.brdf = std::move(brdf);
+    }
+    out.view->warnings = std::move(warnings);
+  } catch (const Error& e) {
+    out.view.reset();
+    out.brdf.reset();
+    out.error = e.what();
+  } catch (const std::exception& e) {
+    out.view.reset();
+    out.brdf.reset();
+    out.error = std::string("unexpected failure: ") + e.what();
+  }
+  return out;
+}
+
+}  // namespace brdf::view_tool
