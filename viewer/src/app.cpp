@@ -161,7 +161,7 @@ class App {
   void BuildSlicesScene(bool reset_camera);
   void BuildPreviewScene(bool reset_camera);
   void AddLobe(const LobeMesh& mesh, bool primary, double opacity);
-  void AddArrow(const Vec3& direction, double length, const double color[3]);
+  void AddArrow(const Vec3& direction, double length, const double color[3], double opacity);
   void ShowPreviewImage();
   void UpdateText();
   bool WriteScreenshot(const std::string& path, std::string* error);
@@ -181,6 +181,7 @@ class App {
   bool all_slices_ = false;
   bool compare_wireframe_ = true;
   bool show_help_ = false;
+  bool interactive_ = false;  // a window with an interactor (false for a screenshot run)
   int current_slice_ = 0;
   double scale_max_ = 1;       // colour scale and log floor for the lobe (fixed while θin moves)
   double arrow_length_ = 1;
@@ -256,7 +257,6 @@ void App::RecomputeScale() {
   }
   log_scale_ = log_saved;
   scale_max_ = max_value > 0 ? max_value : 1.0;
-  arrow_length_ = 1.3 * (log_scale_ ? 3.0 : scale_max_);
 }
 
 void App::SetupColors(double lo, double hi, bool log_scale) {
@@ -349,19 +349,22 @@ void App::AddLobe(const LobeMesh& mesh, bool primary, double opacity) {
       mapper->SetLookupTable(colors_);
       mapper->UseLookupTableScalarRangeOn();
       mapper->SetScalarModeToUsePointData();
-      prop->SetOpacity(cls == Coverage::kExtrapolated ? 0.4 * opacity : opacity);
+      // With a second source the first is see-through, or a smaller lobe inside it would vanish.
+      const double see_through = Compare() ? 0.6 : 1.0;
+      prop->SetOpacity((cls == Coverage::kExtrapolated ? 0.4 : 1.0) * opacity * see_through);
     }
     AddProp(actor);
   }
 }
 
-void App::AddArrow(const Vec3& direction, double length, const double color[3]) {
+void App::AddArrow(const Vec3& direction, double length, const double color[3],
+                   double opacity) {
   vtkNew<vtkArrowSource> arrow;
   arrow->SetTipResolution(24);
   arrow->SetShaftResolution(12);
-  arrow->SetShaftRadius(0.012);
-  arrow->SetTipRadius(0.035);
-  arrow->SetTipLength(0.08);
+  arrow->SetShaftRadius(0.006);
+  arrow->SetTipRadius(0.02);
+  arrow->SetTipLength(0.06);
   // vtkArrowSource points along +x from 0 to 1: rotate +x onto `direction`, then scale.
   const Vec3 d = Normalize(direction);
   const Vec3 axis{0.0, -d.z, d.y};  // x × d
@@ -379,6 +382,7 @@ void App::AddArrow(const Vec3& direction, double length, const double color[3]) 
   actor->SetMapper(mapper);
   actor->GetProperty()->SetColor(color[0], color[1], color[2]);
   actor->GetProperty()->SetAmbient(0.5);
+  actor->GetProperty()->SetOpacity(opacity);
   AddProp(actor);
 }
 
@@ -400,11 +404,15 @@ void App::BuildLobeScene(bool reset_camera) {
     AddLobe(BuildLobe(*other, options), false, 1.0);
   }
   constexpr double kWhite[3] = {0.95, 0.95, 0.95};
-  constexpr double kYellow[3] = {1.0, 0.85, 0.1};
+  constexpr double kOrange[3] = {1.0, 0.35, 0.2};
   constexpr double kCyan[3] = {0.1, 0.85, 1.0};
-  AddArrow(mesh.normal, arrow_length_, kWhite);
-  AddArrow(mesh.light, arrow_length_, kYellow);
-  AddArrow(mesh.mirror, arrow_length_, kCyan);
+  // Arrows reach past the lobe drawn now (all slices: past the largest), so they never hide
+  // inside it; the mirror arrow runs through a glossy lobe and is drawn translucent.
+  const double lobe_radius = all_slices_ ? (log_scale_ ? 3.0 : scale_max_) : mesh.max_radius;
+  arrow_length_ = 1.3 * std::max(lobe_radius, 1e-6);
+  AddArrow(mesh.normal, arrow_length_, kWhite, 1.0);
+  AddArrow(mesh.light, arrow_length_, kOrange, 1.0);
+  AddArrow(mesh.mirror, arrow_length_, kCyan, 0.45);
   // The surface: a circle in the xz = 0 plane.
   vtkNew<vtkRegularPolygonSource> disk;
   disk->SetNumberOfSides(96);
@@ -588,11 +596,13 @@ void App::Rebuild(bool reset_camera) {
     } catch (const Error& e) {
       status_ = std::string("cannot draw: ") + e.what();
     }
-    slider_->SetEnabled(mode_ != Mode::kPreview && Primary()->lut.slices() > 1 ? 1 : 0);
+    if (interactive_) {
+      slider_->SetEnabled(mode_ != Mode::kPreview && Primary()->lut.slices() > 1 ? 1 : 0);
+    }
     slider_rep_->SetValue(theta_in_deg_);
   } else {
     legend_->SetVisibility(0);
-    slider_->SetEnabled(0);
+    if (interactive_) slider_->SetEnabled(0);
   }
   UpdateText();
 }
@@ -617,7 +627,7 @@ void App::UpdateText() {
       info << "\nradius " << (cosine_weighted_ ? "f_r·cosθo" : "f_r") << ", "
            << (log_scale_ ? "log (decades above 10⁻³ of max)" : "linear (1/sr)")
            << (all_slices_ ? ", all slices" : "");
-      info << "\narrows: white normal, yellow light, cyan mirror";
+      info << "\narrows: white normal, orange light, cyan mirror";
       info << "\ntranslucent: extrapolated beyond θb = " << Fixed(source->theta_b_deg, 0)
            << "°;  magenta: not measured";
     } else if (mode_ == Mode::kSlices) {
@@ -804,8 +814,13 @@ ViewerResult App::Run() {
   window_->SetWindowName("brdf-view");
   window_->AddRenderer(renderer_);
   const bool headless = !options_.screenshot_path.empty();
-  if (headless) window_->SetOffScreenRendering(1);
-  interactor_->SetRenderWindow(window_);
+  interactive_ = !headless;
+  // No off-screen rendering for screenshots: VTK 9.1's X interactor crashes (XSync on a null
+  // display) with an off-screen window, and the slider widget needs the interactor. Under
+  // xvfb-run the window is invisible anyway.
+  // A screenshot needs no interactor; VTK 9.1's X interactor sometimes crashed in its
+  // Initialize (XSync) under Xvfb, so headless runs never create one.
+  if (!headless) interactor_->SetRenderWindow(window_);
   style_->app = this;
   interactor_->SetInteractorStyle(style_);
 
@@ -829,6 +844,7 @@ ViewerResult App::Run() {
     renderer_->AddViewProp(t);
   }
   legend_->SetNumberOfLabels(5);
+  legend_->UnconstrainedFontSizeOn();
   legend_->SetMaximumWidthInPixels(90);
   legend_->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
   legend_->GetPositionCoordinate()->SetValue(0.89, 0.15);
@@ -859,7 +875,7 @@ ViewerResult App::Run() {
     slider_rep_->SetMaximumValue(std::max(MaxThetaIn(), MinThetaIn() + 1e-3));
     slider_rep_->SetValue(theta_in_deg_);
   }
-  slider_->SetInteractor(interactor_);
+  if (interactive_) slider_->SetInteractor(interactor_);
   slider_->SetRepresentation(slider_rep_);
   slider_->SetAnimationModeToJump();
   slider_callback_->SetClientData(this);
@@ -870,7 +886,7 @@ ViewerResult App::Run() {
   });
   slider_->AddObserver(vtkCommand::InteractionEvent, slider_callback_);
 
-  interactor_->Initialize();
+  if (interactive_) interactor_->Initialize();
   if (Primary()) {
     try {
       RecomputeScale();
@@ -897,7 +913,6 @@ ViewerResult App::Run() {
       result.ok = false;
       result.message = error;
     }
-    slider_->SetEnabled(0);
     return result;
   }
   timer_callback_->SetClientData(this);
