@@ -26,5 +26,16 @@ echo "== converting captures to RGB9E5 lookup textures -> $out/luts"
 echo "== packing the library into one atlas -> $out/atlas"
 mkdir -p "$out/atlas"
 "$brdf" atlas "$out/captures" --out "$out/atlas/library"
-echo "== done: $(ls "$out/captures" | wc -l) captures in $out/captures, LUTs in $out/luts, atlas in $out/atlas"
+# Pictures to look at: the reflection lobe of a few captures (brdf-view renders under
+# xvfb-run by itself when there is no display).
+cmake --build "$build" -j "$(nproc)" --target brdf-view
+mkdir -p "$out/pictures"
+echo "== lobe pictures -> $out/pictures"
+for material in gold plastic_glossy_red wood_oak paper_white; do
+  "$build/tools/brdf-view" "$out/captures/$material.bpc" --mode lobe --theta-in 40 \
+    --size 960x720 --screenshot "$out/pictures/$material-lobe.png"
+done
+"$build/tools/brdf-view" "$out/captures/gold.bpc" --mode slices --theta-in 40 \
+  --size 960x600 --screenshot "$out/pictures/gold-slices.png"
+echo "== done: $(ls "$out/captures" | wc -l) captures in $out/captures, LUTs in $out/luts, atlas in $out/atlas, pictures in $out/pictures"
 "$brdf" info "$out/luts/gold.ktx2"

@@ -103,6 +103,14 @@ int main(int argc, char** argv) {
           },
           "WxH"))
       ->capture_default_str();
+  std::string channel = "luminance";
+  bool log_scale = false, cosine_weighted = false, all_slices = false;
+  app.add_option("--channel", channel, "Channel the lobe and heat maps show")
+      ->check(CLI::IsMember({"R", "G", "B", "luminance"}))
+      ->capture_default_str();
+  app.add_flag("--log", log_scale, "Log scale for the lobe radius and the colours");
+  app.add_flag("--cos", cosine_weighted, "Lobe radius f_r·cosθo instead of f_r");
+  app.add_flag("--all-slices", all_slices, "Every measured slice at once");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -116,6 +124,10 @@ int main(int argc, char** argv) {
   options.mode = brdf::viewer::ModeFromName(mode_name);
   options.theta_in_deg = theta_in_deg;
   options.screenshot_path = screenshot;
+  options.channel = channel == "R" ? 0 : channel == "G" ? 1 : channel == "B" ? 2 : 3;
+  options.log_scale = log_scale;
+  options.cosine_weighted = cosine_weighted;
+  options.all_slices = all_slices;
 
   const std::string display_problem = brdf::viewer::DisplayProblem();
   if (!display_problem.empty()) {

@@ -63,7 +63,9 @@ namespace {
 
 constexpr const char* kFontFile = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
 constexpr double kBackground[3] = {0.08, 0.08, 0.10};
-constexpr double kSliceGap = 60;  // world units (degrees) between heat maps
+// World units (degrees) between heat maps: room for the axis labels and titles.
+constexpr double kSliceGapX = 130;
+constexpr double kSliceGapY = 110;
 
 // Viridis, sampled at 0, ¼, ½, ¾, 1 (perceptually ordered, readable by colour-blind users).
 constexpr double kViridis[5][3] = {{0.267, 0.005, 0.329},
@@ -104,7 +106,12 @@ class ViewerStyle : public vtkInteractorStyleTrackballCamera {
   void OnKeyPress() override {}
   void OnMouseMove() override;
   void OnLeftButtonDown() override {
-    if (pan_only) {
+    if (orbit_preview) {
+      const int* pos = GetInteractor()->GetEventPosition();
+      drag_x = pos[0];
+      drag_y = pos[1];
+      dragging = true;
+    } else if (pan_only) {
       const int* pos = GetInteractor()->GetEventPosition();
       FindPokedRenderer(pos[0], pos[1]);
       StartPan();
@@ -112,8 +119,14 @@ class ViewerStyle : public vtkInteractorStyleTrackballCamera {
       vtkInteractorStyleTrackballCamera::OnLeftButtonDown();
     }
   }
+  void OnLeftButtonUp() override;
   App* app = nullptr;
   bool pan_only = false;
+  // Preview mode: a drag turns the preview camera once the button is released (each new
+  // camera restarts the progressive render, so it is not redone on every mouse move).
+  bool orbit_preview = false;
+  bool dragging = false;
+  int drag_x = 0, drag_y = 0;
 };
 vtkStandardNewMacro(ViewerStyle)
 
@@ -124,7 +137,11 @@ class App {
         primary_(std::move(primary)),
         compare_(std::move(compare)),
         mode_(options.mode),
-        theta_in_deg_(options.theta_in_deg) {}
+        theta_in_deg_(options.theta_in_deg),
+        channel_(static_cast<Channel>(std::clamp(options.channel, 0, 3))),
+        log_scale_(options.log_scale),
+        cosine_weighted_(options.cosine_weighted),
+        all_slices_(options.all_slices) {}
 
   ViewerResult Run();
   void OnKey(const std::string& keysym);
@@ -132,6 +149,12 @@ class App {
   void OnSlider(double value) {
     theta_in_deg_ = value;
     if (mode_ == Mode::kSlices) current_slice_ = NearestSlice();
+    Rebuild(false);
+    window_->Render();
+  }
+  void OnPreviewDrag(int dx, int dy) {
+    if (mode_ != Mode::kPreview || !preview_ || (dx == 0 && dy == 0)) return;
+    preview_->Orbit(-0.4 * dy, -0.4 * dx);
     Rebuild(false);
     window_->Render();
   }
@@ -175,10 +198,10 @@ class App {
   std::optional<LoadedSource> compare_;
   Mode mode_;
   double theta_in_deg_;
-  Channel channel_ = Channel::kLuminance;
-  bool log_scale_ = false;
-  bool cosine_weighted_ = false;
-  bool all_slices_ = false;
+  Channel channel_;
+  bool log_scale_;
+  bool cosine_weighted_;
+  bool all_slices_;
   bool compare_wireframe_ = true;
   bool show_help_ = false;
   bool interactive_ = false;  // a window with an interactor (false for a screenshot run)
@@ -210,6 +233,16 @@ class App {
 
 void ViewerStyle::OnChar() {
   if (app) app->OnKey(GetInteractor()->GetKeySym() ? GetInteractor()->GetKeySym() : "");
+}
+
+void ViewerStyle::OnLeftButtonUp() {
+  if (dragging) {
+    dragging = false;
+    const int* pos = GetInteractor()->GetEventPosition();
+    if (app) app->OnPreviewDrag(pos[0] - drag_x, pos[1] - drag_y);
+    return;
+  }
+  vtkInteractorStyleTrackballCamera::OnLeftButtonUp();
 }
 
 void ViewerStyle::OnMouseMove() {
@@ -389,6 +422,7 @@ void App::AddArrow(const Vec3& direction, double length, const double color[3],
 void App::BuildLobeScene(bool reset_camera) {
   const ViewSource* source = Primary();
   style_->pan_only = false;
+  style_->orbit_preview = false;
   renderer_->GetActiveCamera()->ParallelProjectionOff();
   const LobeOptions options = CurrentLobeOptions(theta_in_deg_);
   const LobeMesh mesh = BuildLobe(*source, options);
@@ -444,6 +478,7 @@ void App::BuildLobeScene(bool reset_camera) {
 void App::BuildSlicesScene(bool reset_camera) {
   const ViewSource* source = Primary();
   style_->pan_only = true;
+  style_->orbit_preview = false;
   std::vector<int> slices;
   if (all_slices_) {
     for (int k = 0; k < source->lut.slices(); ++k) slices.push_back(k);
@@ -460,8 +495,8 @@ void App::BuildSlicesScene(bool reset_camera) {
   const int columns = static_cast<int>(std::ceil(std::sqrt(static_cast<double>(slices.size()))));
   for (std::size_t n = 0; n < images.size(); ++n) {
     const SliceImage& img = images[n];
-    const double x0 = static_cast<double>(n % columns) * (360.0 + kSliceGap);
-    const double y0 = -static_cast<double>(n / columns) * (180.0 + kSliceGap);
+    const double x0 = static_cast<double>(n % columns) * (360.0 + kSliceGapX);
+    const double y0 = -static_cast<double>(n / columns) * (180.0 + kSliceGapY);
     placements_.push_back({img.slice, x0, y0});
     vtkNew<vtkImageData> data;
     data->SetDimensions(img.width, img.height, 1);
@@ -529,14 +564,18 @@ void App::BuildSlicesScene(bool reset_camera) {
     camera->ParallelProjectionOn();
     camera->SetViewUp(0, 1, 0);
     const int rows = static_cast<int>((slices.size() + columns - 1) / columns);
-    const double w = columns * 360.0 + (columns - 1) * kSliceGap;
-    const double h = rows * 180.0 + (rows - 1) * kSliceGap;
-    const double cx = w / 2, cy = 180.0 - h / 2;
-    camera->SetFocalPoint(cx, cy, 0);
-    camera->SetPosition(cx, cy, 1000);
+    // The content box: θd labels and title to the left, θin title above, φd labels below.
+    const double left = -110, right = columns * 360.0 + (columns - 1) * kSliceGapX;
+    const double top = 180 + 40, bottom = -(rows - 1) * (180.0 + kSliceGapY) - 60;
     const double aspect = static_cast<double>(options_.width) / options_.height;
-    // Room for the axes, the title and the legend on the right.
-    camera->SetParallelScale(0.5 * std::max(h + 2.2 * kSliceGap, (w + 3.5 * kSliceGap) / aspect));
+    // It fills 84 % of the width from 2 % (the legend sits in the right 12 %) and 82 % of the
+    // height below the text lines at the top.
+    const double scale = 0.5 * std::max((top - bottom) / 0.82, (right - left) / 0.84 / aspect);
+    const double fx = left + scale * aspect * (1.0 - 0.04);
+    const double fy = top - scale * (1.0 - 2 * 0.13);
+    camera->SetFocalPoint(fx, fy, 0);
+    camera->SetPosition(fx, fy, 1000);
+    camera->SetParallelScale(scale);
   }
   renderer_->ResetCameraClippingRange();
 }
@@ -556,7 +595,8 @@ void App::ShowPreviewImage() {
 }
 
 void App::BuildPreviewScene(bool reset_camera) {
-  style_->pan_only = true;
+  style_->pan_only = false;
+  style_->orbit_preview = true;
   legend_->SetVisibility(0);
   if (!preview_) {
     preview_ = MakePreviewPanel(primary_.brdf, compare_ ? compare_->brdf : nullptr,
@@ -652,7 +692,8 @@ void App::UpdateText() {
         "Left/Right θin −/+1°   PgUp/PgDn previous/next measured slice\n"
         "a all slices   c channel (R, G, B, luminance)\n"
         "l linear/log   w radius f_r or f_r·cosθo   m compare wireframe/colour\n"
-        "e/E rotate environment (preview)   mouse: drag to orbit/pan, wheel to zoom");
+        "preview: e/E rotate the environment, arrows or drag orbit the camera\n"
+        "mouse: drag to orbit (lobe) or pan (slices), wheel to zoom");
   } else {
     help_->SetInput("h: keyboard help");
   }
@@ -694,6 +735,10 @@ void App::OnKey(const std::string& key) {
   if (key == "1" || key == "2" || key == "3") {
     mode_ = key == "1" ? Mode::kLobe : key == "2" ? Mode::kSlices : Mode::kPreview;
     reset = true;
+  } else if (mode_ == Mode::kPreview && preview_ &&
+             (key == "Left" || key == "Right" || key == "Up" || key == "Down")) {
+    preview_->Orbit(key == "Up" ? -10.0 : key == "Down" ? 10.0 : 0.0,
+                    key == "Left" ? -15.0 : key == "Right" ? 15.0 : 0.0);
   } else if (key == "Left" || key == "Right") {
     theta_in_deg_ = std::clamp(theta_in_deg_ + (key == "Left" ? -1.0 : 1.0), MinThetaIn(),
                                MaxThetaIn());
@@ -902,6 +947,10 @@ ViewerResult App::Run() {
     result.message = primary_.path + ": " + primary_.error;
   }
   if (headless) {
+    if (mode_ == Mode::kPreview && !preview_ && result.ok) {
+      result.ok = false;
+      result.message = "no preview: " + PreviewUnavailableReason();
+    }
     // A progressive preview gets its full budget before the picture is taken.
     if (mode_ == Mode::kPreview && preview_) {
       while (preview_->Refine()) {

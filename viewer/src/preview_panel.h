@@ -25,6 +25,9 @@ class PreviewPanel {
   virtual std::string Describe() const = 0;
   // Turns the environment about the normal (z) by `delta_deg` and restarts the refinement.
   virtual void RotateEnvironment(double delta_deg) = 0;
+  // Moves the preview camera around the object (polar angle from the normal, azimuth) and
+  // restarts the refinement.
+  virtual void Orbit(double delta_theta_deg, double delta_phi_deg) = 0;
 };
 
 // Null when the preview cannot be made (no evaluable source, or the renderer is missing);

@@ -12,6 +12,7 @@
 //   a all slices at once       c channel (R, G, B, luminance)
 //   l linear / log radius      w radius f_r or f_r·cosθo      m compare: wireframe / colour
 //   r reset camera             e / E rotate the environment (preview)
+//   preview: arrow keys or a mouse drag orbit the camera; the picture refines while idle
 #pragma once
 
 #include <memory>
@@ -40,6 +41,11 @@ struct ViewerOptions {
   Mode mode = Mode::kLobe;
   double theta_in_deg = 0;  // starting light angle
   int width = 960, height = 720;
+  // Starting state of the toggles (the keys c, l, w, a change them in the window).
+  int channel = 3;               // 0 R, 1 G, 2 B, 3 luminance
+  bool log_scale = false;        // lobe radius and colours on a log scale
+  bool cosine_weighted = false;  // lobe radius f_r·cosθo
+  bool all_slices = false;       // every measured slice at once
   // Non-empty: render once to this PNG and return, without waiting for input. A JSON file
   // `<screenshot>.json` beside it records the camera (position, focal point, view up, vertical
   // view angle in degrees) and the image size, so a report (or a test) can tell what is where.
