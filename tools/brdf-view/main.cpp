@@ -1,8 +1,11 @@
 // `brdf-view`: the VTK window onto a BRDF source (lobe, slice heat maps, environment-lit
 // preview). This is the only translation unit of brdf-view that sees CLI11; it parses the
-// options, makes sure there is an X display (re-running itself under xvfb-run for a
+// options, makes sure there is an X display (running itself under xvfb-run for a
 // screenshot when there is none), opens the sources and hands them to brdf::viewer::RunViewer.
+#include <sys/wait.h>
 #include <unistd.h>
+
+#include <cerrno>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -51,14 +54,20 @@ std::string FindOnPath(const std::string& program) {
   return {};
 }
 
-// Replaces this process with `xvfb-run -a -s "-screen 0 WxHx24" <this program> <args>`.
-// Returns only if that fails.
-void ReexecUnderXvfb(const std::string& xvfb_run, int argc, char** argv, int width, int height) {
+// Runs `xvfb-run -a -s "-screen 0 WxHx24" <this program> <args>` and returns the exit code of
+// this program's run under it. That code travels through a file: xvfb-run itself sometimes
+// exits 5 ("problem while cleaning up temporary directory") after a successful run when
+// several Xvfb servers start and stop at once. Returns -1 if xvfb-run could not be started.
+int RunUnderXvfb(const std::string& xvfb_run, int argc, char** argv, int width, int height) {
   char self[4096];
   const ssize_t n = readlink("/proc/self/exe", self, sizeof self - 1);
-  if (n <= 0) return;
+  if (n <= 0) return -1;
   self[n] = '\0';
-  setenv(kXvfbGuard, "1", 1);
+  char status_path[] = "/tmp/brdf-view-status-XXXXXX";
+  const int fd = mkstemp(status_path);
+  if (fd < 0) return -1;
+  close(fd);
+  setenv(kXvfbGuard, status_path, 1);
   const std::string screen = "-screen 0 " + std::to_string(std::max(width, 1280)) + "x" +
                              std::to_string(std::max(height, 1024)) + "x24";
   std::vector<std::string> args = {xvfb_run, "-a", "-s", screen, self};
@@ -66,7 +75,34 @@ void ReexecUnderXvfb(const std::string& xvfb_run, int argc, char** argv, int wid
   std::vector<char*> cargs;
   for (std::string& a : args) cargs.push_back(a.data());
   cargs.push_back(nullptr);
-  execv(xvfb_run.c_str(), cargs.data());
+  const pid_t pid = fork();
+  if (pid < 0) return -1;
+  if (pid == 0) {
+    execv(xvfb_run.c_str(), cargs.data());
+    _exit(127);
+  }
+  int wstatus = 0;
+  while (waitpid(pid, &wstatus, 0) < 0 && errno == EINTR) {
+  }
+  int code = -1;
+  if (FILE* f = std::fopen(status_path, "r")) {
+    if (std::fscanf(f, "%d", &code) != 1) code = -1;
+    std::fclose(f);
+  }
+  std::remove(status_path);
+  if (code >= 0) return code;
+  return WIFEXITED(wstatus) && WEXITSTATUS(wstatus) != 0 ? WEXITSTATUS(wstatus) : 1;
+}
+
+// Under RunUnderXvfb: leaves the exit code where the parent reads it, then exits.
+int Finish(int code) {
+  if (const char* status_path = std::getenv(kXvfbGuard)) {
+    if (FILE* f = std::fopen(status_path, "w")) {
+      std::fprintf(f, "%d\n", code);
+      std::fclose(f);
+    }
+  }
+  return code;
 }
 
 }  // namespace
@@ -140,7 +176,8 @@ int main(int argc, char** argv) {
     }
     const std::string xvfb_run = FindOnPath("xvfb-run");
     if (std::getenv(kXvfbGuard) == nullptr && !xvfb_run.empty()) {
-      ReexecUnderXvfb(xvfb_run, argc, argv, options.width, options.height);
+      const int code = RunUnderXvfb(xvfb_run, argc, argv, options.width, options.height);
+      if (code >= 0) return code;
     }
     if (xvfb_run.empty()) {
       std::fprintf(stderr,
@@ -166,11 +203,11 @@ int main(int argc, char** argv) {
         brdf::viewer::RunViewer(options, std::move(primary), std::move(second));
     if (!result.ok) {
       if (!result.message.empty()) std::fprintf(stderr, "brdf-view: %s\n", result.message.c_str());
-      return 1;
+      return Finish(1);
     }
-    return compare_failed && !screenshot.empty() ? 1 : 0;
+    return Finish(compare_failed && !screenshot.empty() ? 1 : 0);
   } catch (const brdf::Error& e) {
     std::fprintf(stderr, "brdf-view: error: %s\n", e.what());
-    return 1;
+    return Finish(1);
   }
 }
