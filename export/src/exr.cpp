@@ -152,8 +152,15 @@ std::vector<unsigned char> ToneMapForPng(const FloatImage& image) {
 }
 
 void WritePng(const std::string& path, const FloatImage& image) {
-  const std::vector<unsigned char> pixels = ToneMapForPng(image);
-  OIIO::ImageSpec spec(image.width, image.height, 3, OIIO::TypeDesc::UINT8);
+  WritePngBytes(path, image.width, image.height, ToneMapForPng(image));
+}
+
+void WritePngBytes(const std::string& path, int width, int height,
+                   const std::vector<unsigned char>& pixels) {
+  if (width < 1 || height < 1 || pixels.size() != static_cast<std::size_t>(width) * height * 3)
+    throw InvalidArgument(fmt::format("PNG: inconsistent image {} × {} with {} bytes", width,
+                                      height, pixels.size()));
+  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
   // zlib level 3: half the encoding time of the default 6 for a file about 25 % larger.
   spec.attribute("png:compressionLevel", 3);
   spec.attribute("Software", BrdfToolWriter());

@@ -75,6 +75,10 @@ void WriteExrComposite(const std::string& path, const Lut& lut, const TextureMet
 
 // The tone-mapped 8-bit sRGB PNG described above, written atomically.
 void WritePng(const std::string& path, const FloatImage& image);
+// An 8-bit RGB PNG of bytes already encoded (width·height·3, row 0 at the top), written
+// atomically: for callers with their own tone map (the preview's, processing/.../preview.h).
+void WritePngBytes(const std::string& path, int width, int height,
+                   const std::vector<unsigned char>& rgb);
 void WritePngComposite(const std::string& path, const Lut& lut);
 // The tone map alone (exposed for tests): 8-bit sRGB values, width·height·3.
 std::vector<unsigned char> ToneMapForPng(const FloatImage& image);

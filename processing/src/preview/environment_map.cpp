@@ -1,0 +1,234 @@
+// Environment maps: validation, lookup, the procedural maps and files.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "brdf/core/error.h"
+#include "brdf/processing/preview.h"
+#include "preview_internal.h"
+
+namespace brdf::preview {
+namespace {
+
+using detail::Length;
+
+// Direction of the centre of pixel (i, j).
+Vec3 PixelCentre(int i, int j, int width, int height) {
+  return SphericalDirection((j + 0.5) * kPi / height, (i + 0.5) * 2.0 * kPi / width);
+}
+
+template <class F>
+std::vector<float> Tabulate(int width, int height, F radiance) {
+  std::vector<float> rgb(static_cast<std::size_t>(width) * height * 3);
+  for (int j = 0; j < height; ++j)
+    for (int i = 0; i < width; ++i) {
+      const Rgb c = radiance(PixelCentre(i, j, width, height));
+      float* p = &rgb[(static_cast<std::size_t>(j) * width + i) * 3];
+      for (int k = 0; k < 3; ++k) p[k] = static_cast<float>(c[k]);
+    }
+  return rgb;
+}
+
+double SmoothStep(double edge0, double edge1, double x) {
+  const double t = std::clamp((x - edge0) / (edge1 - edge0), 0.0, 1.0);
+  return t * t * (3.0 - 2.0 * t);
+}
+
+// A soft box: a rectangle on the sphere centred on direction (θc, φc), `half_width_deg` across
+// and `half_height_deg` up and down in the box's own tangent frame, edges softened over
+// `soft_deg`. Returns the coverage in [0, 1].
+struct SoftBox {
+  double theta_deg, phi_deg, half_width_deg, half_height_deg, soft_deg;
+  Rgb radiance;
+  double Coverage(const Vec3& w) const {
+    const Vec3 c = SphericalDirectionDeg(theta_deg, phi_deg);
+    const double cos_angle = Dot(w, c);
+    if (cos_angle <= 0.0) return 0.0;
+    // Gnomonic coordinates on the plane tangent at c: right is horizontal, up towards +z.
+    Vec3 right = detail::Cross(c, Vec3{0, 0, 1});
+    right = right * (1.0 / Length(right));
+    const Vec3 up = detail::Cross(right, c);
+    const double x = RadToDeg(std::atan(Dot(w, right) / cos_angle));
+    const double y = RadToDeg(std::atan(Dot(w, up) / cos_angle));
+    return (1.0 - SmoothStep(half_width_deg - soft_deg, half_width_deg, std::fabs(x))) *
+           (1.0 - SmoothStep(half_height_deg - soft_deg, half_height_deg, std::fabs(y)));
+  }
+};
+
+void CheckSize(int width, int height) {
+  if (width < 1 || height < 1 || width > 16384 || height > 8192)
+    throw InvalidArgument("environment map: size must be between 1 × 1 and 16384 × 8192, got " +
+                          std::to_string(width) + " × " + std::to_string(height));
+}
+
+}  // namespace
+
+EnvironmentMap::EnvironmentMap(int width, int height, std::vector<float> rgb, std::string name)
+    : width_(width), height_(height), rgb_(std::move(rgb)), name_(std::move(name)) {
+  CheckSize(width, height);
+  if (rgb_.size() != static_cast<std::size_t>(width) * height * 3)
+    throw InvalidArgument("environment map '" + name_ + "': " + std::to_string(width) + " × " +
+                          std::to_string(height) + " pixels need " +
+                          std::to_string(static_cast<std::size_t>(width) * height * 3) +
+                          " floats, got " + std::to_string(rgb_.size()));
+  for (std::size_t k = 0; k < rgb_.size(); ++k)
+    if (!(rgb_[k] >= 0.0f) || !std::isfinite(rgb_[k])) {
+      const std::size_t p = k / 3;
+      throw InvalidArgument("environment map '" + name_ + "': pixel (" +
+                            std::to_string(p % width) + ", " + std::to_string(p / width) +
+                            "): expected a finite radiance ≥ 0, got " + std::to_string(rgb_[k]));
+    }
+}
+
+Rgb EnvironmentMap::Radiance(const Vec3& w) const {
+  int i = 0, j = 0;
+  detail::MapPixelOf(*this, w, &i, &j);
+  const float* p = Pixel(i, j);
+  return {p[0], p[1], p[2]};
+}
+
+EnvironmentMap EnvironmentMap::Studio(int width, int height) {
+  CheckSize(width, height);
+  // The default camera looks from +x (φ = 0); +y is to its right. The key light is high on the
+  // camera's right, the fill low on its left, the rim light behind the object.
+  const SoftBox boxes[] = {
+      {40.0, 35.0, 22.0, 16.0, 4.0, {4.0, 3.9, 3.7}},    // key
+      {70.0, 295.0, 14.0, 20.0, 5.0, {0.9, 0.95, 1.05}}, // fill
+      {55.0, 165.0, 9.0, 28.0, 3.0, {3.0, 3.0, 3.0}},    // rim
+  };
+  std::vector<float> rgb = Tabulate(width, height, [&](const Vec3& w) {
+    // Gradient: 0.05 at and below the horizon, 0.25 at the zenith.
+    const double g = 0.05 + 0.2 * std::max(0.0, w.z);
+    Rgb c = {g, g, g * 1.05};
+    for (const SoftBox& box : boxes) {
+      const double k = box.Coverage(w);
+      for (int ch = 0; ch < 3; ++ch) c[ch] = c[ch] * (1.0 - k) + box.radiance[ch] * k;
+    }
+    return c;
+  });
+  return EnvironmentMap(width, height, std::move(rgb), "studio");
+}
+
+EnvironmentMap EnvironmentMap::Sky(double sun_theta_deg, double sun_phi_deg, int width,
+                                   int height) {
+  CheckSize(width, height);
+  if (!(sun_theta_deg >= 0.0 && sun_theta_deg < 90.0) || !std::isfinite(sun_phi_deg))
+    throw InvalidArgument("sky: the sun's polar angle must be in [0, 90) degrees, got " +
+                          std::to_string(sun_theta_deg));
+  const Vec3 sun = SphericalDirectionDeg(sun_theta_deg, sun_phi_deg);
+  const double sun_theta = DegToRad(sun_theta_deg);
+  // CIE standard clear sky (ISO 15469 type 12): gradation φ(θ) = 1 − exp(−0.32 / cosθ),
+  // indicatrix f(γ) = 1 + 10 (exp(−3γ) − exp(−3π/2)) + 0.45 cos²γ; relative to the zenith.
+  auto gradation = [](double cos_theta) { return 1.0 - std::exp(-0.32 / cos_theta); };
+  auto indicatrix = [](double gamma) {
+    return 1.0 + 10.0 * (std::exp(-3.0 * gamma) - std::exp(-1.5 * kPi)) +
+           0.45 * std::cos(gamma) * std::cos(gamma);
+  };
+  const double zenith_norm = indicatrix(sun_theta) * gradation(1.0);
+  const Rgb sky_tint = {0.55, 0.72, 1.0};
+  auto sky = [&](const Vec3& w) {
+    const double cos_theta = std::max(w.z, 0.02);  // keeps the horizon finite
+    const double gamma = std::acos(std::clamp(Dot(w, sun), -1.0, 1.0));
+    return indicatrix(gamma) * gradation(cos_theta) / zenith_norm;
+  };
+  std::vector<float> rgb = Tabulate(width, height, [&](const Vec3& w) {
+    if (w.z <= 0.0) return Rgb{0, 0, 0};
+    const double l = sky(w);
+    return Rgb{l * sky_tint[0], l * sky_tint[1], l * sky_tint[2]};
+  });
+  // The sun: irradiance kSunIrradiance on a surface facing it, spread over the pixels whose
+  // centres lie within max(0.265°, one pixel) of the sun's direction, so even a coarse map
+  // carries exactly that irradiance.
+  constexpr double kSunIrradiance = 8.0;
+  const Rgb sun_tint = {1.0, 0.95, 0.85};
+  const double pixel_rad = std::max(2.0 * kPi / width, kPi / height);
+  const double radius = std::max(DegToRad(0.265), 0.75 * pixel_rad);
+  std::vector<std::size_t> disc;
+  double disc_solid_angle = 0.0;
+  for (int j = 0; j < height; ++j) {
+    const double cos0 = std::cos(j * kPi / height), cos1 = std::cos((j + 1) * kPi / height);
+    const double pixel_solid_angle = (cos0 - cos1) * 2.0 * kPi / width;
+    for (int i = 0; i < width; ++i)
+      if (Dot(PixelCentre(i, j, width, height), sun) >= std::cos(radius)) {
+        disc.push_back(static_cast<std::size_t>(j) * width + i);
+        disc_solid_angle += pixel_solid_angle * Dot(PixelCentre(i, j, width, height), sun);
+      }
+  }
+  if (disc.empty()) {  // the disc fell between centres: take the sun's own pixel
+    const Vec3 w = sun;
+    const int i = std::min(width - 1, static_cast<int>(PhiOf(w) / (2.0 * kPi) * width));
+    const int j = std::min(height - 1, static_cast<int>(ThetaOf(w) / kPi * height));
+    disc.push_back(static_cast<std::size_t>(j) * width + i);
+    const double cos0 = std::cos(j * kPi / height), cos1 = std::cos((j + 1) * kPi / height);
+    disc_solid_angle = (cos0 - cos1) * 2.0 * kPi / width;
+  }
+  for (std::size_t p : disc)
+    for (int c = 0; c < 3; ++c)
+      rgb[p * 3 + c] += static_cast<float>(kSunIrradiance * sun_tint[c] / disc_solid_angle);
+  // Ground of albedo 0.2 lit by the sky and the sun: L = 0.2 · E_horizontal / π.
+  Rgb e_horizontal = {0, 0, 0};
+  for (int j = 0; j < height / 2 + 1 && j < height; ++j) {
+    const double cos0 = std::cos(j * kPi / height), cos1 = std::cos((j + 1) * kPi / height);
+    const double pixel_solid_angle = (cos0 - cos1) * 2.0 * kPi / width;
+    const double cos_theta = std::cos((j + 0.5) * kPi / height);
+    if (cos_theta <= 0.0) continue;
+    for (int i = 0; i < width; ++i)
+      for (int c = 0; c < 3; ++c)
+        e_horizontal[c] += rgb[(static_cast<std::size_t>(j) * width + i) * 3 + c] * cos_theta *
+                           pixel_solid_angle;
+  }
+  for (int j = 0; j < height; ++j) {
+    if (std::cos((j + 0.5) * kPi / height) > 0.0) continue;
+    for (int i = 0; i < width; ++i)
+      for (int c = 0; c < 3; ++c)
+        rgb[(static_cast<std::size_t>(j) * width + i) * 3 + c] =
+            static_cast<float>(0.2 * e_horizontal[c] * kInvPi);
+  }
+  return EnvironmentMap(width, height, std::move(rgb), "sky");
+}
+
+EnvironmentMap EnvironmentMap::Furnace(Rgb radiance, int width, int height) {
+  CheckSize(width, height);
+  std::vector<float> rgb(static_cast<std::size_t>(width) * height * 3);
+  for (std::size_t p = 0; p < rgb.size(); p += 3)
+    for (int c = 0; c < 3; ++c) rgb[p + c] = static_cast<float>(radiance[c]);
+  return EnvironmentMap(width, height, std::move(rgb), "furnace");
+}
+
+EnvironmentMap EnvironmentMap::AxisCoded(int width, int height) {
+  CheckSize(width, height);
+  std::vector<float> rgb = Tabulate(width, height, [](const Vec3& w) {
+    const double px = std::max(0.0, w.x), py = std::max(0.0, w.y), pz = std::max(0.0, w.z);
+    const double nx = std::max(0.0, -w.x), ny = std::max(0.0, -w.y), nz = std::max(0.0, -w.z);
+    return Rgb{px + 0.5 * (ny + nz), py + 0.5 * (nx + nz), pz + 0.5 * (nx + ny)};
+  });
+  return EnvironmentMap(width, height, std::move(rgb), "axes");
+}
+
+EnvironmentMap EnvironmentMap::Load(const std::string& path) {
+  detail::RgbImage image = detail::ReadEnvironmentImage(path);
+  if (image.width != 2 * image.height)
+    throw FormatError(path, "image size", "an equirectangular map (width = 2 × height)",
+                      std::to_string(image.width) + " × " + std::to_string(image.height));
+  for (float& v : image.rgb)
+    if (!std::isfinite(v) || v < 0.0f) v = 0.0f;  // negative or NaN texels carry no light
+  return EnvironmentMap(image.width, image.height, std::move(image.rgb),
+                        std::filesystem::path(path).filename().string());
+}
+
+EnvironmentMap EnvironmentMap::FromName(const std::string& name_or_path) {
+  if (name_or_path == "studio") return Studio();
+  if (name_or_path == "sky") return Sky();
+  if (name_or_path == "furnace") return Furnace();
+  if (name_or_path == "axes") return AxisCoded();
+  std::error_code ec;
+  if (!std::filesystem::exists(name_or_path, ec))
+    throw InvalidArgument("environment '" + name_or_path +
+                          "': expected studio, sky, furnace, axes or an existing .exr/.hdr file");
+  return Load(name_or_path);
+}
+
+}  // namespace brdf::preview

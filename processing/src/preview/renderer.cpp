@@ -1,0 +1,449 @@
+// The preview integrator (preview.h): camera rays, the per-pixel estimators, progressive
+// accumulation and the deterministic quadrature.
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <thread>
+#include <vector>
+
+#include "brdf/core/error.h"
+#include "brdf/processing/preview.h"
+#include "preview_internal.h"
+#include "scene.h"
+
+namespace brdf::preview {
+namespace {
+
+using detail::Frame;
+using detail::Luminance;
+
+std::uint64_t Mix(std::uint64_t x) {  // SplitMix64 finaliser
+  x += 0x9e3779b97f4a7c15ull;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ull;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebull;
+  return x ^ (x >> 31);
+}
+double ToUnit(std::uint64_t x) { return static_cast<double>(x >> 11) * 0x1.0p-53; }
+
+// Random numbers per pixel and pass: a 5-dimensional Kronecker (R_d) sequence over passes,
+// α_i = g^−i with g the positive root of x⁶ = x + 1 (Roberts 2018), shifted per pixel by
+// uniform random offsets (Cranley–Patterson rotation). Each number is uniform on [0, 1) for
+// every pass, so the estimator stays unbiased; successive passes of a pixel are stratified,
+// so the mean converges faster than with independent numbers.
+struct Kronecker {
+  std::array<double, 5> alpha{};
+  Kronecker() {
+    double g = 1.1;
+    for (int k = 0; k < 60; ++k) g -= (std::pow(g, 6) - g - 1.0) / (6.0 * std::pow(g, 5) - 1.0);
+    double a = 1.0;
+    for (double& x : alpha) {
+      a /= g;
+      x = a;
+    }
+  }
+};
+
+int ResolveJobs(int jobs) {
+  if (jobs > 0) return jobs;
+  return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+}
+
+// What a camera ray through a pixel found, computed once per renderer.
+struct PixelSetup {
+  Vec3 position;
+  Vec3 geometric_normal;
+  Frame frame;
+  Vec3 wo;      // towards the camera, local frame
+  Rgb fixed{};  // background (misses) or the directional light's contribution (hits)
+};
+
+template <class F>
+void ParallelChunks(std::size_t count, std::size_t chunk, int jobs, const std::atomic<bool>* cancel,
+                    F work) {
+  std::atomic<std::size_t> next{0};
+  auto loop = [&] {
+    for (std::size_t begin = next.fetch_add(chunk); begin < count; begin = next.fetch_add(chunk)) {
+      if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) return;
+      work(begin, std::min(count, begin + chunk));
+    }
+  };
+  const int threads = std::max(1, std::min<int>(jobs, static_cast<int>((count + chunk - 1) / chunk)));
+  std::vector<std::thread> workers;
+  for (int t = 1; t < threads; ++t) workers.emplace_back(loop);
+  loop();
+  for (auto& w : workers) w.join();
+}
+
+}  // namespace
+
+struct PreviewRenderer::Impl {
+  const BrdfSource& source;
+  const EnvironmentMap& environment;
+  PreviewOptions options;
+  std::shared_ptr<const BrdfSampler> sampler;
+  std::unique_ptr<EnvironmentSampler> environment_sampler;
+  detail::Scene scene;
+  double cos_rotation = 1.0, sin_rotation = 0.0;
+  int jobs = 1;
+
+  std::vector<std::uint8_t> object;        // per image pixel
+  std::vector<Rgb> fixed;                  // per image pixel: background or directional light
+  std::vector<std::uint32_t> object_index; // image pixel of each object pixel
+  std::vector<PixelSetup> setup;           // per object pixel
+  std::vector<double> sum;                 // per object pixel, RGB
+  std::vector<double> sum_sq;              // per object pixel, luminance²
+  int passes = 0;
+  bool exact = false;  // quadrature or light-only: one pass is the answer
+  double seconds = 0.0;
+
+  Impl(const BrdfSource& s, const EnvironmentMap& e, PreviewOptions o,
+       std::shared_ptr<const BrdfSampler> sp)
+      : source(s), environment(e), options(std::move(o)), sampler(std::move(sp)),
+        scene(options.shape, options.mesh) {}
+
+  Vec3 ToMap(const Vec3& w) const { return detail::RotateZ(w, cos_rotation, -sin_rotation); }
+  Vec3 FromMap(const Vec3& m) const { return detail::RotateZ(m, cos_rotation, sin_rotation); }
+
+  void Validate() const {
+    const PreviewOptions& o = options;
+    auto fail = [](const std::string& what) { throw InvalidArgument("preview: " + what); };
+    if (o.width < 1 || o.height < 1 || o.width > 16384 || o.height > 16384)
+      fail("image size must be between 1 and 16384 pixels a side, got " + std::to_string(o.width) +
+           " × " + std::to_string(o.height));
+    if (!(o.camera.fill > 0.0 && o.camera.fill <= 1.0))
+      fail("camera fill must be in (0, 1], got " + std::to_string(o.camera.fill));
+    if (o.camera.projection == Camera::Projection::kPerspective &&
+        !(o.camera.fov_deg > 0.0 && o.camera.fov_deg < 170.0))
+      fail("field of view must be in (0, 170) degrees, got " + std::to_string(o.camera.fov_deg));
+    if (!std::isfinite(o.camera.theta_deg) || !std::isfinite(o.camera.phi_deg) ||
+        !std::isfinite(o.environment_rotation_deg))
+      fail("camera angles and the map rotation must be finite");
+    if (o.estimator == Estimator::kQuadrature && o.shape == Shape::kMesh)
+      fail("the quadrature reference needs a convex object (sphere or plane), not a mesh");
+    if (o.quadrature_subdivisions < 1 || o.quadrature_subdivisions > 16)
+      fail("quadrature subdivisions must be between 1 and 16");
+    if (o.samples_per_pixel < 1 && !(o.target_relative_rms > 0.0))
+      fail("need samples per pixel ≥ 1 or a target RMS > 0");
+    if (o.target_relative_rms < 0.0 || !std::isfinite(o.target_relative_rms))
+      fail("the target RMS must be ≥ 0");
+    if (o.light) {
+      if (!(o.light->theta_deg >= 0.0 && o.light->theta_deg <= 180.0) ||
+          !std::isfinite(o.light->phi_deg))
+        fail("light direction: polar angle in [0, 180] degrees and a finite azimuth");
+      for (double e : o.light->irradiance)
+        if (!(e >= 0.0) || !std::isfinite(e)) fail("light irradiance must be finite and ≥ 0");
+    }
+  }
+
+  void SetUpPixels() {
+    const PreviewOptions& o = options;
+    const double rot = DegToRad(o.environment_rotation_deg);
+    cos_rotation = std::cos(rot);
+    sin_rotation = std::sin(rot);
+    const Vec3 c = SphericalDirectionDeg(o.camera.theta_deg, o.camera.phi_deg);
+    const Vec3 forward = c * -1.0;
+    Vec3 right = detail::Cross(forward, Vec3{0, 0, 1});
+    if (detail::Length(right) < 1e-9) {  // looking straight down or up: keep φ's sense
+      const double phi = DegToRad(o.camera.phi_deg);
+      right = {-std::sin(phi), std::cos(phi), 0.0};
+    }
+    right = Normalize(right);
+    const Vec3 up = detail::Cross(right, forward);
+    const double aspect = static_cast<double>(o.width) / o.height;
+    const bool perspective = o.camera.projection == Camera::Projection::kPerspective;
+    const double half_fov = DegToRad(o.camera.fov_deg) * 0.5;
+    // The unit bounding sphere's diameter spans `fill` of the frame height.
+    const double ortho_half_height = 1.0 / o.camera.fill;
+    const double distance = perspective ? 1.0 / std::sin(std::atan(std::tan(half_fov) * o.camera.fill)) : 10.0;
+    const double tan_half = std::tan(half_fov);
+    const Vec3 eye = c * distance;
+    Vec3 light_dir{};
+    if (o.light) light_dir = SphericalDirectionDeg(o.light->theta_deg, o.light->phi_deg);
+
+    const std::size_t pixels = static_cast<std::size_t>(o.width) * o.height;
+    object.assign(pixels, 0);
+    fixed.assign(pixels, Rgb{0, 0, 0});
+    std::vector<PixelSetup> all(pixels);
+    ParallelChunks(static_cast<std::size_t>(o.height), 8, jobs, nullptr, [&](std::size_t y0, std::size_t y1) {
+      for (std::size_t y = y0; y < y1; ++y)
+        for (int x = 0; x < o.width; ++x) {
+          const double sx = ((x + 0.5) / o.width * 2.0 - 1.0) * aspect;
+          const double sy = 1.0 - (y + 0.5) / o.height * 2.0;
+          Vec3 origin, dir;
+          if (perspective) {
+            origin = eye;
+            dir = Normalize(forward + right * (sx * tan_half) + up * (sy * tan_half));
+          } else {
+            origin = eye + right * (sx * ortho_half_height) + up * (sy * ortho_half_height);
+            dir = forward;
+          }
+          const std::size_t p = y * o.width + x;
+          detail::Hit hit;
+          if (!scene.Intersect(origin, dir, &hit)) {
+            if (o.show_background) fixed[p] = environment.Radiance(ToMap(dir));
+            continue;
+          }
+          object[p] = 1;
+          PixelSetup& s = all[p];
+          s.position = hit.position;
+          s.geometric_normal = hit.geometric_normal;
+          s.frame = Frame::FromNormal(hit.normal);
+          s.wo = s.frame.ToLocal(dir * -1.0);
+          if (o.light && Dot(light_dir, hit.geometric_normal) > 0.0) {
+            const Vec3 wi = s.frame.ToLocal(light_dir);
+            if (wi.z > 0.0 && !scene.Occluded(ShadowOrigin(s), light_dir)) {
+              const Rgb f = source.Eval(wi, s.wo);
+              for (int k = 0; k < 3; ++k) fixed[p][k] = o.light->irradiance[k] * f[k] * wi.z;
+            }
+          }
+        }
+    });
+    for (std::size_t p = 0; p < pixels; ++p)
+      if (object[p]) {
+        object_index.push_back(static_cast<std::uint32_t>(p));
+        setup.push_back(all[p]);
+      }
+    sum.assign(setup.size() * 3, 0.0);
+    sum_sq.assign(setup.size(), 0.0);
+  }
+
+  static Vec3 ShadowOrigin(const PixelSetup& s) { return s.position + s.geometric_normal * 1e-6; }
+
+  // L_env · f · cos / pdf for world direction w (0 when below the surface or shadowed).
+  Rgb Incident(const PixelSetup& s, const Vec3& w, const Vec3& wi, const Rgb& radiance) const {
+    if (!(wi.z > 0.0) || Dot(w, s.geometric_normal) <= 0.0) return {0, 0, 0};
+    if (radiance[0] == 0.0 && radiance[1] == 0.0 && radiance[2] == 0.0) return {0, 0, 0};
+    const Rgb f = source.Eval(wi, s.wo);
+    if (f[0] == 0.0 && f[1] == 0.0 && f[2] == 0.0) return {0, 0, 0};
+    if (scene.Occluded(ShadowOrigin(s), w)) return {0, 0, 0};
+    return {radiance[0] * f[0] * wi.z, radiance[1] * f[1] * wi.z, radiance[2] * f[2] * wi.z};
+  }
+
+  Rgb EstimateOnce(std::size_t k, int pass, const Kronecker& sequence) const {
+    const PixelSetup& s = setup[k];
+    const std::uint64_t key = Mix(options.seed ^ Mix(object_index[k]));
+    std::array<double, 5> u;
+    for (int d = 0; d < 5; ++d) {
+      const double shift = ToUnit(Mix(key + static_cast<std::uint64_t>(d) * 0x632be59bd9b4e019ull));
+      double x = shift + pass * sequence.alpha[d];
+      u[d] = x - std::floor(x);
+    }
+    Rgb out = {0, 0, 0};
+    const Estimator e = options.estimator;
+    if (e != Estimator::kBrdf) {
+      Vec3 m;
+      double pe = 0;
+      if (environment_sampler->Sample(u[0], u[1], &m, &pe)) {
+        const Vec3 w = FromMap(m);
+        const Vec3 wi = s.frame.ToLocal(w);
+        const float* px = nullptr;
+        int i = 0, j = 0;
+        detail::MapPixelOf(environment, m, &i, &j);
+        px = environment.Pixel(i, j);
+        const Rgb c = Incident(s, w, wi, {px[0], px[1], px[2]});
+        if (c[0] != 0.0 || c[1] != 0.0 || c[2] != 0.0) {
+          double weight = 1.0 / pe;
+          if (e == Estimator::kMis) {
+            const double pb = sampler->Pdf(s.wo, wi);
+            weight = pe / (pe * pe + pb * pb);  // power heuristic pe²/(pe²+pb²), over pe
+          }
+          for (int ch = 0; ch < 3; ++ch) out[ch] += c[ch] * weight;
+        }
+      }
+    }
+    if (e != Estimator::kEnvironment) {
+      Vec3 wi;
+      double pb = 0;
+      if (sampler->Sample(s.wo, u[2], u[3], u[4], &wi, &pb)) {
+        const Vec3 w = s.frame.ToWorld(wi);
+        const Vec3 m = ToMap(w);
+        const Rgb c = Incident(s, w, wi, environment.Radiance(m));
+        if (c[0] != 0.0 || c[1] != 0.0 || c[2] != 0.0) {
+          double weight = 1.0 / pb;
+          if (e == Estimator::kMis) {
+            const double pe = environment_sampler->Pdf(m);
+            weight = pb / (pb * pb + pe * pe);
+          }
+          for (int ch = 0; ch < 3; ++ch) out[ch] += c[ch] * weight;
+        }
+      }
+    }
+    return out;
+  }
+
+  int RenderPasses(int count) {
+    if (count < 1) return 0;
+    if (exact) return 0;
+    const auto start = std::chrono::steady_clock::now();
+    const std::atomic<bool>* cancel = options.cancel;
+    if (!options.environment_lighting) {  // the directional light alone is already exact
+      exact = true;
+      passes = 1;
+      return 1;
+    }
+    if (options.estimator == Estimator::kQuadrature) {
+      Quadrature();
+      if (cancel != nullptr && cancel->load()) return 0;
+      exact = true;
+      passes = 1;
+      seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      return 1;
+    }
+    static const Kronecker kSequence;
+    std::vector<double> call_sum(sum.size(), 0.0), call_sq(sum_sq.size(), 0.0);
+    const int first = passes;
+    ParallelChunks(setup.size(), 128, jobs, cancel, [&](std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k)
+        for (int n = 0; n < count; ++n) {
+          const Rgb v = EstimateOnce(k, first + n, kSequence);
+          for (int ch = 0; ch < 3; ++ch) call_sum[3 * k + ch] += v[ch];
+          const double l = Luminance(v);
+          call_sq[k] += l * l;
+        }
+    });
+    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (cancel != nullptr && cancel->load()) return 0;
+    for (std::size_t i = 0; i < sum.size(); ++i) sum[i] += call_sum[i];
+    for (std::size_t i = 0; i < sum_sq.size(); ++i) sum_sq[i] += call_sq[i];
+    passes += count;
+    return count;
+  }
+
+  // Σ over map pixels (split n × n, midpoint rule in solid angle) of L · f · cos · ΔΩ.
+  void Quadrature() {
+    struct Direction {
+      Vec3 w;
+      Rgb radiance_solid_angle;
+    };
+    std::vector<Direction> dirs;
+    const int n = options.quadrature_subdivisions;
+    const int width = environment.width(), height = environment.height();
+    for (int j = 0; j < height; ++j)
+      for (int a = 0; a < n; ++a) {
+        const double t0 = (j + static_cast<double>(a) / n) * kPi / height;
+        const double t1 = (j + static_cast<double>(a + 1) / n) * kPi / height;
+        const double theta = 0.5 * (t0 + t1);
+        const double solid_angle = (std::cos(t0) - std::cos(t1)) * 2.0 * kPi / (width * n);
+        for (int i = 0; i < width; ++i) {
+          const float* px = environment.Pixel(i, j);
+          if (px[0] == 0.0f && px[1] == 0.0f && px[2] == 0.0f) continue;
+          for (int b = 0; b < n; ++b) {
+            const double phi = (i + (b + 0.5) / n) * 2.0 * kPi / width;
+            dirs.push_back({FromMap(SphericalDirection(theta, phi)),
+                            {px[0] * solid_angle, px[1] * solid_angle, px[2] * solid_angle}});
+          }
+        }
+      }
+    ParallelChunks(setup.size(), 16, jobs, options.cancel, [&](std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k) {
+        const PixelSetup& s = setup[k];
+        Rgb total = {0, 0, 0};
+        for (const Direction& d : dirs) {
+          const Vec3 wi = s.frame.ToLocal(d.w);
+          if (!(wi.z > 0.0)) continue;
+          const Rgb f = source.Eval(wi, s.wo);
+          for (int ch = 0; ch < 3; ++ch) total[ch] += d.radiance_solid_angle[ch] * f[ch] * wi.z;
+        }
+        for (int ch = 0; ch < 3; ++ch) sum[3 * k + ch] = total[ch];
+      }
+    });
+  }
+
+  double RelativeRms() const {
+    if (exact) return 0.0;
+    if (passes < 4 || setup.empty()) return std::numeric_limits<double>::infinity();
+    const double n = passes;
+    double variance = 0.0, mean = 0.0;
+    for (std::size_t k = 0; k < setup.size(); ++k) {
+      const double l = Luminance({sum[3 * k] / n, sum[3 * k + 1] / n, sum[3 * k + 2] / n});
+      mean += l;
+      variance += std::max(0.0, (sum_sq[k] / n - l * l) / (n - 1.0));  // of the mean
+    }
+    mean /= static_cast<double>(setup.size());
+    variance /= static_cast<double>(setup.size());
+    if (!(mean > 0.0)) return variance > 0.0 ? std::numeric_limits<double>::infinity() : 0.0;
+    return std::sqrt(variance) / mean;
+  }
+
+  PreviewImage Image() const {
+    PreviewImage image;
+    image.width = options.width;
+    image.height = options.height;
+    const std::size_t pixels = object.size();
+    image.rgb.assign(pixels * 3, 0.0f);
+    image.object = object;
+    for (std::size_t p = 0; p < pixels; ++p)
+      for (int ch = 0; ch < 3; ++ch) image.rgb[3 * p + ch] = static_cast<float>(fixed[p][ch]);
+    if (passes > 0 && options.environment_lighting)
+      for (std::size_t k = 0; k < setup.size(); ++k)
+        for (int ch = 0; ch < 3; ++ch)
+          image.rgb[3 * object_index[k] + ch] += static_cast<float>(sum[3 * k + ch] / passes);
+    image.samples_per_pixel = passes;
+    image.relative_rms_estimate = RelativeRms();
+    image.seconds = seconds;
+    return image;
+  }
+};
+
+PreviewRenderer::PreviewRenderer(const BrdfSource& source, const EnvironmentMap& environment,
+                                 PreviewOptions options,
+                                 std::shared_ptr<const BrdfSampler> sampler)
+    : impl_(std::make_unique<Impl>(source, environment, std::move(options), std::move(sampler))) {
+  const auto start = std::chrono::steady_clock::now();
+  impl_->Validate();
+  impl_->jobs = ResolveJobs(impl_->options.jobs);
+  const bool sampling = impl_->options.environment_lighting &&
+                        impl_->options.estimator != Estimator::kQuadrature;
+  if (sampling) {
+    if (impl_->sampler == nullptr) impl_->sampler = MakeBrdfSampler(source, impl_->jobs);
+    impl_->environment_sampler = std::make_unique<EnvironmentSampler>(environment);
+  }
+  impl_->SetUpPixels();
+  impl_->seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+PreviewRenderer::~PreviewRenderer() = default;
+
+int PreviewRenderer::RenderPasses(int passes) { return impl_->RenderPasses(passes); }
+int PreviewRenderer::passes() const { return impl_->passes; }
+PreviewImage PreviewRenderer::Image() const { return impl_->Image(); }
+double PreviewRenderer::EstimatedRelativeRms() const { return impl_->RelativeRms(); }
+const std::shared_ptr<const BrdfSampler>& PreviewRenderer::sampler() const {
+  return impl_->sampler;
+}
+
+PreviewImage RenderPreview(const BrdfSource& source, const EnvironmentMap& environment,
+                           const PreviewOptions& options) {
+  PreviewRenderer renderer(source, environment, options);
+  const auto start = std::chrono::steady_clock::now();
+  auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  };
+  const bool by_rms = options.target_relative_rms > 0.0;
+  const int limit = by_rms ? options.max_samples_per_pixel : options.samples_per_pixel;
+  int batch = 1;
+  while (renderer.passes() < limit) {
+    if (options.cancel != nullptr && options.cancel->load()) break;
+    const double t0 = elapsed();
+    const int done = renderer.RenderPasses(std::min(batch, limit - renderer.passes()));
+    if (done == 0) break;  // cancelled, or exact after one pass
+    const double per_pass = (elapsed() - t0) / done;
+    const double rms = renderer.EstimatedRelativeRms();
+    if (options.progress && !options.progress(renderer.passes(), rms, elapsed())) break;
+    if (by_rms && rms <= options.target_relative_rms) break;
+    // About four progress reports a second.
+    batch = std::clamp(static_cast<int>(0.25 / std::max(per_pass, 1e-6)), 1, 256);
+    if (by_rms && std::isfinite(rms) && rms > 0.0) {
+      // rms ∝ 1/√n: do not overshoot the passes the target needs by much.
+      const double needed = renderer.passes() * (rms / options.target_relative_rms) *
+                            (rms / options.target_relative_rms);
+      batch = std::clamp(static_cast<int>(needed) - renderer.passes() + 1, 1, batch);
+    }
+    if (by_rms && renderer.passes() < 4) batch = 4 - renderer.passes();
+  }
+  return renderer.Image();
+}
+
+}  // namespace brdf::preview

@@ -1,0 +1,468 @@
+// Physics of the environment-lit preview (brdf/processing/preview.h). Every expected value comes
+// from outside the renderer: closed forms (furnace, linear-gradient irradiance, mirror
+// geometry), NumPy quadrature of the docs/design.md §9 formulas (tests/python/preview_oracle.py),
+// or another estimator whose error bars are known.
+#include "brdf/processing/preview.h"
+
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <random>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "brdf/core/brdf_source.h"
+#include "brdf/core/error.h"
+#include "brdf/core/rgl.h"
+#include "brdf/exporter/exr.h"
+#include "brdf/processing/measurement_brdf.h"
+#include "processing/synthetic_capture.h"
+
+namespace brdf::preview {
+namespace {
+
+namespace fs = std::filesystem;
+using test::MakeMaterial;
+
+std::string DataDir() {
+  const char* env = std::getenv("BRDF_DATA_DIR");
+  return env != nullptr && *env != '\0' ? std::string(env) : std::string(BRDF_SHARED_DATA_DIR);
+}
+
+// Runs the NumPy oracle and returns its numbers.
+std::vector<double> Oracle(const std::string& args) {
+  const std::string cmd = std::string(BRDF_PYTHON3) + " " BRDF_SOURCE_DIR
+                          "/tests/python/preview_oracle.py " + args;
+  std::FILE* pipe = ::popen(cmd.c_str(), "r");
+  EXPECT_NE(pipe, nullptr) << cmd;
+  if (pipe == nullptr) return {};
+  std::string out;
+  char buf[4096];
+  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, pipe)) > 0;) out.append(buf, n);
+  EXPECT_EQ(::pclose(pipe), 0) << cmd;
+  std::istringstream in(out);
+  std::vector<double> values;
+  for (double v; in >> v;) values.push_back(v);
+  return values;
+}
+
+// The sphere's normal at pixel (x, y) for the default camera (on +x, +y to the right, +z up,
+// orthographic, the unit sphere spanning `fill` of the height), from preview.h's definition.
+bool SphereNormal(int x, int y, int width, int height, double fill, Vec3* n) {
+  const double aspect = static_cast<double>(width) / height;
+  const double s = ((x + 0.5) / width * 2.0 - 1.0) * aspect / fill;
+  const double t = (1.0 - (y + 0.5) / height * 2.0) / fill;
+  const double r2 = s * s + t * t;
+  if (r2 >= 1.0) return false;
+  *n = {std::sqrt(1.0 - r2), s, t};
+  return true;
+}
+
+PreviewOptions SmallOptions(int size, Estimator estimator = Estimator::kMis, int spp = 64) {
+  PreviewOptions o;
+  o.width = o.height = size;
+  o.estimator = estimator;
+  o.samples_per_pixel = spp;
+  o.jobs = 2;
+  return o;
+}
+
+double Lum(const float* p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]; }
+
+TEST(PreviewFurnace, WhiteLambertianRendersTheMapRadianceAtEveryLitPixel) {
+  const AnalyticBrdf white(MakeMaterial(Model::kLambert, {1, 1, 1}, {}, {}));
+  const EnvironmentMap furnace = EnvironmentMap::Furnace({1, 1, 1});
+  // Map-only sampling converges too (PreviewEstimators) but needs far more samples for 1 % at
+  // every single pixel; the default estimator and the quadrature are checked here.
+  for (Estimator e : {Estimator::kMis, Estimator::kQuadrature}) {
+    const PreviewImage image = RenderPreview(white, furnace, SmallOptions(40, e, 1024));
+    int lit = 0;
+    for (int y = 0; y < image.height; ++y)
+      for (int x = 0; x < image.width; ++x) {
+        if (!image.object[y * image.width + x]) continue;
+        ++lit;
+        for (int c = 0; c < 3; ++c)
+          ASSERT_NEAR(image.Pixel(x, y)[c], 1.0, 0.01)
+              << "estimator " << static_cast<int>(e) << " pixel " << x << "," << y;
+      }
+    EXPECT_GT(lit, 900);
+  }
+}
+
+TEST(PreviewFurnace, LambertianOfRhoGivesRhoTimesL) {
+  const Rgb rho = {0.2, 0.5, 0.8}, radiance = {1.5, 1.0, 0.5};
+  const AnalyticBrdf lambert(MakeMaterial(Model::kLambert, rho, {}, {}));
+  const PreviewImage image =
+      RenderPreview(lambert, EnvironmentMap::Furnace(radiance), SmallOptions(32, Estimator::kMis, 1024));
+  for (int y = 0; y < image.height; ++y)
+    for (int x = 0; x < image.width; ++x)
+      if (image.object[y * image.width + x]) {
+        for (int c = 0; c < 3; ++c)
+          ASSERT_NEAR(image.Pixel(x, y)[c], rho[c] * radiance[c], 0.01 * rho[c] * radiance[c]);
+      }
+}
+
+// Furnace value of each pixel against the NumPy directional albedo at its θ_o.
+void ExpectFurnaceMatchesAlbedo(const Material& m, const std::string& model_name) {
+  const int size = 48;
+  const PreviewOptions o = SmallOptions(size, Estimator::kMis, 1024);
+  const PreviewImage image = RenderPreview(AnalyticBrdf(m), EnvironmentMap::Furnace(), o);
+  std::string thetas;
+  for (int t = 0; t <= 86; ++t) thetas += " " + std::to_string(t);
+  std::vector<std::vector<double>> albedo(3);
+  for (int c = 0; c < 3; ++c) {
+    albedo[c] = Oracle("albedo " + model_name + " " + std::to_string(m.kd[c]) + " " +
+                       std::to_string(m.ks[c]) + " " + std::to_string(m.shape[c]) + thetas);
+    ASSERT_EQ(albedo[c].size(), 87u);
+  }
+  double squares = 0, total = 0;
+  int n = 0;
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      Vec3 normal;
+      if (!SphereNormal(x, y, size, size, o.camera.fill, &normal)) continue;
+      const double theta_o = RadToDeg(std::acos(normal.x));
+      if (theta_o > 85.0) continue;  // the rim, where one pixel spans many degrees
+      ASSERT_TRUE(image.object[y * size + x]);
+      const int k = static_cast<int>(theta_o);
+      const double t = theta_o - k;
+      for (int c = 0; c < 3; ++c) {
+        const double expected = albedo[c][k] * (1 - t) + albedo[c][k + 1] * t;
+        const double got = image.Pixel(x, y)[c];
+        EXPECT_NEAR(got, expected, 0.03 * expected) << model_name << " θo " << theta_o << " ch " << c << " got " << got << " want " << expected;
+        squares += (got - expected) * (got - expected);
+        total += expected;
+        ++n;
+      }
+    }
+  EXPECT_LT(std::sqrt(squares / n) / (total / n), 0.01) << model_name;
+}
+
+TEST(PreviewFurnace, GgxEqualsItsDirectionalAlbedo) {
+  ExpectFurnaceMatchesAlbedo(MakeMaterial(Model::kGgx, {0.1, 0.3, 0.0}, {0.9, 0.5, 0.04},
+                                          {0.3, 0.15, 0.5}),
+                             "ggx");
+}
+
+TEST(PreviewFurnace, LafortuneEqualsItsDirectionalAlbedo) {  // the tabulated sampler
+  ExpectFurnaceMatchesAlbedo(MakeMaterial(Model::kLafortune, {0.1, 0.2, 0.3}, {0.6, 0.5, 0.4},
+                                          {20, 60, 8}),
+                             "lafortune");
+}
+
+TEST(PreviewFurnace, WardEqualsItsDirectionalAlbedo) {
+  ExpectFurnaceMatchesAlbedo(
+      MakeMaterial(Model::kWard, {0.3, 0.2, 0.1}, {0.1, 0.2, 0.05}, {0.2, 0.1, 0.3}), "ward");
+}
+
+// L(ω) = a + b·cosθ: a Lambertian of albedo ρ with normal n reflects
+// ρ/π·(aπ + b·(2π/3)·n.z) = ρ·(a + 2b·n.z/3), since ∫_{H(n)} ω (ω·n) dω = (2π/3)·n.
+TEST(PreviewIrradiance, LambertianUnderLinearGradientMatchesTheClosedForm) {
+  const double a = 1.0, b = 0.8, rho = 0.7;
+  const int width = 512, height = 256;
+  std::vector<float> rgb(static_cast<std::size_t>(width) * height * 3);
+  for (int j = 0; j < height; ++j) {
+    // The row's mean of cosθ over its solid angle, so the pixelised map has the same integral
+    // against any function linear in cosθ.
+    const double c0 = std::cos(j * kPi / height), c1 = std::cos((j + 1) * kPi / height);
+    const float value = static_cast<float>(a + b * 0.5 * (c0 + c1));
+    for (int i = 0; i < width; ++i)
+      for (int c = 0; c < 3; ++c) rgb[(static_cast<std::size_t>(j) * width + i) * 3 + c] = value;
+  }
+  const EnvironmentMap map(width, height, std::move(rgb), "gradient");
+  const AnalyticBrdf lambert(MakeMaterial(Model::kLambert, {rho, rho, rho}, {}, {}));
+  const int size = 40;
+  PreviewOptions o = SmallOptions(size, Estimator::kMis, 512);
+  o.camera.theta_deg = 60.0;  // from above, so the normals' z varies over [−0.5, 1]
+  const PreviewImage image = RenderPreview(lambert, map, o);
+  // The camera at (θ = 60°, φ = 0) sees along c = (sin60°, 0, cos60°), with image up
+  // (−cos60°, 0, sin60°): a view-space normal (n.x towards the camera, n.z up) has world
+  // z = n.x·cos60° + n.z·sin60°.
+  const double c60 = 0.5, s60 = std::sqrt(0.75);
+  int checked = 0;
+  double squares = 0, total = 0;
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      Vec3 n;
+      if (!SphereNormal(x, y, size, size, o.camera.fill, &n) || n.x < 0.1) continue;
+      const double nz = n.x * c60 + n.z * s60;
+      const double expected = rho * (a + 2.0 * b * nz / 3.0);
+      EXPECT_NEAR(image.Pixel(x, y)[1], expected, 0.02 * expected) << x << "," << y;
+      squares += (image.Pixel(x, y)[1] - expected) * (image.Pixel(x, y)[1] - expected);
+      total += expected;
+      ++checked;
+    }
+  EXPECT_GT(checked, 800);
+  EXPECT_LT(std::sqrt(squares / checked) / (total / checked), 0.005);
+}
+
+// Mean object luminance and its standard error from the renderer's variance estimate.
+struct Mean {
+  double value, error;
+};
+Mean ObjectMean(const PreviewImage& image) {
+  double sum = 0;
+  std::size_t n = 0;
+  for (std::size_t p = 0; p < image.object.size(); ++p)
+    if (image.object[p]) {
+      sum += Lum(&image.rgb[3 * p]);
+      ++n;
+    }
+  const double mean = sum / n;
+  return {mean, image.relative_rms_estimate * mean / std::sqrt(static_cast<double>(n))};
+}
+
+void ExpectEstimatorsAgree(const BrdfSource& source, const EnvironmentMap& map, int spp) {
+  const int size = 32;
+  PreviewOptions o = SmallOptions(size, Estimator::kQuadrature);
+  o.quadrature_subdivisions = 2;
+  const PreviewImage reference = RenderPreview(source, map, o);
+  std::map<int, Mean> means;
+  for (Estimator e : {Estimator::kMis, Estimator::kEnvironment, Estimator::kBrdf}) {
+    o.estimator = e;
+    o.samples_per_pixel = spp;
+    const PreviewImage image = RenderPreview(source, map, o);
+    const Mean m = ObjectMean(image);
+    means[static_cast<int>(e)] = m;
+    ASSERT_GT(m.error, 0.0);
+    // Pixel by pixel: the RMS difference to the quadrature is the estimator's own noise.
+    const ImageDifference d = CompareImages(image, reference);
+    EXPECT_LT(d.relative_rms, 2.0 * image.relative_rms_estimate + 0.01)
+        << source.Name() << " estimator " << static_cast<int>(e);
+  }
+  const Mean q = ObjectMean(reference);
+  for (const auto& [e, m] : means) {
+    EXPECT_NEAR(m.value, q.value, 4.0 * m.error + 0.003 * q.value)
+        << source.Name() << " estimator " << e << " vs quadrature";
+    for (const auto& [e2, m2] : means)
+      EXPECT_NEAR(m.value, m2.value, 4.0 * std::hypot(m.error, m2.error))
+          << source.Name() << " estimators " << e << " and " << e2;
+  }
+  // MIS is never much worse than the better single strategy.
+  const double mis = means[static_cast<int>(Estimator::kMis)].error;
+  const double best = std::min(means[static_cast<int>(Estimator::kEnvironment)].error,
+                               means[static_cast<int>(Estimator::kBrdf)].error);
+  EXPECT_LT(mis, 1.5 * best) << source.Name();
+}
+
+TEST(PreviewEstimators, EnvironmentBrdfAndMisAgreeWithinErrorBars) {
+  const EnvironmentMap studio = EnvironmentMap::Studio(128, 64);
+  ExpectEstimatorsAgree(AnalyticBrdf(MakeMaterial(Model::kGgx, {0.2, 0.1, 0.05},
+                                                  {0.8, 0.8, 0.8}, {0.25, 0.25, 0.25})),
+                        studio, 64);
+  ExpectEstimatorsAgree(AnalyticBrdf(test::LafortuneN20()), studio, 64);
+}
+
+TEST(PreviewEstimators, RglFileAgreesWithItsOwnDirectQuadrature) {
+  const std::string path = DataDir() + "/rgl/cc_ibiza_sunset_rgb.bsdf";
+  ASSERT_TRUE(fs::exists(path)) << "set BRDF_DATA_DIR to the shared brdf-data folder (" << path
+                                << " is missing)";
+  const RglBrdf rgl = RglBrdf::Load(path);
+  ExpectEstimatorsAgree(rgl, EnvironmentMap::Studio(96, 48), 48);
+}
+
+// A sharp GGX lit by one small bright patch: the highlight sits where the normal is the half
+// vector of the patch and the camera (+x).
+TEST(PreviewHighlight, SharpGgxHighlightSitsWhereMirrorReflectionPredicts) {
+  const int width = 720, height = 360;
+  for (const auto& [patch_theta, patch_phi] :
+       std::vector<std::pair<double, double>>{{60, 20}, {90, 300}, {35, 0}}) {
+    std::vector<float> rgb(static_cast<std::size_t>(width) * height * 3, 0.0f);
+    const Vec3 patch = SphericalDirectionDeg(patch_theta, patch_phi);
+    for (int j = 0; j < height; ++j)
+      for (int i = 0; i < width; ++i) {
+        const Vec3 w = SphericalDirection((j + 0.5) * kPi / height, (i + 0.5) * 2 * kPi / width);
+        if (Dot(w, patch) > std::cos(DegToRad(1.0)))
+          for (int c = 0; c < 3; ++c) rgb[(static_cast<std::size_t>(j) * width + i) * 3 + c] = 100;
+      }
+    const EnvironmentMap map(width, height, std::move(rgb), "patch");
+    const AnalyticBrdf ggx(MakeMaterial(Model::kGgx, {0, 0, 0}, {1, 1, 1}, {0.03, 0.03, 0.03}));
+    const int size = 200;
+    PreviewOptions o = SmallOptions(size, Estimator::kMis, 16);
+    o.show_background = false;
+    const PreviewImage image = RenderPreview(ggx, map, o);
+    int best_x = 0, best_y = 0;
+    double best = -1;
+    for (int y = 0; y < size; ++y)
+      for (int x = 0; x < size; ++x)
+        if (Lum(image.Pixel(x, y)) > best) {
+          best = Lum(image.Pixel(x, y));
+          best_x = x;
+          best_y = y;
+        }
+    Vec3 n;
+    ASSERT_TRUE(SphereNormal(best_x, best_y, size, size, o.camera.fill, &n));
+    const Vec3 half = Normalize(patch + Vec3{1, 0, 0});
+    const double error_deg = RadToDeg(std::acos(std::min(1.0, Dot(n, half))));
+    EXPECT_LT(error_deg, 1.5) << "patch at " << patch_theta << "," << patch_phi;
+  }
+}
+
+// A white Lambertian under the axis-coded map: each normal's colour against NumPy's integral of
+// the continuous map, and the background straight behind the sphere is −x (cyan).
+TEST(PreviewOrientation, AxisCodedMapAppearsWhereTheDocumentedFrameSaysItIs) {
+  const AnalyticBrdf white(MakeMaterial(Model::kLambert, {1, 1, 1}, {}, {}));
+  const EnvironmentMap axes = EnvironmentMap::AxisCoded(512, 256);
+  const int size = 101;
+  PreviewOptions o = SmallOptions(size, Estimator::kMis, 1024);
+  o.camera.fill = 0.5;
+  const PreviewImage image = RenderPreview(white, axes, o);
+  struct Probe {
+    int x, y;
+    const char* what;
+  };
+  const int c = size / 2, r = static_cast<int>(0.45 * size * o.camera.fill);
+  for (const Probe& p : {Probe{c, c, "centre (+x)"}, Probe{c + r, c, "right (+y)"},
+                         Probe{c - r, c, "left (−y)"}, Probe{c, c - r, "top (+z)"},
+                         Probe{c, c + r, "bottom (−z)"}}) {
+    Vec3 n;
+    ASSERT_TRUE(SphereNormal(p.x, p.y, size, size, o.camera.fill, &n));
+    const std::vector<double> expected =
+        Oracle("axes " + std::to_string(n.x) + " " + std::to_string(n.y) + " " + std::to_string(n.z));
+    ASSERT_EQ(expected.size(), 3u);
+    for (int ch = 0; ch < 3; ++ch)
+      EXPECT_NEAR(image.Pixel(p.x, p.y)[ch], expected[ch], 0.02 * expected[ch] + 0.003)
+          << p.what << " channel " << ch << " got " << image.Pixel(p.x, p.y)[ch] << " want " << expected[ch];
+  }
+  // Background: straight behind the sphere is −x: G = B = 0.5, R = 0 (cyan) at the image
+  // centre row near the left and right edges (−x rotated slightly towards ∓y).
+  const float* behind = image.Pixel(2, c);
+  EXPECT_LT(behind[0], 0.1);
+  EXPECT_GT(behind[1], 0.4);
+  EXPECT_GT(behind[2], 0.4);
+}
+
+// ---- χ² tests of every sampler's pdf against its sampling routine.
+
+// Bins uniform in (θ, φ) over the sphere; the expected count of a bin is the pdf integrated
+// over it with a fine midpoint rule in (θ, φ), dω = sinθ dθ dφ (exact for a 1/sinθ factor).
+struct ChiSquare {
+  int theta_bins = 30, phi_bins = 60;
+  double statistic = 0;
+  int dof = 0;
+  double total_expected_fraction = 0;
+};
+
+template <class SampleFn, class PdfFn>
+ChiSquare RunChiSquare(SampleFn sample, PdfFn pdf, int samples, std::uint64_t seed,
+                       int theta_bins = 30, int phi_bins = 60) {
+  ChiSquare result;
+  result.theta_bins = theta_bins;
+  result.phi_bins = phi_bins;
+  const int tb = result.theta_bins, pb = result.phi_bins;
+  std::vector<double> observed(tb * pb, 0.0), expected(tb * pb, 0.0);
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  auto bin_of = [&](const Vec3& w) {
+    const int t = std::min(tb - 1, static_cast<int>(ThetaOf(w) / kPi * tb));
+    const int p = std::min(pb - 1, static_cast<int>(PhiOf(w) / (2 * kPi) * pb));
+    return t * pb + p;
+  };
+  for (int s = 0; s < samples; ++s) {
+    Vec3 w;
+    if (sample(u01(rng), u01(rng), u01(rng), &w)) observed[bin_of(w)] += 1;
+  }
+  const int sub = 24;
+  for (int t = 0; t < tb; ++t)
+    for (int p = 0; p < pb; ++p) {
+      double integral = 0;
+      for (int a = 0; a < sub; ++a) {
+        const double theta = kPi * (t + (a + 0.5) / sub) / tb;
+        for (int b = 0; b < sub; ++b) {
+          const double phi = 2 * kPi * (p + (b + 0.5) / sub) / pb;
+          integral += pdf(SphericalDirection(theta, phi)) * std::sin(theta);
+        }
+      }
+      integral *= (kPi / tb) * (2 * kPi / pb) / (sub * sub);
+      expected[t * pb + p] = integral * samples;
+      result.total_expected_fraction += integral;
+    }
+  // Pool bins with fewer than 5 expected samples into one.
+  double pooled_obs = 0, pooled_exp = 0;
+  for (int k = 0; k < tb * pb; ++k) {
+    if (expected[k] < 5.0) {
+      pooled_obs += observed[k];
+      pooled_exp += expected[k];
+      continue;
+    }
+    result.statistic += (observed[k] - expected[k]) * (observed[k] - expected[k]) / expected[k];
+    ++result.dof;
+  }
+  if (pooled_exp >= 5.0) {
+    result.statistic += (pooled_obs - pooled_exp) * (pooled_obs - pooled_exp) / pooled_exp;
+    ++result.dof;
+  } else {
+    EXPECT_LT(pooled_obs, 5 + 5 * pooled_exp) << "samples where the pdf says there are none";
+  }
+  return result;
+}
+
+// The χ² quantile at significance 1e-4 (Wilson–Hilferty; z = 3.719).
+double ChiSquareThreshold(int dof) {
+  const double k = dof, z = 3.719;
+  const double t = 1.0 - 2.0 / (9.0 * k) + z * std::sqrt(2.0 / (9.0 * k));
+  return k * t * t * t;
+}
+
+TEST(PreviewSamplers, EnvironmentSamplerPdfMatchesItsSamples) {
+  for (const EnvironmentMap& map : {EnvironmentMap::Studio(64, 32), EnvironmentMap::Sky(30, 100, 64, 32),
+                                    EnvironmentMap::AxisCoded(32, 16)}) {
+    const EnvironmentSampler sampler(map);
+    const ChiSquare chi = RunChiSquare(
+        [&](double u1, double u2, double, Vec3* w) {
+          double pdf = 0;
+          return sampler.Sample(u1, u2, w, &pdf);
+        },
+        [&](const Vec3& w) { return sampler.Pdf(w); }, 400000, 7, map.height(), map.width());
+    EXPECT_NEAR(chi.total_expected_fraction, 1.0, 2e-3) << map.name();
+    EXPECT_LT(chi.statistic, ChiSquareThreshold(chi.dof)) << map.name() << " dof " << chi.dof;
+  }
+}
+
+void ExpectBrdfSamplerConsistent(const BrdfSource& source, const std::string& kind) {
+  const auto sampler = MakeBrdfSampler(source, 2);
+  EXPECT_EQ(sampler->Kind(), kind);
+  for (double theta_o : {0.0, 30.0, 65.0, 85.0}) {
+    const Vec3 wo = SphericalDirectionDeg(theta_o, 40.0);
+    const ChiSquare chi = RunChiSquare(
+        [&](double u1, double u2, double u3, Vec3* w) {
+          double pdf = 0;
+          const bool ok = sampler->Sample(wo, u1, u2, u3, w, &pdf);
+          if (ok) {
+            EXPECT_NEAR(pdf, sampler->Pdf(wo, *w), 1e-9 * pdf);
+          }
+          return ok;
+        },
+        [&](const Vec3& w) { return sampler->Pdf(wo, w); }, 400000, 11);
+    EXPECT_LE(chi.total_expected_fraction, 1.0 + 2e-3);
+    EXPECT_LT(chi.statistic, ChiSquareThreshold(chi.dof))
+        << source.Name() << " θo " << theta_o << " dof " << chi.dof;
+  }
+}
+
+TEST(PreviewSamplers, GgxVisibleNormalSamplerPdfMatchesItsSamples) {
+  ExpectBrdfSamplerConsistent(
+      AnalyticBrdf(MakeMaterial(Model::kGgx, {0.3, 0.3, 0.3}, {0.5, 0.5, 0.5}, {0.4, 0.4, 0.4})),
+      "ggx-vndf");
+  ExpectBrdfSamplerConsistent(
+      AnalyticBrdf(MakeMaterial(Model::kGgx, {0.0, 0.0, 0.0}, {0.9, 0.9, 0.9}, {0.15, 0.2, 0.1})),
+      "ggx-vndf");
+}
+
+TEST(PreviewSamplers, TabulatedSamplerPdfMatchesItsSamples) {
+  ExpectBrdfSamplerConsistent(AnalyticBrdf(test::LafortuneN20()), "tabulated");
+  const std::string path = DataDir() + "/rgl/paper_white_rgb.bsdf";
+  ASSERT_TRUE(fs::exists(path)) << "set BRDF_DATA_DIR to the shared brdf-data folder (" << path
+                                << " is missing)";
+  ExpectBrdfSamplerConsistent(RglBrdf::Load(path), "tabulated");
+}
+
+}  // namespace
+}  // namespace brdf::preview
