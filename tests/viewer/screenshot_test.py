@@ -190,6 +190,47 @@ def case_slices(brdf_view, source_dir, tmp):
     print(f"slices: heat map filled {filled:.4f}, mirror rows {top:.1f} vs middle {middle:.1f}")
 
 
+def case_preview(brdf_view, source_dir, tmp):
+    width, height = 640, 480
+    shot = os.path.join(tmp, "preview.png")
+    gold = os.path.join(source_dir, "data-samples", "materials", "gold.json")
+    run_view(brdf_view, [gold, "--mode", "preview", "--size", f"{width}x{height}",
+                         "--screenshot", shot], tmp)
+    img = read_png(shot, width, height)
+    check_not_blank(img)
+    meta = json.load(open(shot + ".json"))
+    cam = meta["camera"]
+    pw, ph = meta["preview_image"]
+    # The render occupies world x in [-0.5, pw - 0.5], y in [-0.5, ph - 0.5] (pixel centres at
+    # integers), seen through the parallel camera recorded beside the picture.
+    s = height / (2 * cam["parallel_scale"])
+    fx, fy = cam["focal_point"][0], cam["focal_point"][1]
+    x0 = width / 2 + (-0.5 - fx) * s
+    x1 = width / 2 + (pw - 0.5 - fx) * s
+    y0 = height / 2 - (ph - 0.5 - fy) * s  # top edge
+    y1 = height / 2 - (-0.5 - fy) * s
+    inside = img[int(np.ceil(y0)) + 2:int(y1) - 2, int(np.ceil(x0)) + 2:int(x1) - 2]
+    if inside.size == 0:
+        fail("the predicted preview rectangle is empty")
+    filled = non_background(inside).mean()
+    if filled < 0.98:
+        fail(f"only {filled:.3f} of the predicted preview rectangle is drawn")
+    # Beside the rectangle (left and right margins, below the text lines) is background.
+    rows = slice(int(np.ceil(y0)) + 2, int(y1) - 2)
+    margins = np.concatenate([img[rows, :max(0, int(x0) - 3)].reshape(-1, 3),
+                              img[rows, int(np.ceil(x1)) + 3:].reshape(-1, 3)])
+    if margins.size and (np.abs(margins - BACKGROUND).max(axis=1) > 12).mean() > 0.02:
+        fail("pixels beside the predicted preview rectangle are drawn")
+    # The sphere fills 90 % of the render's height around its centre; gold reflects red more
+    # than blue, so its middle is warm.
+    cx, cy = (x0 + x1) / 2, (y0 + y1) / 2
+    r = 0.2 * (y1 - y0)
+    core = img[int(cy - r):int(cy + r), int(cx - r):int(cx + r)]
+    if not core[..., 0].mean() > core[..., 2].mean() + 10:
+        fail(f"the sphere's middle is not gold: RGB {core.reshape(-1, 3).mean(axis=0)}")
+    print(f"preview: {pw}x{ph} render filled {filled:.4f} of its predicted rectangle")
+
+
 def case_load_error(brdf_view, source_dir, tmp):
     width, height = 640, 400
     shot = os.path.join(tmp, "error.png")
@@ -229,6 +270,7 @@ CASES = {
     "lobe_lambert": case_lobe_lambert,
     "lobe_glossy": case_lobe_glossy,
     "slices": case_slices,
+    "preview": case_preview,
     "load_error": case_load_error,
     "no_display": case_no_display,
 }

@@ -66,6 +66,8 @@ constexpr double kBackground[3] = {0.08, 0.08, 0.10};
 // World units (degrees) between heat maps: room for the axis labels and titles.
 constexpr double kSliceGapX = 130;
 constexpr double kSliceGapY = 110;
+// Refinement passes a preview screenshot waits for (the window keeps refining while idle).
+constexpr int kScreenshotPreviewPasses = 24;
 
 // Viridis, sampled at 0, ¼, ½, ¾, 1 (perceptually ordered, readable by colour-blind users).
 constexpr double kViridis[5][3] = {{0.267, 0.005, 0.329},
@@ -618,7 +620,11 @@ void App::BuildPreviewScene(bool reset_camera) {
     camera->SetFocalPoint(cx, cy, 0);
     camera->SetPosition(cx, cy, 1000);
     const double aspect = static_cast<double>(options_.width) / options_.height;
-    camera->SetParallelScale(0.5 * std::max<double>(img.height, img.width / aspect));
+    // Room for the text lines above and the help line below.
+    camera->SetParallelScale(0.5 * std::max(img.height / 0.8, img.width / aspect / 0.95));
+    const double shift = 0.5 * std::max(img.height / 0.8, img.width / aspect / 0.95) * 0.06;
+    camera->SetFocalPoint(cx, cy + shift, 0);
+    camera->SetPosition(cx, cy + shift, 1000);
   }
   renderer_->ResetCameraClippingRange();
 }
@@ -652,7 +658,8 @@ void App::UpdateText() {
   if (const ViewSource* source = Primary()) {
     info << source->name;
     if (const ViewSource* other = Compare()) {
-      info << "  vs  " << other->name << (compare_wireframe_ ? " (wireframe)" : " (orange)");
+      info << "  vs  " << other->name;
+      if (mode_ == Mode::kLobe) info << (compare_wireframe_ ? " (wireframe)" : " (orange)");
     }
     info << "\nmode " << ModeName(mode_) << "   channel " << ChannelName(channel_);
     if (mode_ == Mode::kLobe) {
@@ -845,7 +852,13 @@ bool App::WriteScreenshot(const std::string& path, std::string* error) {
        << "],\n    \"view_up\": [" << up[0] << ", " << up[1] << ", " << up[2]
        << "],\n    \"view_angle_deg\": " << camera->GetViewAngle()
        << ",\n    \"parallel_projection\": " << (camera->GetParallelProjection() ? "true" : "false")
-       << ",\n    \"parallel_scale\": " << camera->GetParallelScale() << "\n  }\n}\n";
+       << ",\n    \"parallel_scale\": " << camera->GetParallelScale() << "\n  }";
+  if (mode_ == Mode::kPreview && preview_) {
+    // The rendered picture sits at world x 0…width−1, y 0…height−1 (one unit per pixel).
+    const PreviewPanel::Image img = preview_->Current();
+    json << ",\n  \"preview_image\": [" << img.width << ", " << img.height << "]";
+  }
+  json << "\n}\n";
   if (!json) {
     *error = "cannot write " + path + ".json";
     return false;
@@ -953,9 +966,10 @@ ViewerResult App::Run() {
     }
     // A progressive preview gets its full budget before the picture is taken.
     if (mode_ == Mode::kPreview && preview_) {
-      while (preview_->Refine()) {
+      for (int pass = 0; pass < kScreenshotPreviewPasses && preview_->Refine(); ++pass) {
       }
       ShowPreviewImage();
+      UpdateText();
     }
     std::string error;
     if (!WriteScreenshot(options_.screenshot_path, &error)) {
