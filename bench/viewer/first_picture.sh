@@ -20,7 +20,7 @@ gold=$here/data-samples/materials/gold.json
 median() { sort -n | awk '{a[NR]=$1} END {print a[int((NR+1)/2)]}'; }  # of one column
 time_ms() {  # runs "$@" once, prints wall and CPU (user + system) milliseconds
   /usr/bin/time -f "%e %U %S" -o "$tmp/time.txt" "$@" >/dev/null 2>&1 || true
-  awk '{printf "%d %d\n", $1 * 1000, ($2 + $3) * 1000}' "$tmp/time.txt"
+  tail -n 1 "$tmp/time.txt" | awk '{printf "%d %d\n", $1 * 1000, ($2 + $3) * 1000}'
 }
 declare -A results
 for name in lobe slices window_only brdf_eval; do

@@ -249,6 +249,85 @@ def case_load_error(brdf_view, source_dir, tmp):
     print("load error shown in the window: " + lines[0])
 
 
+def xdo(*args):
+    return subprocess.run(["xdotool"] + list(args), capture_output=True, text=True, timeout=30)
+
+
+def wait_for(path, seconds=30):
+    import time
+    end = time.time() + seconds
+    while time.time() < end:
+        if os.path.exists(path) and os.path.getsize(path) > 0:
+            time.sleep(0.3)  # let the writer finish
+            return True
+        time.sleep(0.1)
+    return False
+
+
+def case_interactive_inner(brdf_view, source_dir, tmp):
+    """Runs with DISPLAY set (under xvfb-run): drives the real window with xdotool."""
+    import time
+    gold = os.path.join(source_dir, "data-samples", "materials", "gold.json")
+    proc = subprocess.Popen([brdf_view, gold, "--size", "800x600"], cwd=tmp,
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        found = xdo("search", "--sync", "--limit", "1", "--name", "brdf-view")
+        wid = found.stdout.strip().splitlines()[0] if found.stdout.strip() else ""
+        if not wid:
+            fail(f"no brdf-view window appeared: {found.stderr}")
+        xdo("windowfocus", "--sync", wid)
+        time.sleep(0.5)
+        xdo("key", "--window", wid, "s")
+        first = os.path.join(tmp, "brdf-view-1.png")
+        if not wait_for(first):
+            fail("the s key wrote no brdf-view-1.png")
+        lobe = read_png(first, 800, 600)
+        check_not_blank(lobe, 0.01)
+        # Slices mode, the pointer over the middle of the heat map, another screenshot.
+        xdo("key", "--window", wid, "2")
+        time.sleep(1.0)
+        xdo("mousemove", "--window", wid, "400", "300")
+        time.sleep(0.5)
+        xdo("mousemove", "--window", wid, "402", "301")
+        time.sleep(0.5)
+        xdo("key", "--window", wid, "s")
+        second = os.path.join(tmp, "brdf-view-2.png")
+        if not wait_for(second):
+            fail("the second s press wrote no brdf-view-2.png")
+        slices = read_png(second, 800, 600)
+        if np.abs(slices - lobe).mean() < 5:
+            fail("key 2 did not change the picture (slices mode expected)")
+        # The hover line (pale yellow text at the bottom) says what is under the pointer.
+        bottom = slices[int(0.85 * 600):, int(0.3 * 800):]
+        r, g, b = bottom[..., 0], bottom[..., 1], bottom[..., 2]
+        pale_yellow = (r > 200) & (g > 190) & (b > 90) & (b < 190)
+        if pale_yellow.sum() < 30:
+            fail("no hover read-out at the bottom of the slices view")
+        xdo("key", "--window", wid, "q")
+        try:
+            proc.wait(timeout=20)
+        except subprocess.TimeoutExpired:
+            fail("q did not close the window")
+        if proc.returncode != 0:
+            fail(f"brdf-view exited {proc.returncode} after q: {proc.stderr.read()}")
+        print("interactive: s, 2, hover and q work")
+    finally:
+        if proc.poll() is None:
+            proc.kill()
+            proc.wait()
+
+
+def case_interactive(brdf_view, source_dir, tmp):
+    env = dict(os.environ)
+    env.pop("DISPLAY", None)
+    proc = subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", sys.executable,
+                           os.path.abspath(__file__), "interactive_inner", brdf_view, source_dir],
+                          env=env, capture_output=True, text=True, timeout=150)
+    sys.stdout.write(proc.stdout)
+    if "PASS" not in proc.stdout:
+        fail(f"interactive run failed (exit {proc.returncode}): {proc.stderr}")
+
+
 def case_no_display(brdf_view, source_dir, tmp):
     env = {"PATH": tmp, "HOME": tmp}  # no DISPLAY, and no xvfb-run on PATH
     gold = os.path.join(source_dir, "data-samples", "materials", "gold.json")
@@ -273,6 +352,8 @@ CASES = {
     "preview": case_preview,
     "load_error": case_load_error,
     "no_display": case_no_display,
+    "interactive": case_interactive,
+    "interactive_inner": case_interactive_inner,
 }
 
 if __name__ == "__main__":

@@ -3,6 +3,7 @@
 #include "brdf/viewer/app.h"
 
 #include <X11/Xlib.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -134,8 +135,10 @@ vtkStandardNewMacro(ViewerStyle)
 
 class App {
  public:
-  App(const ViewerOptions& options, LoadedSource primary, std::optional<LoadedSource> compare)
-      : options_(options),
+  App(const ViewerOptions& options, LoadedSource primary, std::optional<LoadedSource> compare,
+      Display* display)
+      : display_(display),
+        options_(options),
         primary_(std::move(primary)),
         compare_(std::move(compare)),
         mode_(options.mode),
@@ -195,6 +198,7 @@ class App {
     scene_.emplace_back(prop);
   }
 
+  Display* display_;  // owned by RunViewer, outlives every VTK object here
   ViewerOptions options_;
   LoadedSource primary_;
   std::optional<LoadedSource> compare_;
@@ -868,6 +872,7 @@ bool App::WriteScreenshot(const std::string& path, std::string* error) {
 
 ViewerResult App::Run() {
   renderer_->SetBackground(kBackground[0], kBackground[1], kBackground[2]);
+  window_->SetDisplayId(display_);
   window_->SetSize(options_.width, options_.height);
   window_->SetWindowName("brdf-view");
   window_->AddRenderer(renderer_);
@@ -1031,8 +1036,25 @@ ViewerResult RunViewer(const ViewerOptions& options, LoadedSource primary,
   options.Validate();
   const std::string problem = DisplayProblem();
   if (!problem.empty()) return {false, problem};
-  App app(options, std::move(primary), std::move(compare));
-  return app.Run();
+  // The window gets a display connection opened here. Left to itself, VTK 9.1's X interactor
+  // opens one in Initialize and uses it without checking; under a freshly started Xvfb that
+  // open sometimes failed and the program crashed (XSync on a null display). A few retries
+  // cover the start-up race; if they all fail the user gets a sentence, not a crash.
+  Display* display = nullptr;
+  for (int attempt = 0; attempt < 20 && display == nullptr; ++attempt) {
+    display = XOpenDisplay(nullptr);
+    if (display == nullptr) usleep(100000);
+  }
+  if (display == nullptr) {
+    return {false, std::string("cannot open the X display '") + std::getenv("DISPLAY") + "'"};
+  }
+  ViewerResult result;
+  {
+    App app(options, std::move(primary), std::move(compare), display);
+    result = app.Run();
+  }
+  XCloseDisplay(display);
+  return result;
 }
 
 }  // namespace brdf::viewer
