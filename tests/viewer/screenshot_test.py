@@ -297,12 +297,13 @@ def case_interactive_inner(brdf_view, source_dir, tmp):
         slices = read_png(second, 800, 600)
         if np.abs(slices - lobe).mean() < 5:
             fail("key 2 did not change the picture (slices mode expected)")
-        # The hover line (pale yellow text at the bottom) says what is under the pointer.
-        bottom = slices[int(0.85 * 600):, int(0.3 * 800):]
-        r, g, b = bottom[..., 0], bottom[..., 1], bottom[..., 2]
+        # The hover lines (pale yellow text under the info lines, top left) say what is under
+        # the pointer.
+        band = slices[int(0.08 * 600):int(0.18 * 600), :int(0.85 * 800)]
+        r, g, b = band[..., 0], band[..., 1], band[..., 2]
         pale_yellow = (r > 200) & (g > 190) & (b > 90) & (b < 190)
         if pale_yellow.sum() < 30:
-            fail("no hover read-out at the bottom of the slices view")
+            fail("no hover read-out under the info lines of the slices view")
         xdo("key", "--window", wid, "q")
         try:
             proc.wait(timeout=20)

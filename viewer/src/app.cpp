@@ -166,6 +166,7 @@ class App {
   void OnTimer() {
     if (mode_ == Mode::kPreview && preview_ && preview_->Refine()) {
       ShowPreviewImage();
+      UpdateText();
       window_->Render();
     }
   }
@@ -696,6 +697,10 @@ void App::UpdateText() {
   if (!status_.empty()) info << "\n" << status_;
   info_->SetInput(info.str().c_str());
 
+  if (interactive_ && Primary()) {
+    // The help lines cover the slider's place: the slider steps aside while they show.
+    slider_->SetEnabled(!show_help_ && mode_ != Mode::kPreview && Primary()->lut.slices() > 1);
+  }
   if (show_help_) {
     help_->SetInput(
         "h help   q quit   s screenshot   r reset camera\n"
@@ -896,7 +901,8 @@ ViewerResult App::Run() {
   help_->GetPositionCoordinate()->SetValue(0.01, 0.01);
   StyleText(help_->GetTextProperty(), 13, 0.7, 0.8, 0.95);
   hover_->GetPositionCoordinate()->SetCoordinateSystemToNormalizedDisplay();
-  hover_->GetPositionCoordinate()->SetValue(0.35, 0.01);
+  hover_->GetPositionCoordinate()->SetValue(0.01, 0.90);
+  hover_->GetTextProperty()->SetVerticalJustificationToTop();
   StyleText(hover_->GetTextProperty(), 13, 1.0, 0.95, 0.6);
   message_->GetPositionCoordinate()->SetCoordinateSystemToNormalizedDisplay();
   message_->GetPositionCoordinate()->SetValue(0.5, 0.5);
