@@ -26,6 +26,14 @@ echo "== converting captures to RGB9E5 lookup textures -> $out/luts"
 echo "== packing the library into one atlas -> $out/atlas"
 mkdir -p "$out/atlas"
 "$brdf" atlas "$out/captures" --out "$out/atlas/library"
+echo "== environment-lit previews (studio map) -> $out/previews"
+mkdir -p "$out/previews"
+for material in gold plastic_glossy_red wood_oak; do
+  "$brdf" preview "$root/data-samples/materials/$material.json" --size 384 --spp 64 --quiet \
+    --out "$out/previews/$material.png"
+done
+"$brdf" preview "$out/luts/gold.ktx2" --compare "$root/data-samples/materials/gold.json" \
+  --size 256 --spp 64 --quiet --out "$out/previews/gold_lut_vs_material.png"
 # Pictures to look at: the reflection lobe of a few captures (brdf-view renders under
 # xvfb-run by itself when there is no display).
 cmake --build "$build" -j "$(nproc)" --target brdf-view
@@ -37,5 +45,5 @@ for material in gold plastic_glossy_red wood_oak paper_white; do
 done
 "$build/tools/brdf-view" "$out/captures/gold.bpc" --mode slices --theta-in 40 \
   --size 960x600 --screenshot "$out/pictures/gold-slices.png"
-echo "== done: $(ls "$out/captures" | wc -l) captures in $out/captures, LUTs in $out/luts, atlas in $out/atlas, pictures in $out/pictures"
+echo "== done: $(ls "$out/captures" | wc -l) captures in $out/captures, LUTs in $out/luts, atlas in $out/atlas, previews in $out/previews, pictures in $out/pictures"
 "$brdf" info "$out/luts/gold.ktx2"

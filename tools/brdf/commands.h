@@ -107,4 +107,31 @@ struct CaptureOptions {
 };
 int RunCapture(const CaptureOptions& options);
 
+// `brdf preview`: an environment-lit render of any source (brdf/processing/preview.h), to a
+// linear EXR or a tone-mapped PNG; with `compare`, both renders and their signed difference.
+struct PreviewCommandOptions {
+  std::string file;
+  std::string compare;           // second source; empty: none
+  std::string env = "studio";    // studio, sky, furnace, axes, or an .exr/.hdr file
+  bool env_given = false;        // --env on the command line (with --light: map lighting too)
+  double env_rotation_deg = 0;
+  std::string mesh = "sphere";   // sphere, plane, or a .ply/.obj file
+  int size = 512;                // pixels a side
+  int spp = 64;                  // passes per pixel (ignored with rms > 0)
+  double rms = 0;                // target relative RMS error, e.g. 0.01; 0: use spp
+  std::string light;             // "THETA,PHI" in degrees (world frame); empty: none
+  std::string view = "90,0";     // camera position THETA,PHI seen from the object
+  double fov_deg = 0;            // > 0: perspective camera with this vertical field of view
+  double exposure_ev = 0;
+  std::string tone_map = "clamp";     // clamp or reinhard (PNG only)
+  std::string estimator = "mis";      // mis, env, brdf, quadrature
+  std::string extrapolate;            // captures: "P,L"
+  std::string out;                    // .exr or .png
+  int jobs = DefaultJobs();
+  std::uint64_t seed = 1;
+  bool no_background = false;  // black instead of the map where the object is not
+  bool quiet = false;
+};
+int RunPreview(const PreviewCommandOptions& options);
+
 }  // namespace brdf::cli

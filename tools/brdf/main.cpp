@@ -292,6 +292,78 @@ int main(int argc, char** argv) {
   export_csv_cmd->add_flag("--force", export_csv.force, "Overwrite --out if it already exists");
   export_csv_cmd->callback([&] { exit_code = brdf::cli::RunExportCsv(export_csv); });
 
+  // brdf preview
+  brdf::cli::PreviewCommandOptions preview;
+  auto* preview_cmd = app.add_subcommand(
+      "preview",
+      "Render a material, capture, LUT or measured file on a sphere, plane or mesh lit by an "
+      "environment map, to a linear .exr or a tone-mapped .png (docs/preview.md)");
+  preview_cmd->add_option("source", preview.file, "Anything 'brdf eval' reads")->required();
+  preview_cmd->add_option("--compare", preview.compare,
+                          "A second source: both renders side by side with their signed "
+                          "difference, and the RMS difference printed");
+  auto* preview_env = preview_cmd
+      ->add_option("--env", preview.env,
+                   "Environment: studio, sky, furnace, axes (orientation check) or an "
+                   "equirectangular .exr/.hdr file")
+      ->capture_default_str();
+  preview_cmd->add_option("--env-rotate", preview.env_rotation_deg,
+                          "Turn the map about the up axis, degrees")
+      ->capture_default_str();
+  preview_cmd->add_option("--mesh", preview.mesh, "Object: sphere, plane, or a .ply/.obj file")
+      ->capture_default_str();
+  preview_cmd->add_option("--size", preview.size, "Image width and height in pixels")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 8192));
+  auto* preview_spp = preview_cmd
+      ->add_option("--spp", preview.spp, "Samples (passes) per pixel")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1 << 20));
+  preview_cmd
+      ->add_option("--rms", preview.rms,
+                   "Instead of --spp: render until the estimated relative RMS error is below "
+                   "this (e.g. 0.01)")
+      ->check(CLI::Range(1e-6, 1.0))
+      ->excludes(preview_spp);
+  preview_cmd
+      ->add_option("--light", preview.light,
+                   "A directional light from THETA,PHI (degrees, world frame, z up); without "
+                   "--env the map then does not light the object")
+      ->check(AnglePairValidator());
+  preview_cmd->add_option("--view", preview.view, "Camera position THETA,PHI seen from the object")
+      ->capture_default_str()
+      ->check(AnglePairValidator());
+  preview_cmd->add_option("--fov", preview.fov_deg,
+                          "Perspective camera with this vertical field of view, degrees "
+                          "(default: orthographic)");
+  preview_cmd->add_option("--exposure", preview.exposure_ev, "PNG exposure in stops")
+      ->capture_default_str();
+  preview_cmd->add_option("--tone-map", preview.tone_map, "PNG tone curve after exposure")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"clamp", "reinhard"}));
+  preview_cmd->add_option("--estimator", preview.estimator,
+                          "mis (default), env, brdf, or quadrature (sphere and plane only)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"mis", "env", "brdf", "quadrature"}));
+  preview_cmd->add_option("--extrapolate", preview.extrapolate,
+                          "Captures: grazing extrapolation P,L (docs/design.md §6)");
+  preview_cmd->add_option("--jobs", preview.jobs, "Worker threads")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  preview_cmd->add_option("--seed", preview.seed, "Random seed")->capture_default_str();
+  preview_cmd->add_option("--out", preview.out, "Output image (.exr or .png)")->required();
+  preview_cmd->add_flag("--no-background", preview.no_background,
+                        "Black where the object is not, instead of the map");
+  preview_cmd->add_flag("--quiet", preview.quiet, "No progress on stderr");
+  preview_cmd->footer(
+      "World frame: z up; the map's top row is the zenith, its left edge azimuth 0 (+x), "
+      "azimuth growing to the right. The default camera looks from +x, so the map's centre is "
+      "behind the object. EXR: linear radiance; PNG: exposure, then the tone curve, then sRGB.\n");
+  preview_cmd->callback([&] {
+    preview.env_given = preview_env->count() > 0;
+    exit_code = brdf::cli::RunPreview(preview);
+  });
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

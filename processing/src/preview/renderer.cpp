@@ -28,21 +28,20 @@ std::uint64_t Mix(std::uint64_t x) {  // SplitMix64 finaliser
 }
 double ToUnit(std::uint64_t x) { return static_cast<double>(x >> 11) * 0x1.0p-53; }
 
-// Random numbers per pixel and pass: a 5-dimensional Kronecker (R_d) sequence over passes,
-// α_i = g^−i with g the positive root of x⁶ = x + 1 (Roberts 2018), shifted per pixel by
-// uniform random offsets (Cranley–Patterson rotation). Each number is uniform on [0, 1) for
-// every pass, so the estimator stays unbiased; successive passes of a pixel are stratified,
-// so the mean converges faster than with independent numbers.
+// Random numbers per pixel and pass: each strategy's 2D point comes from the R2 Kronecker
+// sequence over passes, α = (g⁻¹, g⁻²) with g the plastic number, the positive root of
+// x³ = x + 1 (Roberts 2018); the BRDF sampler's lobe choice from the golden-ratio sequence.
+// Every pixel shifts the sequences by its own uniform random offsets (Cranley–Patterson
+// rotation), so each number is uniform on [0, 1) for every pass and the estimator stays
+// unbiased, while successive passes of a pixel are stratified and the mean converges faster
+// than with independent numbers. The per-pixel variance estimate treats the passes as
+// independent, so it overstates the error of the mean (a conservative stop rule).
 struct Kronecker {
   std::array<double, 5> alpha{};
   Kronecker() {
-    double g = 1.1;
-    for (int k = 0; k < 60; ++k) g -= (std::pow(g, 6) - g - 1.0) / (6.0 * std::pow(g, 5) - 1.0);
-    double a = 1.0;
-    for (double& x : alpha) {
-      a /= g;
-      x = a;
-    }
+    double g = 1.3;
+    for (int k = 0; k < 60; ++k) g -= (g * g * g - g - 1.0) / (3.0 * g * g - 1.0);
+    alpha = {1.0 / g, 1.0 / (g * g), 1.0 / g, 1.0 / (g * g), 0.5 * (std::sqrt(5.0) - 1.0)};
   }
 };
 

@@ -1,0 +1,79 @@
+// `brdf preview` run as a user runs it: outputs, the compare panel and its printed RMS, progress,
+// and one-line failures.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <string>
+
+#include "brdf/exporter/exr.h"
+#include "tools/tool_runner.h"
+
+namespace brdf::testing {
+namespace {
+
+const std::string kMaterials = std::string(BRDF_SOURCE_DIR) + "/data-samples/materials/";
+
+// Width and height from a PNG's IHDR chunk (big-endian at bytes 16–23).
+std::pair<int, int> PngSize(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  unsigned char header[24] = {};
+  in.read(reinterpret_cast<char*>(header), 24);
+  auto be = [&](int o) {
+    return (header[o] << 24) | (header[o + 1] << 16) | (header[o + 2] << 8) | header[o + 3];
+  };
+  return {be(16), be(20)};
+}
+
+class PreviewCli : public ToolTest {};
+
+TEST_F(PreviewCli, WhiteLambertianUnderTheFurnaceIsOneInTheExr) {
+  std::ofstream(dir_ / "white.json") << R"({"model": "lambert", "rho": 1.0})";
+  const ToolRun r = Run("preview " + Quote(dir_ / "white.json") +
+                        " --env furnace --size 32 --spp 1024 --out " + Quote(dir_ / "w.exr"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const exporter::ExrFile exr = exporter::ReadExr((dir_ / "w.exr").string());
+  ASSERT_EQ(exr.image.width, 32);
+  for (int y = 10; y < 22; ++y)
+    for (int x = 10; x < 22; ++x) EXPECT_NEAR(exr.image.Pixel(x, y)[1], 1.0, 0.01);
+  EXPECT_NE(r.err.find("ETA"), std::string::npos) << r.err;
+}
+
+TEST_F(PreviewCli, CompareWritesThreePanelsAndPrintsTheRms) {
+  const ToolRun same = Run("preview " + Quote(kMaterials + "gold.json") + " --compare " +
+                           Quote(kMaterials + "gold.json") + " --size 32 --spp 4 --quiet --out " +
+                           Quote(dir_ / "same.png"));
+  ASSERT_EQ(same.exit_code, 0) << same.err;
+  EXPECT_NE(same.out.find("RMS difference: 0 (0.000 %"), std::string::npos) << same.out;
+  EXPECT_EQ(PngSize(dir_ / "same.png"), std::make_pair(3 * 32 + 8, 32));
+  const ToolRun other = Run("preview " + Quote(kMaterials + "gold.json") + " --compare " +
+                            Quote(kMaterials + "silver.json") +
+                            " --size 32 --spp 4 --quiet --out " + Quote(dir_ / "other.exr"));
+  ASSERT_EQ(other.exit_code, 0) << other.err;
+  EXPECT_EQ(other.out.find("RMS difference: 0 "), std::string::npos) << other.out;
+  EXPECT_NE(other.out.find("RMS difference: "), std::string::npos) << other.out;
+}
+
+TEST_F(PreviewCli, BadArgumentsFailWithOneLine) {
+  const ToolRun ext = Run("preview " + Quote(kMaterials + "gold.json") + " --out " +
+                          Quote(dir_ / "x.tif"));
+  EXPECT_EQ(ext.exit_code, 1);
+  ASSERT_EQ(ext.ErrLines().size(), 1u) << ext.err;
+  EXPECT_NE(ext.err.find(".exr"), std::string::npos) << ext.err;
+  const ToolRun missing = Run("preview " + Quote(dir_ / "nope.json") + " --out " +
+                              Quote(dir_ / "x.png"));
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_NE(missing.err.find("nope.json"), std::string::npos) << missing.err;
+  const ToolRun env = Run("preview " + Quote(kMaterials + "gold.json") +
+                          " --env moon --out " + Quote(dir_ / "x.png"));
+  EXPECT_EQ(env.exit_code, 1);
+  ASSERT_EQ(env.ErrLines().size(), 1u) << env.err;
+  EXPECT_NE(env.err.find("moon"), std::string::npos) << env.err;
+  const ToolRun mesh = Run("preview " + Quote(kMaterials + "gold.json") + " --mesh " +
+                           Quote(dir_ / "none.obj") + " --out " + Quote(dir_ / "x.png"));
+  EXPECT_EQ(mesh.exit_code, 1);
+  EXPECT_NE(mesh.err.find("none.obj"), std::string::npos) << mesh.err;
+}
+
+}  // namespace
+}  // namespace brdf::testing

@@ -1,0 +1,183 @@
+// `brdf preview SOURCE [--compare SOURCE2] --out IMAGE.exr|.png`: renders a source on a sphere,
+// a plane or a mesh under an environment map (brdf::preview), prints the RMS difference with
+// --compare, shows progress with an ETA on stderr.
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "brdf/core/error.h"
+#include "brdf/processing/preview.h"
+#include "cli_support.h"
+#include "commands.h"
+#include "progress.h"
+#include "sources.h"
+
+namespace brdf::cli {
+namespace {
+
+bool ParsePair(const std::string& text, double* a, double* b) {
+  const auto comma = text.find(',');
+  if (comma == std::string::npos) return false;
+  try {
+    std::size_t used = 0;
+    *a = std::stod(text.substr(0, comma), &used);
+    if (used != comma) return false;
+    const std::string rest = text.substr(comma + 1);
+    *b = std::stod(rest, &used);
+    return used == rest.size() && std::isfinite(*a) && std::isfinite(*b);
+  } catch (const std::exception&) {
+    return false;
+  }
+}
+
+preview::Estimator EstimatorFromName(const std::string& name) {
+  if (name == "mis") return preview::Estimator::kMis;
+  if (name == "env") return preview::Estimator::kEnvironment;
+  if (name == "brdf") return preview::Estimator::kBrdf;
+  if (name == "quadrature") return preview::Estimator::kQuadrature;
+  throw InvalidArgument("--estimator: expected mis, env, brdf or quadrature, got '" + name + "'");
+}
+
+// One line on stderr, redrawn on a terminal, at most one plain line a second otherwise.
+class PassProgress {
+ public:
+  PassProgress(std::string label, bool enabled)
+      : label_(std::move(label)), enabled_(enabled), tty_(::isatty(2) == 1) {}
+  void Update(int passes, int target_passes, double rms, double target_rms, double seconds) {
+    if (!enabled_) return;
+    if (!tty_ && seconds - last_ < 1.0) return;
+    last_ = seconds;
+    double eta = 0;
+    std::string what;
+    if (target_rms > 0) {
+      // The error falls as 1/√passes.
+      const double needed = std::isfinite(rms) ? passes * (rms / target_rms) * (rms / target_rms) : 0;
+      eta = needed > passes ? seconds / passes * (needed - passes) : 0;
+      what = std::isfinite(rms) ? "error " + Percent(rms) + " → " + Percent(target_rms)
+                                : "estimating the error";
+    } else {
+      eta = seconds / passes * (target_passes - passes);
+      what = std::to_string(passes) + "/" + std::to_string(target_passes) + " passes";
+    }
+    std::fprintf(stderr, "%s%s: %s, %s elapsed, ETA %s%s", tty_ ? "\r\033[K" : "",
+                 label_.c_str(), what.c_str(), Progress::FormatDuration(seconds).c_str(),
+                 Progress::FormatDuration(eta).c_str(), tty_ ? "" : "\n");
+    std::fflush(stderr);
+  }
+  void Done(int passes, double rms, double seconds) {
+    if (!enabled_) return;
+    std::fprintf(stderr, "%s%s: %d passes, estimated error %s, %s\n", tty_ ? "\r\033[K" : "",
+                 label_.c_str(), passes, std::isfinite(rms) ? Percent(rms).c_str() : "unknown",
+                 Progress::FormatDuration(seconds).c_str());
+  }
+
+ private:
+  static std::string Percent(double x) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.2f %%", 100.0 * x);
+    return buf;
+  }
+  std::string label_;
+  bool enabled_, tty_;
+  double last_ = -1.0;
+};
+
+preview::PreviewImage Render(const BrdfSource& source, const preview::EnvironmentMap& map,
+                             preview::PreviewOptions options, const PreviewCommandOptions& cli) {
+  PassProgress progress("preview " + source.Name(), !cli.quiet);
+  options.progress = [&](int passes, double rms, double seconds) {
+    progress.Update(passes, options.samples_per_pixel, rms, options.target_relative_rms, seconds);
+    return true;
+  };
+  preview::PreviewImage image = preview::RenderPreview(source, map, options);
+  progress.Done(image.samples_per_pixel, image.relative_rms_estimate, image.seconds);
+  return image;
+}
+
+}  // namespace
+
+int RunPreview(const PreviewCommandOptions& cli) {
+  const std::string ext = LowerExtension(cli.out);
+  if (ext != ".exr" && ext != ".png")
+    throw InvalidArgument("--out: expected an .exr (linear HDR) or .png (tone-mapped) file, got '" +
+                          cli.out + "'");
+  if (cli.size < 1 || cli.size > 8192)
+    throw InvalidArgument("--size: expected 1 to 8192 pixels, got " + std::to_string(cli.size));
+  preview::PreviewOptions options;
+  options.width = options.height = cli.size;
+  options.estimator = EstimatorFromName(cli.estimator);
+  options.samples_per_pixel = cli.spp;
+  options.target_relative_rms = cli.rms;
+  options.jobs = cli.jobs;
+  options.seed = cli.seed;
+  options.environment_rotation_deg = cli.env_rotation_deg;
+  double a = 0, b = 0;
+  if (!ParsePair(cli.view, &a, &b) || a < 0 || a > 180)
+    throw InvalidArgument("--view: expected THETA,PHI in degrees with THETA in [0, 180], got '" +
+                          cli.view + "'");
+  options.camera.theta_deg = a;
+  options.camera.phi_deg = b;
+  if (cli.fov_deg > 0) {
+    options.camera.projection = preview::Camera::Projection::kPerspective;
+    options.camera.fov_deg = cli.fov_deg;
+  }
+  if (!cli.light.empty()) {
+    if (!ParsePair(cli.light, &a, &b) || a < 0 || a > 180)
+      throw InvalidArgument("--light: expected THETA,PHI in degrees with THETA in [0, 180], got '" +
+                            cli.light + "'");
+    options.light = preview::DirectionalLight{a, b};
+    // A direct-lighting picture: the map lights the object only when --env says so.
+    options.environment_lighting = cli.env_given;
+    options.show_background = cli.env_given;
+  }
+  if (cli.no_background) options.show_background = false;
+  preview::Mesh mesh;
+  if (cli.mesh == "sphere") {
+    options.shape = preview::Shape::kSphere;
+  } else if (cli.mesh == "plane") {
+    options.shape = preview::Shape::kPlane;
+  } else {
+    mesh = preview::LoadMesh(cli.mesh);
+    options.shape = preview::Shape::kMesh;
+    options.mesh = &mesh;
+  }
+  const preview::EnvironmentMap map = preview::EnvironmentMap::FromName(cli.env);
+
+  std::optional<processing::ExtrapolationParams> extrapolate;
+  if (!cli.extrapolate.empty()) extrapolate = processing::ParseExtrapolation(cli.extrapolate);
+  std::vector<std::string> warnings;
+  const std::unique_ptr<BrdfSource> source = OpenEvalSource(cli.file, extrapolate, &warnings);
+  std::unique_ptr<BrdfSource> second;
+  if (!cli.compare.empty()) second = OpenEvalSource(cli.compare, extrapolate, &warnings);
+  for (const std::string& w : warnings) std::fprintf(stderr, "%s\n", w.c_str());
+
+  const preview::PreviewImage first = Render(*source, map, options, cli);
+  preview::PreviewImage out = first;
+  std::vector<std::pair<std::string, std::string>> attributes = {
+      {"brdf:source", cli.file}, {"brdf:environment", map.name()},
+      {"brdf:object", cli.mesh}, {"brdf:estimator", cli.estimator}};
+  if (second) {
+    const preview::PreviewImage other = Render(*second, map, options, cli);
+    const preview::ImageDifference d = preview::CompareImages(first, other);
+    out = preview::SideBySide(first, other);
+    attributes.emplace_back("brdf:compare", cli.compare);
+    attributes.emplace_back("brdf:layout", "source | compare | signed difference (red: source "
+                                           "brighter, blue: compare brighter)");
+    std::printf("RMS difference: %.6g (%.3f %% of the mean of %s) over %zu pixels; largest %.6g\n",
+                d.rms, 100.0 * d.relative_rms, cli.compare.c_str(), d.pixels, d.max_abs);
+  }
+  preview::WritePreviewImage(cli.out, out, cli.exposure_ev,
+                             cli.tone_map == "reinhard" ? preview::ToneMapCurve::kReinhard
+                                                        : preview::ToneMapCurve::kClamp,
+                             attributes);
+  if (!cli.quiet) std::fprintf(stderr, "wrote %s\n", cli.out.c_str());
+  return 0;
+}
+
+}  // namespace brdf::cli
