@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <string>
 #include <vector>
 
@@ -22,6 +23,10 @@
 namespace {
 
 constexpr const char* kXvfbGuard = "BRDF_VIEW_UNDER_XVFB";
+// Exit code of a run under xvfb-run whose display could not be opened: concurrent
+// `xvfb-run -a` calls sometimes pick the same display number, so the parent tries again.
+constexpr int kDisplayRetry = 75;
+constexpr int kXvfbAttempts = 3;
 
 // "WxH" → width, height; an error text otherwise.
 std::string ParseSize(const std::string& text, int* width, int* height) {
@@ -75,11 +80,28 @@ int RunUnderXvfb(const std::string& xvfb_run, int argc, char** argv, int width, 
   std::vector<char*> cargs;
   for (std::string& a : args) cargs.push_back(a.data());
   cargs.push_back(nullptr);
+  // xvfb-run's own complaint about its temporary folder is not the user's business: stderr
+  // passes through a pipe that drops it.
+  int err_pipe[2];
+  if (pipe(err_pipe) != 0) return -1;
   const pid_t pid = fork();
   if (pid < 0) return -1;
   if (pid == 0) {
+    close(err_pipe[0]);
+    dup2(err_pipe[1], STDERR_FILENO);
+    close(err_pipe[1]);
     execv(xvfb_run.c_str(), cargs.data());
     _exit(127);
+  }
+  close(err_pipe[1]);
+  if (FILE* err = fdopen(err_pipe[0], "r")) {
+    char line[4096];
+    while (std::fgets(line, sizeof line, err) != nullptr) {
+      if (std::strstr(line, "xvfb-run: error: problem while cleaning up") == nullptr) {
+        std::fputs(line, stderr);
+      }
+    }
+    std::fclose(err);
   }
   int wstatus = 0;
   while (waitpid(pid, &wstatus, 0) < 0 && errno == EINTR) {
@@ -174,10 +196,15 @@ int main(int argc, char** argv) {
                    display_problem.c_str());
       return 1;
     }
+    if (std::getenv(kXvfbGuard) != nullptr) return Finish(kDisplayRetry);
     const std::string xvfb_run = FindOnPath("xvfb-run");
-    if (std::getenv(kXvfbGuard) == nullptr && !xvfb_run.empty()) {
-      const int code = RunUnderXvfb(xvfb_run, argc, argv, options.width, options.height);
-      if (code >= 0) return code;
+    if (!xvfb_run.empty()) {
+      int code = -1;
+      for (int attempt = 0; attempt < kXvfbAttempts; ++attempt) {
+        code = RunUnderXvfb(xvfb_run, argc, argv, options.width, options.height);
+        if (code != kDisplayRetry) break;
+      }
+      if (code >= 0 && code != kDisplayRetry) return code;
     }
     if (xvfb_run.empty()) {
       std::fprintf(stderr,
@@ -185,8 +212,8 @@ int main(int argc, char** argv) {
                    "xvfb and xauth (tools/install-deps.sh) or run inside an X session\n",
                    display_problem.c_str());
     } else {
-      std::fprintf(stderr, "brdf-view: %s, even under xvfb-run (%s)\n", display_problem.c_str(),
-                   xvfb_run.c_str());
+      std::fprintf(stderr, "brdf-view: no usable X display even under xvfb-run (%s), tried %d times\n",
+                   xvfb_run.c_str(), kXvfbAttempts);
     }
     return 1;
   }
@@ -202,6 +229,9 @@ int main(int argc, char** argv) {
     const brdf::viewer::ViewerResult result =
         brdf::viewer::RunViewer(options, std::move(primary), std::move(second));
     if (!result.ok) {
+      if (result.display_failed && std::getenv(kXvfbGuard) != nullptr) {
+        return Finish(kDisplayRetry);  // the parent starts another Xvfb
+      }
       if (!result.message.empty()) std::fprintf(stderr, "brdf-view: %s\n", result.message.c_str());
       return Finish(1);
     }

@@ -1041,7 +1041,7 @@ ViewerResult RunViewer(const ViewerOptions& options, LoadedSource primary,
                        std::optional<LoadedSource> compare) {
   options.Validate();
   const std::string problem = DisplayProblem();
-  if (!problem.empty()) return {false, problem};
+  if (!problem.empty()) return {false, problem, true};
   // The window gets a display connection opened here. Left to itself, VTK 9.1's X interactor
   // opens one in Initialize and uses it without checking; under a freshly started Xvfb that
   // open sometimes failed and the program crashed (XSync on a null display). A few retries
@@ -1052,7 +1052,8 @@ ViewerResult RunViewer(const ViewerOptions& options, LoadedSource primary,
     if (display == nullptr) usleep(100000);
   }
   if (display == nullptr) {
-    return {false, std::string("cannot open the X display '") + std::getenv("DISPLAY") + "'"};
+    return {false, std::string("cannot open the X display '") + std::getenv("DISPLAY") + "'",
+            true};
   }
   ViewerResult result;
   {

@@ -58,6 +58,7 @@ struct ViewerOptions {
 struct ViewerResult {
   bool ok = true;        // false when a source failed to open or the screenshot failed
   std::string message;   // what to tell the user on failure (one line)
+  bool display_failed = false;  // the X display could not be opened (worth another try)
 };
 
 // Empty when an X display can be opened; otherwise one sentence saying why not ($DISPLAY unset,
