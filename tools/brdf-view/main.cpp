@@ -6,6 +6,9 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <csignal>
+#include <filesystem>
+#include <fstream>
 
 #include <CLI/CLI.hpp>
 #include <algorithm>
@@ -59,6 +62,29 @@ std::string FindOnPath(const std::string& program) {
   return {};
 }
 
+// xvfb-run sometimes leaves its Xvfb running after a short run (seen when the program exits
+// within a second). That server is recognised exactly, by the unique status-file path in its
+// environment (it inherits ours), and stopped by its pid.
+void StopLeftoverXvfb(const std::string& status_path) {
+  const std::string marker = std::string(kXvfbGuard) + "=" + status_path;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator("/proc", ec)) {
+    const std::string name = entry.path().filename().string();
+    if (name.empty() || !std::all_of(name.begin(), name.end(), ::isdigit)) continue;
+    std::ifstream comm(entry.path() / "comm");
+    std::string command;
+    if (!std::getline(comm, command) || command != "Xvfb") continue;
+    std::ifstream environ(entry.path() / "environ", std::ios::binary);
+    std::string variable;
+    while (std::getline(environ, variable, '\0')) {
+      if (variable == marker) {
+        kill(static_cast<pid_t>(std::stol(name)), SIGTERM);
+        break;
+      }
+    }
+  }
+}
+
 // Runs `xvfb-run -a -s "-screen 0 WxHx24" <this program> <args>` and returns the exit code of
 // this program's run under it. That code travels through a file: xvfb-run itself sometimes
 // exits 5 ("problem while cleaning up temporary directory") after a successful run when
@@ -106,6 +132,7 @@ int RunUnderXvfb(const std::string& xvfb_run, int argc, char** argv, int width, 
   int wstatus = 0;
   while (waitpid(pid, &wstatus, 0) < 0 && errno == EINTR) {
   }
+  StopLeftoverXvfb(status_path);
   int code = -1;
   if (FILE* f = std::fopen(status_path, "r")) {
     if (std::fscanf(f, "%d", &code) != 1) code = -1;
