@@ -35,3 +35,12 @@ endif()
 if(BRDF_BUILD_BENCH)
   find_package(benchmark REQUIRED)
 endif()
+
+# The viewer (brdf::viewer, tools/brdf-view): VTK 9.1 and Xlib (to check for a display).
+if(BRDF_BUILD_VIEWER)
+  find_package(VTK 9.1 REQUIRED COMPONENTS
+    CommonCore CommonDataModel CommonTransforms FiltersCore FiltersGeneral FiltersSources
+    ImagingCore IOImage InteractionStyle InteractionWidgets RenderingAnnotation RenderingCore
+    RenderingFreeType RenderingOpenGL2)
+  find_package(X11 REQUIRED)
+endif()

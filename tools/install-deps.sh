@@ -23,6 +23,10 @@ packages=(
   # Engine hand-off tests (tests/engines): real clients for the shipped files.
   chromium glslang-tools spirv-cross mono-mcs python3-openimageio
 )
+# brdf-view: DejaVu Sans draws the Greek letters (θ, φ) in the window's labels.
+packages+=(fonts-dejavu-core)
+# The interactive brdf-view test presses keys and moves the mouse in an Xvfb window.
+packages+=(xdotool)
 
 # Debian's npm is a separate package; a Node.js that already ships npm (e.g. NodeSource's)
 # conflicts with it, so npm is only requested when no npm command exists.

@@ -34,5 +34,16 @@ for material in gold plastic_glossy_red wood_oak; do
 done
 "$brdf" preview "$out/luts/gold.ktx2" --compare "$root/data-samples/materials/gold.json" \
   --size 256 --spp 64 --quiet --out "$out/previews/gold_lut_vs_material.png"
-echo "== done: $(ls "$out/captures" | wc -l) captures in $out/captures, LUTs in $out/luts, atlas in $out/atlas, previews in $out/previews"
+# Pictures to look at: the reflection lobe of a few captures (brdf-view renders under
+# xvfb-run by itself when there is no display).
+cmake --build "$build" -j "$(nproc)" --target brdf-view
+mkdir -p "$out/pictures"
+echo "== lobe pictures -> $out/pictures"
+for material in gold plastic_glossy_red wood_oak paper_white; do
+  "$build/tools/brdf-view" "$out/captures/$material.bpc" --mode lobe --theta-in 40 \
+    --size 960x720 --screenshot "$out/pictures/$material-lobe.png"
+done
+"$build/tools/brdf-view" "$out/captures/gold.bpc" --mode slices --theta-in 40 \
+  --size 960x600 --screenshot "$out/pictures/gold-slices.png"
+echo "== done: $(ls "$out/captures" | wc -l) captures in $out/captures, LUTs in $out/luts, atlas in $out/atlas, previews in $out/previews, pictures in $out/pictures"
 "$brdf" info "$out/luts/gold.ktx2"
