@@ -22,11 +22,8 @@ using namespace brdf;
 using namespace brdf::device;
 
 SimulatorConfig GoldConfig() {
-  Material m;
-  m.model = Model::kGgx;
-  m.kd = {0, 0, 0};
-  m.ks = {0.962585, 0.786916, 0.408220};
-  m.shape = {0.15, 0.15, 0.15};
+  Material m = Material::Make(Model::kGgx, {Rgb{0, 0, 0}, Rgb{0.962585, 0.786916, 0.408220},
+                                            Rgb{0.15, 0.15, 0.15}});
   m.name = "gold";
   SimulatorConfig c;
   c.sample = std::make_shared<AnalyticBrdf>(m);

@@ -312,10 +312,7 @@ TEST_F(CaptureCli, SignalAbortsTheScanAndLeavesAResumableFile) {
 // RGL paints whose specular peaks clipped at the 1 ms minimum exposure before the ND filter
 // stage (1,019 and 759 saturated samples at the reference geometry): now none clips.
 TEST_F(CaptureCli, RglPaintPeaksNoLongerClip) {
-  const char* env = std::getenv("BRDF_DATA_DIR");
-  const fs::path data = env ? fs::path(env) : fs::path(BRDF_SHARED_DATA_DIR);
-  ASSERT_TRUE(fs::is_directory(data / "rgl"))
-      << "third-party data not found: set BRDF_DATA_DIR (now " << data << ")";
+  const fs::path data = brdf::test::DataDir();
   for (const char* paint : {"chm_orange_rgb", "chm_light_blue_rgb"}) {
     const std::string out = Path(std::string(paint) + ".bpc");
     const ToolRun r = Run("capture --material " + (data / "rgl" / (std::string(paint) + ".bsdf")).string() +

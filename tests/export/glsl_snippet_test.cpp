@@ -28,7 +28,7 @@ int Compile(const std::string& version_line, const std::string& snippet,
 
 TEST(GlslSnippet, CompilesAsGlslEs300AndGlsl450) {
   const brdf::test::ScopedTempDir dir("glsl");
-  const std::string snippet = ShaderSnippetGlsl(20.0, 4);
+  const std::string snippet = ShaderSnippetGlsl({0, 20, 40, 60});
   for (const auto& [version, name] :
        {std::pair<std::string, std::string>{"#version 300 es", "es300"},
         std::pair<std::string, std::string>{"#version 450", "gl450"}}) {

@@ -10,6 +10,8 @@
 // cm_military_green (a matte paint) are not.
 #include <gtest/gtest.h>
 
+#include "test_support.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
@@ -25,10 +27,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-std::string DataDir() {
-  if (const char* env = std::getenv("BRDF_DATA_DIR"); env != nullptr && *env) return env;
-  return BRDF_SHARED_DATA_DIR;
-}
+std::string DataDir() { return brdf::test::DataDir(); }
 
 // The reference geometry with φout every 4° (27,360 samples instead of 109,440): the RGL
 // materials' lobes are all several degrees wide, and the virtual capture dominates the cost.

@@ -5,6 +5,8 @@
 #include "brdf/processing/preview.h"
 
 #include <gtest/gtest.h>
+
+#include "test_support.h"
 #include <unistd.h>
 
 #include <atomic>
@@ -32,10 +34,7 @@ namespace {
 namespace fs = std::filesystem;
 using test::MakeMaterial;
 
-std::string DataDir() {
-  const char* env = std::getenv("BRDF_DATA_DIR");
-  return env != nullptr && *env != '\0' ? std::string(env) : std::string(BRDF_SHARED_DATA_DIR);
-}
+std::string DataDir() { return brdf::test::DataDir(); }
 
 // Runs the NumPy oracle and returns its numbers.
 std::vector<double> Oracle(const std::string& args) {
@@ -119,8 +118,9 @@ void ExpectFurnaceMatchesAlbedo(const Material& m, const std::string& model_name
   for (int t = 0; t <= 86; ++t) thetas += " " + std::to_string(t);
   std::vector<std::vector<double>> albedo(3);
   for (int c = 0; c < 3; ++c) {
-    albedo[c] = Oracle("albedo " + model_name + " " + std::to_string(m.kd[c]) + " " +
-                       std::to_string(m.ks[c]) + " " + std::to_string(m.shape[c]) + thetas);
+    albedo[c] = Oracle("albedo " + model_name + " " + std::to_string(m.Parameter(0)[c]) + " " +
+                       std::to_string(m.Parameter(1)[c]) + " " +
+                       std::to_string(m.Parameter(2)[c]) + thetas);
     ASSERT_EQ(albedo[c].size(), 87u);
   }
   double squares = 0, total = 0;

@@ -7,9 +7,9 @@
 #include <string>
 
 #include "brdf/exporter/exr.h"
-#include "tools/tool_runner.h"
+#include "tool_test_util.h"
 
-namespace brdf::testing {
+namespace brdf::tooltest {
 namespace {
 
 const std::string kMaterials = std::string(BRDF_SOURCE_DIR) + "/data-samples/materials/";
@@ -76,4 +76,4 @@ TEST_F(PreviewCli, BadArgumentsFailWithOneLine) {
 }
 
 }  // namespace
-}  // namespace brdf::testing
+}  // namespace brdf::tooltest

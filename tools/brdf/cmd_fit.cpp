@@ -99,10 +99,10 @@ int RunFit(const FitCommandOptions& options) {
         if (e.is_regular_file() && IsEvaluableFile(e.path().string()))
           evaluable.push_back(e.path().string());
       std::sort(evaluable.begin(), evaluable.end());
-      for (const std::string& f : evaluable) inputs.push_back({f, OutputNameOf(f)});
+      for (const std::string& f : evaluable) inputs.push_back({f, sources::OutputNameOf(f)});
       rest.push_back(arg);
     } else if (IsEvaluableFile(arg)) {
-      inputs.push_back({arg, OutputNameOf(arg)});
+      inputs.push_back({arg, sources::OutputNameOf(arg)});
     } else {
       rest.push_back(arg);
     }

@@ -26,7 +26,6 @@
 #include "brdf/sources/detect.h"
 #include "cli_support.h"
 #include "commands.h"
-#include "evaluable_capture.h"
 
 namespace brdf::cli {
 

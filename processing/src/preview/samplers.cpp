@@ -220,9 +220,10 @@ std::shared_ptr<const BrdfSampler> MakeBrdfSampler(const BrdfSource& source, int
   if (const auto* analytic = dynamic_cast<const AnalyticBrdf*>(&source);
       analytic != nullptr && analytic->material().model == Model::kGgx) {
     const Material& m = analytic->material();
-    const double alpha = (m.shape[0] + m.shape[1] + m.shape[2]) / 3.0;
-    const double specular = std::max(1e-3, (m.ks[0] + m.ks[1] + m.ks[2]) / 3.0);
-    const double diffuse = std::max(0.0, (m.kd[0] + m.kd[1] + m.kd[2]) / 3.0);
+    const Rgb a = m.Parameter("alpha"), f0 = m.Parameter("f0"), kd = m.Parameter("kd");
+    const double alpha = (a[0] + a[1] + a[2]) / 3.0;
+    const double specular = std::max(1e-3, (f0[0] + f0[1] + f0[2]) / 3.0);
+    const double diffuse = std::max(0.0, (kd[0] + kd[1] + kd[2]) / 3.0);
     const double p = std::clamp(specular / (specular + diffuse), 0.1, 0.95);
     return std::make_shared<GgxSampler>(alpha, p);
   }
