@@ -24,7 +24,7 @@ double AngleDeg(const Vec3& a, const Vec3& b) {
   return RadToDeg(std::acos(std::fmax(-1.0, std::fmin(1.0, c))));
 }
 
-// The mirror of the light (θin, φin = 0) about z, written out from DESIGN §4.
+// The mirror of the light (θin, φin = 0) about z, written out from docs/design.md §4.
 Vec3 MirrorOf(double theta_in_deg) {
   const double t = DegToRad(theta_in_deg);
   return {-std::sin(t), 0.0, std::cos(t)};
@@ -77,7 +77,7 @@ TEST(Lobe, LogScaleRadiusCountsDecadesAboveTheFloor) {
   for (const Vec3& p : mesh.points) ASSERT_NEAR(std::sqrt(Dot(p, p)), 2.0, 1e-5);
 }
 
-// Lafortune's lobe max(v·r, 0)^n peaks exactly at the mirror direction r (DESIGN §9).
+// Lafortune's lobe max(v·r, 0)^n peaks exactly at the mirror direction r (docs/design.md §9).
 TEST(Lobe, GlossyLobePeaksAtTheMirrorDirectionForEveryThetaIn) {
   const ViewSource source =
       FromJson(R"({"model": "lafortune", "kd": 0.05, "ks": 0.9, "n": 300})");

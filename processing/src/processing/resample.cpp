@@ -31,7 +31,7 @@ std::string Who(const Measurement& m) {
                                         : "measurement '" + m.metadata.sample_name + "'";
 }
 
-// Slice indices in ascending θin, checked against DESIGN §5's θin,k = k·Δin (only distinct
+// Slice indices in ascending θin, checked against docs/design.md §5's θin,k = k·Δin (only distinct
 // when !uniform; *delta_in is then 0).
 std::vector<std::size_t> ThetaInOrder(const Measurement& m, bool uniform, double* delta_in) {
   if (m.slices.empty()) throw InvalidArgument(Who(m) + " has no slices; cannot build a LUT");

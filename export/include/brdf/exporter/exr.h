@@ -1,5 +1,5 @@
 // EXR and PNG images of a LUT or an atlas, written through OpenEXR and libpng (brdf::image_io,
-// never OpenImageIO; DESIGN §5, §7).
+// never OpenImageIO; docs/design.md §5, §7).
 //
 // The 3D texture is laid out flat: the K slices in a grid of C = ceil(√K) columns and
 // R = ceil(K/C) rows, row-major, ascending θin, top-left first (4 slices: 2 × 2, 722 × 362

@@ -121,7 +121,7 @@ struct LutInputProblem {
 std::vector<LutInputProblem> FindLutInputProblems(const Measurement& measurement,
                                                   const ResampleOptions& options = {});
 
-// Builds the LUT of DESIGN §5 from `measurement` with the §6 extrapolation `params`.
+// Builds the LUT of docs/design.md §5 from `measurement` with the §6 extrapolation `params`.
 // Requirements (InvalidArgument otherwise, naming the sample and what is wrong):
 //  - at least one slice; the θin values, in any order, are k·Δin for k = 0…K−1 (uniform,
 //    starting at 0°, no duplicates; within 1e-3°); LUT slice k is θin = k·Δin exactly;

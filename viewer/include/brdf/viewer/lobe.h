@@ -1,7 +1,7 @@
 // The reflection lobe of a ViewSource as a triangle mesh, and the camera that frames it.
 //
 // The lobe is a deformed hemisphere over the outgoing directions ω_out(θo, φo) of the local
-// frame (DESIGN §4: z is the normal, directions point away from the surface, the light is at
+// frame (docs/design.md §4: z is the normal, directions point away from the surface, the light is at
 // (θin, φin = 0), i.e. in the +x half of the xz-plane, so the mirror direction is
 // (θin, 180°)). The vertex in direction ω_out sits at distance r(ω_out) from the origin:
 //   linear scale: r = q,  log scale: r = max(0, log10(q / q_floor))  (in decades),

@@ -1,6 +1,6 @@
 // The LUT slices as heat-map images, and what lies under the cursor.
 //
-// Slice k of the LUT (DESIGN §5) is an equirectangular image in the specular frame of θin,k:
+// Slice k of the LUT (docs/design.md §5) is an equirectangular image in the specular frame of θin,k:
 // column i at φd = i·1° (i = 0…360, column 360 repeats column 0), row j at θd = j·1° (j = 0…180,
 // row 0 at the top, θd = 0 is the mirror direction). A probe maps a texel back to the outgoing
 // direction it holds, ω_out = S(θin)·ω_d (brdf::SpecularFrame), in the measurement frame.

@@ -1,4 +1,4 @@
-// What the viewer shows of one BRDF source: its LUT (DESIGN §5, the asset an engine samples)
+// What the viewer shows of one BRDF source: its LUT (docs/design.md §5, the asset an engine samples)
 // and, when the source was a measurement, which outgoing directions were actually measured.
 //
 // Every picture in brdf-view (lobes, slice heat maps) is drawn from the LUT and sampled the way
@@ -22,7 +22,7 @@ namespace brdf::viewer {
 // Where a value at an outgoing direction came from.
 enum class Coverage : std::uint8_t {
   kMeasured,      // interpolated from measured samples (θout ≤ θb, a valid sample nearby)
-  kExtrapolated,  // θb < θout: the DESIGN §6 grazing extrapolation
+  kExtrapolated,  // θb < θout: the docs/design.md §6 grazing extrapolation
   kUnmeasured,    // θout ≤ θb but no valid sample nearby (blind spot, samples flagged invalid)
 };
 const char* CoverageName(Coverage coverage);  // "measured", "extrapolated", "unmeasured"
@@ -70,7 +70,7 @@ ViewSource ViewSourceFromMeasurement(const Measurement& measurement,
 ViewSource ViewSourceFromLut(Lut lut, std::string name, double theta_b_deg = 90);
 
 // Any evaluable BRDF (RGL, MERL, a fit): captured noise-free on the reference instrument's
-// geometry (θin 0/20/40/60°, θout 0–75°, φout 0–359° at 1°, DESIGN §1) and resampled with the
+// geometry (θin 0/20/40/60°, θout 0–75°, φout 0–359° at 1°, docs/design.md §1) and resampled with the
 // default §6 parameters, i.e. exactly the LUT `brdf convert` would make from that capture.
 ViewSource ViewSourceFromBrdf(const BrdfSource& source, std::string name);
 
