@@ -14,6 +14,7 @@
 #include <stdlib.h>
 
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <memory>
@@ -86,6 +87,22 @@ inline std::filesystem::path NewTempDir(std::string_view tag) {
   static std::vector<std::unique_ptr<ScopedTempDir>> dirs;
   dirs.push_back(std::make_unique<ScopedTempDir>(tag));
   return dirs.back()->path();
+}
+
+// Runs `command` through /bin/sh and returns its stdout and its exit status (pclose: 0 on
+// success; -1 if the command could not be started). For the numpy oracles of tests/python/.
+struct CommandOutput {
+  int status = -1;
+  std::string out;
+};
+inline CommandOutput RunCommand(const std::string& command) {
+  CommandOutput r;
+  std::FILE* pipe = ::popen(command.c_str(), "r");
+  if (pipe == nullptr) return r;
+  char buf[65536];
+  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, pipe)) > 0;) r.out.append(buf, n);
+  r.status = ::pclose(pipe);
+  return r;
 }
 
 }  // namespace brdf::test

@@ -17,6 +17,7 @@
 
 #include "brdf/core/error.h"
 #include "brdf/core/models.h"
+#include "test_support.h"
 
 namespace brdf {
 namespace {
@@ -76,12 +77,9 @@ TEST(EngineModels, AgreeWithTheNumpyTranscriptionOfTheShaderFunctions) {
   }
   const std::string cmd = std::string(BRDF_PYTHON3) + " " + BRDF_SOURCE_DIR +
                           "/tests/python/engine_brdf_oracle.py < '" + input.string() + "'";
-  std::FILE* pipe = ::popen(cmd.c_str(), "r");
-  ASSERT_NE(pipe, nullptr) << cmd;
-  std::string text;
-  char buf[65536];
-  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, pipe)) > 0;) text.append(buf, n);
-  ASSERT_EQ(::pclose(pipe), 0) << cmd << "\n" << text.substr(0, 500);
+  const brdf::test::CommandOutput oracle = brdf::test::RunCommand(cmd);
+  ASSERT_EQ(oracle.status, 0) << cmd << "\n" << oracle.out.substr(0, 500);
+  const std::string& text = oracle.out;
   std::istringstream lines(text);
   std::size_t i = 0;
   double worst = 0;

@@ -10,9 +10,17 @@
 #include <regex>
 #include <set>
 #include <tuple>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
 
 #include "brdf/core/error.h"
+#include "brdf/core/virtual_capture.h"
 #include "device_test_support.h"
+#include "test_support.h"
 
 namespace brdf::device {
 namespace {
@@ -51,6 +59,87 @@ TEST(Capture, NoiseFreeMatchesTheAnalyticTruthAtEverySampleOfEveryLibraryMateria
     EXPECT_EQ(samples, 109440u) << name;
     EXPECT_LT(worst, 1e-5) << name << ": worst relative error at sample " << worst_index;
   }
+}
+
+// Blinn-Phong and Ward (no library material uses them) against numpy written from the
+// docs/design.md §9 formulas (tests/python/analytic_brdf_oracle.py), for both noise-free
+// captures: the simulated instrument at noise 0 through the driver, and CaptureNoiseFree.
+// Samples are stored as float32 (relative rounding ≤ 2^-24 ≈ 6e-8); the tolerance 1e-6 leaves
+// room for the instrument's exposure × responsivity and back, and nothing else.
+TEST(Capture, NoiseFreeBlinnPhongAndWardMatchNumpyFromTheFormulas) {
+  const std::vector<Material> materials = {
+      Material::Make(Model::kBlinnPhong, {{0.3, 0.2, 0.1}, {0.5, 0.4, 0.2}, {40, 40, 40}}),
+      Material::Make(Model::kWard, {{0.2, 0.25, 0.3}, {0.3, 0.2, 0.1}, {0.15, 0.15, 0.15}})};
+  struct Case {
+    std::string what;
+    Sample sample;
+  };
+  std::vector<Case> cases;
+  const brdf::test::ScopedTempDir dir("oracle");
+  const std::string input = (dir / "directions.txt").string();
+  {
+    std::ofstream out(input);
+    out.precision(17);
+    for (const Material& m : materials) {
+      SimulatedFirmware fw(Config(m, 0));
+      testing::CaptureRun run;
+      RunCapture(fw, &run);
+      ASSERT_EQ(run.slices.size(), 4u);
+      const Measurement direct = CaptureNoiseFree(AnalyticBrdf(m));
+      ASSERT_EQ(direct.slices.size(), 4u);
+      const std::pair<const char*, const std::vector<Slice>*> captures[] = {
+          {"simulator", &run.slices}, {"CaptureNoiseFree", &direct.slices}};
+      for (const auto& [source, slices] : captures) {
+        for (const Slice& slice : *slices) {
+          // Up to 100 samples per slice: every 271st of the 27360 (all θout rows, varied φout), plus
+          // the neighbourhood of the mirror direction where the lobe peaks.
+          std::vector<const Sample*> picked;
+          for (std::size_t i = 0; i < slice.samples.size() && picked.size() < 80; i += 271)
+            picked.push_back(&slice.samples[i]);
+          for (const Sample& s : slice.samples)
+            if (std::fabs(s.theta_out_deg - slice.theta_in_deg) <= 2 &&
+                std::fabs(s.phi_out_deg - 180) <= 2 && picked.size() < 100)
+              picked.push_back(&s);
+          for (const Sample* s : picked) {
+            const Rgb kd = m.Parameter(0), ks = m.Parameter(1);
+            out << ModelName(m.model) << ' ' << kd[0] << ' ' << kd[1] << ' ' << kd[2] << ' '
+                << ks[0] << ' ' << ks[1] << ' ' << ks[2] << ' ' << m.Parameter(2)[0] << ' '
+                << s->theta_in_deg << ' ' << s->phi_in_deg << ' ' << s->theta_out_deg << ' '
+                << s->phi_out_deg << '\n';
+            cases.push_back({std::string(ModelName(m.model)) + " " + source, *s});
+          }
+        }
+      }
+    }
+  }
+  ASSERT_GE(cases.size(), 2u * 2u * 4u * 95u);  // θin 0: only 15 samples near the mirror
+  const std::string cmd = std::string(BRDF_PYTHON3) + " " + BRDF_SOURCE_DIR +
+                          "/tests/python/analytic_brdf_oracle.py < '" + input + "'";
+  const brdf::test::CommandOutput oracle = brdf::test::RunCommand(cmd);
+  ASSERT_EQ(oracle.status, 0) << cmd << "\n" << oracle.out.substr(0, 500);
+  const std::string& text = oracle.out;
+  std::istringstream lines(text);
+  std::size_t i = 0;
+  double worst = 0;
+  for (std::string line; std::getline(lines, line); ++i) {
+    ASSERT_LT(i, cases.size());
+    std::istringstream fields(line);
+    Rgb want{};
+    fields >> want[0] >> want[1] >> want[2];
+    const Sample& s = cases[i].sample;
+    for (int c = 0; c < 3; ++c) {
+      ASSERT_GT(want[c], 0) << cases[i].what << ": the oracle gave no value";
+      const double err = std::fabs(s.rgb[c] - want[c]) / want[c];
+      worst = std::max(worst, err);
+      EXPECT_LE(err, 1e-6) << cases[i].what << " at θin " << s.theta_in_deg << " θout "
+                           << s.theta_out_deg << " φout " << s.phi_out_deg << " channel " << c
+                           << ": " << s.rgb[c] << " vs numpy " << want[c];
+    }
+  }
+  EXPECT_EQ(i, cases.size());
+  char worst_text[32];
+  std::snprintf(worst_text, sizeof worst_text, "%.3g", worst);
+  RecordProperty("worst_relative_error", worst_text);
 }
 
 TEST(Capture, RecordsEveryGridDirectionOnceInRowMajorOrder) {
