@@ -52,7 +52,7 @@ class GgxSampler final : public BrdfSampler {
     const Vec3 h = Normalize(wo + wi);
     // D_wo(h) = G1(wo)·max(0, wo·h)·D(h)/wo.z; reflecting about h has Jacobian 1/(4 wo·h).
     const double specular =
-        models::GgxG1(wo.z, alpha_) * models::GgxD(h.z, alpha_) / (4.0 * wo.z);
+        models::GgxG1(wo.z, alpha_ * alpha_) * models::GgxD(h.z, alpha_ * alpha_) / (4.0 * wo.z);
     return specular_probability_ * specular + (1.0 - specular_probability_) * CosinePdf(wi);
   }
 
