@@ -154,7 +154,8 @@ std::string AtlasManifestJson(const Atlas& atlas, const std::vector<std::string>
                            {"height", Lut::kHeight}}}});
     if (static_cast<std::size_t>(m) < atlas.saturated_samples.size() &&
         atlas.saturated_samples[m])
-      materials.back()["saturated_samples"] = detail::SaturatedCountsJson(*atlas.saturated_samples[m]);
+      materials.back()["saturated_samples"] =
+          detail::SaturatedCountsJson(*atlas.saturated_samples[m]);
   }
   j["materials"] = std::move(materials);
   j["grid"] = {

@@ -48,7 +48,7 @@ struct SrgbByteTable {
 
 FloatImage CompositeImage(const Lut& lut) {
   ValidateLutForExport(lut);
-  return AtlasImage({AtlasMaterial{"lut", &lut, "", std::nullopt}});
+  return AtlasImage({AtlasMaterial{"lut", &lut, ""}});
 }
 
 Lut LutFromComposite(const FloatImage& image, std::vector<double> theta_in_deg) {

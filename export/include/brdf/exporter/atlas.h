@@ -43,7 +43,7 @@ struct AtlasMaterial {
   const Lut* lut = nullptr;  // not owned; must outlive the call
   std::string source;        // where the LUT came from (for the manifest)
   // Saturated samples per measured slice (the manifest's "saturated_samples"); absent: unknown.
-  std::optional<std::vector<SaturatedCount>> saturated_samples;
+  std::optional<std::vector<SaturatedCount>> saturated_samples = std::nullopt;
 };
 
 struct Atlas {
@@ -80,7 +80,8 @@ Lut ExtractAtlasCell(const PackedVolume& atlas_volume, const AtlasLayout& layout
 struct AtlasManifestEntry {
   std::string name, source;
   int index = 0, column = 0, row = 0, x0 = 0, y0 = 0;
-  std::optional<std::vector<SaturatedCount>> saturated_samples;  // absent: not recorded
+  // Absent: the manifest did not record them.
+  std::optional<std::vector<SaturatedCount>> saturated_samples = std::nullopt;
 };
 struct AtlasManifest {
   std::vector<double> theta_in_deg;
