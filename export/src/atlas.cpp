@@ -70,6 +70,7 @@ Atlas BuildAtlas(const std::vector<AtlasMaterial>& materials) {
   for (std::size_t m = 0; m < materials.size(); ++m) {
     atlas.names.push_back(materials[m].name);
     atlas.sources.push_back(materials[m].source);
+    atlas.saturated_samples.push_back(materials[m].saturated_samples);
     const Lut& lut = *materials[m].lut;
     const int x0 = atlas.layout.cells.CellColumn(static_cast<int>(m)) * Lut::kWidth;
     const int y0 = atlas.layout.cells.CellRow(static_cast<int>(m)) * Lut::kHeight;
@@ -151,6 +152,10 @@ std::string AtlasManifestJson(const Atlas& atlas, const std::vector<std::string>
                            {"y0", row * Lut::kHeight},
                            {"width", Lut::kWidth},
                            {"height", Lut::kHeight}}}});
+    if (static_cast<std::size_t>(m) < atlas.saturated_samples.size() &&
+        atlas.saturated_samples[m])
+      materials.back()["saturated_samples"] =
+          detail::SaturatedCountsJson(*atlas.saturated_samples[m]);
   }
   j["materials"] = std::move(materials);
   j["grid"] = {
@@ -241,6 +246,9 @@ AtlasManifest ParseAtlasManifest(std::string_view json_text, const std::string& 
     detail::JsonFields c(e.Object("cell"), file, prefix + "cell.");
     AtlasManifestEntry entry{e.String("name"), e.String("source"), e.Int("index"), c.Int("column"),
                              c.Int("row"),     c.Int("x0"),        c.Int("y0")};
+    if (list[i].contains("saturated_samples"))
+      entry.saturated_samples = detail::ParseSaturatedCounts(list[i]["saturated_samples"], file,
+                                                             prefix + "saturated_samples");
     m.materials.push_back(std::move(entry));
   }
   detail::JsonFields p(f.Object("payload"), file, "payload.");

@@ -144,4 +144,27 @@ std::vector<std::string> JsonFields::StringArray(const char* name) const {
   return out;
 }
 
+ordered_json SaturatedCountsJson(const std::vector<SaturatedCount>& counts) {
+  ordered_json a = ordered_json::array();
+  for (const SaturatedCount& c : counts)
+    a.push_back({{"theta_in_deg", c.theta_in_deg}, {"count", c.count}});
+  return a;
+}
+
+std::vector<SaturatedCount> ParseSaturatedCounts(const ordered_json& array, const std::string& file,
+                                                 const std::string& member) {
+  if (!array.is_array())
+    throw FormatError(file, "member '" + member + "'", "an array", array.type_name());
+  std::vector<SaturatedCount> counts;
+  for (std::size_t k = 0; k < array.size(); ++k) {
+    const std::string item = member + "[" + std::to_string(k) + "]";
+    if (!array[k].is_object())
+      throw FormatError(file, "member '" + item + "'", "an object with theta_in_deg and count",
+                        array[k].type_name());
+    JsonFields f(array[k], file, item + ".");
+    counts.push_back({f.Number("theta_in_deg"), f.UInt64("count")});
+  }
+  return counts;
+}
+
 }  // namespace brdf::exporter::detail

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "brdf/exporter/metadata.h"
 #include "brdf/exporter/packed_volume.h"
 
 namespace brdf::exporter::detail {
@@ -29,6 +30,12 @@ std::uint32_t ParseHex32(const std::string& text, const std::string& file,
 ordered_json ParseEmbeddedJson(const std::string& text, const std::string& what);
 // Parses a whole document; throws FormatError with the parser's byte position.
 ordered_json ParseJsonDocument(std::string_view text, const std::string& file);
+
+// [{"theta_in_deg": 0, "count": 0}, ...] and back; the parser throws FormatError naming
+// "member '<member>[k].count'" etc.
+ordered_json SaturatedCountsJson(const std::vector<SaturatedCount>& counts);
+std::vector<SaturatedCount> ParseSaturatedCounts(const ordered_json& array, const std::string& file,
+                                                 const std::string& member);
 
 // Typed member access that throws FormatError(file, "member '<prefix><name>'", ...).
 class JsonFields {

@@ -37,6 +37,9 @@ std::string SidecarJson(const PackedVolume& payload, const std::vector<double>& 
   } else {
     j["extrapolation"] = nullptr;
   }
+  if (metadata.saturated_samples) {
+    j["saturated_samples"] = detail::SaturatedCountsJson(*metadata.saturated_samples);
+  }
   j["fitted_models"] = ordered_json::array();
   for (const std::string& text : metadata.fitted_models_json)
     j["fitted_models"].push_back(detail::ParseEmbeddedJson(text, "fitted model"));
@@ -93,6 +96,9 @@ SidecarInfo ParseSidecarJson(std::string_view json_text, const std::string& file
     detail::JsonFields e(f.Object("extrapolation"), file, "extrapolation.");
     info.extrapolation = ExtrapolationInfo{e.Number("p"), e.Number("l"), e.Number("theta_b_deg")};
   }
+  if (j.contains("saturated_samples"))
+    info.saturated_samples =
+        detail::ParseSaturatedCounts(j["saturated_samples"], file, "saturated_samples");
   if (j.contains("fitted_models")) {
     if (!j["fitted_models"].is_array())
       throw FormatError(file, "member 'fitted_models'", "an array", j["fitted_models"].type_name());

@@ -72,6 +72,7 @@ int RunAtlas(const AtlasOptions& options) {
   processing::ResampleOptions resample;
   resample.parallel = found.inputs.size() == 1 && options.jobs > 1;
   std::vector<Lut> luts(found.inputs.size());
+  std::vector<std::optional<std::vector<exporter::SaturatedCount>>> saturated(found.inputs.size());
 
   Progress progress("atlas", found.inputs.size(), !options.quiet);
   const std::vector<JobResult> results = RunJobs(
@@ -84,6 +85,9 @@ int RunAtlas(const AtlasOptions& options) {
         sources::InputLut built = sources::LutFromInput(in.path, in.kind, chosen, resample);
         exporter::ValidateLutForExport(built.lut);
         result.warnings = std::move(built.warnings);
+        if (auto note = sources::SaturationNote(in.path, built.saturated_samples))
+          result.warnings.push_back(std::move(*note));
+        saturated[i] = std::move(built.saturated_samples);
         luts[i] = std::move(built.lut);
       },
       [&](std::size_t i, const JobResult& result) {
@@ -108,7 +112,7 @@ int RunAtlas(const AtlasOptions& options) {
 
   std::vector<exporter::AtlasMaterial> materials;
   for (std::size_t i = 0; i < luts.size(); ++i)
-    materials.push_back({found.inputs[i].name, &luts[i], found.inputs[i].path});
+    materials.push_back({found.inputs[i].name, &luts[i], found.inputs[i].path, saturated[i]});
   const fs::path parent = fs::path(options.out).parent_path();
   if (!parent.empty()) {
     std::error_code ec;

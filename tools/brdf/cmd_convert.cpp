@@ -155,11 +155,14 @@ int RunConvert(const ConvertOptions& options) {
         if (automatic) chosen = automatic->params;
         sources::InputLut built = sources::LutFromInput(in.path, in.kind, chosen, resample);
         result.warnings = std::move(built.warnings);
+        if (auto note = sources::SaturationNote(in.path, built.saturated_samples))
+          result.warnings.push_back(std::move(*note));
         exporter::TextureMetadata metadata;
         if (automatic) metadata.fitted_models_json.push_back(automatic->record_json);
         metadata.name = in.name;
         metadata.source = in.path;
         metadata.extrapolation = built.extrapolation;
+        metadata.saturated_samples = built.saturated_samples;
         std::vector<std::string> outputs = OutputPaths(out_dir, in.name, export_options.formats);
         for (std::string& p : engines::EngineOutputPaths(out_dir.string(), in.name, engine_set))
           outputs.push_back(std::move(p));

@@ -304,18 +304,47 @@ InputLut LutFromInput(const std::string& path, FileKind kind,
     if (!t.texture.IsSingleLut())
       throw InvalidArgument(path + ": an atlas, not a single material's LUT");
     if (command_line) out.warnings.push_back(ExtrapolationIgnored(path));
-    if (t.sidecar) out.extrapolation = t.sidecar->extrapolation;
+    if (t.sidecar) {
+      out.extrapolation = t.sidecar->extrapolation;
+      out.saturated_samples = t.sidecar->saturated_samples;
+    }
     out.lut = std::move(t.texture.lut);
     return out;
   }
   PreparedMeasurement p = PrepareMeasurement(path, kind, command_line);
   out.warnings = std::move(p.warnings);
+  out.saturated_samples = CountSaturated(p.measurement);
   processing::ResampleReport report;
   out.lut = processing::BuildLut(p.measurement, p.extrapolation.params, resample_options, &report);
   if (report.theta_b_deg < 90.0)
     out.extrapolation = exporter::ExtrapolationInfo{p.extrapolation.params.p,
                                                     p.extrapolation.params.l, report.theta_b_deg};
   return out;
+}
+
+std::vector<exporter::SaturatedCount> CountSaturated(const Measurement& m) {
+  std::vector<exporter::SaturatedCount> counts;
+  for (const Slice& slice : m.slices) {
+    std::uint64_t n = 0;
+    for (const Sample& sample : slice.samples) n += (sample.flags & kFlagSaturated) != 0;
+    counts.push_back({slice.theta_in_deg, n});
+  }
+  return counts;
+}
+
+std::optional<std::string> SaturationNote(
+    const std::string& path, const std::optional<std::vector<exporter::SaturatedCount>>& counts) {
+  if (!counts) return std::nullopt;
+  std::uint64_t total = 0;
+  std::string per_slice;
+  for (const exporter::SaturatedCount& c : *counts) {
+    total += c.count;
+    per_slice += (per_slice.empty() ? "θin " : ", ") + Deg(c.theta_in_deg) + "°: " +
+                 std::to_string(c.count);
+  }
+  if (total == 0) return std::nullopt;
+  return path + ": " + std::to_string(total) + " saturated sample" + (total == 1 ? "" : "s") +
+         " (" + per_slice + "); their values are clipped";
 }
 
 }  // namespace brdf::sources

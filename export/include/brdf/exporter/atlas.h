@@ -14,6 +14,7 @@
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -41,12 +42,15 @@ struct AtlasMaterial {
   std::string name;
   const Lut* lut = nullptr;  // not owned; must outlive the call
   std::string source;        // where the LUT came from (for the manifest)
+  // Saturated samples per measured slice (the manifest's "saturated_samples"); absent: unknown.
+  std::optional<std::vector<SaturatedCount>> saturated_samples = std::nullopt;
 };
 
 struct Atlas {
   AtlasLayout layout;
   std::vector<double> theta_in_deg;
   std::vector<std::string> names, sources;
+  std::vector<std::optional<std::vector<SaturatedCount>>> saturated_samples;  // per material
   PackedVolume volume;  // Cm·361 × Rm·181 × K, RGB9E5
 };
 
@@ -76,6 +80,8 @@ Lut ExtractAtlasCell(const PackedVolume& atlas_volume, const AtlasLayout& layout
 struct AtlasManifestEntry {
   std::string name, source;
   int index = 0, column = 0, row = 0, x0 = 0, y0 = 0;
+  // Absent: the manifest did not record them.
+  std::optional<std::vector<SaturatedCount>> saturated_samples = std::nullopt;
 };
 struct AtlasManifest {
   std::vector<double> theta_in_deg;

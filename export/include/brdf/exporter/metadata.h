@@ -5,6 +5,7 @@
 // came from, how to address it and whether its content is intact.
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -18,12 +19,23 @@ struct ExtrapolationInfo {
   double theta_b_deg = 75;  // the last measured θout of the data
 };
 
+// How many samples of one measured slice carried the saturated flag (kFlagSaturated of
+// brdf/core/measurement.h): their values are clipped at the detector's full scale, so the LUT
+// texels built from them are lower bounds.
+struct SaturatedCount {
+  double theta_in_deg = 0;
+  std::uint64_t count = 0;
+};
+
 struct TextureMetadata {
   std::string name;    // material name, usually the input file's stem
   std::string source;  // where the values came from: input path(s), device, material file
   // Absent when the values did not need extrapolating (an analytic material evaluated
   // everywhere).
   std::optional<ExtrapolationInfo> extrapolation;
+  // Saturated samples per measured slice, θin ascending. Absent when unknown (an exported LUT
+  // whose sidecar did not record them); written as the sidecar's "saturated_samples".
+  std::optional<std::vector<SaturatedCount>> saturated_samples;
   // Fitted analytic models (docs/design.md §9 material JSON objects, each a complete JSON text), if
   // any. Written verbatim into the sidecar's "fitted_models" array; must be valid JSON.
   std::vector<std::string> fitted_models_json;

@@ -20,6 +20,8 @@
 //     "texel_convention": { "centre_exact": "u = (phi_d/1deg + 0.5)/361, ...",
 //                           "published": "u = phi_d/(2 pi), ..." },
 //     "extrapolation": { "p": 1, "l": 0.5, "theta_b_deg": 75, ... },
+//     "saturated_samples": [{ "theta_in_deg": 0, "count": 0 }, { "theta_in_deg": 20, "count": 12 },
+//                           ...],   (only when known; samples flagged saturated, per slice)
 //     "fitted_models": [], "tool": { "name": "brdf-toolchain", "version": "0.1.0" },
 //     "payload": { "bytes": 1045456, "checksum": { "algorithm": "crc32", "value": "0x…" } },
 //     "files": ["gold.ktx2", "gold.dds"] }
@@ -52,6 +54,7 @@ struct SidecarInfo {
   std::uint64_t payload_bytes = 0;
   std::uint32_t payload_crc32 = 0;
   std::optional<ExtrapolationInfo> extrapolation;
+  std::optional<std::vector<SaturatedCount>> saturated_samples;  // absent: not recorded
   std::vector<std::string> fitted_models_json;  // each model as compact JSON text
   std::string tool_version;
   std::vector<std::string> files;  // companion file names

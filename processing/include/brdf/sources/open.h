@@ -143,13 +143,27 @@ OpenedSource OpenBrdf(const std::string& path, const OpenOptions& options = {});
 // A LUT ready to export or to place in an atlas, built from any input `brdf convert` or
 // `brdf atlas` accepts: captures and material files are resampled (processing::BuildLut with
 // the chosen extrapolation); exported LUTs (.ktx2, .dds, sidecar) are decoded as stored.
+//
+// Saturated samples: for a measurement, the samples of each slice that carry kFlagSaturated
+// (counted over the slices the LUT is built from, θin ascending as the measurement lists them);
+// for an exported LUT, what its sidecar recorded, or nothing when it recorded none.
 struct InputLut {
   Lut lut;
   std::optional<exporter::ExtrapolationInfo> extrapolation;  // what filled θout > θb
+  std::optional<std::vector<exporter::SaturatedCount>> saturated_samples;  // absent: unknown
   std::vector<std::string> warnings;
 };
 InputLut LutFromInput(const std::string& path, FileKind kind,
                       const std::optional<processing::ExtrapolationParams>& command_line,
                       const processing::ResampleOptions& resample_options);
+
+// The samples flagged saturated (kFlagSaturated) in each slice of `m`, in slice order.
+std::vector<exporter::SaturatedCount> CountSaturated(const Measurement& m);
+
+// The one line `brdf convert` and `brdf atlas` print for an input with saturated samples, e.g.
+// "gold.bpc: 12 saturated samples (θin 0°: 0, 20°: 12, 40°: 0, 60°: 0); their values are
+// clipped"; nullopt when there are none (or the counts are unknown).
+std::optional<std::string> SaturationNote(
+    const std::string& path, const std::optional<std::vector<exporter::SaturatedCount>>& counts);
 
 }  // namespace brdf::sources
