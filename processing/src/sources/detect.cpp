@@ -36,23 +36,6 @@ std::string Lower(std::string s) {
   return s;
 }
 
-const char* NotRegularName(fs::file_type type) {
-  switch (type) {
-    case fs::file_type::directory:
-      return "a directory";
-    case fs::file_type::fifo:
-      return "a FIFO (named pipe)";
-    case fs::file_type::socket:
-      return "a socket";
-    case fs::file_type::block:
-      return "a block device";
-    case fs::file_type::character:
-      return "a character device";
-    default:
-      return "not a regular file";
-  }
-}
-
 FileKind ClassifyJson(const std::string& path) {
   if (EndsWith(Lower(fs::path(path).filename().string()), kExtrapolationSuffix))
     return FileKind::kExtrapolation;
@@ -114,8 +97,7 @@ FileKind DetectFileKind(const std::string& path) {
   const fs::file_status status = fs::status(path, ec);
   if (ec || status.type() == fs::file_type::not_found)
     throw IoError(path + ": no such file");
-  if (status.type() != fs::file_type::regular)
-    throw IoError(path + ": " + NotRegularName(status.type()) + ", not a file to read");
+  if (status.type() != fs::file_type::regular) CheckRegularFile(path);  // names what it is
   const std::uint64_t size = fs::file_size(path, ec);
   if (ec) throw IoError(path + ": cannot read its size: " + ec.message());
 
