@@ -3,23 +3,38 @@
 # captures every material of the virtual sample library with the simulated scatterometer and
 # converts the captures into engine-ready lookup textures.
 # Usage: tools/run-demo.sh [OUT_DIR]   (default: out/demo)
+# The test suite runs this same script on a reduced job (tests/tools/CMakeLists.txt, run_demo):
+#   BRDF_DEMO_TOOLS=DIR        use the brdf and brdf-view already built in DIR (no install, no build)
+#   BRDF_DEMO_MATERIALS="a b"  capture only these library materials (must include gold,
+#                              plastic_glossy_red, wood_oak and paper_white, which the pictures use)
+#   BRDF_DEMO_PHI_OUT_STEP=N   detector azimuth step in degrees (default: the instrument's 1°)
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 out="${1:-$root/out/demo}"
 build="$root/build/release"
 
-"$root/tools/install-deps.sh"
-cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
-  -DBRDF_BUILD_TESTS=OFF -DBRDF_BUILD_BENCH=OFF >/dev/null
-cmake --build "$build" -j "$(nproc)" --target brdf
-brdf="$build/tools/brdf"
+if [ -n "${BRDF_DEMO_TOOLS:-}" ]; then
+  tools="$BRDF_DEMO_TOOLS"
+else
+  "$root/tools/install-deps.sh"
+  cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
+    -DBRDF_BUILD_TESTS=OFF -DBRDF_BUILD_BENCH=OFF >/dev/null
+  cmake --build "$build" -j "$(nproc)" --target brdf brdf-view
+  tools="$build/tools"
+fi
+brdf="$tools/brdf"
+capture_options=()
+if [ -n "${BRDF_DEMO_PHI_OUT_STEP:-}" ]; then
+  capture_options+=(--phi-out-step "$BRDF_DEMO_PHI_OUT_STEP")
+fi
 
 mkdir -p "$out/captures"
 echo "== capturing the virtual sample library with the simulated scatterometer -> $out/captures"
 "$brdf" materials
-for material in $("$brdf" materials --json | /usr/bin/python3 -c 'import json,sys; print(" ".join(m["name"] for m in json.load(sys.stdin)))'); do
+materials="${BRDF_DEMO_MATERIALS:-$("$brdf" materials --json | /usr/bin/python3 -c 'import json,sys; print(" ".join(m["name"] for m in json.load(sys.stdin)))')}"
+for material in $materials; do
   "$brdf" capture --device sim --material "$material" --sample "$material" \
-    --out "$out/captures/$material.bpc" --seed 1 --force
+    --out "$out/captures/$material.bpc" --seed 1 --force "${capture_options[@]}"
 done
 echo "== converting captures to RGB9E5 lookup textures -> $out/luts"
 "$brdf" convert "$out/captures" --out "$out/luts" --force
@@ -36,14 +51,13 @@ done
   --size 256 --spp 64 --quiet --out "$out/previews/gold_lut_vs_material.png"
 # Pictures to look at: the reflection lobe of a few captures (brdf-view renders under
 # xvfb-run by itself when there is no display).
-cmake --build "$build" -j "$(nproc)" --target brdf-view
 mkdir -p "$out/pictures"
 echo "== lobe pictures -> $out/pictures"
 for material in gold plastic_glossy_red wood_oak paper_white; do
-  "$build/tools/brdf-view" "$out/captures/$material.bpc" --mode lobe --theta-in 40 \
+  "$tools/brdf-view" "$out/captures/$material.bpc" --mode lobe --theta-in 40 \
     --size 960x720 --screenshot "$out/pictures/$material-lobe.png"
 done
-"$build/tools/brdf-view" "$out/captures/gold.bpc" --mode slices --theta-in 40 \
+"$tools/brdf-view" "$out/captures/gold.bpc" --mode slices --theta-in 40 \
   --size 960x600 --screenshot "$out/pictures/gold-slices.png"
 echo "== done: $(ls "$out/captures" | wc -l) captures in $out/captures, LUTs in $out/luts, atlas in $out/atlas, previews in $out/previews, pictures in $out/pictures"
 "$brdf" info "$out/luts/gold.ktx2"
