@@ -61,6 +61,13 @@ TEST_F(Overwrite, ExportCsvRefusesAnExistingFileWithoutForce) {
                           dir_ / "g.csv");
 }
 
+TEST_F(Overwrite, PreviewRefusesAnExistingImageWithoutForce) {
+  ExpectRefusedThenForced("preview " + Quote(std::string(BRDF_SOURCE_DIR) +
+                                             "/data-samples/materials/gold.json") +
+                              " --size 16 --spp 1 --quiet --out " + Quote(dir_ / "p.png"),
+                          dir_ / "p.png");
+}
+
 TEST_F(Overwrite, ImportRefusesAnExistingFileWithoutForce) {
   const fs::path csv = dir_ / "in.csv";
   WriteText(csv, "theta_in,phi_in,theta_out,phi_out,r,g,b\n20,0,30,180,0.1,0.2,0.3\n");

@@ -16,7 +16,9 @@
 #include "cli_support.h"
 #include "commands.h"
 #include "progress.h"
+#include "brdf/core/file_util.h"
 #include "brdf/sources/open.h"
+#include "cli_support.h"
 
 namespace brdf::cli {
 namespace {
@@ -147,6 +149,8 @@ int RunPreview(const PreviewCommandOptions& cli) {
     options.shape = preview::Shape::kMesh;
     options.mesh = &mesh;
   }
+  // The overwrite rule of every writing command, checked before any rendering work.
+  ReportRemovedTemporaries(CheckWritableOutput(cli.out, cli.force));
   const preview::EnvironmentMap map = preview::EnvironmentMap::FromName(cli.env);
 
   std::optional<processing::ExtrapolationParams> extrapolate;

@@ -173,6 +173,7 @@ struct PreviewCommandOptions {
   std::string estimator = "mis";      // mis, env, brdf, quadrature
   std::string extrapolate;            // captures: "P,L"
   std::string out;                    // .exr or .png
+  bool force = false;                 // overwrite an existing --out
   int jobs = DefaultJobs();
   std::uint64_t seed = 1;
   bool no_background = false;  // black instead of the map where the object is not

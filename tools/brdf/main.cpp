@@ -507,6 +507,7 @@ int main(int argc, char** argv) {
   preview_cmd->add_flag("--no-background", preview.no_background,
                         "Black where the object is not, instead of the map");
   preview_cmd->add_flag("--quiet", preview.quiet, "No progress on stderr");
+  preview_cmd->add_flag("--force", preview.force, "Overwrite --out if it already exists");
   preview_cmd->footer(
       "World frame: z up; the map's top row is the zenith, its left edge azimuth 0 (+x), "
       "azimuth growing to the right. The default camera looks from +x, so the map's centre is "
