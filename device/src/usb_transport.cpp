@@ -97,12 +97,36 @@ std::string SerialOf(libusb_device_handle* h, const libusb_device_descriptor& d)
                : std::string();
 }
 
+// Bytes one transfer delivered, handed out to Read calls until used up: both transports receive
+// in units (bulk transfers, HID reports) larger than what the codec asks for at a time.
+class Inbox {
+ public:
+  bool Empty() const { return start_ == bytes_.size(); }
+  // Empties the inbox and returns its storage, to be filled by the next transfer.
+  std::vector<std::uint8_t>& Refill() {
+    bytes_.clear();
+    start_ = 0;
+    return bytes_;
+  }
+  // Copies as many waiting bytes as fit into `buffer`; returns how many.
+  std::size_t Drain(std::span<std::uint8_t> buffer) {
+    const std::size_t n = std::min(buffer.size(), bytes_.size() - start_);
+    std::memcpy(buffer.data(), bytes_.data() + start_, n);
+    start_ += n;
+    return n;
+  }
+
+ private:
+  std::vector<std::uint8_t> bytes_;
+  std::size_t start_ = 0;
+};
+
 class LibusbTransport final : public CountingTransport {
  public:
   LibusbTransport(std::unique_ptr<LibusbContext> ctx, libusb_device_handle* handle,
                   UsbModel model, std::string description)
       : ctx_(std::move(ctx)), handle_(handle), model_(model), description_(std::move(description)) {
-    inbox_.reserve(model_.bulk_read_bytes);
+    inbox_.Refill().reserve(model_.bulk_read_bytes);
   }
   ~LibusbTransport() override {
     libusb_release_interface(handle_, model_.interface_number);
@@ -130,30 +154,26 @@ class LibusbTransport final : public CountingTransport {
   }
 
   std::size_t Read(std::span<std::uint8_t> buffer, int timeout_ms) override {
-    if (inbox_start_ == inbox_.size()) {
-      inbox_.clear();
-      inbox_start_ = 0;
-      inbox_.resize(model_.bulk_read_bytes);
+    if (inbox_.Empty()) {
+      std::vector<std::uint8_t>& bytes = inbox_.Refill();
+      bytes.resize(model_.bulk_read_bytes);
       int got = 0, halts = 0;
       for (;;) {
-        const int r = libusb_bulk_transfer(handle_, model_.bulk_in_endpoint, inbox_.data(),
-                                           static_cast<int>(inbox_.size()), &got, timeout_ms);
+        const int r = libusb_bulk_transfer(handle_, model_.bulk_in_endpoint, bytes.data(),
+                                           static_cast<int>(bytes.size()), &got, timeout_ms);
         ++stats.transfers_in;
         if (r == 0 || (r == LIBUSB_ERROR_TIMEOUT)) break;
         if (r == LIBUSB_ERROR_PIPE && halts++ < kMaxHaltRetries) {
           ClearHalt(model_.bulk_in_endpoint);
           continue;
         }
-        inbox_.clear();
+        bytes.clear();
         Throw(r, "read");
       }
-      inbox_.resize(static_cast<std::size_t>(std::max(got, 0)));
-      if (inbox_.empty()) return 0;
+      bytes.resize(static_cast<std::size_t>(std::max(got, 0)));
+      if (bytes.empty()) return 0;
     }
-    const std::size_t n = std::min(buffer.size(), inbox_.size() - inbox_start_);
-    std::memcpy(buffer.data(), inbox_.data() + inbox_start_, n);
-    inbox_start_ += n;
-    return n;
+    return inbox_.Drain(buffer);
   }
 
   std::string Description() const override { return description_; }
@@ -177,8 +197,7 @@ class LibusbTransport final : public CountingTransport {
   libusb_device_handle* handle_;
   UsbModel model_;
   std::string description_;
-  std::vector<std::uint8_t> inbox_;
-  std::size_t inbox_start_ = 0;
+  Inbox inbox_;
 };
 
 // ---- hidapi ----------------------------------------------------------------------------
@@ -230,27 +249,23 @@ class HidTransport final : public CountingTransport {
   }
 
   std::size_t Read(std::span<std::uint8_t> buffer, int timeout_ms) override {
-    if (inbox_start_ == inbox_.size()) {
-      inbox_.clear();
-      inbox_start_ = 0;
-      std::vector<unsigned char> report(model_.hid_report_bytes);
-      const int r = hid_read_timeout(dev_, report.data(), report.size(), timeout_ms);
+    if (inbox_.Empty()) {
+      std::vector<std::uint8_t>& bytes = inbox_.Refill();
+      report_.resize(model_.hid_report_bytes);
+      const int r = hid_read_timeout(dev_, report_.data(), report_.size(), timeout_ms);
       ++stats.transfers_in;
       if (r < 0)
         throw DeviceError(description_ + ": the instrument disconnected (read failed: " +
                           Narrow(hid_error(dev_)) + ")");
       if (r == 0) return 0;
-      const std::size_t count = report[0];
+      const std::size_t count = report_[0];
       if (count > static_cast<std::size_t>(r) - 1)
         throw DeviceError(description_ + ": HID report says " + std::to_string(count) +
                           " stream bytes, the report holds " + std::to_string(r - 1));
-      inbox_.assign(report.begin() + 1, report.begin() + 1 + static_cast<std::ptrdiff_t>(count));
-      if (inbox_.empty()) return 0;
+      bytes.assign(report_.begin() + 1, report_.begin() + 1 + static_cast<std::ptrdiff_t>(count));
+      if (bytes.empty()) return 0;
     }
-    const std::size_t n = std::min(buffer.size(), inbox_.size() - inbox_start_);
-    std::memcpy(buffer.data(), inbox_.data() + inbox_start_, n);
-    inbox_start_ += n;
-    return n;
+    return inbox_.Drain(buffer);
   }
 
   std::string Description() const override { return description_; }
@@ -260,8 +275,8 @@ class HidTransport final : public CountingTransport {
   hid_device* dev_;
   UsbModel model_;
   std::string description_;
-  std::vector<std::uint8_t> inbox_;
-  std::size_t inbox_start_ = 0;
+  std::vector<unsigned char> report_;  // one HID report, reused by every Read
+  Inbox inbox_;
 };
 
 struct HidCandidate {
