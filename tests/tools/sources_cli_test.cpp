@@ -208,7 +208,7 @@ TEST_F(Repair, RepairedAndResumedCaptureEqualsTheUninterruptedOne) {
   }
 }
 
-TEST_F(Repair, RefusesToOverwriteAndHasNothingToDoOnAnIntactCapture) {
+TEST_F(Repair, RefusesToOverwriteAndRefusesAnIntactCapture) {
   const fs::path ref = dir_ / "ref.bpc";
   ASSERT_EQ(RunTool(CaptureArgs(ref), dir_).exit_code, 0);
   ToolRun r = RunTool("repair " + Quote(ref) + " --out " + Quote(dir_ / "x.bpc"), dir_);
