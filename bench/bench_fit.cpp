@@ -7,8 +7,8 @@
 // prints one JSON object per line: {"model", "mode", "threads", "seconds" (median), "cost"}.
 #include <algorithm>
 #include <chrono>
-#include <ctime>
 #include <cstdio>
+#include <ctime>
 #include <fstream>
 #include <string>
 #include <vector>
@@ -51,8 +51,9 @@ int main(int argc, char** argv) {
   WriteData(out_dir + "/fit_data.csv", processing::PrepareFitData(meas, FitOptions{}));
   std::fprintf(stderr, "%zu samples\n", meas.SampleCount());
 
-  const Model models[] = {Model::kGgx, Model::kLafortune, Model::kBlinnPhong, Model::kWard,
-                          Model::kUnrealDefaultLit, Model::kUnityHdrpLit, Model::kUnityUrpLit};
+  const Model models[] = {Model::kGgx,        Model::kLafortune,        Model::kBlinnPhong,
+                          Model::kWard,       Model::kUnrealDefaultLit, Model::kUnityHdrpLit,
+                          Model::kUnityUrpLit};
   for (Model model : models) {
     const std::string name(ModelName(model));
     if (argc > 4 && name != argv[4]) continue;
@@ -67,13 +68,16 @@ int main(int argc, char** argv) {
         const auto t0 = std::chrono::steady_clock::now();
         const std::clock_t c0 = std::clock();
         const processing::FitResult fit = processing::FitMaterial(meas, o);
-        seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+        seconds.push_back(
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
         cpu.push_back(static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC);
         cost = fit.report.final_cost;
         iterations = fit.report.iterations;
       }
-      std::printf("{\"model\": \"%s\", \"mode\": \"multistart\", \"threads\": %d, \"seconds\": %.4f, \"cpu_seconds\": %.4f, \"iterations\": %d, \"cost\": %.10g}\n",
-                  name.c_str(), threads, Median(seconds), Median(cpu), iterations, cost);
+      std::printf(
+          "{\"model\": \"%s\", \"mode\": \"multistart\", \"threads\": %d, \"seconds\": %.4f, "
+          "\"cpu_seconds\": %.4f, \"iterations\": %d, \"cost\": %.10g}\n",
+          name.c_str(), threads, Median(seconds), Median(cpu), iterations, cost);
       std::fflush(stdout);
     }
     if (model == Model::kGgx || model == Model::kLafortune) {
@@ -81,7 +85,8 @@ int main(int argc, char** argv) {
       Material start;
       start.model = model;
       for (const ParameterInfo& p : DescribeModel(model).parameters)
-        for (int c = 0; c < p.Count(); ++c) start.values[static_cast<std::size_t>(p.offset + c)] = p.start;
+        for (int c = 0; c < p.Count(); ++c)
+          start.values[static_cast<std::size_t>(p.offset + c)] = p.start;
       std::ofstream(out_dir + "/start_" + name + ".json") << MaterialToJson(start);
       std::vector<double> seconds, cpu;
       double cost = 0;
@@ -94,13 +99,16 @@ int main(int argc, char** argv) {
         const auto t0 = std::chrono::steady_clock::now();
         const std::clock_t c0 = std::clock();
         const processing::FitResult fit = processing::FitMaterial(meas, o);
-        seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+        seconds.push_back(
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
         cpu.push_back(static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC);
         cost = fit.report.final_cost;
         iterations = fit.report.iterations;
       }
-      std::printf("{\"model\": \"%s\", \"mode\": \"single-start\", \"threads\": 1, \"seconds\": %.4f, \"cpu_seconds\": %.4f, \"iterations\": %d, \"cost\": %.10g}\n",
-                  name.c_str(), Median(seconds), Median(cpu), iterations, cost);
+      std::printf(
+          "{\"model\": \"%s\", \"mode\": \"single-start\", \"threads\": 1, \"seconds\": %.4f, "
+          "\"cpu_seconds\": %.4f, \"iterations\": %d, \"cost\": %.10g}\n",
+          name.c_str(), Median(seconds), Median(cpu), iterations, cost);
       std::fflush(stdout);
     }
   }

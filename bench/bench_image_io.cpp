@@ -1,7 +1,8 @@
 // Writing the 722 × 362 EXR and PNG of a K = 4 LUT: brdf::image_io (OpenEXR, libpng) side by
 // side with the OpenImageIO path the exporter used before (reproduced here as the baseline).
 // Both write atomically (temporary sibling, fsync, rename) into a temporary folder.
-//   build/dev/bench/bench_image_io --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+//   build/dev/bench/bench_image_io --benchmark_repetitions=5
+//   --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 
@@ -41,7 +42,8 @@ const RgbImage& Composite() {
 
 std::vector<unsigned char> Bytes() {
   std::vector<unsigned char> out;
-  for (float v : Composite().rgb) out.push_back(static_cast<unsigned char>(std::min(v, 1.0f) * 255));
+  for (float v : Composite().rgb)
+    out.push_back(static_cast<unsigned char>(std::min(v, 1.0f) * 255));
   return out;
 }
 
@@ -109,7 +111,8 @@ void BM_Png_Oiio(benchmark::State& state) {
   OIIO::ImageSpec spec(722, 362, 3, OIIO::TypeDesc::UINT8);
   spec.attribute("png:compressionLevel", 3);
   spec.attribute("Software", "bench");
-  for (auto _ : state) OiioWrite(Dir() + "/oiio.png", "png", spec, OIIO::TypeDesc::UINT8, bytes.data());
+  for (auto _ : state)
+    OiioWrite(Dir() + "/oiio.png", "png", spec, OIIO::TypeDesc::UINT8, bytes.data());
 }
 
 #define BRDF_BENCH(name) BENCHMARK(name)->Unit(benchmark::kMillisecond)->UseRealTime()

@@ -22,8 +22,8 @@ using namespace brdf;
 using namespace brdf::device;
 
 SimulatorConfig GoldConfig() {
-  Material m = Material::Make(Model::kGgx, {Rgb{0, 0, 0}, Rgb{0.962585, 0.786916, 0.408220},
-                                            Rgb{0.15, 0.15, 0.15}});
+  Material m = Material::Make(
+      Model::kGgx, {Rgb{0, 0, 0}, Rgb{0.962585, 0.786916, 0.408220}, Rgb{0.15, 0.15, 0.15}});
   m.name = "gold";
   SimulatorConfig c;
   c.sample = std::make_shared<AnalyticBrdf>(m);
@@ -86,7 +86,12 @@ void BM_CaptureOverUsb(benchmark::State& state) {
   }
 }
 // 0: libusb bulk, 1: hidapi reports.
-BENCHMARK(BM_CaptureOverUsb)->Arg(0)->Arg(1)->Iterations(3)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_CaptureOverUsb)
+    ->Arg(0)
+    ->Arg(1)
+    ->Iterations(3)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // Frames of the whole capture, found and CRC-checked from one byte stream.
 void BM_DecodeCaptureStream(benchmark::State& state) {
@@ -95,10 +100,11 @@ void BM_DecodeCaptureStream(benchmark::State& state) {
     SimulatedFirmware fw(GoldConfig());
     std::uint8_t seq = 0;
     for (float t : {0.f, 20.f, 40.f, 60.f}) {
-      fw.Receive(EncodeFrame({static_cast<std::uint8_t>(MessageType::kMeasureSlice), seq++,
-                              EncodeThetaIn(t)}));
+      fw.Receive(EncodeFrame(
+          {static_cast<std::uint8_t>(MessageType::kMeasureSlice), seq++, EncodeThetaIn(t)}));
       for (std::size_t n; (n = fw.Transmit(buffer)) > 0;)
-        stream.insert(stream.end(), buffer.begin(), buffer.begin() + static_cast<std::ptrdiff_t>(n));
+        stream.insert(stream.end(), buffer.begin(),
+                      buffer.begin() + static_cast<std::ptrdiff_t>(n));
     }
   }
   std::size_t frames = 0;

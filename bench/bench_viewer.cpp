@@ -55,7 +55,10 @@ void BM_DirectEvaluationSameGrid(benchmark::State& state) {
     benchmark::DoNotOptimize(sum);
   }
 }
-BENCHMARK(BM_DirectEvaluationSameGrid)->Args({90, 180})->Args({180, 360})->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_DirectEvaluationSameGrid)
+    ->Args({90, 180})
+    ->Args({180, 360})
+    ->Unit(benchmark::kMillisecond);
 
 void BM_SliceImage(benchmark::State& state) {
   const brdf::viewer::ViewSource& view = GoldView();

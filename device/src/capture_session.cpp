@@ -195,8 +195,8 @@ CaptureSessionResult RunCaptureSession(const CaptureRequest& request, Transport&
       return result;
     };
     if (old.sample_name != request.sample_name)
-      return refuse(path + " holds sample '" + old.sample_name + "', not '" +
-                    request.sample_name + "'");
+      return refuse(path + " holds sample '" + old.sample_name + "', not '" + request.sample_name +
+                    "'");
     for (const auto& [key, value] : settings) {
       const auto it = old.extra.find(key);
       if (it != old.extra.end() && it->second != value)
@@ -248,7 +248,8 @@ CaptureSessionResult RunCaptureSession(const CaptureRequest& request, Transport&
     const std::string old_geometry = Text(old.extra, "instrument_geometry");
     const std::size_t per_slice = std::size_t{info.geometry.rows} * info.geometry.columns;
     bool same = old_geometry.empty() || old_geometry == geometry;
-    for (const Slice& s : existing->measurement.slices) same = same && s.samples.size() == per_slice;
+    for (const Slice& s : existing->measurement.slices)
+      same = same && s.samples.size() == per_slice;
     if (!same)
       throw Refusal{NextStep::kAcceptInstrument,
                     path + " was captured with geometry " +
@@ -303,8 +304,8 @@ CaptureSessionResult RunCaptureSession(const CaptureRequest& request, Transport&
     result.message = r.message;
     return result;
   } catch (const DriverFault& e) {
-    result.outcome = e.kind() == FaultKind::kCancelled ? CaptureOutcome::kInterrupted
-                                                       : CaptureOutcome::kFailed;
+    result.outcome =
+        e.kind() == FaultKind::kCancelled ? CaptureOutcome::kInterrupted : CaptureOutcome::kFailed;
     result.problem = ProblemOf(e);
     result.message = e.what();
     result.next = appender ? NextStep::kResume : NextStep::kRetry;

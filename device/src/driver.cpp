@@ -92,8 +92,8 @@ Frame Driver::NextFrame(std::string_view waiting_for, bool check_sequence) {
     }
     if (n == 0) {
       if (!last_damage_.empty())
-        Fail(FaultKind::kDamagedFrame, "damaged frame while waiting for " +
-                                           std::string(waiting_for) + ": " + last_damage_);
+        Fail(FaultKind::kDamagedFrame,
+             "damaged frame while waiting for " + std::string(waiting_for) + ": " + last_damage_);
       Fail(FaultKind::kTimeout, "timeout: no answer within " + std::to_string(options_.timeout_ms) +
                                     " ms while waiting for " + std::string(waiting_for));
     }
@@ -106,9 +106,9 @@ void Driver::ThrowInstrumentError(const Frame& frame, MessageType request) const
   if (frame.type == static_cast<std::uint8_t>(MessageType::kError)) {
     const ErrorReply e = DecodeError(frame.payload);
     throw DriverFault(FaultKind::kInstrumentError,
-                      transport_.Description() + ": the instrument refused " + request_name +
-                          ": " + e.message + " (error code " +
-                          std::to_string(static_cast<int>(e.code)) + ")",
+                      transport_.Description() + ": the instrument refused " + request_name + ": " +
+                          e.message + " (error code " + std::to_string(static_cast<int>(e.code)) +
+                          ")",
                       e.code);
   }
   Fail(FaultKind::kProtocol,
@@ -125,19 +125,19 @@ const InstrumentInfo& Driver::Connect() {
   Send(MessageType::kIdentify, {});
   info_.identity = DecodeIdentity(Expect(MessageType::kIdentify, MessageType::kIdentity).payload);
   if (info_.identity.protocol_major != kProtocolMajor)
-    Fail(FaultKind::kProtocol, "instrument speaks protocol " +
-                      std::to_string(info_.identity.protocol_major) + "." +
-                      std::to_string(info_.identity.protocol_minor) + ", this driver " +
-                      std::to_string(kProtocolMajor) + ".x (update the toolchain or firmware)");
+    Fail(FaultKind::kProtocol,
+         "instrument speaks protocol " + std::to_string(info_.identity.protocol_major) + "." +
+             std::to_string(info_.identity.protocol_minor) + ", this driver " +
+             std::to_string(kProtocolMajor) + ".x (update the toolchain or firmware)");
   Send(MessageType::kGetGeometry, {});
   info_.geometry =
       DecodeGeometry(Expect(MessageType::kGetGeometry, MessageType::kGeometry).payload);
   const std::size_t per_slice = std::size_t{info_.geometry.rows} * info_.geometry.columns;
   if (per_slice == 0 || per_slice > kMaxSamplesPerSlice)
-    Fail(FaultKind::kProtocol, "geometry of " +
-                      std::to_string(info_.geometry.rows) + " × " +
-                      std::to_string(info_.geometry.columns) +
-                      " samples per slice is outside 1 … " + std::to_string(kMaxSamplesPerSlice));
+    Fail(FaultKind::kProtocol, "geometry of " + std::to_string(info_.geometry.rows) + " × " +
+                                   std::to_string(info_.geometry.columns) +
+                                   " samples per slice is outside 1 … " +
+                                   std::to_string(kMaxSamplesPerSlice));
   connected_ = true;
   have_dark_ = false;
   whites_.clear();
@@ -149,8 +149,7 @@ void Driver::SetExposure(const ExposureSetting& setting) {
   const std::uint8_t acked =
       DecodeAck(Expect(MessageType::kSetExposure, MessageType::kAck).payload);
   if (acked != static_cast<std::uint8_t>(MessageType::kSetExposure))
-    Fail(FaultKind::kProtocol, "SET_EXPOSURE acknowledged as " +
-                      MessageTypeName(acked));
+    Fail(FaultKind::kProtocol, "SET_EXPOSURE acknowledged as " + MessageTypeName(acked));
   exposure_ = setting;
 }
 
@@ -179,9 +178,9 @@ const WhiteCalibration& Driver::MeasureWhite(double theta_in_deg) {
   const WhiteReading r =
       DecodeWhite(Expect(MessageType::kMeasureWhite, MessageType::kWhite).payload);
   if (r.clipped_channels != 0)
-    Fail(FaultKind::kInstrumentError, "white reference at θin " +
-                      AngleText(theta_in_deg) + "° saturated (clip bits " +
-                      std::to_string(r.clipped_channels) + "); cannot calibrate");
+    Fail(FaultKind::kInstrumentError,
+         "white reference at θin " + AngleText(theta_in_deg) + "° saturated (clip bits " +
+             std::to_string(r.clipped_channels) + "); cannot calibrate");
   WhiteCalibration w;
   w.theta_in_deg = r.theta_in_deg;
   w.exposure_ms = r.exposure_ms;
@@ -193,10 +192,11 @@ const WhiteCalibration& Driver::MeasureWhite(double theta_in_deg) {
   for (int c = 0; c < 3; ++c) {
     w.counts[c] = r.counts[c];
     if (!(w.counts[c] - dark_.mean_counts[c] > 0))
-      Fail(FaultKind::kInstrumentError, "white reference at θin " +
-                        AngleText(theta_in_deg) + "° gives no signal above dark in channel " +
-                        std::to_string(c) + " (" + Fmt("%g", w.counts[c]) + " counts, dark " +
-                        Fmt("%g", dark_.mean_counts[c]) + "); is the panel in place?");
+      Fail(FaultKind::kInstrumentError, "white reference at θin " + AngleText(theta_in_deg) +
+                                            "° gives no signal above dark in channel " +
+                                            std::to_string(c) + " (" + Fmt("%g", w.counts[c]) +
+                                            " counts, dark " + Fmt("%g", dark_.mean_counts[c]) +
+                                            "); is the panel in place?");
   }
   w.frames = r.frames;
   w.time = UtcNowIso8601();
@@ -221,9 +221,10 @@ Slice Driver::MeasureSlice(double theta_in_deg, SliceReport* report) {
   const SliceBegin begin =
       DecodeSliceBegin(Expect(MessageType::kMeasureSlice, MessageType::kSliceBegin).payload);
   if (begin.rows != g.rows || begin.columns != g.columns)
-    Fail(FaultKind::kProtocol, "slice of " + std::to_string(begin.rows) +
-                      " × " + std::to_string(begin.columns) + " samples announced, geometry says " +
-                      std::to_string(g.rows) + " × " + std::to_string(g.columns));
+    Fail(FaultKind::kProtocol, "slice of " + std::to_string(begin.rows) + " × " +
+                                   std::to_string(begin.columns) +
+                                   " samples announced, geometry says " + std::to_string(g.rows) +
+                                   " × " + std::to_string(g.columns));
 
   // Per-channel constants of the calibration (see the header for the formula).
   const double frames = info_.identity.frames_per_reading;
@@ -236,8 +237,8 @@ Slice Driver::MeasureSlice(double theta_in_deg, SliceReport* report) {
     var_w[c] = (read_var[c] + shot * w_signal[c]) / white->frames;
     var_dark[c] = read_var[c] / dark_.frames;
     floor[c] = options_.noise_floor_sigmas * sr / std::sqrt(frames);
-    scale[c] = options_.white.rho[c] * kInvPi * white->exposure_ms * white->nd_transmittance /
-               w_signal[c];
+    scale[c] =
+        options_.white.rho[c] * kInvPi * white->exposure_ms * white->nd_transmittance / w_signal[c];
   }
 
   Slice slice;
@@ -261,9 +262,9 @@ Slice Driver::MeasureSlice(double theta_in_deg, SliceReport* report) {
     if (f.type == static_cast<std::uint8_t>(MessageType::kSliceEnd)) {
       const SliceEnd end = DecodeSliceEnd(f.payload);
       if (received != total || end.samples != total)
-        Fail(FaultKind::kOutOfSequence, "slice θin " + AngleText(theta_in_deg) +
-                          "° ended after " + std::to_string(received) + " of " +
-                          std::to_string(total) + " samples");
+        Fail(FaultKind::kOutOfSequence, "slice θin " + AngleText(theta_in_deg) + "° ended after " +
+                                            std::to_string(received) + " of " +
+                                            std::to_string(total) + " samples");
       break;
     }
     if (f.type != static_cast<std::uint8_t>(MessageType::kRowData))
@@ -271,14 +272,12 @@ Slice Driver::MeasureSlice(double theta_in_deg, SliceReport* report) {
     const RowData row = DecodeRowData(f.payload);
     if (row.row != next_row || row.first_column != next_column ||
         next_column + row.samples.size() > g.columns || row.samples.empty())
-      Fail(FaultKind::kOutOfSequence, "ROW_DATA out of order: expected row " +
-                        std::to_string(next_row) + " column " + std::to_string(next_column) +
-                        ", got row " + std::to_string(row.row) + " columns " +
-                        std::to_string(row.first_column) + "+" +
-                        std::to_string(row.samples.size()));
+      Fail(FaultKind::kOutOfSequence,
+           "ROW_DATA out of order: expected row " + std::to_string(next_row) + " column " +
+               std::to_string(next_column) + ", got row " + std::to_string(row.row) + " columns " +
+               std::to_string(row.first_column) + "+" + std::to_string(row.samples.size()));
     if (!(row.exposure_ms > 0))
-      Fail(FaultKind::kProtocol, "ROW_DATA with exposure " +
-                        Fmt("%g", row.exposure_ms) + " ms");
+      Fail(FaultKind::kProtocol, "ROW_DATA with exposure " + Fmt("%g", row.exposure_ms) + " ms");
     const float theta_out = g.ThetaOutDeg(row.row);
     if (row.nd_index >= g.nd_transmittance.size())
       Fail(FaultKind::kProtocol, "ROW_DATA names ND filter " + std::to_string(row.nd_index) +
@@ -404,7 +403,8 @@ Metadata Driver::CalibrationMetadata() const {
     const std::string key = "white_theta_in_" + AngleText(wc.theta_in_deg);
     m.extra[key + "_counts"] = Triple(wc.counts);
     m.extra[key + "_exposure_ms"] = Fmt("%.9g", wc.exposure_ms);
-    if (wc.nd_transmittance != 1) m.extra[key + "_nd_transmittance"] = Fmt("%.9g", wc.nd_transmittance);
+    if (wc.nd_transmittance != 1)
+      m.extra[key + "_nd_transmittance"] = Fmt("%.9g", wc.nd_transmittance);
     m.extra[key + "_frames"] = std::to_string(wc.frames);
     m.extra[key + "_time"] = wc.time;
   }
@@ -431,9 +431,8 @@ auto WithRetries(Driver& driver, const CaptureCallbacks& callbacks, Step step) {
 
 Metadata Capture(Driver& driver, const CapturePlan& plan, const CaptureCallbacks& callbacks) {
   const std::string start = UtcNowIso8601();
-  const InstrumentInfo& info = WithRetries(driver, callbacks, [&]() -> const InstrumentInfo& {
-    return driver.Connect();
-  });
+  const InstrumentInfo& info =
+      WithRetries(driver, callbacks, [&]() -> const InstrumentInfo& { return driver.Connect(); });
   if (plan.theta_in_deg.empty()) throw InvalidArgument("capture plan has no incidence angle");
   for (std::size_t i = 0; i < plan.theta_in_deg.size(); ++i) {
     const double t = plan.theta_in_deg[i];
@@ -469,8 +468,8 @@ Metadata Capture(Driver& driver, const CapturePlan& plan, const CaptureCallbacks
   if (callbacks.on_calibrated) callbacks.on_calibrated(merge(driver.CalibrationMetadata()));
   for (double t : plan.theta_in_deg) {
     if (driver.cancelled())
-      throw DriverFault(FaultKind::kCancelled, "capture cancelled before the slice at θin " +
-                                                   AngleText(t) + "°");
+      throw DriverFault(FaultKind::kCancelled,
+                        "capture cancelled before the slice at θin " + AngleText(t) + "°");
     SliceReport report;
     Slice slice = WithRetries(driver, callbacks, [&] { return driver.MeasureSlice(t, &report); });
     if (callbacks.on_slice) callbacks.on_slice(slice, report);

@@ -2,8 +2,8 @@
 
 #include <algorithm>
 #include <bit>
-#include <cmath>
 #include <chrono>
+#include <cmath>
 #include <thread>
 #include <tuple>
 
@@ -90,10 +90,10 @@ bool FaultPlan::HasFirmwareFaults() const {
 
 FaultPlan ParseFaultPlan(std::string_view spec) {
   static constexpr std::pair<std::string_view, FaultType> kNames[] = {
-      {"disconnect", FaultType::kDisconnect}, {"stall", FaultType::kStall},
-      {"timeout", FaultType::kTimeout},       {"corrupt", FaultType::kCorrupt},
-      {"duplicate", FaultType::kDuplicate},   {"reorder", FaultType::kReorder},
-      {"lamp", FaultType::kLampFailure},      {"contact", FaultType::kSampleContact},
+      {"disconnect", FaultType::kDisconnect},    {"stall", FaultType::kStall},
+      {"timeout", FaultType::kTimeout},          {"corrupt", FaultType::kCorrupt},
+      {"duplicate", FaultType::kDuplicate},      {"reorder", FaultType::kReorder},
+      {"lamp", FaultType::kLampFailure},         {"contact", FaultType::kSampleContact},
       {"overtemp", FaultType::kOverTemperature}, {"halt", FaultType::kEndpointHalt}};
   std::string names;
   for (const auto& [name, type] : kNames) names += (names.empty() ? "" : ", ") + std::string(name);
@@ -249,10 +249,10 @@ void SimulatedFirmware::Send(MessageType type, const std::vector<std::uint8_t>& 
       streaming_ = false;
       std::vector<std::uint8_t> bytes;
       AppendFrame(bytes, static_cast<std::uint8_t>(MessageType::kError), sequence_++,
-                  EncodeError({code, type == MessageType::kRowData ||
-                                             type == MessageType::kSliceEnd
-                                         ? static_cast<std::uint8_t>(MessageType::kMeasureSlice)
-                                         : static_cast<std::uint8_t>(0),
+                  EncodeError({code,
+                               type == MessageType::kRowData || type == MessageType::kSliceEnd
+                                   ? static_cast<std::uint8_t>(MessageType::kMeasureSlice)
+                                   : static_cast<std::uint8_t>(0),
                                text}));
       output_.insert(output_.end(), bytes.begin(), bytes.end());
       return;

@@ -54,8 +54,7 @@ struct LibusbContext {
   libusb_context* ctx = nullptr;
   LibusbContext() {
     const int r = libusb_init(&ctx);
-    if (r != 0)
-      throw DeviceError(std::string("USB: cannot start libusb: ") + libusb_strerror(r));
+    if (r != 0) throw DeviceError(std::string("USB: cannot start libusb: ") + libusb_strerror(r));
   }
   ~LibusbContext() { libusb_exit(ctx); }
   LibusbContext(const LibusbContext&) = delete;
@@ -123,8 +122,8 @@ class Inbox {
 
 class LibusbTransport final : public CountingTransport {
  public:
-  LibusbTransport(std::unique_ptr<LibusbContext> ctx, libusb_device_handle* handle,
-                  UsbModel model, std::string description)
+  LibusbTransport(std::unique_ptr<LibusbContext> ctx, libusb_device_handle* handle, UsbModel model,
+                  std::string description)
       : ctx_(std::move(ctx)), handle_(handle), model_(model), description_(std::move(description)) {
     inbox_.Refill().reserve(model_.bulk_read_bytes);
   }
@@ -288,13 +287,12 @@ std::vector<HidCandidate> EnumerateHid(const DeviceSpec* spec) {
   std::vector<HidCandidate> out;
   hid_device_info* list = hid_enumerate(0, 0);
   for (hid_device_info* d = list; d != nullptr; d = d->next) {
-    const bool match = spec ? Matches(*spec, d->vendor_id, d->product_id, true)
-                            : (FindUsbModel(d->vendor_id, d->product_id) &&
-                               FindUsbModel(d->vendor_id, d->product_id)->hid_product_id ==
-                                   d->product_id);
+    const bool match =
+        spec ? Matches(*spec, d->vendor_id, d->product_id, true)
+             : (FindUsbModel(d->vendor_id, d->product_id) &&
+                FindUsbModel(d->vendor_id, d->product_id)->hid_product_id == d->product_id);
     if (!match) continue;
-    HidCandidate c{d->path ? d->path : "", Narrow(d->serial_number), d->vendor_id,
-                   d->product_id};
+    HidCandidate c{d->path ? d->path : "", Narrow(d->serial_number), d->vendor_id, d->product_id};
     if (spec && !spec->serial.empty() && c.serial != spec->serial) continue;
     out.push_back(std::move(c));
   }
@@ -346,10 +344,10 @@ std::unique_ptr<Transport> OpenUsbTransport(const DeviceSpec& spec) {
       libusb_close(h);
       continue;
     }
-    result = std::make_unique<LibusbTransport>(
-        std::move(ctx), h, model,
-        "USB " + std::string(model.model) + " " + (serial.empty() ? "(no serial)" : serial) +
-            " (" + where + ")");
+    result = std::make_unique<LibusbTransport>(std::move(ctx), h, model,
+                                               "USB " + std::string(model.model) + " " +
+                                                   (serial.empty() ? "(no serial)" : serial) +
+                                                   " (" + where + ")");
   }
   libusb_free_device_list(list, 1);
   if (!result)
@@ -367,15 +365,16 @@ std::unique_ptr<Transport> OpenHidTransport(const DeviceSpec& spec) {
   for (const HidCandidate& c : found) {
     hid_device* dev = hid_open_path(c.path.c_str());
     if (dev == nullptr) {
-      problems += "; HID " + c.path + ": cannot open it (permission denied or in use; install "
+      problems += "; HID " + c.path +
+                  ": cannot open it (permission denied or in use; install "
                   "the udev rule 70-brdf-scatterometer.rules)";
       continue;
     }
     const UsbModel model = ModelFor(c.vid, c.pid);
-    return std::make_unique<HidTransport>(
-        std::move(lib), dev, model,
-        "HID " + std::string(model.model) + " " + (c.serial.empty() ? "(no serial)" : c.serial) +
-            " (" + c.path + ")");
+    return std::make_unique<HidTransport>(std::move(lib), dev, model,
+                                          "HID " + std::string(model.model) + " " +
+                                              (c.serial.empty() ? "(no serial)" : c.serial) + " (" +
+                                              c.path + ")");
   }
   throw DeviceError("no " + LookedFor(spec, "HID") + " found" + problems);
 }
@@ -462,8 +461,7 @@ std::vector<FoundInstrument> ListInstruments(bool identify) {
       f.problem = AccessProblem::kPermission;
       f.problem_detail = "cannot open " + c.path;
     } else if (identify) {
-      HidTransport t(std::make_unique<HidLibrary>(), dev, ModelFor(c.vid, c.pid),
-                     "HID " + c.path);
+      HidTransport t(std::make_unique<HidLibrary>(), dev, ModelFor(c.vid, c.pid), "HID " + c.path);
       ask_identity(f, t);
     } else {
       hid_close(dev);

@@ -152,8 +152,7 @@ std::string AtlasManifestJson(const Atlas& atlas, const std::vector<std::string>
                            {"y0", row * Lut::kHeight},
                            {"width", Lut::kWidth},
                            {"height", Lut::kHeight}}}});
-    if (static_cast<std::size_t>(m) < atlas.saturated_samples.size() &&
-        atlas.saturated_samples[m])
+    if (static_cast<std::size_t>(m) < atlas.saturated_samples.size() && atlas.saturated_samples[m])
       materials.back()["saturated_samples"] =
           detail::SaturatedCountsJson(*atlas.saturated_samples[m]);
   }

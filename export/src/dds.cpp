@@ -70,8 +70,8 @@ std::string EncodeDds(const PackedVolume& volume) {
     throw InvalidArgument(fmt::format("DDS: inconsistent volume {} × {} × {} with {} texels",
                                       volume.width, volume.height, volume.depth,
                                       volume.words.size()));
-  std::string out = DdsVolumeHeader(volume.width, volume.height, volume.depth,
-                                    kDxgiFormatR9g9b9e5Sharedexp, 4);
+  std::string out =
+      DdsVolumeHeader(volume.width, volume.height, volume.depth, kDxgiFormatR9g9b9e5Sharedexp, 4);
   out += volume.Bytes();
   return out;
 }

@@ -65,12 +65,16 @@ TEST(EngineModels, AgreeWithTheNumpyTranscriptionOfTheShaderFunctions) {
         // A third of the pairs near the mirror direction, where the lobes are.
         const double ti = theta(rng), pi = phi(rng);
         double to = theta(rng), po = phi(rng);
-        if (k % 3 == 0) to = std::clamp(ti + (theta(rng) - 45) / 20, 0.5, 89.0), po = pi + 180 + (phi(rng) - 180) / 40;
+        if (k % 3 == 0)
+          to = std::clamp(ti + (theta(rng) - 45) / 20, 0.5, 89.0),
+          po = pi + 180 + (phi(rng) - 180) / 40;
         const Vec3 l = SphericalDirectionDeg(ti, pi), v = SphericalDirectionDeg(to, po);
         out << ModelName(m.model);
         const ModelInfo& info = DescribeModel(m.model);
-        for (int i = 0; i < info.value_count; ++i) out << ' ' << m.values[static_cast<std::size_t>(i)];
-        out << " ; " << l.x << ' ' << l.y << ' ' << l.z << ' ' << v.x << ' ' << v.y << ' ' << v.z << '\n';
+        for (int i = 0; i < info.value_count; ++i)
+          out << ' ' << m.values[static_cast<std::size_t>(i)];
+        out << " ; " << l.x << ' ' << l.y << ' ' << l.z << ' ' << v.x << ' ' << v.y << ' ' << v.z
+            << '\n';
         cases.push_back({m, {l, v}});
       }
     }
@@ -110,7 +114,8 @@ TEST(EngineModels, MaterialFilesRoundTripAndSayWhatToTypeWhere) {
       R"({"model":"unreal-defaultlit","base_color":[0.91,0.78,0.34],"metallic":1,"specular":0.5,"roughness":0.31})");
   EXPECT_EQ(EngineInstructions(ue),
             "Base Color 0.91 0.78 0.34, Metallic 1.00, Specular 0.50, Roughness 0.31");
-  EXPECT_EQ(EngineInstructions(Material::Make(Model::kGgx, {{0.1, 0.1, 0.1}, {0.04, 0.04, 0.04}, {0.2, 0.2, 0.2}})),
+  EXPECT_EQ(EngineInstructions(Material::Make(
+                Model::kGgx, {{0.1, 0.1, 0.1}, {0.04, 0.04, 0.04}, {0.2, 0.2, 0.2}})),
             "");
 }
 
@@ -144,7 +149,8 @@ TEST(MaterialValidation, RefusesValuesOutsideThePhysicalRange) {
 }
 
 TEST(MaterialValidation, TheSampleLibraryIsInRange) {
-  for (const auto& e : fs::directory_iterator(std::string(BRDF_SOURCE_DIR) + "/data-samples/materials")) {
+  for (const auto& e :
+       fs::directory_iterator(std::string(BRDF_SOURCE_DIR) + "/data-samples/materials")) {
     if (e.path().extension() != ".json") continue;
     EXPECT_NO_THROW(LoadMaterialFile(e.path().string())) << e.path();
   }

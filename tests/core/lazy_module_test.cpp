@@ -108,8 +108,7 @@ TEST_F(LazyModuleTest, RealModuleLoadsOnFirstUseAndReportsAMissingEntryPoint) {
 TEST_F(LazyModuleTest, ModuleLinkingAProjectLibraryRunsItsCode) {
   ::setenv("BRDF_MODULE_DIR", BRDF_TEST_MODULE_DIR, 1);
   LazyModule module("libbrdf_lazy_module_fixture.so", "testing the loader");
-  auto* position =
-      module.Entry<void(unsigned long long, std::string*)>("brdf_test_byte_position");
+  auto* position = module.Entry<void(unsigned long long, std::string*)>("brdf_test_byte_position");
   std::string text;
   position(1840, &text);
   EXPECT_EQ(text, "byte 1840");  // the spelling error.h documents

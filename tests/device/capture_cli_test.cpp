@@ -263,8 +263,7 @@ TEST_F(CaptureCli, RefusesToOverwriteAnExistingFileWithoutForce) {
 // slices stay in a valid, unfinished file, and --resume completes it to the uninterrupted
 // result. The simulated firmware is paced (5 ms per row) so the signal lands mid-capture.
 TEST_F(CaptureCli, SignalAbortsTheScanAndLeavesAResumableFile) {
-  const std::string common =
-      " --material gold --sample g --seed 3" + kCoarse + " --sim-pace-ms 5";
+  const std::string common = " --material gold --sample g --seed 3" + kCoarse + " --sim-pace-ms 5";
   const std::string whole = Path("whole.bpc");
   ASSERT_EQ(Run("capture --quiet --out " + whole + common).exit_code, 0);
   const Measurement expected = LoadBpc(whole);
@@ -315,8 +314,9 @@ TEST_F(CaptureCli, RglPaintPeaksNoLongerClip) {
   const fs::path data = brdf::test::DataDir();
   for (const char* paint : {"chm_orange_rgb", "chm_light_blue_rgb"}) {
     const std::string out = Path(std::string(paint) + ".bpc");
-    const ToolRun r = Run("capture --material " + (data / "rgl" / (std::string(paint) + ".bsdf")).string() +
-                          " --sample p --out " + out);
+    const ToolRun r =
+        Run("capture --material " + (data / "rgl" / (std::string(paint) + ".bsdf")).string() +
+            " --sample p --out " + out);
     ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_NE(r.err.find(", 0 saturated, "), std::string::npos) << r.err;
     for (const Slice& s : LoadBpc(out).slices)

@@ -7,14 +7,14 @@
 
 #include <algorithm>
 #include <cmath>
-#include <regex>
-#include <set>
-#include <tuple>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <regex>
+#include <set>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "brdf/core/error.h"
@@ -91,8 +91,8 @@ TEST(Capture, NoiseFreeBlinnPhongAndWardMatchNumpyFromTheFormulas) {
           {"simulator", &run.slices}, {"CaptureNoiseFree", &direct.slices}};
       for (const auto& [source, slices] : captures) {
         for (const Slice& slice : *slices) {
-          // Up to 100 samples per slice: every 271st of the 27360 (all θout rows, varied φout), plus
-          // the neighbourhood of the mirror direction where the lobe peaks.
+          // Up to 100 samples per slice: every 271st of the 27360 (all θout rows, varied φout),
+          // plus the neighbourhood of the mirror direction where the lobe peaks.
           std::vector<const Sample*> picked;
           for (std::size_t i = 0; i < slice.samples.size() && picked.size() < 80; i += 271)
             picked.push_back(&slice.samples[i]);

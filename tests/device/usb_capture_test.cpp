@@ -80,8 +80,7 @@ TEST_P(UsbCapture, WholeCaptureEqualsTheLoopbackCaptureValueForValue) {
 INSTANTIATE_TEST_SUITE_P(Transports, UsbCapture,
                          ::testing::Values(UsbPersonality::kBulk, UsbPersonality::kHid),
                          [](const auto& param_info) {
-                           return param_info.param == UsbPersonality::kBulk ? "Libusb"
-                                                                            : "Hidapi";
+                           return param_info.param == UsbPersonality::kBulk ? "Libusb" : "Hidapi";
                          });
 
 // ---- The tool against an emulated instrument -------------------------------------------
@@ -108,25 +107,24 @@ TEST_P(UsbCapture, DevicesListsTheInstrumentAndCaptureOpensItByVidPidSerial) {
   const bool usb = GetParam() == UsbPersonality::kBulk;
   const std::string json = RunTool("devices --json", &code);
   EXPECT_EQ(code, 0) << json;
-  EXPECT_NE(json.find(usb ? "\"interface\": \"usb\"" : "\"interface\": \"hid\""),
-            std::string::npos)
+  EXPECT_NE(json.find(usb ? "\"interface\": \"usb\"" : "\"interface\": \"hid\""), std::string::npos)
       << json;
   EXPECT_NE(json.find("\"serial\": \"SN-4711\""), std::string::npos) << json;
-  EXPECT_NE(json.find("\"firmware\": \"" + c.model.firmware_version + "\""),
-            std::string::npos)
+  EXPECT_NE(json.find("\"firmware\": \"" + c.model.firmware_version + "\""), std::string::npos)
       << json;
   const std::string text = RunTool("devices", &code);
-  EXPECT_NE(text.find(std::string(usb ? "usb" : "hid") + ":1209:" + (usb ? "b7d1" : "b7d2") +
-                      ":SN-4711"),
-            std::string::npos)
+  EXPECT_NE(
+      text.find(std::string(usb ? "usb" : "hid") + ":1209:" + (usb ? "b7d1" : "b7d2") + ":SN-4711"),
+      std::string::npos)
       << text;
 
   char tmpl[] = "/tmp/brdf_usb_cli_XXXXXX";
   ASSERT_NE(::mkdtemp(tmpl), nullptr);
   const std::string out = std::string(tmpl) + "/real.bpc";
-  const std::string spec = std::string(usb ? "usb" : "hid") + ":1209:" +
-                           (usb ? "b7d1" : "b7d2") + ":SN-4711";
-  const std::string wrong = RunTool("capture --device " + spec + "0 --sample s --out " + out, &code);
+  const std::string spec =
+      std::string(usb ? "usb" : "hid") + ":1209:" + (usb ? "b7d1" : "b7d2") + ":SN-4711";
+  const std::string wrong =
+      RunTool("capture --device " + spec + "0 --sample s --out " + out, &code);
   EXPECT_EQ(code, 1) << wrong;
   EXPECT_NE(wrong.find("SN-47110"), std::string::npos) << wrong;
   const std::string log = RunTool("capture --device " + spec + " --sample s --out " + out, &code);

@@ -82,14 +82,14 @@ TEST(ParseEngines, AcceptsEachEngineAllAndNone) {
 TEST(FloatToHalf, MatchesPublishedBitPatterns) {
   EXPECT_EQ(engines::FloatToHalf(1.0f), 0x3c00);
   EXPECT_EQ(engines::FloatToHalf(-2.0f), 0xc000);
-  EXPECT_EQ(engines::FloatToHalf(65504.0f), 0x7bff);    // largest finite
-  EXPECT_EQ(engines::FloatToHalf(65520.0f), 0x7c00);    // rounds to infinity
+  EXPECT_EQ(engines::FloatToHalf(65504.0f), 0x7bff);               // largest finite
+  EXPECT_EQ(engines::FloatToHalf(65520.0f), 0x7c00);               // rounds to infinity
   EXPECT_EQ(engines::FloatToHalf(std::ldexp(1.0f, -14)), 0x0400);  // smallest normal
   EXPECT_EQ(engines::FloatToHalf(std::ldexp(1.0f, -24)), 0x0001);  // smallest subnormal
   EXPECT_EQ(engines::FloatToHalf(std::ldexp(1.0f, -25)), 0x0000);  // ties to even: 0
   EXPECT_EQ(engines::FloatToHalf(0.333333343f), 0x3555);
   EXPECT_EQ(engines::FloatToHalf(0.1f), 0x2e66);
-  EXPECT_EQ(engines::FloatToHalf(65408.0f), 0x7bfc);    // the largest RGB9E5 value, exact
+  EXPECT_EQ(engines::FloatToHalf(65408.0f), 0x7bfc);  // the largest RGB9E5 value, exact
 }
 
 TEST_F(EngineExport, WritesEveryEngineFolderWithTheContainersAsBytes) {
@@ -98,14 +98,27 @@ TEST_F(EngineExport, WritesEveryEngineFolderWithTheContainersAsBytes) {
   meta.name = "felt";
   meta.source = "felt.bpc";
   const auto r = engines::ExportLutWithEngines(dir_.string(), lut, meta, {}, ParseEngines("all"));
-  for (const char* f :
-       {"unity/felt.brdf3d", "unity/Editor/MeasuredBrdfImporter.cs", "unity/MeasuredBrdf.hlsl",
-        "unity/felt.manifest.json", "unreal/felt.dds", "unreal/felt_tiles.exr",
-        "unreal/MeasuredBrdf.ush", "unreal/import_measured_brdf.py", "unreal/felt.manifest.json",
-        "godot/felt.dds", "godot/felt_slices.exr", "godot/felt_slices.exr.import",
-        "godot/measured_brdf.gdshader", "godot/felt.manifest.json", "web/felt.ktx2",
-        "web/measured_brdf.js", "web/index.html", "web/package.json",
-        "web/felt.manifest.json", "web/MeasuredBrdf.es300.glsl", "web/MeasuredBrdf.450.glsl"})
+  for (const char* f : {"unity/felt.brdf3d",
+                        "unity/Editor/MeasuredBrdfImporter.cs",
+                        "unity/MeasuredBrdf.hlsl",
+                        "unity/felt.manifest.json",
+                        "unreal/felt.dds",
+                        "unreal/felt_tiles.exr",
+                        "unreal/MeasuredBrdf.ush",
+                        "unreal/import_measured_brdf.py",
+                        "unreal/felt.manifest.json",
+                        "godot/felt.dds",
+                        "godot/felt_slices.exr",
+                        "godot/felt_slices.exr.import",
+                        "godot/measured_brdf.gdshader",
+                        "godot/felt.manifest.json",
+                        "web/felt.ktx2",
+                        "web/measured_brdf.js",
+                        "web/index.html",
+                        "web/package.json",
+                        "web/felt.manifest.json",
+                        "web/MeasuredBrdf.es300.glsl",
+                        "web/MeasuredBrdf.450.glsl"})
     EXPECT_TRUE(fs::is_regular_file(dir_ / f)) << f;
   EXPECT_EQ(r.written.size(), 21u);
   const std::string ktx2 = Read(dir_ / "felt.ktx2");
@@ -137,7 +150,8 @@ TEST_F(EngineExport, ManifestProbesAreTheTexturesOwnTexels) {
     ASSERT_GE(j["probe_texels"].size(), 4u * 7u);
     for (const auto& p : j["probe_texels"]) {
       const int x = p["index"][0], y = p["index"][1], z = p["index"][2];
-      const auto expect = Decode(U32(ktx2, level + 4 * ((static_cast<std::size_t>(z) * 181 + y) * 361 + x)));
+      const auto expect =
+          Decode(U32(ktx2, level + 4 * ((static_cast<std::size_t>(z) * 181 + y) * 361 + x)));
       for (int c = 0; c < 3; ++c) EXPECT_EQ(p["rgb"][c].get<double>(), expect[c]) << p.dump();
       EXPECT_DOUBLE_EQ(p["uvw"][0].get<double>(), (x + 0.5) / 361);
       EXPECT_DOUBLE_EQ(p["theta_in_deg"].get<double>(), 20.0 * z);
@@ -161,7 +175,8 @@ TEST_F(EngineExport, LayoutsOtherThanTheReferenceGetTheirOwnShaderFiles) {
   exporter::TextureMetadata a, b;
   a.name = "a";
   b.name = "b";
-  engines::ExportLutWithEngines(dir_.string(), Pattern({0, 20, 40, 60}), a, {}, ParseEngines("unity"));
+  engines::ExportLutWithEngines(dir_.string(), Pattern({0, 20, 40, 60}), a, {},
+                                ParseEngines("unity"));
   engines::ExportLutWithEngines(dir_.string(), Pattern({10, 25, 40}), b, {}, ParseEngines("unity"));
   const std::string ref = Read(dir_ / "unity/MeasuredBrdf.hlsl");
   const std::string other = Read(dir_ / "unity/MeasuredBrdf_3x15from10.hlsl");
@@ -173,12 +188,13 @@ TEST_F(EngineExport, LayoutsOtherThanTheReferenceGetTheirOwnShaderFiles) {
 }
 
 TEST_F(EngineExport, AtlasFoldersAddressEachMaterialsCell) {
-  const Lut l0 = Pattern({0, 20, 40, 60}), l1 = Pattern({0, 20, 40, 60}), l2 = Pattern({0, 20, 40, 60});
-  const std::vector<exporter::AtlasMaterial> materials = {{"m0", &l0, "m0.json"},
-                                                          {"m1", &l1, "m1.json"},
-                                                          {"m2", &l2, "m2.json"}};
+  const Lut l0 = Pattern({0, 20, 40, 60}), l1 = Pattern({0, 20, 40, 60}),
+            l2 = Pattern({0, 20, 40, 60});
+  const std::vector<exporter::AtlasMaterial> materials = {
+      {"m0", &l0, "m0.json"}, {"m1", &l1, "m1.json"}, {"m2", &l2, "m2.json"}};
   const std::string prefix = (dir_ / "set").string();
-  const auto written = engines::WriteAtlasWithEngines(prefix, materials, {}, ParseEngines("godot,web"));
+  const auto written =
+      engines::WriteAtlasWithEngines(prefix, materials, {}, ParseEngines("godot,web"));
   EXPECT_TRUE(fs::is_regular_file(dir_ / "godot/set.dds"));
   EXPECT_EQ(Read(dir_ / "godot/set.dds"), Read(dir_ / "set.dds"));
   EXPECT_EQ(Read(dir_ / "web/set.ktx2"), Read(dir_ / "set.ktx2"));

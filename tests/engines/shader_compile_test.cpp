@@ -82,20 +82,20 @@ class ShaderCompile : public ::testing::Test {
 };
 
 const std::vector<ShaderLutLayout> kLayouts = {
-    {0, 20, 4, 361, 181},    // the reference instrument
-    {10, 15, 3, 361, 181},   // another θin list
-    {0, 1, 1, 361, 181},     // a single slice
-    {0, 20, 4, 1083, 362},   // an atlas of 3 × 2 cells
+    {0, 20, 4, 361, 181},   // the reference instrument
+    {10, 15, 3, 361, 181},  // another θin list
+    {0, 1, 1, 361, 181},    // a single slice
+    {0, 20, 4, 1083, 362},  // an atlas of 3 × 2 cells
 };
 
 TEST_F(ShaderCompile, GlslFilesCompileAsGlslEs300And450) {
   for (const ShaderLutLayout& l : kLayouts) {
     const std::string tag = std::to_string(l.slices) + "_" + std::to_string(l.texture_width);
     ExpectCompiles("-S frag " + Write("es_" + tag + ".frag", exporter::MeasuredBrdfGlslFile(
-                                                                  exporter::GlslVersion::kEs300, l)),
+                                                                 exporter::GlslVersion::kEs300, l)),
                    "GLSL ES 3.00 " + tag);
     ExpectCompiles("-S frag " + Write("gl_" + tag + ".frag", exporter::MeasuredBrdfGlslFile(
-                                                                  exporter::GlslVersion::k450, l)),
+                                                                 exporter::GlslVersion::k450, l)),
                    "GLSL 4.50 " + tag);
   }
 }
@@ -108,8 +108,9 @@ TEST_F(ShaderCompile, Glsl450LinksToSpirvWithAMain) {
       "layout(location = 2) in vec3 v_in;\nlayout(location = 0) out vec4 color;\n"
       "void main() { color = vec4(MeasuredBrdf(brdf_lut, normalize(n_in), normalize(l_in), "
       "normalize(v_in)) + MeasuredBrdfTangent(brdf_lut, vec2(0.0), l_in, v_in), 1.0); }\n";
-  ExpectCompiles("-V -S frag -o " + (dir_ / "a.spv").string() + " " + Write("a.frag", body + main_text),
-                 "GLSL 4.50 to SPIR-V");
+  ExpectCompiles(
+      "-V -S frag -o " + (dir_ / "a.spv").string() + " " + Write("a.frag", body + main_text),
+      "GLSL 4.50 to SPIR-V");
 }
 
 // docs/design.md §5 / issue: the sidecar's "glsl" snippet compiles as it ships (ES 3.00 needs a
@@ -120,7 +121,8 @@ TEST_F(ShaderCompile, SidecarSnippetIsTheShippedGlslAndCompiles) {
   meta.name = "m";
   const auto j = nlohmann::json::parse(exporter::SidecarJson(v, {0, 20, 40, 60}, meta));
   const std::string snippet = j["texel_convention"]["glsl"];
-  const std::string file = exporter::MeasuredBrdfGlslFile(exporter::GlslVersion::kEs300, kLayouts[0]);
+  const std::string file =
+      exporter::MeasuredBrdfGlslFile(exporter::GlslVersion::kEs300, kLayouts[0]);
   EXPECT_EQ("#version 300 es\n" + snippet, file);
   ExpectCompiles("-S frag " + Write("sidecar_es.frag", "#version 300 es\n" + snippet),
                  "sidecar snippet as GLSL ES 3.00");
@@ -134,7 +136,8 @@ TEST_F(ShaderCompile, ShippedWebGlslFilesCompile) {
   ExpectCompiles("-S frag " + (out / "web/MeasuredBrdf.450.glsl").string(), "web 450 file");
   // The ES module embeds the same GLSL body.
   const std::string js = Read(out / "web/measured_brdf.js");
-  const std::string body = exporter::MeasuredBrdfShaderCode(exporter::ShaderLanguage::kGlsl, kLayouts[0]);
+  const std::string body =
+      exporter::MeasuredBrdfShaderCode(exporter::ShaderLanguage::kGlsl, kLayouts[0]);
   EXPECT_NE(js.find("export const MEASURED_BRDF_GLSL = `" + body + "`;"), std::string::npos);
 }
 
@@ -161,7 +164,8 @@ TEST_F(ShaderCompile, UnityIncludeCompilesForShaderGraphAndBuiltInPipeline) {
       if (e.path().extension() == ".hlsl") include = e.path().filename().string();
     ASSERT_FALSE(include.empty());
     const std::string harness = std::string(kUnityStandIns) +
-        "#define MEASURED_BRDF_BUILTIN_LIGHTING\n#include \"" + include + "\"\n" + R"(
+                                "#define MEASURED_BRDF_BUILTIN_LIGHTING\n#include \"" + include +
+                                "\"\n" + R"(
 Texture3D g_lut; SamplerState g_lut_sampler;
 float4 main(float3 n : TEXCOORD0, float3 l : TEXCOORD1, float3 v : TEXCOORD2) : SV_Target {
   UnityTexture3D t; t.tex = g_lut; t.samplerstate = g_lut_sampler;
@@ -192,8 +196,10 @@ TEST_F(ShaderCompile, UnrealUshCompilesInACustomNodeAsTheCommentSays) {
   ASSERT_TRUE(std::regex_search(ush, m, std::regex(R"(// Code:\s+(return [^\n]+;))"))) << ush;
   // Unreal passes a TextureObject input "Lut" as Texture3D Lut and SamplerState LutSampler and
   // wraps the code in a function (MaterialTemplate.ush: CustomExpressionN).
-  const std::string harness = "#include \"MeasuredBrdf.ush\"\n"
-      "float3 CustomExpression0(Texture3D Lut, SamplerState LutSampler, float3 N, float3 L, float3 V) {\n  " +
+  const std::string harness =
+      "#include \"MeasuredBrdf.ush\"\n"
+      "float3 CustomExpression0(Texture3D Lut, SamplerState LutSampler, float3 N, float3 L, float3 "
+      "V) {\n  " +
       m[1].str() + "\n}\n" + R"(
 Texture3D Material_Texture3D_0; SamplerState Material_Texture3D_0Sampler;
 float4 main(float3 n : TEXCOORD0, float3 l : TEXCOORD1, float3 v : TEXCOORD2) : SV_Target {
@@ -224,8 +230,10 @@ TEST_F(ShaderCompile, GodotShaderIsValidOnceGodotsAdditionsAreReplaced) {
       "vec3 NORMAL; vec3 LIGHT; vec3 VIEW; vec3 LIGHT_COLOR; float ATTENUATION;\n"
       "vec3 DIFFUSE_LIGHT; vec3 SPECULAR_LIGHT;\n";
   const std::string tail =
-      "out vec4 color;\nvoid main() { godot_fragment(); godot_light(); color = vec4(DIFFUSE_LIGHT, 1.0); }\n";
-  ExpectCompiles("-S frag " + Write("godot.frag", builtins + src + tail), "Godot shader as GLSL ES");
+      "out vec4 color;\nvoid main() { godot_fragment(); godot_light(); color = vec4(DIFFUSE_LIGHT, "
+      "1.0); }\n";
+  ExpectCompiles("-S frag " + Write("godot.frag", builtins + src + tail),
+                 "Godot shader as GLSL ES");
 }
 
 }  // namespace

@@ -21,7 +21,8 @@ int Compile(const std::string& version_line, const std::string& snippet,
       << "precision highp float;\n"
       << snippet << "uniform sampler3D lut;\n"
       << "out vec4 color;\n"
-      << "void main() { color = vec4(MeasuredBrdf(lut, vec3(0.0, 0.0, 1.0), normalize(vec3(0.3, 0.0, 1.0)), normalize(vec3(-0.3, 0.1, 1.0))), 1.0); }\n";
+      << "void main() { color = vec4(MeasuredBrdf(lut, vec3(0.0, 0.0, 1.0), normalize(vec3(0.3, "
+         "0.0, 1.0)), normalize(vec3(-0.3, 0.1, 1.0))), 1.0); }\n";
   const int status = std::system(("glslangValidator " + path + " > " + path + ".log 2>&1").c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }

@@ -109,8 +109,9 @@ TEST_F(ImageIoTest, HalfExrRoundsToNearestAndOverflowsToInfinity) {
   // 1 + 2^-11 lies exactly between the halfs 1 and 1 + 2^-10: ties go to even, i.e. 1.
   // 1 + 3·2^-11 lies between 1 + 2^-10 and 1 + 2^-9: ties to even give 1 + 2^-9.
   // 65504 is the largest half; 65536 and above (beyond 65520) overflow to +inf.
-  image.rgb = {1.0f + std::ldexp(1.0f, -11), 1.0f + 3 * std::ldexp(1.0f, -11), 65504.0f,
-               70000.0f, 0.1f, std::ldexp(1.0f, -24)};
+  image.rgb = {
+      1.0f + std::ldexp(1.0f, -11), 1.0f + 3 * std::ldexp(1.0f, -11), 65504.0f, 70000.0f, 0.1f,
+      std::ldexp(1.0f, -24)};
   WriteExrImage(Path("h.exr"), image, ExrPixelType::kHalf, ExrCompression::kNone, {});
   const RgbImage back = ReadRgbImage(Path("h.exr"));
   ASSERT_EQ(back.rgb.size(), 6u);
@@ -118,7 +119,7 @@ TEST_F(ImageIoTest, HalfExrRoundsToNearestAndOverflowsToInfinity) {
   EXPECT_EQ(back.rgb[1], 1.0f + std::ldexp(1.0f, -9));
   EXPECT_EQ(back.rgb[2], 65504.0f);
   EXPECT_TRUE(std::isinf(back.rgb[3]));
-  EXPECT_EQ(back.rgb[4], 1638.0f / 16384.0f);  // 0.1 → 0x2E66 = 1.599609375 · 2^-4
+  EXPECT_EQ(back.rgb[4], 1638.0f / 16384.0f);     // 0.1 → 0x2E66 = 1.599609375 · 2^-4
   EXPECT_EQ(back.rgb[5], std::ldexp(1.0f, -24));  // the smallest subnormal half
   EXPECT_EQ(ReadExrImage(Path("h.exr")).pixel_type, ExrPixelType::kHalf);
   EXPECT_EQ(ReadExrImage(Path("h.exr")).compression, ExrCompression::kNone);
@@ -143,8 +144,7 @@ TEST_F(ImageIoTest, PngReadsBackAsCodesOver255ThroughOpenImageIo) {
   ASSERT_EQ(back.width, 4);
   ASSERT_EQ(back.height, 3);
   ASSERT_EQ(back.rgb.size(), rgb8.size());
-  for (std::size_t i = 0; i < rgb8.size(); ++i)
-    EXPECT_FLOAT_EQ(back.rgb[i], rgb8[i] / 255.0f) << i;
+  for (std::size_t i = 0; i < rgb8.size(); ++i) EXPECT_FLOAT_EQ(back.rgb[i], rgb8[i] / 255.0f) << i;
   // The PNG signature and a tEXt chunk with the keyword (PNG 1.2, §11.3.4.3).
   std::ifstream in(Path("p.png"), std::ios::binary);
   const std::string bytes((std::istreambuf_iterator<char>(in)), {});
@@ -181,8 +181,7 @@ TEST_F(ImageIoTest, MissingFilesFoldersAndFifosAreRefusedWithoutBlocking) {
 TEST_F(ImageIoTest, InconsistentImagesAreRefusedBeforeAnythingIsWritten) {
   RgbImage image = TestImage();
   image.rgb.pop_back();
-  EXPECT_THROW(WriteExrImage(Path("x.exr"), image, ExrPixelType::kFloat, ExrCompression::kNone,
-                             {}),
+  EXPECT_THROW(WriteExrImage(Path("x.exr"), image, ExrPixelType::kFloat, ExrCompression::kNone, {}),
                InvalidArgument);
   EXPECT_THROW(WritePng8(Path("x.png"), 2, 2, std::vector<unsigned char>(11), 3, {}),
                InvalidArgument);

@@ -57,8 +57,8 @@ bool StartsWith(const std::string& s, const char* prefix) { return s.rfind(prefi
 
 TEST(FitRgl, EveryMaterialConvergesGgxBeatsLambertOnGlossyOnesAndFilmsAreFlagged) {
   const fs::path dir = fs::path(DataDir()) / "rgl";
-  ASSERT_TRUE(fs::is_directory(dir)) << "no RGL data at " << dir
-                                     << "; set BRDF_DATA_DIR to the shared brdf-data folder";
+  ASSERT_TRUE(fs::is_directory(dir))
+      << "no RGL data at " << dir << "; set BRDF_DATA_DIR to the shared brdf-data folder";
   std::vector<fs::path> files;
   for (const auto& e : fs::directory_iterator(dir))
     if (e.path().extension() == ".bsdf") files.push_back(e.path());
@@ -89,7 +89,8 @@ TEST(FitRgl, EveryMaterialConvergesGgxBeatsLambertOnGlossyOnesAndFilmsAreFlagged
     std::vector<double> lum;
     for (const Sample& x : meas.slices[1].samples)
       lum.push_back(0.2126 * x.rgb[0] + 0.7152 * x.rgb[1] + 0.0722 * x.rgb[2]);
-    std::nth_element(lum.begin(), lum.begin() + static_cast<std::ptrdiff_t>(lum.size() / 2), lum.end());
+    std::nth_element(lum.begin(), lum.begin() + static_cast<std::ptrdiff_t>(lum.size() / 2),
+                     lum.end());
     const double peak = 0.2126 * mirror[0] + 0.7152 * mirror[1] + 0.0722 * mirror[2];
     if (peak > 5 * lum[lum.size() / 2]) {
       ++glossy;

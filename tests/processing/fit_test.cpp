@@ -65,20 +65,32 @@ std::vector<Case> RecoveryCases() {
   using M = Material;
   return {
       {"lambert", M::Make(Model::kLambert, {{0.8, 0.5, 0.2}})},
-      {"ggx sharp alpha 0.05", M::Make(Model::kGgx, {{0.1, 0.2, 0.3}, {0.9, 0.6, 0.3}, {0.05, 0.05, 0.05}})},
-      {"ggx rough alpha 0.5", M::Make(Model::kGgx, {{0.3, 0.2, 0.1}, {0.04, 0.04, 0.04}, {0.5, 0.5, 0.5}})},
-      {"lafortune sharp n 500", M::Make(Model::kLafortune, {{0.2, 0.3, 0.1}, {0.5, 0.4, 0.6}, {500, 500, 500}})},
-      {"lafortune rough n 5", M::Make(Model::kLafortune, {{0.4, 0.3, 0.2}, {0.3, 0.3, 0.3}, {5, 5, 5}})},
-      {"blinn-phong sharp n 500", M::Make(Model::kBlinnPhong, {{0.1, 0.1, 0.2}, {0.6, 0.5, 0.4}, {500, 500, 500}})},
-      {"blinn-phong rough n 10", M::Make(Model::kBlinnPhong, {{0.3, 0.4, 0.5}, {0.2, 0.2, 0.2}, {10, 10, 10}})},
-      {"ward sharp alpha 0.05", M::Make(Model::kWard, {{0.2, 0.1, 0.05}, {0.1, 0.08, 0.06}, {0.05, 0.05, 0.05}})},
-      {"ward rough alpha 0.4", M::Make(Model::kWard, {{0.3, 0.3, 0.3}, {0.2, 0.2, 0.2}, {0.4, 0.4, 0.4}})},
-      {"unreal metal-ish", M::Make(Model::kUnrealDefaultLit, {{0.9, 0.7, 0.3}, {0.6, 0, 0}, {0.5, 0, 0}, {0.25, 0, 0}})},
-      {"unreal rough dielectric", M::Make(Model::kUnrealDefaultLit, {{0.2, 0.5, 0.3}, {0.1, 0, 0}, {0.7, 0, 0}, {0.7, 0, 0}})},
+      {"ggx sharp alpha 0.05",
+       M::Make(Model::kGgx, {{0.1, 0.2, 0.3}, {0.9, 0.6, 0.3}, {0.05, 0.05, 0.05}})},
+      {"ggx rough alpha 0.5",
+       M::Make(Model::kGgx, {{0.3, 0.2, 0.1}, {0.04, 0.04, 0.04}, {0.5, 0.5, 0.5}})},
+      {"lafortune sharp n 500",
+       M::Make(Model::kLafortune, {{0.2, 0.3, 0.1}, {0.5, 0.4, 0.6}, {500, 500, 500}})},
+      {"lafortune rough n 5",
+       M::Make(Model::kLafortune, {{0.4, 0.3, 0.2}, {0.3, 0.3, 0.3}, {5, 5, 5}})},
+      {"blinn-phong sharp n 500",
+       M::Make(Model::kBlinnPhong, {{0.1, 0.1, 0.2}, {0.6, 0.5, 0.4}, {500, 500, 500}})},
+      {"blinn-phong rough n 10",
+       M::Make(Model::kBlinnPhong, {{0.3, 0.4, 0.5}, {0.2, 0.2, 0.2}, {10, 10, 10}})},
+      {"ward sharp alpha 0.05",
+       M::Make(Model::kWard, {{0.2, 0.1, 0.05}, {0.1, 0.08, 0.06}, {0.05, 0.05, 0.05}})},
+      {"ward rough alpha 0.4",
+       M::Make(Model::kWard, {{0.3, 0.3, 0.3}, {0.2, 0.2, 0.2}, {0.4, 0.4, 0.4}})},
+      {"unreal metal-ish", M::Make(Model::kUnrealDefaultLit,
+                                   {{0.9, 0.7, 0.3}, {0.6, 0, 0}, {0.5, 0, 0}, {0.25, 0, 0}})},
+      {"unreal rough dielectric",
+       M::Make(Model::kUnrealDefaultLit, {{0.2, 0.5, 0.3}, {0.1, 0, 0}, {0.7, 0, 0}, {0.7, 0, 0}})},
       {"hdrp lit", M::Make(Model::kUnityHdrpLit, {{0.8, 0.3, 0.2}, {0.4, 0, 0}, {0.75, 0, 0}})},
-      {"hdrp lit specular", M::Make(Model::kUnityHdrpLitSpecular, {{0.5, 0.4, 0.3}, {0.3, 0.2, 0.1}, {0.5, 0, 0}})},
+      {"hdrp lit specular",
+       M::Make(Model::kUnityHdrpLitSpecular, {{0.5, 0.4, 0.3}, {0.3, 0.2, 0.1}, {0.5, 0, 0}})},
       {"urp lit", M::Make(Model::kUnityUrpLit, {{0.3, 0.6, 0.9}, {0.6, 0, 0}, {0.8, 0, 0}})},
-      {"urp lit specular", M::Make(Model::kUnityUrpLitSpecular, {{0.6, 0.5, 0.2}, {0.2, 0.3, 0.4}, {0.4, 0, 0}})},
+      {"urp lit specular",
+       M::Make(Model::kUnityUrpLitSpecular, {{0.6, 0.5, 0.2}, {0.2, 0.3, 0.4}, {0.4, 0, 0}})},
   };
 }
 
@@ -134,10 +146,9 @@ TEST(FitRecovery, NoisyCapturesGiveTheParametersBackWithinStatedTolerances) {
         const double t = c->truth.values[static_cast<std::size_t>(p.offset + ch)];
         const double f = r.material.values[static_cast<std::size_t>(p.offset + ch)];
         const bool shape = static_cast<int>(&p - info.parameters.data()) == info.shape_parameter;
-        const double tolerance = p.name == "specular" ? 0.05
-                                 : std::max((shape ? 0.05 : 0.03) * std::fabs(t), 0.005);
-        EXPECT_NEAR(f, t, tolerance)
-            << label << ": " << p.name << "[" << ch << "]";
+        const double tolerance =
+            p.name == "specular" ? 0.05 : std::max((shape ? 0.05 : 0.03) * std::fabs(t), 0.005);
+        EXPECT_NEAR(f, t, tolerance) << label << ": " << p.name << "[" << ch << "]";
       }
   }
 }
@@ -227,9 +238,8 @@ TEST(FitEngines, EngineFitsAreNeverWorseThanTheNaiveMappingOfTheGgxFit) {
   FitOptions o;
   o.model = Model::kGgx;
   const Material ggx = FitMaterial(meas, o).material;
-  for (Model engine : {Model::kUnrealDefaultLit, Model::kUnityHdrpLit,
-                       Model::kUnityHdrpLitSpecular, Model::kUnityUrpLit,
-                       Model::kUnityUrpLitSpecular}) {
+  for (Model engine : {Model::kUnrealDefaultLit, Model::kUnityHdrpLit, Model::kUnityHdrpLitSpecular,
+                       Model::kUnityUrpLit, Model::kUnityUrpLitSpecular}) {
     o.model = engine;
     const FitReport fit = FitMaterial(meas, o).report;
     const FitReport naive = EvaluateFit(meas, NaiveFromGgx(ggx, engine), o);

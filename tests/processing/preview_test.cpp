@@ -6,8 +6,8 @@
 
 #include <gtest/gtest.h>
 
-#include "test_support.h"
 #include <unistd.h>
+#include "test_support.h"
 
 #include <atomic>
 #include <cmath>
@@ -38,8 +38,8 @@ std::string DataDir() { return brdf::test::DataDir(); }
 
 // Runs the NumPy oracle and returns its numbers.
 std::vector<double> Oracle(const std::string& args) {
-  const std::string cmd = std::string(BRDF_PYTHON3) + " " BRDF_SOURCE_DIR
-                          "/tests/python/preview_oracle.py " + args;
+  const std::string cmd =
+      std::string(BRDF_PYTHON3) + " " BRDF_SOURCE_DIR "/tests/python/preview_oracle.py " + args;
   std::FILE* pipe = ::popen(cmd.c_str(), "r");
   EXPECT_NE(pipe, nullptr) << cmd;
   if (pipe == nullptr) return {};
@@ -99,8 +99,8 @@ TEST(PreviewFurnace, WhiteLambertianRendersTheMapRadianceAtEveryLitPixel) {
 TEST(PreviewFurnace, LambertianOfRhoGivesRhoTimesL) {
   const Rgb rho = {0.2, 0.5, 0.8}, radiance = {1.5, 1.0, 0.5};
   const AnalyticBrdf lambert(MakeMaterial(Model::kLambert, rho, {}, {}));
-  const PreviewImage image =
-      RenderPreview(lambert, EnvironmentMap::Furnace(radiance), SmallOptions(32, Estimator::kMis, 1024));
+  const PreviewImage image = RenderPreview(lambert, EnvironmentMap::Furnace(radiance),
+                                           SmallOptions(32, Estimator::kMis, 1024));
   for (int y = 0; y < image.height; ++y)
     for (int x = 0; x < image.width; ++x)
       if (image.object[y * image.width + x]) {
@@ -119,8 +119,8 @@ void ExpectFurnaceMatchesAlbedo(const Material& m, const std::string& model_name
   std::vector<std::vector<double>> albedo(3);
   for (int c = 0; c < 3; ++c) {
     albedo[c] = Oracle("albedo " + model_name + " " + std::to_string(m.Parameter(0)[c]) + " " +
-                       std::to_string(m.Parameter(1)[c]) + " " +
-                       std::to_string(m.Parameter(2)[c]) + thetas);
+                       std::to_string(m.Parameter(1)[c]) + " " + std::to_string(m.Parameter(2)[c]) +
+                       thetas);
     ASSERT_EQ(albedo[c].size(), 87u);
   }
   double squares = 0, total = 0;
@@ -137,7 +137,8 @@ void ExpectFurnaceMatchesAlbedo(const Material& m, const std::string& model_name
       for (int c = 0; c < 3; ++c) {
         const double expected = albedo[c][k] * (1 - t) + albedo[c][k + 1] * t;
         const double got = image.Pixel(x, y)[c];
-        EXPECT_NEAR(got, expected, 0.03 * expected) << model_name << " θo " << theta_o << " ch " << c << " got " << got << " want " << expected;
+        EXPECT_NEAR(got, expected, 0.03 * expected) << model_name << " θo " << theta_o << " ch "
+                                                    << c << " got " << got << " want " << expected;
         squares += (got - expected) * (got - expected);
         total += expected;
         ++n;
@@ -147,15 +148,13 @@ void ExpectFurnaceMatchesAlbedo(const Material& m, const std::string& model_name
 }
 
 TEST(PreviewFurnace, GgxEqualsItsDirectionalAlbedo) {
-  ExpectFurnaceMatchesAlbedo(MakeMaterial(Model::kGgx, {0.1, 0.3, 0.0}, {0.9, 0.5, 0.04},
-                                          {0.3, 0.15, 0.5}),
-                             "ggx");
+  ExpectFurnaceMatchesAlbedo(
+      MakeMaterial(Model::kGgx, {0.1, 0.3, 0.0}, {0.9, 0.5, 0.04}, {0.3, 0.15, 0.5}), "ggx");
 }
 
 TEST(PreviewFurnace, LafortuneEqualsItsDirectionalAlbedo) {  // the tabulated sampler
-  ExpectFurnaceMatchesAlbedo(MakeMaterial(Model::kLafortune, {0.1, 0.2, 0.3}, {0.6, 0.5, 0.4},
-                                          {20, 60, 8}),
-                             "lafortune");
+  ExpectFurnaceMatchesAlbedo(
+      MakeMaterial(Model::kLafortune, {0.1, 0.2, 0.3}, {0.6, 0.5, 0.4}, {20, 60, 8}), "lafortune");
 }
 
 TEST(PreviewFurnace, WardEqualsItsDirectionalAlbedo) {
@@ -255,8 +254,8 @@ void ExpectEstimatorsAgree(const BrdfSource& source, const EnvironmentMap& map, 
 
 TEST(PreviewEstimators, EnvironmentBrdfAndMisAgreeWithinErrorBars) {
   const EnvironmentMap studio = EnvironmentMap::Studio(128, 64);
-  ExpectEstimatorsAgree(AnalyticBrdf(MakeMaterial(Model::kGgx, {0.2, 0.1, 0.05},
-                                                  {0.8, 0.8, 0.8}, {0.25, 0.25, 0.25})),
+  ExpectEstimatorsAgree(AnalyticBrdf(MakeMaterial(Model::kGgx, {0.2, 0.1, 0.05}, {0.8, 0.8, 0.8},
+                                                  {0.25, 0.25, 0.25})),
                         studio, 64);
   ExpectEstimatorsAgree(AnalyticBrdf(test::LafortuneN20()), studio, 64);
 }
@@ -320,17 +319,18 @@ TEST(PreviewOrientation, AxisCodedMapAppearsWhereTheDocumentedFrameSaysItIs) {
     const char* what;
   };
   const int c = size / 2, r = static_cast<int>(0.45 * size * o.camera.fill);
-  for (const Probe& p : {Probe{c, c, "centre (+x)"}, Probe{c + r, c, "right (+y)"},
-                         Probe{c - r, c, "left (−y)"}, Probe{c, c - r, "top (+z)"},
-                         Probe{c, c + r, "bottom (−z)"}}) {
+  for (const Probe& p :
+       {Probe{c, c, "centre (+x)"}, Probe{c + r, c, "right (+y)"}, Probe{c - r, c, "left (−y)"},
+        Probe{c, c - r, "top (+z)"}, Probe{c, c + r, "bottom (−z)"}}) {
     Vec3 n;
     ASSERT_TRUE(SphereNormal(p.x, p.y, size, size, o.camera.fill, &n));
-    const std::vector<double> expected =
-        Oracle("axes " + std::to_string(n.x) + " " + std::to_string(n.y) + " " + std::to_string(n.z));
+    const std::vector<double> expected = Oracle("axes " + std::to_string(n.x) + " " +
+                                                std::to_string(n.y) + " " + std::to_string(n.z));
     ASSERT_EQ(expected.size(), 3u);
     for (int ch = 0; ch < 3; ++ch)
       EXPECT_NEAR(image.Pixel(p.x, p.y)[ch], expected[ch], 0.02 * expected[ch] + 0.003)
-          << p.what << " channel " << ch << " got " << image.Pixel(p.x, p.y)[ch] << " want " << expected[ch];
+          << p.what << " channel " << ch << " got " << image.Pixel(p.x, p.y)[ch] << " want "
+          << expected[ch];
   }
   // Background: straight behind the sphere is −x: G = B = 0.5, R = 0 (cyan) at the image
   // centre row near the left and right edges (−x rotated slightly towards ∓y).
@@ -413,8 +413,9 @@ double ChiSquareThreshold(int dof) {
 }
 
 TEST(PreviewSamplers, EnvironmentSamplerPdfMatchesItsSamples) {
-  for (const EnvironmentMap& map : {EnvironmentMap::Studio(64, 32), EnvironmentMap::Sky(30, 100, 64, 32),
-                                    EnvironmentMap::AxisCoded(32, 16)}) {
+  for (const EnvironmentMap& map :
+       {EnvironmentMap::Studio(64, 32), EnvironmentMap::Sky(30, 100, 64, 32),
+        EnvironmentMap::AxisCoded(32, 16)}) {
     const EnvironmentSampler sampler(map);
     const ChiSquare chi = RunChiSquare(
         [&](double u1, double u2, double, Vec3* w) {
@@ -593,7 +594,8 @@ TEST_F(PreviewFiles, TessellatedSphereMeshRendersLikeTheAnalyticSphere) {
   o.mesh = &mesh;
   const PreviewImage meshed = RenderPreview(material, studio, o);
   std::size_t disagree = 0;
-  for (std::size_t p = 0; p < sphere.object.size(); ++p) disagree += sphere.object[p] != meshed.object[p];
+  for (std::size_t p = 0; p < sphere.object.size(); ++p)
+    disagree += sphere.object[p] != meshed.object[p];
   EXPECT_LT(disagree, 40u);
   EXPECT_LT(CompareImages(meshed, sphere).relative_rms, 0.03);
 }
@@ -709,9 +711,10 @@ TEST_F(PreviewFiles, BrokenMeshesAndMapsFailWithTheFileAndPosition) {
     EXPECT_NE(std::string(e.what()).find("bad.obj"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("line 4"), std::string::npos) << e.what();
   }
-  const std::string ply = Write("bad.ply", "ply\nformat binary_little_endian 1.0\nelement vertex 3\n"
-                                           "property float x\nproperty float y\nproperty float z\n"
-                                           "end_header\n\x01\x02");
+  const std::string ply = Write("bad.ply",
+                                "ply\nformat binary_little_endian 1.0\nelement vertex 3\n"
+                                "property float x\nproperty float y\nproperty float z\n"
+                                "end_header\n\x01\x02");
   EXPECT_THROW(LoadMesh(ply), FormatError);
   EXPECT_THROW(LoadMesh(Write("mesh.stl", "solid")), InvalidArgument);
   // A map that is not 2:1.

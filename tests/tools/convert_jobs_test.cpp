@@ -43,11 +43,13 @@ std::set<std::string> Extensions(const std::map<std::string, std::string>& files
 // Whether `bytes` is a whole file of the container its name says, read from its specification.
 std::string Defect(const std::string& name, const std::string& bytes) {
   const std::string ext = fs::path(name).extension().string();
-  static const unsigned char kKtx2[12] = {0xAB, 'K', 'T', 'X', ' ', '2', '0', 0xBB, '\r', '\n', 0x1A, '\n'};
+  static const unsigned char kKtx2[12] = {0xAB, 'K',  'T',  'X',  ' ',  '2',
+                                          '0',  0xBB, '\r', '\n', 0x1A, '\n'};
   static const unsigned char kPng[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1A, '\n'};
   static const unsigned char kExr[4] = {0x76, 0x2f, 0x31, 0x01};
   if (ext == ".ktx2") {
-    if (bytes.size() < 104 || std::memcmp(bytes.data(), kKtx2, 12) != 0) return "no KTX2 identifier";
+    if (bytes.size() < 104 || std::memcmp(bytes.data(), kKtx2, 12) != 0)
+      return "no KTX2 identifier";
     if (LoadU64(bytes, 80) + LoadU64(bytes, 88) > bytes.size()) return "KTX2 level 0 cut short";
   } else if (ext == ".dds") {
     if (bytes.size() < 148 || bytes.compare(0, 4, "DDS ") != 0) return "no DDS magic";
@@ -55,7 +57,8 @@ std::string Defect(const std::string& name, const std::string& bytes) {
     if (bytes.size() < 8 || std::memcmp(bytes.data(), kExr, 4) != 0) return "no OpenEXR magic";
   } else if (ext == ".png") {
     if (bytes.size() < 8 || std::memcmp(bytes.data(), kPng, 8) != 0) return "no PNG signature";
-    if (bytes.size() < 12 || bytes.compare(bytes.size() - 8, 4, "IEND") != 0) return "PNG without IEND";
+    if (bytes.size() < 12 || bytes.compare(bytes.size() - 8, 4, "IEND") != 0)
+      return "PNG without IEND";
   } else if (ext == ".json") {
     if (!nlohmann::json::accept(bytes)) return "JSON that does not parse";
   }
@@ -64,9 +67,11 @@ std::string Defect(const std::string& name, const std::string& bytes) {
 
 TEST_F(ConvertJobs, TwoJobsWriteTheSameBytesAsOneForEveryOutputFile) {
   const fs::path in = Inputs();
-  const ToolRun one = Run("convert " + Quote(in) + " --out " + Quote(dir_ / "jobs1") + " --jobs 1 --quiet");
+  const ToolRun one =
+      Run("convert " + Quote(in) + " --out " + Quote(dir_ / "jobs1") + " --jobs 1 --quiet");
   ASSERT_EQ(one.exit_code, 0) << one.err;
-  const ToolRun two = Run("convert " + Quote(in) + " --out " + Quote(dir_ / "jobs2") + " --jobs 2 --quiet");
+  const ToolRun two =
+      Run("convert " + Quote(in) + " --out " + Quote(dir_ / "jobs2") + " --jobs 2 --quiet");
   ASSERT_EQ(two.exit_code, 0) << two.err;
   const auto a = Files(dir_ / "jobs1"), b = Files(dir_ / "jobs2");
   // Four inputs, each with a LUT in every format and a sidecar.
@@ -90,7 +95,8 @@ TEST_F(ConvertJobs, TwoJobsWriteTheSameBytesAsOneForEveryOutputFile) {
 
 TEST_F(ConvertJobs, ConcurrentForcedRunsIntoOneFolderLeaveIntactFiles) {
   const fs::path in = Inputs();
-  const ToolRun ref = Run("convert " + Quote(in) + " --out " + Quote(dir_ / "single") + " --jobs 1 --quiet");
+  const ToolRun ref =
+      Run("convert " + Quote(in) + " --out " + Quote(dir_ / "single") + " --jobs 1 --quiet");
   ASSERT_EQ(ref.exit_code, 0) << ref.err;
   const auto expected = Files(dir_ / "single");
   ASSERT_GE(expected.size(), 4u * 5u);
@@ -121,8 +127,8 @@ TEST_F(ConvertJobs, ConcurrentForcedRunsIntoOneFolderLeaveIntactFiles) {
       const auto it = expected.find(name);
       if (it == expected.end()) continue;
       EXPECT_EQ(bytes.size(), it->second.size()) << "round " << round << ": " << name;
-      EXPECT_TRUE(bytes == it->second) << "round " << round << ": " << name
-                                       << " differs from the single run's file";
+      EXPECT_TRUE(bytes == it->second)
+          << "round " << round << ": " << name << " differs from the single run's file";
     }
   }
 }

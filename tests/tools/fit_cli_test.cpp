@@ -18,9 +18,9 @@ class FitCommand : public ToolTest {};
 TEST_F(FitCommand, FitsAMaterialFileBackToItsOwnParameters) {
   WriteText(dir_ / "plastic.json",
             R"({"model":"ggx","kd":[0.4,0.1,0.05],"f0":0.04,"alpha":[0.12,0.12,0.12]})");
-  const ToolRun r = RunTool("fit " + Quote(dir_ / "plastic.json") + " --model ggx --out " +
-                                Quote(dir_ / "fit.json"),
-                            dir_);
+  const ToolRun r = RunTool(
+      "fit " + Quote(dir_ / "plastic.json") + " --model ggx --out " + Quote(dir_ / "fit.json"),
+      dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const Json j = Json::parse(ReadAll(dir_ / "fit.json"));
   EXPECT_EQ(j["model"], "ggx");
@@ -38,23 +38,22 @@ TEST_F(FitCommand, FitsAMaterialFileBackToItsOwnParameters) {
   const ToolRun e = RunTool("eval " + Quote(dir_ / "fit.json") + " --in 30,0 --out 30,180", dir_);
   EXPECT_EQ(e.exit_code, 0) << e.err;
   // Writing over it again needs --force.
-  const ToolRun again = RunTool("fit " + Quote(dir_ / "plastic.json") + " --model ggx --out " +
-                                    Quote(dir_ / "fit.json"),
-                                dir_);
+  const ToolRun again = RunTool(
+      "fit " + Quote(dir_ / "plastic.json") + " --model ggx --out " + Quote(dir_ / "fit.json"),
+      dir_);
   EXPECT_NE(again.exit_code, 0);
   EXPECT_NE(again.err.find("--force"), std::string::npos) << again.err;
 }
 
 TEST_F(FitCommand, AllModelsWriteOneFileEachAndSayWhatToTypeInTheEngines) {
-  WriteText(dir_ / "red.json",
-            R"({"model":"ggx","kd":[0.5,0.05,0.05],"f0":0.04,"alpha":0.2})");
-  const ToolRun r = RunTool("fit " + Quote(dir_ / "red.json") + " --model all --out " +
-                                Quote(dir_ / "fits") + " --quiet",
-                            dir_);
+  WriteText(dir_ / "red.json", R"({"model":"ggx","kd":[0.5,0.05,0.05],"f0":0.04,"alpha":0.2})");
+  const ToolRun r = RunTool(
+      "fit " + Quote(dir_ / "red.json") + " --model all --out " + Quote(dir_ / "fits") + " --quiet",
+      dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  for (const char* m : {"lambert", "lafortune", "ggx", "blinn-phong", "ward", "unreal-defaultlit",
-                        "unity-hdrp-lit", "unity-hdrp-lit-specular", "unity-urp-lit",
-                        "unity-urp-lit-specular"}) {
+  for (const char* m :
+       {"lambert", "lafortune", "ggx", "blinn-phong", "ward", "unreal-defaultlit", "unity-hdrp-lit",
+        "unity-hdrp-lit-specular", "unity-urp-lit", "unity-urp-lit-specular"}) {
     const fs::path f = dir_ / "fits" / (std::string("red.") + m + ".json");
     ASSERT_TRUE(fs::exists(f)) << f;
     EXPECT_EQ(Json::parse(ReadAll(f))["model"], m);

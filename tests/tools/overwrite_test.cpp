@@ -62,10 +62,10 @@ TEST_F(Overwrite, ExportCsvRefusesAnExistingFileWithoutForce) {
 }
 
 TEST_F(Overwrite, PreviewRefusesAnExistingImageWithoutForce) {
-  ExpectRefusedThenForced("preview " + Quote(std::string(BRDF_SOURCE_DIR) +
-                                             "/data-samples/materials/gold.json") +
-                              " --size 16 --spp 1 --quiet --out " + Quote(dir_ / "p.png"),
-                          dir_ / "p.png");
+  ExpectRefusedThenForced(
+      "preview " + Quote(std::string(BRDF_SOURCE_DIR) + "/data-samples/materials/gold.json") +
+          " --size 16 --spp 1 --quiet --out " + Quote(dir_ / "p.png"),
+      dir_ / "p.png");
 }
 
 TEST_F(Overwrite, ImportRefusesAnExistingFileWithoutForce) {

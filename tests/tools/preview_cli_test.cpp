@@ -55,17 +55,17 @@ TEST_F(PreviewCli, CompareWritesThreePanelsAndPrintsTheRms) {
 }
 
 TEST_F(PreviewCli, BadArgumentsFailWithOneLine) {
-  const ToolRun ext = Run("preview " + Quote(kMaterials + "gold.json") + " --out " +
-                          Quote(dir_ / "x.tif"));
+  const ToolRun ext =
+      Run("preview " + Quote(kMaterials + "gold.json") + " --out " + Quote(dir_ / "x.tif"));
   EXPECT_EQ(ext.exit_code, 1);
   ASSERT_EQ(ext.ErrLines().size(), 1u) << ext.err;
   EXPECT_NE(ext.err.find(".exr"), std::string::npos) << ext.err;
-  const ToolRun missing = Run("preview " + Quote(dir_ / "nope.json") + " --out " +
-                              Quote(dir_ / "x.png"));
+  const ToolRun missing =
+      Run("preview " + Quote(dir_ / "nope.json") + " --out " + Quote(dir_ / "x.png"));
   EXPECT_EQ(missing.exit_code, 1);
   EXPECT_NE(missing.err.find("nope.json"), std::string::npos) << missing.err;
-  const ToolRun env = Run("preview " + Quote(kMaterials + "gold.json") +
-                          " --env moon --out " + Quote(dir_ / "x.png"));
+  const ToolRun env = Run("preview " + Quote(kMaterials + "gold.json") + " --env moon --out " +
+                          Quote(dir_ / "x.png"));
   EXPECT_EQ(env.exit_code, 1);
   ASSERT_EQ(env.ErrLines().size(), 1u) << env.err;
   EXPECT_NE(env.err.find("moon"), std::string::npos) << env.err;

@@ -47,8 +47,9 @@ class SaturatedSamples : public ToolTest {
   }
 };
 
-const char kLine[] = ": 17 saturated samples (θin 0°: 0, 20°: 12, 40°: 0, 60°: 5); their values "
-                     "are clipped\n";
+const char kLine[] =
+    ": 17 saturated samples (θin 0°: 0, 20°: 12, 40°: 0, 60°: 5); their values "
+    "are clipped\n";
 
 TEST_F(SaturatedSamples, ConvertReportsAndRecordsCounts) {
   const fs::path bpc = WriteFlaggedCapture("sat", true);
@@ -83,9 +84,8 @@ TEST_F(SaturatedSamples, CleanCaptureRecordsZerosAndPrintsNothing) {
 TEST_F(SaturatedSamples, AtlasReportsAndRecordsPerMaterial) {
   const fs::path sat = WriteFlaggedCapture("sat", true);
   const fs::path clean = WriteFlaggedCapture("clean", false);
-  const ToolRun r = RunTool("atlas " + Quote(sat) + " " + Quote(clean) + " --out " +
-                                Quote(dir_ / "out" / "atlas"),
-                            dir_);
+  const ToolRun r = RunTool(
+      "atlas " + Quote(sat) + " " + Quote(clean) + " --out " + Quote(dir_ / "out" / "atlas"), dir_);
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   EXPECT_EQ(Occurrences(r.err, sat.string() + kLine), 1u) << r.err;
   EXPECT_EQ(Occurrences(r.err, "saturated"), 1u) << r.err;

@@ -64,9 +64,9 @@ TEST_F(SourcesCli, CaptureBetweenSlicesInterpolatesInTheSpecularFrameLikeTheLut)
   }
   // The exported texture of the same capture: the same path, up to RGB9E5 rounding of the
   // texels (at most half a step of the largest channel each).
-  const ToolRun conv = RunTool("convert " + Quote(bpc) + " --out " + Quote(dir_ / "luts") +
-                                   " --formats ktx2,json --quiet",
-                               dir_);
+  const ToolRun conv = RunTool(
+      "convert " + Quote(bpc) + " --out " + Quote(dir_ / "luts") + " --formats ktx2,json --quiet",
+      dir_);
   ASSERT_EQ(conv.exit_code, 0) << conv.err;
   const fs::path ktx2 = dir_ / "luts" / "ggx.ktx2";
   for (const auto& [in, out] : std::vector<std::pair<std::string, std::string>>{
@@ -138,12 +138,12 @@ class Repair : public SourcesCli {
       std::size_t differing = 0;
       for (std::size_t n = 0; n < s.samples.size(); ++n) {
         const Sample &x = s.samples[n], &y = it->samples[n];
-        const std::array<float, 10> fx = {x.theta_in_deg, x.phi_in_deg, x.theta_out_deg,
-                                          x.phi_out_deg, x.rgb[0], x.rgb[1], x.rgb[2],
-                                          x.sigma[0], x.sigma[1], x.sigma[2]};
-        const std::array<float, 10> fy = {y.theta_in_deg, y.phi_in_deg, y.theta_out_deg,
-                                          y.phi_out_deg, y.rgb[0], y.rgb[1], y.rgb[2],
-                                          y.sigma[0], y.sigma[1], y.sigma[2]};
+        const std::array<float, 10> fx = {
+            x.theta_in_deg, x.phi_in_deg, x.theta_out_deg, x.phi_out_deg, x.rgb[0],
+            x.rgb[1],       x.rgb[2],     x.sigma[0],      x.sigma[1],    x.sigma[2]};
+        const std::array<float, 10> fy = {
+            y.theta_in_deg, y.phi_in_deg, y.theta_out_deg, y.phi_out_deg, y.rgb[0],
+            y.rgb[1],       y.rgb[2],     y.sigma[0],      y.sigma[1],    y.sigma[2]};
         differing += std::memcmp(fx.data(), fy.data(), sizeof fx) != 0 || x.flags != y.flags;
       }
       EXPECT_EQ(differing, 0u) << "θin " << s.theta_in_deg;
@@ -160,8 +160,8 @@ TEST_F(Repair, RepairedAndResumedCaptureEqualsTheUninterruptedOne) {
   ASSERT_EQ(chunks.size(), 6u);  // HEAD, 4 × SLCE, END
   struct Damage {
     std::string name;
-    std::size_t cut = 0;      // 0: no cut
-    std::size_t flip = 0;     // 0: no flipped byte
+    std::size_t cut = 0;   // 0: no cut
+    std::size_t flip = 0;  // 0: no flipped byte
     bool expect_dropped = true;
   };
   const std::vector<Damage> damages = {
@@ -257,13 +257,15 @@ TEST_F(SourcesCli, InfoReportsWhatConvertAndEvalRefuse) {
     Measurement x = CaptureOf(m, {0, 20}, 75, 5, 10);
     x.slices[1].samples[17].rgb[0] = std::numeric_limits<float>::quiet_NaN();
     WriteBpc((dir_ / "tmp.bpc").string(), x);
-    cases.push_back({"nan", "red value not a finite number (first: sample 17", ReadAll(dir_ / "tmp.bpc")});
+    cases.push_back(
+        {"nan", "red value not a finite number (first: sample 17", ReadAll(dir_ / "tmp.bpc")});
   }
   {
     Measurement x = CaptureOf(m, {0, 20}, 75, 5, 10);
     x.slices[0].samples[3].theta_out_deg = 95.0f;
     WriteBpc((dir_ / "tmp.bpc").string(), x);
-    cases.push_back({"theta", "θout outside [−90°, 90°] (first: sample 3, θout 95°", ReadAll(dir_ / "tmp.bpc")});
+    cases.push_back({"theta", "θout outside [−90°, 90°] (first: sample 3, θout 95°",
+                     ReadAll(dir_ / "tmp.bpc")});
   }
   {
     Measurement x = CaptureOf(m, {0, 20}, 0, 5, 10);  // θout max 0: only the pole

@@ -32,8 +32,7 @@ Vec3 MirrorOf(double theta_in_deg) {
 
 TEST(Lobe, LambertianIsASphereOfRadiusRhoOverPi) {
   const double rho[3] = {0.8, 0.5, 0.2};
-  const ViewSource source =
-      FromJson(R"({"model": "lambert", "rho": [0.8, 0.5, 0.2]})");
+  const ViewSource source = FromJson(R"({"model": "lambert", "rho": [0.8, 0.5, 0.2]})");
   for (double theta_in : {0.0, 30.0, 60.0}) {
     for (Channel ch : {Channel::kRed, Channel::kGreen, Channel::kBlue, Channel::kLuminance}) {
       LobeOptions options;
@@ -42,7 +41,8 @@ TEST(Lobe, LambertianIsASphereOfRadiusRhoOverPi) {
       const LobeMesh mesh = BuildLobe(source, options);
       const double want =
           (ch == Channel::kLuminance ? 0.2126 * rho[0] + 0.7152 * rho[1] + 0.0722 * rho[2]
-                                     : rho[static_cast<int>(ch)]) / kPi;
+                                     : rho[static_cast<int>(ch)]) /
+          kPi;
       ASSERT_EQ(mesh.points.size(), 91u * 180u);
       for (const Vec3& p : mesh.points) {
         ASSERT_NEAR(std::sqrt(Dot(p, p)), want, 1e-6 * want) << "θin " << theta_in;
@@ -79,8 +79,7 @@ TEST(Lobe, LogScaleRadiusCountsDecadesAboveTheFloor) {
 
 // Lafortune's lobe max(v·r, 0)^n peaks exactly at the mirror direction r (docs/design.md §9).
 TEST(Lobe, GlossyLobePeaksAtTheMirrorDirectionForEveryThetaIn) {
-  const ViewSource source =
-      FromJson(R"({"model": "lafortune", "kd": 0.05, "ks": 0.9, "n": 300})");
+  const ViewSource source = FromJson(R"({"model": "lafortune", "kd": 0.05, "ks": 0.9, "n": 300})");
   for (double theta_in = 0; theta_in <= 60; theta_in += 5) {  // measured and in between
     LobeOptions options;
     options.theta_in_deg = theta_in;
@@ -93,8 +92,8 @@ TEST(Lobe, GlossyLobePeaksAtTheMirrorDirectionForEveryThetaIn) {
 
 // Gold (GGX, α = 0.15) from the sample library's form: a real microfacet lobe.
 TEST(Lobe, GgxLobePeaksWithinTwoDegreesOfTheMirror) {
-  const ViewSource source = FromJson(
-      R"({"model": "ggx", "kd": 0.0, "f0": [0.96, 0.79, 0.41], "alpha": 0.1})");
+  const ViewSource source =
+      FromJson(R"({"model": "ggx", "kd": 0.0, "f0": [0.96, 0.79, 0.41], "alpha": 0.1})");
   for (double theta_in = 0; theta_in <= 60; theta_in += 10) {
     LobeOptions options;
     options.theta_in_deg = theta_in;
@@ -158,8 +157,7 @@ TEST(Lobe, RejectsBadOptions) {
 // The starting camera sees every vertex and arrow tip: projected with a pinhole model written
 // here from the camera's position, focal point, up vector and vertical view angle.
 TEST(LobeCamera, FramesTheLobeAndItsArrows) {
-  const ViewSource source =
-      FromJson(R"({"model": "lafortune", "kd": 0.1, "ks": 0.8, "n": 40})");
+  const ViewSource source = FromJson(R"({"model": "lafortune", "kd": 0.1, "ks": 0.8, "n": 40})");
   for (double aspect : {0.75, 1.0, 16.0 / 9.0}) {
     LobeOptions options;
     options.theta_in_deg = 50;

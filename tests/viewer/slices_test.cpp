@@ -95,11 +95,13 @@ TEST(Coverage, BlindSpotIsUnmeasuredOnlyWhereSamplesWereInvalid) {
   for (int t = 0; t <= 90; ++t) {
     for (int p = 0; p < 360; ++p) {
       const bool blind = t >= 30 && t <= 34 && p >= 100 && p <= 110;
-      const Coverage want =
-          t > 75 ? Coverage::kExtrapolated : blind ? Coverage::kUnmeasured : Coverage::kMeasured;
+      const Coverage want = t > 75  ? Coverage::kExtrapolated
+                            : blind ? Coverage::kUnmeasured
+                                    : Coverage::kMeasured;
       ASSERT_EQ(source.CoverageAt(20.0, t, p), want) << "θout " << t << " φout " << p;
       // Other slices have no blind spot.
-      ASSERT_EQ(source.CoverageAt(40.0, t, p), t > 75 ? Coverage::kExtrapolated : Coverage::kMeasured);
+      ASSERT_EQ(source.CoverageAt(40.0, t, p),
+                t > 75 ? Coverage::kExtrapolated : Coverage::kMeasured);
     }
   }
   // Between 20° and 40° the LUT blends both slices at the same (θd, φd): the blind direction

@@ -38,7 +38,8 @@ std::string ParseSize(const std::string& text, int* width, int* height) {
   if (x == std::string::npos || x == 0 || x + 1 >= text.size()) return bad;
   const std::string w = text.substr(0, x), h = text.substr(x + 1);
   auto digits = [](const std::string& s) {
-    return s.size() <= 5 && std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
+    return s.size() <= 5 &&
+           std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
   };
   if (!digits(w) || !digits(h)) return bad;
   *width = std::stoi(w);
@@ -239,7 +240,8 @@ int main(int argc, char** argv) {
                    "xvfb and xauth (tools/install-deps.sh) or run inside an X session\n",
                    display_problem.c_str());
     } else {
-      std::fprintf(stderr, "brdf-view: no usable X display even under xvfb-run (%s), tried %d times\n",
+      std::fprintf(stderr,
+                   "brdf-view: no usable X display even under xvfb-run (%s), tried %d times\n",
                    xvfb_run.c_str(), kXvfbAttempts);
     }
     return 1;

@@ -16,9 +16,8 @@ viewer::LoadedSource OpenViewSource(const std::string& path_or_name) {
   viewer::LoadedSource out;
   out.path = path_or_name;
   try {
-    const std::string path = std::filesystem::exists(path_or_name)
-                                 ? path_or_name
-                                 : cli::ResolveMaterial(path_or_name);
+    const std::string path =
+        std::filesystem::exists(path_or_name) ? path_or_name : cli::ResolveMaterial(path_or_name);
     const std::string name = sources::OutputNameOf(path);
     std::vector<std::string> warnings;
     const sources::FileKind kind = sources::DetectFileKind(path);

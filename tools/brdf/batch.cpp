@@ -11,8 +11,8 @@
 #include <thread>
 
 #include "brdf/core/error.h"
-#include "cli_support.h"
 #include "brdf/core/file_util.h"
+#include "cli_support.h"
 
 namespace brdf::cli {
 
@@ -81,8 +81,8 @@ DiscoveredInputs DiscoverInputs(const std::vector<std::string>& arguments,
         if (IsInputKind(kind, kinds))
           add(arg, kind);
         else
-          out.failures.push_back(
-              {arg, "not an input: expected " + Accepted(kinds) + ", got a " + sources::FileKindName(kind)});
+          out.failures.push_back({arg, "not an input: expected " + Accepted(kinds) + ", got a " +
+                                           sources::FileKindName(kind)});
       } catch (const Error& e) {
         out.failures.push_back({arg, ReasonWithoutPath(arg, e.what())});
       }

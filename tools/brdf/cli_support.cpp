@@ -29,8 +29,8 @@ std::string DegList(const std::vector<double>& values) {
 
 std::string RemedyText(const Remedy& remedy, const std::string& command) {
   const std::string& f = remedy.file;
-  const std::string missing =
-      remedy.theta_in_deg.empty() ? std::string()
+  const std::string missing = remedy.theta_in_deg.empty()
+                                  ? std::string()
                                   : " (it captures θin " + DegList(remedy.theta_in_deg) + "°)";
   switch (remedy.kind) {
     case RemedyKind::kNone:
@@ -57,7 +57,8 @@ std::string RemedyText(const Remedy& remedy, const std::string& command) {
       return command == "import" ? "name the format with --format"
                                  : "if you know its format, 'brdf import --format NAME' reads it";
     case RemedyKind::kCaptureEvaluable:
-      return "'brdf import " + f + " --out FILE.bpc' captures it noise-free at the reference "
+      return "'brdf import " + f +
+             " --out FILE.bpc' captures it noise-free at the reference "
              "geometry; 'brdf eval' evaluates it directly";
     case RemedyKind::kEvaluateSingleLut:
       return "evaluate one material's own LUT (written by 'brdf convert')";

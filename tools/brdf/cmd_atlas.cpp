@@ -20,8 +20,8 @@
 #include "brdf/sources/open.h"
 #include "cli_support.h"
 #include "commands.h"
-#include "progress.h"
 #include "fit_support.h"
+#include "progress.h"
 
 namespace brdf::cli {
 
@@ -81,7 +81,8 @@ int RunAtlas(const AtlasOptions& options) {
         const BatchInput& in = found.inputs[i];
         std::optional<processing::ExtrapolationParams> chosen = extrapolate;
         if (auto_extrapolate)
-          if (const auto automatic = AutoExtrapolationFor(in.path, in.kind)) chosen = automatic->params;
+          if (const auto automatic = AutoExtrapolationFor(in.path, in.kind))
+            chosen = automatic->params;
         sources::InputLut built = sources::LutFromInput(in.path, in.kind, chosen, resample);
         exporter::ValidateLutForExport(built.lut);
         result.warnings = std::move(built.warnings);

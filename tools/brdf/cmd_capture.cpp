@@ -19,9 +19,9 @@
 #include "brdf/device/capture_session.h"
 #include "brdf/device/driver.h"
 #include "brdf/device/emulated_usb.h"
-#include "brdf/device/usb_models.h"
 #include "brdf/device/simulator.h"
 #include "brdf/device/transport.h"
+#include "brdf/device/usb_models.h"
 #include "cli_support.h"
 #include "commands.h"
 
@@ -90,9 +90,9 @@ void Validate(const CaptureOptions& o) {
 // Settings that must agree between an interrupted capture and its resumption, as recorded in
 // the metadata `extra` map. "theta_in_deg" is the planned θin list ("0,20,40,60"), written into
 // the header before the first slice so that `brdf convert` can tell an interrupted capture
-// missing slices from a complete one (brdf::PlannedThetaInDeg in brdf/core/virtual_capture.h reads it). A resumption must
-// plan the same list: the header on disk is not rewritten, so a different list would make the
-// recorded plan untrue.
+// missing slices from a complete one (brdf::PlannedThetaInDeg in brdf/core/virtual_capture.h reads
+// it). A resumption must plan the same list: the header on disk is not rewritten, so a different
+// list would make the recorded plan untrue.
 std::map<std::string, std::string> SettingsOf(const CaptureOptions& o,
                                               const std::string& material) {
   char seed[32];
@@ -109,7 +109,6 @@ std::map<std::string, std::string> SettingsOf(const CaptureOptions& o,
           {"phi_out_step_deg", Deg(o.phi_out_step_deg)},
           {"exposure", o.exposure}};
 }
-
 
 std::string Eta(double seconds) {
   char buf[32];
@@ -143,7 +142,8 @@ class SignalScope {
   SignalScope& operator=(const SignalScope&) = delete;
 
  private:
-  struct sigaction old_int_ {}, old_term_ {};
+  struct sigaction old_int_ {
+  }, old_term_{};
 };
 
 // The session's next step in this tool's words (options by their flag names).
@@ -154,7 +154,8 @@ std::string Advice(const device::CaptureSessionResult& r, const std::string& out
       return {};
     case NextStep::kResume:
       return std::to_string(r.slices_saved) + " of " + std::to_string(r.slices_planned) +
-             " slices are saved in " + out + "; run the same command with --resume to capture "
+             " slices are saved in " + out +
+             "; run the same command with --resume to capture "
              "the rest";
     case NextStep::kRetry:
       return "nothing was saved; check the instrument and run the command again";

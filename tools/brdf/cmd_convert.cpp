@@ -13,7 +13,6 @@
 #include <set>
 
 #include "batch.h"
-#include "fit_support.h"
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
 #include "brdf/engines/engine_export.h"
@@ -21,6 +20,7 @@
 #include "brdf/sources/open.h"
 #include "cli_support.h"
 #include "commands.h"
+#include "fit_support.h"
 #include "progress.h"
 
 namespace brdf::cli {

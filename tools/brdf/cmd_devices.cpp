@@ -94,7 +94,8 @@ int RunDevices(const DevicesOptions& o) {
     permission = permission || f.problem == device::AccessProblem::kPermission;
     std::printf("%s\n", line.c_str());
   }
-  if (permission) std::printf("to open the instruments marked 'permission denied': %s\n", kUdevHint);
+  if (permission)
+    std::printf("to open the instruments marked 'permission denied': %s\n", kUdevHint);
   return 0;
 }
 

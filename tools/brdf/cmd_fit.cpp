@@ -16,11 +16,11 @@
 #include "brdf/core/file_util.h"
 #include "brdf/core/importers.h"
 #include "brdf/processing/fit.h"
+#include "brdf/sources/detect.h"
+#include "brdf/sources/open.h"
 #include "cli_support.h"
 #include "commands.h"
 #include "fit_support.h"
-#include "brdf/sources/detect.h"
-#include "brdf/sources/open.h"
 
 namespace brdf::cli {
 
@@ -57,7 +57,8 @@ std::string SliceErrors(const processing::FitReport& r) {
 
 }  // namespace
 
-std::optional<AutoExtrapolationChoice> AutoExtrapolationFor(const std::string& path, sources::FileKind kind) {
+std::optional<AutoExtrapolationChoice> AutoExtrapolationFor(const std::string& path,
+                                                            sources::FileKind kind) {
   if (kind != sources::FileKind::kCapture && kind != sources::FileKind::kMaterial)
     return std::nullopt;
   const sources::PreparedMeasurement p = sources::PrepareMeasurement(path, kind, std::nullopt);
@@ -197,8 +198,7 @@ int RunFit(const FitCommandOptions& options) {
       if (!engine.empty())
         std::printf("    %s: %s\n", std::string(DescribeModel(r.material.model).engine).c_str(),
                     engine.c_str());
-      for (const std::string& w : r.report.warnings)
-        std::printf("    warning: %s\n", w.c_str());
+      for (const std::string& w : r.report.warnings) std::printf("    warning: %s\n", w.c_str());
     }
     std::printf("  written: ");
     for (std::size_t k = 0; k < models.size(); ++k)

@@ -17,9 +17,9 @@
 #include "brdf/core/csv.h"
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
+#include "brdf/core/geometry.h"
 #include "brdf/core/gonio.h"
 #include "brdf/core/importers.h"
-#include "brdf/core/geometry.h"
 #include "brdf/core/lighttools.h"
 #include "brdf/core/measurement.h"
 #include "brdf/core/merl.h"
@@ -272,38 +272,39 @@ Json DescribeImported(const std::string& path, ImportFormat format) {
       h["phi_i_deg"] = phi_i_deg;
       h["isotropic"] = info.isotropic ? "yes" : "no";
       h["jacobian"] = info.jacobian ? "yes" : "no";
-      h["vndf_resolution"] = std::to_string(info.vndf_theta_res) + " x " +
-                             std::to_string(info.vndf_phi_res);
+      h["vndf_resolution"] =
+          std::to_string(info.vndf_theta_res) + " x " + std::to_string(info.vndf_phi_res);
       h["rgb_resolution"] = std::to_string(info.rgb_res) + " x " + std::to_string(info.rgb_res);
-      h["negative_rgb_values"] = std::to_string(info.negative_rgb_values) + " of " +
-                                 std::to_string(info.rgb_values);
+      h["negative_rgb_values"] =
+          std::to_string(info.negative_rgb_values) + " of " + std::to_string(info.rgb_values);
       std::string fields;
       for (const TensorField& f : tensor.fields())
         fields += (fields.empty() ? "" : ", ") + f.name + " " + f.ShapeString();
       h["fields"] = fields;
       j["header"] = h;
       j["theta_in_deg"] = theta_i_deg;
-      j["advice"] = "an evaluable BRDF, not a point cloud: 'brdf eval' evaluates it, 'brdf import " +
-                    path + " --out FILE.bpc' captures it noise-free at the reference geometry";
+      j["advice"] =
+          "an evaluable BRDF, not a point cloud: 'brdf eval' evaluates it, 'brdf import " + path +
+          " --out FILE.bpc' captures it noise-free at the reference geometry";
       break;
     }
     case ImportFormat::kMerl: {
       const MerlBrdf merl = MerlBrdf::Load(path);
       const auto& u = merl.info().unmeasured_bins;
-      constexpr std::uint64_t kBins = static_cast<std::uint64_t>(kMerlThetaHalfBins) *
-                                      kMerlThetaDiffBins * kMerlPhiDiffBins;
+      constexpr std::uint64_t kBins =
+          static_cast<std::uint64_t>(kMerlThetaHalfBins) * kMerlThetaDiffBins * kMerlPhiDiffBins;
       Json h;
-      h["resolution"] = std::to_string(kMerlThetaHalfBins) + " x " +
-                        std::to_string(kMerlThetaDiffBins) + " x " +
-                        std::to_string(kMerlPhiDiffBins) +
-                        " bins (theta_half, theta_diff, phi_diff)";
+      h["resolution"] =
+          std::to_string(kMerlThetaHalfBins) + " x " + std::to_string(kMerlThetaDiffBins) + " x " +
+          std::to_string(kMerlPhiDiffBins) + " bins (theta_half, theta_diff, phi_diff)";
       h["unmeasured_bins"] = "red " + std::to_string(u[0]) + ", green " + std::to_string(u[1]) +
                              ", blue " + std::to_string(u[2]) + " of " + std::to_string(kBins);
       j["header"] = h;
       j["unmeasured_bins"] = {u[0], u[1], u[2]};
-      j["advice"] = "an evaluable BRDF, not a point cloud: 'brdf eval' evaluates it, 'brdf import " +
-                    path + " --out FILE.bpc' captures it noise-free at the reference geometry "
-                    "(samples in unmeasured bins flagged invalid)";
+      j["advice"] =
+          "an evaluable BRDF, not a point cloud: 'brdf eval' evaluates it, 'brdf import " + path +
+          " --out FILE.bpc' captures it noise-free at the reference geometry "
+          "(samples in unmeasured bins flagged invalid)";
       break;
     }
     case ImportFormat::kAuto:

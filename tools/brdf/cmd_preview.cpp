@@ -12,13 +12,12 @@
 #include <vector>
 
 #include "brdf/core/error.h"
+#include "brdf/core/file_util.h"
 #include "brdf/processing/preview.h"
+#include "brdf/sources/open.h"
 #include "cli_support.h"
 #include "commands.h"
 #include "progress.h"
-#include "brdf/core/file_util.h"
-#include "brdf/sources/open.h"
-#include "cli_support.h"
 
 namespace brdf::cli {
 namespace {
@@ -59,7 +58,8 @@ class PassProgress {
     std::string what;
     if (target_rms > 0) {
       // The error falls as 1/√passes.
-      const double needed = std::isfinite(rms) ? passes * (rms / target_rms) * (rms / target_rms) : 0;
+      const double needed =
+          std::isfinite(rms) ? passes * (rms / target_rms) * (rms / target_rms) : 0;
       eta = needed > passes ? seconds / passes * (needed - passes) : 0;
       what = std::isfinite(rms) ? "error " + Percent(rms) + " → " + Percent(target_rms)
                                 : "estimating the error";
@@ -67,8 +67,8 @@ class PassProgress {
       eta = seconds / passes * (target_passes - passes);
       what = std::to_string(passes) + "/" + std::to_string(target_passes) + " passes";
     }
-    std::fprintf(stderr, "%s%s: %s, %s elapsed, ETA %s%s", tty_ ? "\r\033[K" : "",
-                 label_.c_str(), what.c_str(), Progress::FormatDuration(seconds).c_str(),
+    std::fprintf(stderr, "%s%s: %s, %s elapsed, ETA %s%s", tty_ ? "\r\033[K" : "", label_.c_str(),
+                 what.c_str(), Progress::FormatDuration(seconds).c_str(),
                  Progress::FormatDuration(eta).c_str(), tty_ ? "" : "\n");
     std::fflush(stderr);
   }
@@ -171,23 +171,25 @@ int RunPreview(const PreviewCommandOptions& cli) {
 
   const preview::PreviewImage first = Render(*source, map, options, cli);
   preview::PreviewImage out = first;
-  std::vector<std::pair<std::string, std::string>> attributes = {
-      {"brdf:source", cli.file}, {"brdf:environment", map.name()},
-      {"brdf:object", cli.mesh}, {"brdf:estimator", cli.estimator}};
+  std::vector<std::pair<std::string, std::string>> attributes = {{"brdf:source", cli.file},
+                                                                 {"brdf:environment", map.name()},
+                                                                 {"brdf:object", cli.mesh},
+                                                                 {"brdf:estimator", cli.estimator}};
   if (second) {
     const preview::PreviewImage other = Render(*second, map, options, cli);
     const preview::ImageDifference d = preview::CompareImages(first, other);
     out = preview::SideBySide(first, other);
     attributes.emplace_back("brdf:compare", cli.compare);
-    attributes.emplace_back("brdf:layout", "source | compare | signed difference (red: source "
-                                           "brighter, blue: compare brighter)");
+    attributes.emplace_back("brdf:layout",
+                            "source | compare | signed difference (red: source "
+                            "brighter, blue: compare brighter)");
     std::printf("RMS difference: %.6g (%.3f %% of the mean of %s) over %zu pixels; largest %.6g\n",
                 d.rms, 100.0 * d.relative_rms, cli.compare.c_str(), d.pixels, d.max_abs);
   }
-  preview::WritePreviewImage(cli.out, out, cli.exposure_ev,
-                             cli.tone_map == "reinhard" ? preview::ToneMapCurve::kReinhard
-                                                        : preview::ToneMapCurve::kClamp,
-                             attributes);
+  preview::WritePreviewImage(
+      cli.out, out, cli.exposure_ev,
+      cli.tone_map == "reinhard" ? preview::ToneMapCurve::kReinhard : preview::ToneMapCurve::kClamp,
+      attributes);
   if (!cli.quiet) std::fprintf(stderr, "wrote %s\n", cli.out.c_str());
   return 0;
 }

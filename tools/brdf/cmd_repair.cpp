@@ -35,18 +35,20 @@ int RunRepair(const RepairOptions& options) {
     std::string what = d.slice_index >= 0 ? "slice " + std::to_string(d.slice_index) : "data";
     if (d.theta_in_deg) what += " (theta_in " + DegList({*d.theta_in_deg}) + " deg)";
     std::printf("  dropped %s at byte %llu (%llu bytes): %s\n", what.c_str(),
-                static_cast<unsigned long long>(d.offset),
-                static_cast<unsigned long long>(d.size), d.reason.c_str());
+                static_cast<unsigned long long>(d.offset), static_cast<unsigned long long>(d.size),
+                d.reason.c_str());
   }
   if (r.missing_theta_in_deg.empty()) {
-    std::printf("every planned slice (theta_in %s deg) is intact; %s is an unfinished capture "
-                "that 'brdf capture ... --out %s --resume' finishes without measuring\n",
-                DegList(r.planned_theta_in_deg).c_str(), r.output.c_str(), r.output.c_str());
+    std::printf(
+        "every planned slice (theta_in %s deg) is intact; %s is an unfinished capture "
+        "that 'brdf capture ... --out %s --resume' finishes without measuring\n",
+        DegList(r.planned_theta_in_deg).c_str(), r.output.c_str(), r.output.c_str());
   } else {
-    std::printf("missing theta_in %s deg of the plan (%s deg): rerun the 'brdf capture' command "
-                "that made %s with --out %s --resume to capture them\n",
-                DegList(r.missing_theta_in_deg).c_str(), DegList(r.planned_theta_in_deg).c_str(),
-                r.input.c_str(), r.output.c_str());
+    std::printf(
+        "missing theta_in %s deg of the plan (%s deg): rerun the 'brdf capture' command "
+        "that made %s with --out %s --resume to capture them\n",
+        DegList(r.missing_theta_in_deg).c_str(), DegList(r.planned_theta_in_deg).c_str(),
+        r.input.c_str(), r.output.c_str());
   }
   return 0;
 }

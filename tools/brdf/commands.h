@@ -63,7 +63,7 @@ struct AtlasOptions {
   std::string exr_compression = "none";  // as convert's: one default for every EXR written
   int jobs = DefaultJobs();
   bool quiet = false;
-  bool force = false;  // overwrite existing PREFIX.* files
+  bool force = false;   // overwrite existing PREFIX.* files
   std::string engines;  // as ConvertOptions::engines; folders beside the prefix
 };
 int RunAtlas(const AtlasOptions& options);
@@ -100,9 +100,9 @@ struct CaptureOptions {
   // firmware behind real libusb / hidapi through umockdev; run under umockdev-wrapper).
   std::string transport = "loopback";
   double sim_pace_ms = 0;  // testing: real time per θout row of the simulated firmware
-  std::string material;  // library name or file
-  std::string sample;    // sample name recorded in the metadata
-  std::string out;       // .bpc path
+  std::string material;    // library name or file
+  std::string sample;      // sample name recorded in the metadata
+  std::string out;         // .bpc path
   // Defaults: the reference geometry (brdf/core/virtual_capture.h).
   std::vector<double> theta_in_deg = ReferenceGeometry().theta_in_deg;
   double theta_out_max_deg = ReferenceGeometry().theta_out_max_deg;
@@ -127,8 +127,8 @@ int RunCapture(const CaptureOptions& options);
 // capture written to a new, unfinished capture that `brdf capture --resume` completes
 // (brdf::sources::RepairCapture).
 struct RepairOptions {
-  std::string file;   // the damaged .bpc
-  std::string out;    // the new .bpc, written atomically
+  std::string file;    // the damaged .bpc
+  std::string out;     // the new .bpc, written atomically
   bool force = false;  // overwrite an existing --out
 };
 int RunRepair(const RepairOptions& options);
@@ -157,23 +157,23 @@ int RunDevices(const DevicesOptions& options);
 // linear EXR or a tone-mapped PNG; with `compare`, both renders and their signed difference.
 struct PreviewCommandOptions {
   std::string file;
-  std::string compare;           // second source; empty: none
-  std::string env = "studio";    // studio, sky, furnace, axes, or an .exr/.hdr file
-  bool env_given = false;        // --env on the command line (with --light: map lighting too)
+  std::string compare;         // second source; empty: none
+  std::string env = "studio";  // studio, sky, furnace, axes, or an .exr/.hdr file
+  bool env_given = false;      // --env on the command line (with --light: map lighting too)
   double env_rotation_deg = 0;
-  std::string mesh = "sphere";   // sphere, plane, or a .ply/.obj file
-  int size = 512;                // pixels a side
-  int spp = 64;                  // passes per pixel (ignored with rms > 0)
-  double rms = 0;                // target relative RMS error, e.g. 0.01; 0: use spp
-  std::string light;             // "THETA,PHI" in degrees (world frame); empty: none
-  std::string view = "90,0";     // camera position THETA,PHI seen from the object
-  double fov_deg = 0;            // > 0: perspective camera with this vertical field of view
+  std::string mesh = "sphere";  // sphere, plane, or a .ply/.obj file
+  int size = 512;               // pixels a side
+  int spp = 64;                 // passes per pixel (ignored with rms > 0)
+  double rms = 0;               // target relative RMS error, e.g. 0.01; 0: use spp
+  std::string light;            // "THETA,PHI" in degrees (world frame); empty: none
+  std::string view = "90,0";    // camera position THETA,PHI seen from the object
+  double fov_deg = 0;           // > 0: perspective camera with this vertical field of view
   double exposure_ev = 0;
-  std::string tone_map = "clamp";     // clamp or reinhard (PNG only)
-  std::string estimator = "mis";      // mis, env, brdf, quadrature
-  std::string extrapolate;            // captures: "P,L"
-  std::string out;                    // .exr or .png
-  bool force = false;                 // overwrite an existing --out
+  std::string tone_map = "clamp";  // clamp or reinhard (PNG only)
+  std::string estimator = "mis";   // mis, env, brdf, quadrature
+  std::string extrapolate;         // captures: "P,L"
+  std::string out;                 // .exr or .png
+  bool force = false;              // overwrite an existing --out
   int jobs = DefaultJobs();
   std::uint64_t seed = 1;
   bool no_background = false;  // black instead of the map where the object is not

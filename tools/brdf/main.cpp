@@ -149,10 +149,9 @@ int main(int argc, char** argv) {
                    "simulated firmware behind real libusb or hidapi through umockdev; run "
                    "under umockdev-wrapper)")
       ->capture_default_str();
-  capture_cmd
-      ->add_option("--material", capture.material,
-                   "Virtual sample of --device sim (required for it): a library name ('brdf "
-                   "materials') or a material .json");
+  capture_cmd->add_option("--material", capture.material,
+                          "Virtual sample of --device sim (required for it): a library name ('brdf "
+                          "materials') or a material .json");
   capture_cmd->add_option("--sample", capture.sample, "Sample name recorded in the file")
       ->required();
   capture_cmd->add_option("--out", capture.out, "Output .bpc file")->required();
@@ -388,8 +387,7 @@ int main(int argc, char** argv) {
       "'brdf capture --resume' completes; names every part it drops (slice, theta_in, byte "
       "offset, reason)");
   repair_cmd->add_option("file", repair.file, "Damaged or unfinished capture (.bpc)")->required();
-  repair_cmd->add_option("--out", repair.out, "New capture (.bpc, written atomically)")
-      ->required();
+  repair_cmd->add_option("--out", repair.out, "New capture (.bpc, written atomically)")->required();
   repair_cmd->add_flag("--force", repair.force, "Overwrite --out if it already exists");
   repair_cmd->footer(
       "The new file keeps the original header (sample, settings, planned theta_in list) and "
@@ -417,10 +415,11 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"lambert", "lafortune", "ggx", "blinn-phong", "ward",
                              "unreal-defaultlit", "unity-hdrp-lit", "unity-hdrp-lit-specular",
                              "unity-urp-lit", "unity-urp-lit-specular", "all"}));
-  fit_cmd->add_option("--out", fit.out,
-                      "Output material file (.json) for one input and one model; otherwise a "
-                      "folder receiving INPUT.MODEL.json (or FIT.MODEL.json beside a .json name "
-                      "with --model all)")
+  fit_cmd
+      ->add_option("--out", fit.out,
+                   "Output material file (.json) for one input and one model; otherwise a "
+                   "folder receiving INPUT.MODEL.json (or FIT.MODEL.json beside a .json name "
+                   "with --model all)")
       ->required();
   fit_cmd
       ->add_option("--loss", fit.loss,
@@ -454,23 +453,24 @@ int main(int argc, char** argv) {
   preview_cmd->add_option("--compare", preview.compare,
                           "A second source: both renders side by side with their signed "
                           "difference, and the RMS difference printed");
-  auto* preview_env = preview_cmd
-      ->add_option("--env", preview.env,
-                   "Environment: studio, sky, furnace, axes (orientation check) or an "
-                   "equirectangular .exr/.hdr file")
-      ->capture_default_str();
-  preview_cmd->add_option("--env-rotate", preview.env_rotation_deg,
-                          "Turn the map about the up axis, degrees")
+  auto* preview_env =
+      preview_cmd
+          ->add_option("--env", preview.env,
+                       "Environment: studio, sky, furnace, axes (orientation check) or an "
+                       "equirectangular .exr/.hdr file")
+          ->capture_default_str();
+  preview_cmd
+      ->add_option("--env-rotate", preview.env_rotation_deg,
+                   "Turn the map about the up axis, degrees")
       ->capture_default_str();
   preview_cmd->add_option("--mesh", preview.mesh, "Object: sphere, plane, or a .ply/.obj file")
       ->capture_default_str();
   preview_cmd->add_option("--size", preview.size, "Image width and height in pixels")
       ->capture_default_str()
       ->check(CLI::Range(1, 8192));
-  auto* preview_spp = preview_cmd
-      ->add_option("--spp", preview.spp, "Samples (passes) per pixel")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 1 << 20));
+  auto* preview_spp = preview_cmd->add_option("--spp", preview.spp, "Samples (passes) per pixel")
+                          ->capture_default_str()
+                          ->check(CLI::Range(1, 1 << 20));
   preview_cmd
       ->add_option("--rms", preview.rms,
                    "Instead of --spp: render until the estimated relative RMS error is below "
@@ -493,8 +493,9 @@ int main(int argc, char** argv) {
   preview_cmd->add_option("--tone-map", preview.tone_map, "PNG tone curve after exposure")
       ->capture_default_str()
       ->check(CLI::IsMember({"clamp", "reinhard"}));
-  preview_cmd->add_option("--estimator", preview.estimator,
-                          "mis (default), env, brdf, or quadrature (sphere and plane only)")
+  preview_cmd
+      ->add_option("--estimator", preview.estimator,
+                   "mis (default), env, brdf, or quadrature (sphere and plane only)")
       ->capture_default_str()
       ->check(CLI::IsMember({"mis", "env", "brdf", "quadrature"}));
   preview_cmd->add_option("--extrapolate", preview.extrapolate,

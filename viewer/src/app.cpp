@@ -56,8 +56,8 @@
 
 #include "brdf/core/error.h"
 #include "brdf/viewer/lobe.h"
-#include "preview_panel.h"
 #include "brdf/viewer/slices.h"
+#include "preview_panel.h"
 
 namespace brdf::viewer {
 namespace {
@@ -104,8 +104,7 @@ class App;
 class ViewerStyle : public vtkInteractorStyleTrackballCamera {
  public:
   static ViewerStyle* New();
-  vtkTypeMacro(ViewerStyle, vtkInteractorStyleTrackballCamera)
-  void OnChar() override;
+  vtkTypeMacro(ViewerStyle, vtkInteractorStyleTrackballCamera) void OnChar() override;
   void OnKeyPress() override {}
   void OnMouseMove() override;
   void OnLeftButtonDown() override {
@@ -133,7 +132,7 @@ class ViewerStyle : public vtkInteractorStyleTrackballCamera {
 };
 vtkStandardNewMacro(ViewerStyle)
 
-class App {
+    class App {
  public:
   App(const ViewerOptions& options, LoadedSource primary, std::optional<LoadedSource> compare,
       Display* display)
@@ -178,9 +177,7 @@ class App {
   }
   int NearestSlice() const;
   double MinThetaIn() const { return Primary()->lut.theta_in_deg.front(); }
-  double MaxThetaIn() const {
-    return std::min(89.0, Primary()->lut.theta_in_deg.back());
-  }
+  double MaxThetaIn() const { return std::min(89.0, Primary()->lut.theta_in_deg.back()); }
   LobeOptions CurrentLobeOptions(double theta_in_deg) const;
   void RecomputeScale();
   void SetupColors(double lo, double hi, bool log_scale);
@@ -213,9 +210,9 @@ class App {
   bool show_help_ = false;
   bool interactive_ = false;  // a window with an interactor (false for a screenshot run)
   int current_slice_ = 0;
-  double scale_max_ = 1;       // colour scale and log floor for the lobe (fixed while θin moves)
+  double scale_max_ = 1;  // colour scale and log floor for the lobe (fixed while θin moves)
   double arrow_length_ = 1;
-  std::string status_;         // last action ("saved brdf-view-1.png")
+  std::string status_;  // last action ("saved brdf-view-1.png")
   std::string hover_text_;
 
   vtkNew<vtkRenderer> renderer_;
@@ -397,8 +394,7 @@ void App::AddLobe(const LobeMesh& mesh, bool primary, double opacity) {
   }
 }
 
-void App::AddArrow(const Vec3& direction, double length, const double color[3],
-                   double opacity) {
+void App::AddArrow(const Vec3& direction, double length, const double color[3], double opacity) {
   vtkNew<vtkArrowSource> arrow;
   arrow->SetTipResolution(24);
   arrow->SetShaftResolution(12);
@@ -595,7 +591,8 @@ void App::ShowPreviewImage() {
   auto* dst = static_cast<unsigned char*>(preview_image_->GetScalarPointer());
   for (int y = 0; y < img.height; ++y) {
     // VTK images start at the bottom row.
-    const unsigned char* src = &img.rgb8[static_cast<std::size_t>(img.height - 1 - y) * img.width * 3];
+    const unsigned char* src =
+        &img.rgb8[static_cast<std::size_t>(img.height - 1 - y) * img.width * 3];
     std::copy(src, src + img.width * 3, dst + static_cast<std::size_t>(y) * img.width * 3);
   }
   preview_image_->Modified();
@@ -606,8 +603,8 @@ void App::BuildPreviewScene(bool reset_camera) {
   style_->orbit_preview = true;
   legend_->SetVisibility(0);
   if (!preview_) {
-    preview_ = MakePreviewPanel(primary_.brdf, compare_ ? compare_->brdf : nullptr,
-                                options_.width, options_.height);
+    preview_ = MakePreviewPanel(primary_.brdf, compare_ ? compare_->brdf : nullptr, options_.width,
+                                options_.height);
   }
   if (!preview_) return;  // UpdateText says why
   preview_->Refine();
@@ -640,9 +637,15 @@ void App::Rebuild(bool reset_camera) {
   if (Primary()) {
     try {
       switch (mode_) {
-        case Mode::kLobe: BuildLobeScene(reset_camera); break;
-        case Mode::kSlices: BuildSlicesScene(reset_camera); break;
-        case Mode::kPreview: BuildPreviewScene(reset_camera); break;
+        case Mode::kLobe:
+          BuildLobeScene(reset_camera);
+          break;
+        case Mode::kSlices:
+          BuildSlicesScene(reset_camera);
+          break;
+        case Mode::kPreview:
+          BuildPreviewScene(reset_camera);
+          break;
       }
     } catch (const Error& e) {
       status_ = std::string("cannot draw: ") + e.what();
@@ -753,22 +756,32 @@ void App::OnKey(const std::string& key) {
     reset = true;
   } else if (mode_ == Mode::kPreview && preview_ &&
              (key == "Left" || key == "Right" || key == "Up" || key == "Down")) {
-    preview_->Orbit(key == "Up" ? -10.0 : key == "Down" ? 10.0 : 0.0,
-                    key == "Left" ? -15.0 : key == "Right" ? 15.0 : 0.0);
+    preview_->Orbit(key == "Up"     ? -10.0
+                    : key == "Down" ? 10.0
+                                    : 0.0,
+                    key == "Left"    ? -15.0
+                    : key == "Right" ? 15.0
+                                     : 0.0);
   } else if (key == "Left" || key == "Right") {
-    theta_in_deg_ = std::clamp(theta_in_deg_ + (key == "Left" ? -1.0 : 1.0), MinThetaIn(),
-                               MaxThetaIn());
+    theta_in_deg_ =
+        std::clamp(theta_in_deg_ + (key == "Left" ? -1.0 : 1.0), MinThetaIn(), MaxThetaIn());
     current_slice_ = NearestSlice();
   } else if (key == "Prior" || key == "Next" || key == "Page_Up" || key == "Page_Down") {
     const bool up = key == "Prior" || key == "Page_Up";
     double target = theta_in_deg_;
     if (up) {
       for (int k = lut.slices() - 1; k >= 0; --k) {
-        if (lut.theta_in_deg[k] < theta_in_deg_ - 1e-6) { target = lut.theta_in_deg[k]; break; }
+        if (lut.theta_in_deg[k] < theta_in_deg_ - 1e-6) {
+          target = lut.theta_in_deg[k];
+          break;
+        }
       }
     } else {
       for (int k = 0; k < lut.slices(); ++k) {
-        if (lut.theta_in_deg[k] > theta_in_deg_ + 1e-6) { target = lut.theta_in_deg[k]; break; }
+        if (lut.theta_in_deg[k] > theta_in_deg_ + 1e-6) {
+          target = lut.theta_in_deg[k];
+          break;
+        }
       }
     }
     theta_in_deg_ = std::min(target, MaxThetaIn());
@@ -990,9 +1003,8 @@ ViewerResult App::Run() {
     return result;
   }
   timer_callback_->SetClientData(this);
-  timer_callback_->SetCallback([](vtkObject*, unsigned long, void* client, void*) {
-    static_cast<App*>(client)->OnTimer();
-  });
+  timer_callback_->SetCallback(
+      [](vtkObject*, unsigned long, void* client, void*) { static_cast<App*>(client)->OnTimer(); });
   interactor_->AddObserver(vtkCommand::TimerEvent, timer_callback_);
   interactor_->CreateRepeatingTimer(30);
   window_->Render();
@@ -1004,9 +1016,12 @@ ViewerResult App::Run() {
 
 const char* ModeName(Mode mode) {
   switch (mode) {
-    case Mode::kLobe: return "lobe";
-    case Mode::kSlices: return "slices";
-    case Mode::kPreview: return "preview";
+    case Mode::kLobe:
+      return "lobe";
+    case Mode::kSlices:
+      return "slices";
+    case Mode::kPreview:
+      return "preview";
   }
   return "?";
 }
@@ -1052,8 +1067,7 @@ ViewerResult RunViewer(const ViewerOptions& options, LoadedSource primary,
     if (display == nullptr) usleep(100000);
   }
   if (display == nullptr) {
-    return {false, std::string("cannot open the X display '") + std::getenv("DISPLAY") + "'",
-            true};
+    return {false, std::string("cannot open the X display '") + std::getenv("DISPLAY") + "'", true};
   }
   ViewerResult result;
   {

@@ -16,20 +16,28 @@ Vec3 Cross(const Vec3& a, const Vec3& b) {
 
 const char* ChannelName(Channel channel) {
   switch (channel) {
-    case Channel::kRed: return "R";
-    case Channel::kGreen: return "G";
-    case Channel::kBlue: return "B";
-    case Channel::kLuminance: return "luminance";
+    case Channel::kRed:
+      return "R";
+    case Channel::kGreen:
+      return "G";
+    case Channel::kBlue:
+      return "B";
+    case Channel::kLuminance:
+      return "luminance";
   }
   return "?";
 }
 
 double ChannelValue(const float* rgb, Channel channel) {
   switch (channel) {
-    case Channel::kRed: return rgb[0];
-    case Channel::kGreen: return rgb[1];
-    case Channel::kBlue: return rgb[2];
-    case Channel::kLuminance: return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
+    case Channel::kRed:
+      return rgb[0];
+    case Channel::kGreen:
+      return rgb[1];
+    case Channel::kBlue:
+      return rgb[2];
+    case Channel::kLuminance:
+      return 0.2126 * rgb[0] + 0.7152 * rgb[1] + 0.0722 * rgb[2];
   }
   return 0;
 }
@@ -42,8 +50,7 @@ void LobeOptions::Validate() const {
     throw InvalidArgument("lobe theta_rows must be in 2…1800, got " + std::to_string(theta_rows));
   }
   if (phi_columns < 3 || phi_columns > 3600) {
-    throw InvalidArgument("lobe phi_columns must be in 3…3600, got " +
-                          std::to_string(phi_columns));
+    throw InvalidArgument("lobe phi_columns must be in 3…3600, got " + std::to_string(phi_columns));
   }
   if (!std::isfinite(log_floor) || log_floor < 0) {
     throw InvalidArgument("lobe log_floor must be ≥ 0, got " + std::to_string(log_floor));

@@ -53,8 +53,8 @@ class RenderedPreview final : public PreviewPanel {
                        "° φ " + std::to_string(static_cast<int>(camera_phi_deg_)) + "°, " +
                        std::to_string(first_->passes()) + " passes";
     if (std::isfinite(rms)) {
-      text += ", est. error " + std::to_string(static_cast<int>(std::lround(rms * 1000)) / 10.0)
-                                    .substr(0, 4) + " %";
+      text += ", est. error " +
+              std::to_string(static_cast<int>(std::lround(rms * 1000)) / 10.0).substr(0, 4) + " %";
     }
     if (second_) text += "\nleft: first source, middle: second, right: difference";
     return text;
@@ -92,8 +92,8 @@ class RenderedPreview final : public PreviewPanel {
     first_ = std::make_unique<preview::PreviewRenderer>(*primary_, environment_, Options(),
                                                         first_ ? first_->sampler() : nullptr);
     if (compare_) {
-      second_ = std::make_unique<preview::PreviewRenderer>(
-          *compare_, environment_, Options(), second_ ? second_->sampler() : nullptr);
+      second_ = std::make_unique<preview::PreviewRenderer>(*compare_, environment_, Options(),
+                                                           second_ ? second_->sampler() : nullptr);
     }
   }
 

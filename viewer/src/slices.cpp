@@ -30,8 +30,7 @@ SliceImage BuildSliceImage(const ViewSource& source, int slice, Channel channel)
   image.max_value = 0;
   for (int j = 0; j < image.height; ++j) {
     for (int i = 0; i < image.width; ++i) {
-      const float v =
-          static_cast<float>(ChannelValue(source.lut.Texel(slice, j, i), channel));
+      const float v = static_cast<float>(ChannelValue(source.lut.Texel(slice, j, i), channel));
       image.values[static_cast<std::size_t>(j) * image.width + i] = v;
       image.min_value = std::min(image.min_value, v);
       image.max_value = std::max(image.max_value, v);
@@ -44,10 +43,10 @@ SliceProbe ProbeSlice(const ViewSource& source, int slice, Channel channel, doub
                       double theta_d_deg) {
   CheckSlice(source, slice);
   SliceProbe probe;
-  probe.i = std::clamp(static_cast<int>(std::lround(phi_d_deg / Lut::kTexelDeg)), 0,
-                       Lut::kWidth - 1);
-  probe.j = std::clamp(static_cast<int>(std::lround(theta_d_deg / Lut::kTexelDeg)), 0,
-                       Lut::kHeight - 1);
+  probe.i =
+      std::clamp(static_cast<int>(std::lround(phi_d_deg / Lut::kTexelDeg)), 0, Lut::kWidth - 1);
+  probe.j =
+      std::clamp(static_cast<int>(std::lround(theta_d_deg / Lut::kTexelDeg)), 0, Lut::kHeight - 1);
   probe.phi_d_deg = probe.i * Lut::kTexelDeg;
   probe.theta_d_deg = probe.j * Lut::kTexelDeg;
   const float* texel = source.lut.Texel(slice, probe.j, probe.i);

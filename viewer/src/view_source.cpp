@@ -84,9 +84,12 @@ int Severity(Coverage c) { return static_cast<int>(c); }
 
 const char* CoverageName(Coverage coverage) {
   switch (coverage) {
-    case Coverage::kMeasured: return "measured";
-    case Coverage::kExtrapolated: return "extrapolated";
-    case Coverage::kUnmeasured: return "unmeasured";
+    case Coverage::kMeasured:
+      return "measured";
+    case Coverage::kExtrapolated:
+      return "extrapolated";
+    case Coverage::kUnmeasured:
+      return "unmeasured";
   }
   return "?";
 }
@@ -147,10 +150,9 @@ ViewSource ViewSourceFromMeasurement(const Measurement& measurement,
   out.theta_b_deg = report.theta_b_deg;
   for (int k = 0; k < out.lut.slices(); ++k) {
     const double theta_in = out.lut.theta_in_deg[k];
-    const auto slice = std::find_if(measurement.slices.begin(), measurement.slices.end(),
-                                    [&](const Slice& s) {
-                                      return std::abs(s.theta_in_deg - theta_in) < 1e-3;
-                                    });
+    const auto slice =
+        std::find_if(measurement.slices.begin(), measurement.slices.end(),
+                     [&](const Slice& s) { return std::abs(s.theta_in_deg - theta_in) < 1e-3; });
     const auto rep = std::find_if(report.slices.begin(), report.slices.end(),
                                   [&](const processing::SliceResampleReport& r) {
                                     return std::abs(r.theta_in_deg - theta_in) < 1e-3;

@@ -37,14 +37,13 @@ constexpr std::uint8_t kDescDevice = 0x01, kDescConfig = 0x02, kDescString = 0x0
 // A HID report descriptor for one vendor-defined 64-byte input and output report.
 std::vector<std::uint8_t> HidReportDescriptor(std::size_t report_bytes) {
   const auto n = static_cast<std::uint8_t>(report_bytes);
-  return {0x06, 0x00, 0xFF,  // usage page: vendor defined 0xFF00
-          0x09, 0x01,        // usage 1
-          0xA1, 0x01,        // collection: application
-          0x09, 0x02, 0x15, 0x00, 0x26, 0xFF, 0x00, 0x75, 0x08, 0x95, n,
-          0x81, 0x02,  // input: n bytes
-          0x09, 0x03, 0x15, 0x00, 0x26, 0xFF, 0x00, 0x75, 0x08, 0x95, n,
-          0x91, 0x02,  // output: n bytes
-          0xC0};
+  return {
+      0x06, 0x00, 0xFF,  // usage page: vendor defined 0xFF00
+      0x09, 0x01,        // usage 1
+      0xA1, 0x01,        // collection: application
+      0x09, 0x02, 0x15, 0x00, 0x26, 0xFF, 0x00, 0x75, 0x08, 0x95, n, 0x81, 0x02,  // input: n bytes
+      0x09, 0x03, 0x15, 0x00, 0x26, 0xFF, 0x00, 0x75, 0x08, 0x95, n, 0x91, 0x02,  // output: n bytes
+      0xC0};
 }
 
 void Put16(std::vector<std::uint8_t>& v, std::size_t n) {
@@ -55,11 +54,11 @@ void Put16(std::vector<std::uint8_t>& v, std::size_t n) {
 // Device descriptor followed by the configuration descriptor (what sysfs "descriptors" holds).
 std::vector<std::uint8_t> Descriptors(const UsbModel& m, UsbPersonality p,
                                       std::vector<std::uint8_t>* config_only) {
-  std::vector<std::uint8_t> d = {18, kDescDevice, 0x00, 0x02,  // USB 2.00
-                                 0x00, 0x00, 0x00, 64};         // class per interface, EP0 64
+  std::vector<std::uint8_t> d = {18,   kDescDevice, 0x00, 0x02,  // USB 2.00
+                                 0x00, 0x00,        0x00, 64};   // class per interface, EP0 64
   Put16(d, m.vendor_id);
   Put16(d, p == UsbPersonality::kBulk ? m.bulk_product_id : m.hid_product_id);
-  Put16(d, 0x0100);   // bcdDevice
+  Put16(d, 0x0100);                 // bcdDevice
   d.insert(d.end(), {1, 2, 3, 1});  // manufacturer, product, serial strings; one configuration
   std::vector<std::uint8_t> c;
   const bool hid = p == UsbPersonality::kHid;
@@ -67,8 +66,8 @@ std::vector<std::uint8_t> Descriptors(const UsbModel& m, UsbPersonality p,
   c.insert(c.end(), {9, kDescConfig});
   Put16(c, total);
   c.insert(c.end(), {1, 1, 0, 0x80, 50});  // one interface, config 1, bus powered, 100 mA
-  c.insert(c.end(), {9, 0x04, m.interface_number, 0, 2, static_cast<std::uint8_t>(hid ? 0x03 : 0xFF),
-                     0, 0, 0});
+  c.insert(c.end(), {9, 0x04, m.interface_number, 0, 2,
+                     static_cast<std::uint8_t>(hid ? 0x03 : 0xFF), 0, 0, 0});
   if (hid) {
     const std::size_t report = HidReportDescriptor(m.hid_report_bytes).size();
     c.insert(c.end(), {9, 0x21, 0x11, 0x01, 0, 1, kDescHidReport});
@@ -213,8 +212,8 @@ struct EmulatedUsbInstrument::Impl {
     auto* buffer = static_cast<std::uint8_t*>(urb->buffer);
     std::size_t n = 0;
     if (hid) {
-      const std::size_t report = std::min<std::size_t>(model.hid_report_bytes,
-                                                        static_cast<std::size_t>(urb->buffer_length));
+      const std::size_t report = std::min<std::size_t>(
+          model.hid_report_bytes, static_cast<std::size_t>(urb->buffer_length));
       n = Pull(std::span<std::uint8_t>(buffer + 1, report - 1));
       if (n == 0) return false;
       buffer[0] = static_cast<std::uint8_t>(n);
@@ -233,9 +232,10 @@ struct EmulatedUsbInstrument::Impl {
       urb->actual_length = 0;
     } else {
       urb->status = 0;
-      urb->actual_length = static_cast<int>(hid ? std::min<std::size_t>(model.hid_report_bytes,
-                                                                         static_cast<std::size_t>(urb->buffer_length))
-                                                : n);
+      urb->actual_length =
+          static_cast<int>(hid ? std::min<std::size_t>(model.hid_report_bytes,
+                                                       static_cast<std::size_t>(urb->buffer_length))
+                               : n);
       ++in_transfers;
     }
     last_in = now;
@@ -291,9 +291,9 @@ struct EmulatedUsbInstrument::Impl {
         Urb u;
         u.data = umockdev_ioctl_data_resolve(arg, 0, sizeof(usbdevfs_urb), nullptr);
         usbdevfs_urb* urb = u.urb();
-        UMockdevIoctlData* buf = umockdev_ioctl_data_resolve(
-            u.data, offsetof(usbdevfs_urb, buffer), static_cast<gsize>(urb->buffer_length),
-            nullptr);
+        UMockdevIoctlData* buf =
+            umockdev_ioctl_data_resolve(u.data, offsetof(usbdevfs_urb, buffer),
+                                        static_cast<gsize>(urb->buffer_length), nullptr);
         if (buf) umockdev_ioctl_data_unref(buf);  // stays attached to u.data
         urb = u.urb();
         auto* bytes = static_cast<std::uint8_t*>(urb->buffer);
@@ -408,13 +408,18 @@ EmulatedUsbInstrument::EmulatedUsbInstrument(SimulatorConfig config, UsbPersonal
       "E: DRIVER=usb\n"
       "E: BUSNUM=001\n"
       "E: DEVNUM=002\n"
-      "E: DEVNAME=" + m.devnode + "\n"
+      "E: DEVNAME=" +
+      m.devnode +
+      "\n"
       "A: busnum=1\\n\n"
       "A: devnum=2\\n\n"
       "A: speed=480\\n\n"
       "A: bConfigurationValue=1\\n\n"
-      "A: serial=" + m.config.serial + "\\n\n"
-      "H: descriptors=" + Hex(descriptors) + "\n";
+      "A: serial=" +
+      m.config.serial +
+      "\\n\n"
+      "H: descriptors=" +
+      Hex(descriptors) + "\n";
   if (!umockdev_testbed_add_from_string(m.testbed, description.c_str(), &error)) {
     const std::string why = error ? error->message : "unknown error";
     if (error) g_error_free(error);
@@ -441,8 +446,8 @@ EmulatedUsbInstrument::~EmulatedUsbInstrument() {
 
 DeviceSpec EmulatedUsbInstrument::Spec() const {
   DeviceSpec s;
-  s.kind = impl_->personality == UsbPersonality::kBulk ? DeviceSpec::Kind::kUsb
-                                                       : DeviceSpec::Kind::kHid;
+  s.kind =
+      impl_->personality == UsbPersonality::kBulk ? DeviceSpec::Kind::kUsb : DeviceSpec::Kind::kHid;
   s.vendor_id = impl_->model.vendor_id;
   s.product_id = impl_->personality == UsbPersonality::kBulk ? impl_->model.bulk_product_id
                                                              : impl_->model.hid_product_id;

@@ -9,8 +9,8 @@
 #include <string>
 
 #include <fmt/format.h>
-#include <nlohmann/json.hpp>
 #include <unistd.h>
+#include <nlohmann/json.hpp>
 
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
@@ -37,10 +37,14 @@ enum class Engine { kUnity, kUnreal, kGodot, kWeb };
 
 const char* FolderOf(Engine e) {
   switch (e) {
-    case Engine::kUnity: return "unity";
-    case Engine::kUnreal: return "unreal";
-    case Engine::kGodot: return "godot";
-    case Engine::kWeb: return "web";
+    case Engine::kUnity:
+      return "unity";
+    case Engine::kUnreal:
+      return "unreal";
+    case Engine::kGodot:
+      return "godot";
+    case Engine::kWeb:
+      return "web";
   }
   return "";
 }
@@ -70,7 +74,9 @@ MaterialFiles FilesOf(Engine e, const std::string& name) {
   MaterialFiles f;
   f.manifest = name + ".manifest.json";
   switch (e) {
-    case Engine::kUnity: f.texture = name + ".brdf3d"; break;
+    case Engine::kUnity:
+      f.texture = name + ".brdf3d";
+      break;
     case Engine::kUnreal:
       f.texture = name + ".dds";
       f.tiles = name + "_tiles.exr";
@@ -90,8 +96,10 @@ MaterialFiles FilesOf(Engine e, const std::string& name) {
 std::string ShaderFile(Engine e, const exporter::ShaderLutLayout& layout) {
   const std::string stem = detail::ShaderStem(layout);
   switch (e) {
-    case Engine::kUnity: return stem + ".hlsl";
-    case Engine::kUnreal: return stem + ".ush";
+    case Engine::kUnity:
+      return stem + ".hlsl";
+    case Engine::kUnreal:
+      return stem + ".ush";
     case Engine::kGodot: {
       // Godot resource names are conventionally snake_case.
       std::string s = "measured_brdf" + stem.substr(std::string("MeasuredBrdf").size());
@@ -108,20 +116,23 @@ std::string ShaderFile(Engine e, const exporter::ShaderLutLayout& layout) {
 ordered_json AxesJson(const Handoff& h) {
   const double last = h.layout.theta_in0_deg + h.layout.delta_in_deg * (h.layout.slices - 1);
   return ordered_json{
-      {"u", {{"meaning", "phi_d: azimuth in the specular frame of theta_in (degrees)"},
-             {"range_deg", {0, 360}},
-             {"texels_per_cell", 361},
-             {"texel_centre_deg", "i * 1 deg, i = 0..360 (column 360 repeats column 0)"}}},
-      {"v", {{"meaning", "theta_d: polar angle from the mirror direction (degrees)"},
-             {"range_deg", {0, 180}},
-             {"texels_per_cell", 181},
-             {"texel_centre_deg", "j * 1 deg, j = 0..180 (row 0 = the mirror direction)"}}},
-      {"w", {{"meaning", "theta_in: incidence angle of the light (degrees)"},
-             {"range_deg", {h.layout.theta_in0_deg, last}},
-             {"texels", h.layout.slices},
-             {"texel_centre_deg", fmt::format("{:g} + k * {:g} deg, k = 0..{}", h.layout.theta_in0_deg,
-                                              h.layout.delta_in_deg, h.layout.slices - 1)},
-             {"beyond_range", "clamp-to-edge: the first or last slice (constant extension)"}}}};
+      {"u",
+       {{"meaning", "phi_d: azimuth in the specular frame of theta_in (degrees)"},
+        {"range_deg", {0, 360}},
+        {"texels_per_cell", 361},
+        {"texel_centre_deg", "i * 1 deg, i = 0..360 (column 360 repeats column 0)"}}},
+      {"v",
+       {{"meaning", "theta_d: polar angle from the mirror direction (degrees)"},
+        {"range_deg", {0, 180}},
+        {"texels_per_cell", 181},
+        {"texel_centre_deg", "j * 1 deg, j = 0..180 (row 0 = the mirror direction)"}}},
+      {"w",
+       {{"meaning", "theta_in: incidence angle of the light (degrees)"},
+        {"range_deg", {h.layout.theta_in0_deg, last}},
+        {"texels", h.layout.slices},
+        {"texel_centre_deg", fmt::format("{:g} + k * {:g} deg, k = 0..{}", h.layout.theta_in0_deg,
+                                         h.layout.delta_in_deg, h.layout.slices - 1)},
+        {"beyond_range", "clamp-to-edge: the first or last slice (constant extension)"}}}};
 }
 
 ordered_json ProbeJson(const Handoff& h) {
@@ -150,14 +161,14 @@ ordered_json ProbeJson(const Handoff& h) {
       for (const auto& [i, j] : ij) {
         const int x = cell.x0 + i, y = cell.y0 + j;
         const auto c = exporter::DecodeRgb9e5(vol.words[vol.Index(x, y, k)]);
-        probes.push_back({{"material", cell.name},
-                          {"index", {x, y, k}},
-                          {"phi_d_deg", i},
-                          {"theta_d_deg", j},
-                          {"theta_in_deg", h.layout.theta_in0_deg + k * h.layout.delta_in_deg},
-                          {"uvw", {(x + 0.5) / vol.width, (y + 0.5) / vol.height,
-                                   (k + 0.5) / vol.depth}},
-                          {"rgb", {c[0], c[1], c[2]}}});
+        probes.push_back(
+            {{"material", cell.name},
+             {"index", {x, y, k}},
+             {"phi_d_deg", i},
+             {"theta_d_deg", j},
+             {"theta_in_deg", h.layout.theta_in0_deg + k * h.layout.delta_in_deg},
+             {"uvw", {(x + 0.5) / vol.width, (y + 0.5) / vol.height, (k + 0.5) / vol.depth}},
+             {"rgb", {c[0], c[1], c[2]}}});
       }
     }
   }
@@ -173,8 +184,9 @@ ordered_json FallbackMaterialJson(const std::vector<std::string>& fitted_models_
   if (fitted_models_json.empty()) return nullptr;
   ordered_json models = ordered_json::array();
   for (const std::string& m : fitted_models_json) models.push_back(ordered_json::parse(m));
-  return ordered_json{{"note", "analytic fits of the same data, for engines or LODs that cannot "
-                               "sample the 3D LUT; see each model's \"fit\" member for its error"},
+  return ordered_json{{"note",
+                       "analytic fits of the same data, for engines or LODs that cannot "
+                       "sample the 3D LUT; see each model's \"fit\" member for its error"},
                       {"models", std::move(models)}};
 }
 
@@ -182,14 +194,14 @@ ordered_json FallbackMaterialJson(const std::vector<std::string>& fitted_models_
 ordered_json EngineSectionJson(Engine e, const Handoff& h) {
   const exporter::PackedVolume& vol = *h.volume;
   const MaterialFiles f = FilesOf(e, h.name);
-  ordered_json files = {{"texture", f.texture}, {"shader", ShaderFile(e, h.layout)},
-                        {"manifest", f.manifest}};
+  ordered_json files = {
+      {"texture", f.texture}, {"shader", ShaderFile(e, h.layout)}, {"manifest", f.manifest}};
   ordered_json texture;
   ordered_json orientation, import;
   std::string versions;
-  const std::string tiles = fmt::format(
-      "{} x {} tiles of {} x {} texels, row-major, top-left first, slice k in tile k",
-      h.composite.columns, h.composite.rows, vol.width, vol.height);
+  const std::string tiles =
+      fmt::format("{} x {} tiles of {} x {} texels, row-major, top-left first, slice k in tile k",
+                  h.composite.columns, h.composite.rows, vol.width, vol.height);
   switch (e) {
     case Engine::kUnity:
       versions = "Unity 2021.3 LTS to Unity 6 (URP, HDRP Shader Graph; built-in pipeline)";
@@ -204,8 +216,14 @@ ordered_json EngineSectionJson(Engine e, const Handoff& h) {
           ": " + tiles +
           "; exact tiles, no gutters; Non-Power of 2 None, sRGB off, no mipmaps, clamp, bilinear; "
           "check slice order against the probe texels";
-      import = {{"flipbook", {{"columns", h.composite.columns}, {"rows", h.composite.rows},
-                              {"npot_scale", "None"}, {"srgb", false}, {"mipmaps", false}}}};
+      import = {
+          { "flipbook",
+            { {"columns", h.composite.columns},
+              {"rows", h.composite.rows},
+              {"npot_scale", "None"},
+              {"srgb", false},
+              { "mipmaps",
+                false } } }};
       break;
     case Engine::kUnreal:
       versions = "Unreal Engine 5.1 to 5.5";
@@ -221,8 +239,12 @@ ordered_json EngineSectionJson(Engine e, const Handoff& h) {
                 {"mip_gen_settings", "TMGS_NoMipmaps"},
                 {"address_mode", "TA_Clamp"},
                 {"filter", "TF_Bilinear"},
-                {"tiles", {{"tile_width", vol.width}, {"tile_height", vol.height},
-                           {"columns", h.composite.columns}, {"rows", h.composite.rows}}}};
+                { "tiles",
+                  { {"tile_width", vol.width},
+                    {"tile_height", vol.height},
+                    {"columns", h.composite.columns},
+                    { "rows",
+                      h.composite.rows } } }};
       break;
     case Engine::kGodot:
       versions = "Godot 4.2 to 4.5 (RGB9E5 3D DDS: 4.4 and later; sliced EXR: every 4.x)";
@@ -233,9 +255,12 @@ ordered_json EngineSectionJson(Engine e, const Handoff& h) {
           "DDS texel (x, y, z) = Texture3D texel (x, y, z); row 0 (theta_d = 0) first, at v = 0; "
           "no flip";
       orientation["sliced_exr"] = f.tiles + ": " + tiles + " (slices/horizontal, slices/vertical)";
-      import = {{"slices_horizontal", h.composite.columns}, {"slices_vertical", h.composite.rows},
-                {"compress_mode", "VRAM Uncompressed"}, {"mipmaps", false},
-                {"sampler", "filter_linear, repeat_disable"}};
+      import = {{"slices_horizontal", h.composite.columns},
+                {"slices_vertical", h.composite.rows},
+                {"compress_mode", "VRAM Uncompressed"},
+                {"mipmaps", false},
+                { "sampler",
+                  "filter_linear, repeat_disable" }};
       break;
     case Engine::kWeb:
       versions = fmt::format("three.js r{} (0.{}.0) or later, WebGL 2",
@@ -245,8 +270,11 @@ ordered_json EngineSectionJson(Engine e, const Handoff& h) {
       orientation["ktx2loader"] =
           "KTX2 texel (x, y, z) = Data3DTexture texel (x, y, z) (KTXorientation rdi; three.js "
           "does not flip 3D textures); row 0 (theta_d = 0) at v = 0";
-      import = {{"min_filter", "LinearFilter"}, {"mag_filter", "LinearFilter"},
-                {"wrap", "ClampToEdgeWrapping"}, {"color_space", "NoColorSpace"}};
+      import = {{"min_filter", "LinearFilter"},
+                {"mag_filter", "LinearFilter"},
+                {"wrap", "ClampToEdgeWrapping"},
+                { "color_space",
+                  "NoColorSpace" }};
       break;
   }
   return ordered_json{{"folder", FolderOf(e)},
@@ -287,8 +315,9 @@ std::string ManifestJson(const Handoff& h, const std::vector<Engine>& engines) {
                              "clamped to the cell's outer texel centres",
                              vol.width, vol.height)},
         {"published", exporter::PublishedFormula()}}},
-      {"units", "f_r in 1/sr, linear Rec.709 RGB, not multiplied by cos(theta); radiance = f_r * "
-                "E * max(n.l, 0) for a directional light of irradiance E at normal incidence"},
+      {"units",
+       "f_r in 1/sr, linear Rec.709 RGB, not multiplied by cos(theta); radiance = f_r * "
+       "E * max(n.l, 0) for a directional light of irradiance E at normal incidence"},
       {"shader_contract",
        "MeasuredBrdf(n, l, v): unit vectors away from the surface in one frame; tangent frame "
        "from the light (x = l projected on the tangent plane, phi_in = 0); omega_d = "
@@ -371,9 +400,9 @@ std::vector<std::string> WriteEngineFolder(Engine e, const fs::path& dir, const 
         path, src.composite(),
         exporter::ExrOptions(exporter::ExrPixelType::kHalf, exporter::ExrCompression::kNone),
         {{"brdf:theta_in_deg", exporter::FormatThetaList(h.theta_in_deg)},
-         {"brdf:layout", fmt::format("{} x {} tiles of {} x {}, row-major, top-left first",
-                                     h.composite.columns, h.composite.rows, h.volume->width,
-                                     h.volume->height)},
+         {"brdf:layout",
+          fmt::format("{} x {} tiles of {} x {}, row-major, top-left first", h.composite.columns,
+                      h.composite.rows, h.volume->width, h.volume->height)},
          {"brdf:texel_convention", exporter::TexelCentreFormula()}});
     written.push_back(path);
   };
@@ -409,8 +438,10 @@ std::vector<std::string> WriteEngineFolder(Engine e, const fs::path& dir, const 
       break;
   }
   // The manifest: written into the first folder, hard-linked into the others.
-  if (!LinkAtomically(manifest_path, (dir / f.manifest).string())) put(f.manifest, manifest);
-  else written.push_back((dir / f.manifest).string());
+  if (!LinkAtomically(manifest_path, (dir / f.manifest).string()))
+    put(f.manifest, manifest);
+  else
+    written.push_back((dir / f.manifest).string());
   if (manifest_path.empty()) manifest_path = (dir / f.manifest).string();
   return written;
 }
@@ -515,8 +546,8 @@ std::string Rgba16fBytes(const exporter::PackedVolume& volume) {
 std::string EncodeRgba16fDds(const exporter::PackedVolume& volume) {
   if (volume.width < 1 || volume.height < 1 || volume.depth < 1 ||
       volume.words.size() != static_cast<std::size_t>(volume.width) * volume.height * volume.depth)
-    throw InvalidArgument(fmt::format("RGBA16F DDS: inconsistent volume {} × {} × {}",
-                                      volume.width, volume.height, volume.depth));
+    throw InvalidArgument(fmt::format("RGBA16F DDS: inconsistent volume {} × {} × {}", volume.width,
+                                      volume.height, volume.depth));
   return exporter::DdsVolumeHeader(volume.width, volume.height, volume.depth,
                                    kDxgiFormatR16g16b16a16Float, 8) +
          Rgba16fBytes(volume);
@@ -568,10 +599,9 @@ EngineExportResult ExportLutWithEngines(const std::string& out_dir, const Lut& l
   return result;
 }
 
-std::vector<std::string> WriteAtlasWithEngines(const std::string& prefix,
-                                               const std::vector<exporter::AtlasMaterial>& materials,
-                                               const exporter::ExrOptions& exr_options,
-                                               const EngineSet& engines) {
+std::vector<std::string> WriteAtlasWithEngines(
+    const std::string& prefix, const std::vector<exporter::AtlasMaterial>& materials,
+    const exporter::ExrOptions& exr_options, const EngineSet& engines) {
   std::vector<std::string> written = exporter::WriteAtlas(prefix, materials, exr_options);
   if (!engines.Any()) return written;
   const exporter::Atlas atlas = exporter::BuildAtlas(materials);
@@ -597,9 +627,9 @@ std::vector<std::string> WriteAtlasWithEngines(const std::string& prefix,
   src.exr_path = prefix + ".exr";
   src.ktx2_bytes = [&] {
     return exporter::EncodeKtx2(
-        atlas.volume, {{"brdf.atlas", exporter::AtlasManifestJson(
-                                          atlas, {h.name + ".ktx2", h.name + ".dds",
-                                                  h.name + ".exr", h.name + ".json"})}});
+        atlas.volume,
+        {{"brdf.atlas", exporter::AtlasManifestJson(atlas, {h.name + ".ktx2", h.name + ".dds",
+                                                            h.name + ".exr", h.name + ".json"})}});
   };
   src.composite = [&] { return exporter::AtlasImage(materials); };
   const auto w = WriteHandoff(base, h, src, engines);

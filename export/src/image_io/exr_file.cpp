@@ -1,13 +1,13 @@
 // EXR through OpenEXR's C++ API (no OpenImageIO), see brdf/image_io/image_io.h.
 #include <sys/stat.h>
 
+#include <Imath/half.h>
 #include <ImfChannelList.h>
 #include <ImfFrameBuffer.h>
 #include <ImfHeader.h>
 #include <ImfInputFile.h>
 #include <ImfOutputFile.h>
 #include <ImfStringAttribute.h>
-#include <Imath/half.h>
 
 #include <cerrno>
 #include <cstring>
@@ -102,8 +102,7 @@ ExrImage ReadExrImage(const std::string& path) {
                           names.empty() ? "no channels" : "channels " + names);
       if (channel->xSampling != 1 || channel->ySampling != 1)
         throw FormatError(path, std::string("channel ") + name, "one sample per pixel",
-                          fmt::format("sampling {} × {}", channel->xSampling,
-                                      channel->ySampling));
+                          fmt::format("sampling {} × {}", channel->xSampling, channel->ySampling));
     }
     const Imath::Box2i window = header.dataWindow();
     const long long width = static_cast<long long>(window.max.x) - window.min.x + 1;

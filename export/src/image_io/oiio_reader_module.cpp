@@ -18,8 +18,8 @@ namespace {
 using brdf::image_io::RgbImage;
 using brdf::image_io::detail::OiioReadStatus;
 
-OiioReadStatus Read(const char* path, RgbImage* image, std::string* position,
-                    std::string* expected, std::string* got) {
+OiioReadStatus Read(const char* path, RgbImage* image, std::string* position, std::string* expected,
+                    std::string* got) {
   auto in = OIIO::ImageInput::open(path);
   if (!in) {
     // OIIO does not tell "unknown format" from "damaged" apart; both mean the content is not a
@@ -38,8 +38,7 @@ OiioReadStatus Read(const char* path, RgbImage* image, std::string* position,
     *expected = "a 2D image of 1 to " + std::to_string(brdf::image_io::kMaxReadPixels) +
                 " pixels with at least one channel";
     *got = std::to_string(spec.width) + " × " + std::to_string(spec.height) + " × " +
-           std::to_string(spec.depth) + " pixels, " + std::to_string(spec.nchannels) +
-           " channels";
+           std::to_string(spec.depth) + " pixels, " + std::to_string(spec.nchannels) + " channels";
     return OiioReadStatus::kBadContent;
   }
   const int used = spec.nchannels >= 3 ? 3 : 1;
@@ -57,8 +56,7 @@ OiioReadStatus Read(const char* path, RgbImage* image, std::string* position,
     image->rgb = std::move(values);
   } else {
     image->rgb.resize(pixels * 3);
-    for (std::size_t p = 0; p < pixels; ++p)
-      std::fill_n(&image->rgb[3 * p], 3, values[p]);
+    for (std::size_t p = 0; p < pixels; ++p) std::fill_n(&image->rgb[3 * p], 3, values[p]);
   }
   return OiioReadStatus::kOk;
 }
@@ -81,6 +79,6 @@ BRDF_MODULE_ENTRY OiioReadStatus brdf_oiio_read_rgb(const char* path, RgbImage* 
   }
 }
 
-static_assert(std::is_same_v<decltype(brdf_oiio_read_rgb),
-                             brdf::image_io::detail::OiioReadFunction>,
-              "the exported entry point must match its declaration in oiio_module_abi.h");
+static_assert(
+    std::is_same_v<decltype(brdf_oiio_read_rgb), brdf::image_io::detail::OiioReadFunction>,
+    "the exported entry point must match its declaration in oiio_module_abi.h");

@@ -41,8 +41,7 @@ void IgnoreWarning(png_structp, png_const_charp) {}
 // libpng leaves it with longjmp on error. Returns false on error (message in state).
 bool Encode(EncodeState* state, int width, int height, png_bytepp rows, png_textp text,
             int text_count, int zlib_level) {
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, state, KeepError,
-                                            IgnoreWarning);
+  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, state, KeepError, IgnoreWarning);
   if (png == nullptr) return false;
   png_infop info = png_create_info_struct(png);
   if (info == nullptr) {
@@ -74,8 +73,8 @@ void WritePng8(const std::string& path, int width, int height,
     throw InvalidArgument(fmt::format("{}: PNG: inconsistent image {} × {} with {} bytes", path,
                                       width, height, rgb8.size()));
   if (zlib_level < 0 || zlib_level > 9)
-    throw InvalidArgument(fmt::format("{}: PNG: zlib level must be 0 to 9, got {}", path,
-                                      zlib_level));
+    throw InvalidArgument(
+        fmt::format("{}: PNG: zlib level must be 0 to 9, got {}", path, zlib_level));
   // libpng takes non-const strings and row pointers; these copies keep the caller's data const.
   std::vector<std::string> keys, values;
   for (const auto& [key, value] : text) {
@@ -101,8 +100,8 @@ void WritePng8(const std::string& path, int width, int height,
   if (!Encode(&state, width, height, rows.data(), chunks.data(), static_cast<int>(chunks.size()),
               zlib_level))
     throw IoError(path + ": encoding the PNG failed: " + state.message);
-  WriteFileAtomically(path, std::string_view(reinterpret_cast<const char*>(bytes.data()),
-                                             bytes.size()));
+  WriteFileAtomically(path,
+                      std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));
 }
 
 }  // namespace brdf::image_io

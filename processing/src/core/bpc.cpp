@@ -526,8 +526,7 @@ class BpcParser {
     std::string position = BytePosition(offset);
     if (slice >= 0) position += " (slice " + std::to_string(slice) + ")";
     std::string hint;
-    if (kind == BpcProblemKind::kTruncated)
-      hint = "damaged tail of an interrupted capture";
+    if (kind == BpcProblemKind::kTruncated) hint = "damaged tail of an interrupted capture";
     problem.message = FormatError(file_, position, expected, got, hint).what();
     problem.expected = std::move(expected);
     problem.got = std::move(got);
@@ -752,8 +751,7 @@ BpcAppender BpcAppender::Resume(const std::string& path, BpcReadResult* existing
   if (r.intact_data_after_damage)
     throw FormatError(path, BytePosition(r.valid_bytes),
                       "damage only at the tail of an interrupted capture",
-                      "intact chunks after a damaged one",
-                      "resuming would truncate them",
+                      "intact chunks after a damaged one", "resuming would truncate them",
                       Remedy{RemedyKind::kRepairCapture, path});
   if (::truncate(path.c_str(), static_cast<off_t>(r.valid_bytes)) != 0)
     throw IoError(path + ": cannot truncate to " + std::to_string(r.valid_bytes) +

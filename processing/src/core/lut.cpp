@@ -54,8 +54,9 @@ double Lut::SliceCoordinate(double theta_in) const {
   if (theta_in_deg.size() < 2 || !(delta > 0)) return 0.0;
   bool uniform = true;
   for (std::size_t k = 0; k < theta_in_deg.size() && uniform; ++k)
-    uniform = std::fabs(theta_in_deg[k] - (theta_in_deg.front() + static_cast<double>(k) * delta)) <=
-              1e-9 * std::max(1.0, std::fabs(theta_in_deg[k]));
+    uniform =
+        std::fabs(theta_in_deg[k] - (theta_in_deg.front() + static_cast<double>(k) * delta)) <=
+        1e-9 * std::max(1.0, std::fabs(theta_in_deg[k]));
   if (uniform) return (theta_in - theta_in_deg.front()) / delta;
   // Piecewise linear between neighbouring entries; beyond the ends, extended with the end
   // intervals' spacing (the sampler clamps anyway).

@@ -20,9 +20,7 @@ ParameterInfo Rgb01(std::string_view name, double start, std::string_view label 
 ParameterInfo Scalar01(std::string_view name, double start, std::string_view label = {}) {
   return {name, false, 0.0, 1.0, start, false, label, 0};
 }
-ParameterInfo Exponent(std::string_view name) {
-  return {name, true, 1e-3, 1e6, 20.0, true, {}, 0};
-}
+ParameterInfo Exponent(std::string_view name) { return {name, true, 1e-3, 1e6, 20.0, true, {}, 0}; }
 ParameterInfo Width(std::string_view name) { return {name, true, 1e-3, 1.0, 0.2, true, {}, 0}; }
 
 ModelInfo Info(Model model, std::string_view name, std::string_view engine,
@@ -38,13 +36,12 @@ ModelInfo Info(Model model, std::string_view name, std::string_view engine,
 const std::vector<ModelInfo>& Registry() {
   static const std::vector<ModelInfo> registry = {
       Info(Model::kLambert, "lambert", "", {Rgb01("rho", 0.5)}, -1),
-      Info(Model::kLafortune, "lafortune", "",
-           {Rgb01("kd", 0.3), Rgb01("ks", 0.3), Exponent("n")}, 2),
+      Info(Model::kLafortune, "lafortune", "", {Rgb01("kd", 0.3), Rgb01("ks", 0.3), Exponent("n")},
+           2),
       Info(Model::kBlinnPhong, "blinn-phong", "",
            {Rgb01("kd", 0.3), Rgb01("ks", 0.3), Exponent("n")}, 2),
       Info(Model::kGgx, "ggx", "", {Rgb01("kd", 0.3), Rgb01("f0", 0.3), Width("alpha")}, 2),
-      Info(Model::kWard, "ward", "", {Rgb01("rho_d", 0.3), Rgb01("rho_s", 0.3), Width("alpha")},
-           2),
+      Info(Model::kWard, "ward", "", {Rgb01("rho_d", 0.3), Rgb01("rho_s", 0.3), Width("alpha")}, 2),
       Info(Model::kUnrealDefaultLit, "unreal-defaultlit", "Unreal Engine",
            {Rgb01("base_color", 0.5, "Base Color"), Scalar01("metallic", 0.5, "Metallic"),
             Scalar01("specular", 0.5, "Specular"), Scalar01("roughness", 0.5, "Roughness")},
@@ -70,10 +67,11 @@ const std::vector<ModelInfo>& Registry() {
 }
 
 constexpr Model kAllModels[] = {
-    Model::kLambert,          Model::kLafortune,    Model::kBlinnPhong,
-    Model::kGgx,              Model::kWard,         Model::kUnrealDefaultLit,
-    Model::kUnityHdrpLit,     Model::kUnityHdrpLitSpecular, Model::kUnityUrpLit,
-    Model::kUnityUrpLitSpecular,
+    Model::kLambert,      Model::kLafortune,
+    Model::kBlinnPhong,   Model::kGgx,
+    Model::kWard,         Model::kUnrealDefaultLit,
+    Model::kUnityHdrpLit, Model::kUnityHdrpLitSpecular,
+    Model::kUnityUrpLit,  Model::kUnityUrpLitSpecular,
 };
 
 std::string KnownModelNames() {
@@ -162,7 +160,8 @@ Material Material::Make(Model model, const std::vector<Rgb>& parameters,
   Material m;
   m.model = model;
   m.name = std::move(material_name);
-  for (std::size_t i = 0; i < parameters.size(); ++i) m.SetParameter(static_cast<int>(i), parameters[i]);
+  for (std::size_t i = 0; i < parameters.size(); ++i)
+    m.SetParameter(static_cast<int>(i), parameters[i]);
   return m;
 }
 
@@ -303,7 +302,8 @@ std::string EngineInstructions(const Material& material) {
     out += std::string(p.engine_label);
     char buf[64];
     for (int c = 0; c < p.Count(); ++c) {
-      std::snprintf(buf, sizeof buf, " %.2f", material.values[static_cast<std::size_t>(p.offset + c)]);
+      std::snprintf(buf, sizeof buf, " %.2f",
+                    material.values[static_cast<std::size_t>(p.offset + c)]);
       out += buf;
     }
   }

@@ -82,8 +82,7 @@ Measurement CaptureNoiseFree(const BrdfSource& source, const CaptureGeometry& ge
   m.metadata.instrument_model = "virtual noise-free capture";
   m.metadata.capture_start = m.metadata.capture_end = UtcNowIso8601();
   m.metadata.software_version = SoftwareVersion();
-  m.metadata.extra["capture"] =
-      "virtual, noise-free: f_r evaluated at " + geometry.Describe();
+  m.metadata.extra["capture"] = "virtual, noise-free: f_r evaluated at " + geometry.Describe();
   m.metadata.extra[kPlannedThetaInKey] = EncodeThetaInList(geometry.theta_in_deg);
   for (const double theta_in : geometry.theta_in_deg) {
     Slice slice;
@@ -126,8 +125,7 @@ std::optional<std::vector<double>> PlannedThetaInDeg(const Metadata& metadata,
   if (it == metadata.extra.end()) return std::nullopt;
   const auto fail = [&](const std::string& got) -> FormatError {
     return FormatError(file, std::string("metadata extra '") + kPlannedThetaInKey + "'",
-                       "a list of incidence angles in [0, 90) degrees such as \"0,20,40,60\"",
-                       got);
+                       "a list of incidence angles in [0, 90) degrees such as \"0,20,40,60\"", got);
   };
   std::vector<double> planned;
   std::string text = it->second;

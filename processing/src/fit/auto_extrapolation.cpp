@@ -122,7 +122,8 @@ std::string AutoExtrapolationJson(const AutoExtrapolationResult& result) {
       "theta_b and 90 deg";
   j["band_rmse"] = result.band_rmse;
   j["band_rmse_clamp"] = result.band_rmse_clamp;
-  if (result.fit) j["ggx_fit"] = nlohmann::ordered_json::parse(MaterialToJson(result.fit->material));
+  if (result.fit)
+    j["ggx_fit"] = nlohmann::ordered_json::parse(MaterialToJson(result.fit->material));
   return j.dump();
 }
 

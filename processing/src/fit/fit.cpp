@@ -14,8 +14,8 @@
 #include <map>
 #include <memory>
 #include <mutex>
-#include <thread>
 #include <nlohmann/json.hpp>
+#include <thread>
 
 #include "brdf/core/error.h"
 #include "fit_data.h"
@@ -119,12 +119,13 @@ const ParameterInfo& ParameterOfValue(const ModelInfo& info, int value_index) {
 }
 
 template <int N>
-void AddBlockResiduals(ceres::Problem& problem, const std::vector<FitSample>& samples,
-                       Model model, const Block& block, FitLoss loss,
-                       ceres::LossFunction* robust, double* x) {
+void AddBlockResiduals(ceres::Problem& problem, const std::vector<FitSample>& samples, Model model,
+                       const Block& block, FitLoss loss, ceres::LossFunction* robust, double* x) {
   ChunkCost<N> proto{&samples, 0, 0, model, block.channel, loss, {}};
   const ModelInfo& info = DescribeModel(model);
-  for (int i = 0; i < N; ++i) proto.log_scale[static_cast<std::size_t>(i)] = ParameterOfValue(info, block.value_index[static_cast<std::size_t>(i)]).log_scale;
+  for (int i = 0; i < N; ++i)
+    proto.log_scale[static_cast<std::size_t>(i)] =
+        ParameterOfValue(info, block.value_index[static_cast<std::size_t>(i)]).log_scale;
   const int per_sample = block.channel >= 0 ? 1 : 3;
   for (std::size_t begin = 0; begin < samples.size(); begin += kChunk) {
     auto* functor = new ChunkCost<N>(proto);
@@ -179,7 +180,8 @@ double MedianAbsResidual(const std::vector<FitSample>& samples, const Material& 
   r.reserve(samples.size() * 3);
   for (const FitSample& s : samples) {
     const std::array<double, 3> f = models::EvaluateRgb(m.model, s.g, m.values.data());
-    for (int c = 0; c < 3; ++c) r.push_back(std::fabs(Residual(loss, f[c], s.m[c], s.cos_in, s.sqrt_w)));
+    for (int c = 0; c < 3; ++c)
+      r.push_back(std::fabs(Residual(loss, f[c], s.m[c], s.cos_in, s.sqrt_w)));
   }
   if (r.empty()) return 0;
   auto mid = r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2);
@@ -191,8 +193,7 @@ double MedianAbsResidual(const std::vector<FitSample>& samples, const Material& 
 // The sweep.
 
 std::vector<double> ShapeGrid(const ParameterInfo& p) {
-  if (p.name == "n")
-    return {1, 2, 4, 8, 16, 32, 64, 128, 256, 512, 1024, 2048, 4096, 10000, 30000};
+  if (p.name == "n") return {1, 2, 4, 8, 16, 32, 64, 128, 256, 512, 1024, 2048, 4096, 10000, 30000};
   if (p.name == "alpha")
     return {0.005, 0.01, 0.02, 0.035, 0.05, 0.07, 0.1, 0.14, 0.2, 0.28, 0.4, 0.56, 0.8, 1.0};
   // roughness / smoothness sliders in [0, 1]
@@ -240,8 +241,9 @@ void SweepLegacy(const std::vector<FitSample>& sub, Model model, FitLoss loss,
   const ModelInfo& info = DescribeModel(model);
   const bool two = info.parameters.size() > 1;
   const std::vector<double> grid =
-      info.shape_parameter >= 0 ? ShapeGrid(info.parameters[static_cast<std::size_t>(info.shape_parameter)])
-                                : std::vector<double>{0.0};
+      info.shape_parameter >= 0
+          ? ShapeGrid(info.parameters[static_cast<std::size_t>(info.shape_parameter)])
+          : std::vector<double>{0.0};
   for (const double shape : grid) {
     Material m;
     m.model = model;
@@ -274,19 +276,23 @@ void SweepEngine(const std::vector<FitSample>& sub, Model model, FitLoss loss,
   const ModelInfo& info = DescribeModel(model);
   const ParameterInfo& shape_p = info.parameters[static_cast<std::size_t>(info.shape_parameter)];
   const ParameterInfo& second = info.parameters[1];  // metallic or specular_color
-  const std::vector<double> second_grid =
-      second.rgb ? std::vector<double>{0.02, 0.04, 0.08, 0.2, 0.5, 0.9}
-                 : std::vector<double>{0.0, 0.5, 1.0};
+  const std::vector<double> second_grid = second.rgb
+                                              ? std::vector<double>{0.02, 0.04, 0.08, 0.2, 0.5, 0.9}
+                                              : std::vector<double>{0.0, 0.5, 1.0};
   for (const double shape : ShapeGrid(shape_p)) {
     for (const double level : second_grid) {
       Material m;
       m.model = model;
       for (const ParameterInfo& p : info.parameters)
-        for (int c = 0; c < p.Count(); ++c) m.values[static_cast<std::size_t>(p.offset + c)] = p.start;
-      for (int c = 0; c < second.Count(); ++c) m.values[static_cast<std::size_t>(second.offset + c)] = level;
-      for (int c = 0; c < shape_p.Count(); ++c) m.values[static_cast<std::size_t>(shape_p.offset + c)] = shape;
+        for (int c = 0; c < p.Count(); ++c)
+          m.values[static_cast<std::size_t>(p.offset + c)] = p.start;
+      for (int c = 0; c < second.Count(); ++c)
+        m.values[static_cast<std::size_t>(second.offset + c)] = level;
+      for (int c = 0; c < shape_p.Count(); ++c)
+        m.values[static_cast<std::size_t>(shape_p.offset + c)] = shape;
       Material zero = m, one = m;
-      for (int c = 0; c < 3; ++c) zero.values[static_cast<std::size_t>(c)] = 0, one.values[static_cast<std::size_t>(c)] = 1;
+      for (int c = 0; c < 3; ++c)
+        zero.values[static_cast<std::size_t>(c)] = 0, one.values[static_cast<std::size_t>(c)] = 1;
       std::array<Sums, 3> s{};
       for (const FitSample& x : sub) {
         const auto f0 = models::EvaluateRgb(model, x.g, zero.values.data());
@@ -297,7 +303,8 @@ void SweepEngine(const std::vector<FitSample>& sub, Model model, FitLoss loss,
           s[c].aa += wa * wa, s[c].am += wa * wm, s[c].mm += wm * wm;
         }
       }
-      for (int c = 0; c < 3; ++c) m.values[static_cast<std::size_t>(c)] = SolveBox(s[c], false).first;
+      for (int c = 0; c < 3; ++c)
+        m.values[static_cast<std::size_t>(c)] = SolveBox(s[c], false).first;
       out->push_back({m, Cost(sub, m, loss)});
     }
   }
@@ -355,8 +362,10 @@ BlockOutcome SolveBlock(const std::vector<FitSample>& samples, const Material& s
   AddResiduals(problem, samples, start.model, block, options.loss, robust, out.x.data());
   for (std::size_t i = 0; i < block.value_index.size(); ++i) {
     const ParameterInfo& p = ParameterOfValue(info, block.value_index[i]);
-    problem.SetParameterLowerBound(out.x.data(), static_cast<int>(i), p.log_scale ? std::log(p.min) : p.min);
-    problem.SetParameterUpperBound(out.x.data(), static_cast<int>(i), p.log_scale ? std::log(p.max) : p.max);
+    problem.SetParameterLowerBound(out.x.data(), static_cast<int>(i),
+                                   p.log_scale ? std::log(p.min) : p.min);
+    problem.SetParameterUpperBound(out.x.data(), static_cast<int>(i),
+                                   p.log_scale ? std::log(p.max) : p.max);
   }
   ceres::Solver::Options so;
   so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
@@ -539,7 +548,7 @@ FitResult FitMaterial(const Measurement& measurement, const FitOptions& options)
       best = std::move(r);
   }
   report.converged = best->termination == ceres::CONVERGENCE;
-  report.status = report.converged ? "converged"
+  report.status = report.converged                             ? "converged"
                   : best->termination == ceres::NO_CONVERGENCE ? "no-convergence"
                                                                : "failed";
   report.message = best->message;

@@ -18,9 +18,13 @@ namespace {
 std::vector<std::pair<double, double>> RowEdges(const std::vector<double>& rows_deg) {
   std::vector<std::pair<double, double>> edges(rows_deg.size());
   for (std::size_t i = 0; i < rows_deg.size(); ++i) {
-    const double prev = i > 0 ? rows_deg[i - 1] : rows_deg[i] - (rows_deg.size() > 1 ? rows_deg[1] - rows_deg[0] : 1.0);
-    const double next = i + 1 < rows_deg.size() ? rows_deg[i + 1]
-                                                 : rows_deg[i] + (rows_deg.size() > 1 ? rows_deg[i] - rows_deg[i - 1] : 1.0);
+    const double prev = i > 0
+                            ? rows_deg[i - 1]
+                            : rows_deg[i] - (rows_deg.size() > 1 ? rows_deg[1] - rows_deg[0] : 1.0);
+    const double next =
+        i + 1 < rows_deg.size()
+            ? rows_deg[i + 1]
+            : rows_deg[i] + (rows_deg.size() > 1 ? rows_deg[i] - rows_deg[i - 1] : 1.0);
     const double lo = std::max(0.0, 0.5 * (prev + rows_deg[i]));
     const double hi = std::min(90.0, 0.5 * (rows_deg[i] + next));
     edges[i] = {DegToRad(lo), DegToRad(hi)};
@@ -127,7 +131,8 @@ void FillErrors(const FitData& data, const Material& material, FitReport* report
   for (auto& b : bins)
     for (auto& cellv : b) cellv.fill(0.0);
   for (const FitSample& x : data.samples) {
-    const std::array<double, 3> f = models::EvaluateRgb(material.model, x.g, material.values.data());
+    const std::array<double, 3> f =
+        models::EvaluateRgb(material.model, x.g, material.values.data());
     const std::size_t s = static_cast<std::size_t>(x.slice);
     ++count[s];
     int bin = kBins - 1;
@@ -159,14 +164,18 @@ void FillErrors(const FitData& data, const Material& material, FitReport* report
     report->slices.push_back(e);
   }
   std::sort(report->slices.begin(), report->slices.end(),
-            [](const SliceFitError& a, const SliceFitError& b) { return a.theta_in_deg < b.theta_in_deg; });
+            [](const SliceFitError& a, const SliceFitError& b) {
+              return a.theta_in_deg < b.theta_in_deg;
+            });
   report->rmse = std::sqrt(all_sq / (3.0 * static_cast<double>(data.samples.size())));
   report->median_relative_error = Median(all_rel);
 
   // Hue that changes with angle differently from the model's.
   double worst = 0;
   std::string where;
-  auto luminance = [](double r, double g, double b) { return 0.2126 * r + 0.7152 * g + 0.0722 * b; };
+  auto luminance = [](double r, double g, double b) {
+    return 0.2126 * r + 0.7152 * g + 0.0722 * b;
+  };
   for (std::size_t s = 0; s < n_slices; ++s) {
     double slice_lum = 0;
     for (const auto& b : bins[s]) slice_lum += luminance(b[0], b[1], b[2]);
@@ -214,7 +223,8 @@ void FillErrors(const FitData& data, const Material& material, FitReport* report
     }
     const double angle = 0.5 * std::atan2(2 * srg, srr - sgg);  // principal direction
     const double nx = -std::sin(angle), ny = std::cos(angle);   // its normal
-    for (const auto& p : points) spread = std::max(spread, std::fabs((p[0] - mr) * nx + (p[1] - mg) * ny));
+    for (const auto& p : points)
+      spread = std::max(spread, std::fabs((p[0] - mr) * nx + (p[1] - mg) * ny));
   }
   report->hue_spread = spread;
   report->colour_shift = spread > 0.02;

@@ -77,8 +77,8 @@ EnvironmentMap::EnvironmentMap(int width, int height, std::vector<float> rgb, st
   for (std::size_t k = 0; k < rgb_.size(); ++k)
     if (!(rgb_[k] >= 0.0f) || !std::isfinite(rgb_[k])) {
       const std::size_t p = k / 3;
-      throw InvalidArgument("environment map '" + name_ + "': pixel (" +
-                            std::to_string(p % width) + ", " + std::to_string(p / width) +
+      throw InvalidArgument("environment map '" + name_ + "': pixel (" + std::to_string(p % width) +
+                            ", " + std::to_string(p / width) +
                             "): expected a finite radiance ≥ 0, got " + std::to_string(rgb_[k]));
     }
 }
@@ -95,9 +95,9 @@ EnvironmentMap EnvironmentMap::Studio(int width, int height) {
   // The default camera looks from +x (φ = 0); +y is to its right. The key light is high on the
   // camera's right, the fill low on its left, the rim light behind the object.
   const SoftBox boxes[] = {
-      {40.0, 35.0, 22.0, 16.0, 4.0, {4.0, 3.9, 3.7}},    // key
-      {70.0, 295.0, 14.0, 20.0, 5.0, {0.9, 0.95, 1.05}}, // fill
-      {55.0, 165.0, 9.0, 28.0, 3.0, {3.0, 3.0, 3.0}},    // rim
+      {40.0, 35.0, 22.0, 16.0, 4.0, {4.0, 3.9, 3.7}},     // key
+      {70.0, 295.0, 14.0, 20.0, 5.0, {0.9, 0.95, 1.05}},  // fill
+      {55.0, 165.0, 9.0, 28.0, 3.0, {3.0, 3.0, 3.0}},     // rim
   };
   std::vector<float> rgb = Tabulate(width, height, [&](const Vec3& w) {
     // Gradient: 0.05 at and below the horizon, 0.25 at the zenith.
@@ -177,8 +177,8 @@ EnvironmentMap EnvironmentMap::Sky(double sun_theta_deg, double sun_phi_deg, int
     if (cos_theta <= 0.0) continue;
     for (int i = 0; i < width; ++i)
       for (int c = 0; c < 3; ++c)
-        e_horizontal[c] += rgb[(static_cast<std::size_t>(j) * width + i) * 3 + c] * cos_theta *
-                           pixel_solid_angle;
+        e_horizontal[c] +=
+            rgb[(static_cast<std::size_t>(j) * width + i) * 3 + c] * cos_theta * pixel_solid_angle;
   }
   for (int j = 0; j < height; ++j) {
     if (std::cos((j + 0.5) * kPi / height) > 0.0) continue;

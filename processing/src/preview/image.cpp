@@ -140,8 +140,8 @@ namespace detail {
 RgbImage ReadEnvironmentImage(const std::string& path) {
   if (!EndsWith(path, ".exr") && !EndsWith(path, ".hdr"))
     throw InvalidArgument(path + ": an environment map must be an equirectangular .exr or .hdr");
-  image_io::RgbImage image = EndsWith(path, ".exr") ? image_io::ReadExrImage(path).image
-                                                    : image_io::ReadRgbImage(path);
+  image_io::RgbImage image =
+      EndsWith(path, ".exr") ? image_io::ReadExrImage(path).image : image_io::ReadRgbImage(path);
   return {image.width, image.height, std::move(image.rgb)};
 }
 

@@ -44,10 +44,10 @@ void AddPolygon(Mesh* mesh, const std::vector<std::uint32_t>& indices, const std
                       std::to_string(indices.size()) + " vertices");
   for (std::uint32_t i : indices)
     if (i >= mesh->positions.size())
-      throw FormatError(path, position,
-                        "vertex indices below the vertex count " +
-                            std::to_string(mesh->positions.size()),
-                        "index " + std::to_string(i));
+      throw FormatError(
+          path, position,
+          "vertex indices below the vertex count " + std::to_string(mesh->positions.size()),
+          "index " + std::to_string(i));
   for (std::size_t k = 1; k + 1 < indices.size(); ++k)
     mesh->triangles.push_back({indices[0], indices[k], indices[k + 1]});
   if (mesh->triangles.size() > kMaxElements)
@@ -140,8 +140,7 @@ struct PlyElement {
 std::size_t PlyTypeSize(const std::string& t) {
   if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
   if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
-  if (t == "int" || t == "uint" || t == "float" || t == "int32" || t == "uint32" ||
-      t == "float32")
+  if (t == "int" || t == "uint" || t == "float" || t == "int32" || t == "uint32" || t == "float32")
     return 4;
   if (t == "double" || t == "float64") return 8;
   return 0;
@@ -189,8 +188,8 @@ Mesh ParsePly(const std::string& data, const std::string& path) {
     if (tag == "format") {
       in >> format;
       if (format != "ascii" && format != "binary_little_endian")
-        throw FormatError(path, LinePosition(line_number),
-                          "format ascii or binary_little_endian", "'" + format + "'");
+        throw FormatError(path, LinePosition(line_number), "format ascii or binary_little_endian",
+                          "'" + format + "'");
     } else if (tag == "element") {
       PlyElement e;
       if (!(in >> e.name >> e.count) || e.count > kMaxElements)

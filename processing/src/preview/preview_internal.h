@@ -31,8 +31,8 @@ struct Frame {
     const double sign = std::copysign(1.0, n.z);
     const double a = -1.0 / (sign + n.z);
     const double b = n.x * n.y * a;
-    return {{1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x}, {b, sign + n.y * n.y * a, -n.y},
-            n};
+    return {
+        {1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x}, {b, sign + n.y * n.y * a, -n.y}, n};
   }
   Vec3 ToLocal(const Vec3& w) const { return {Dot(w, s), Dot(w, t), Dot(w, n)}; }
   Vec3 ToWorld(const Vec3& w) const { return s * w.x + t * w.y + n * w.z; }

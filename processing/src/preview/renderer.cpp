@@ -69,7 +69,8 @@ void ParallelChunks(std::size_t count, std::size_t chunk, int jobs, const std::a
       work(begin, std::min(count, begin + chunk));
     }
   };
-  const int threads = std::max(1, std::min<int>(jobs, static_cast<int>((count + chunk - 1) / chunk)));
+  const int threads =
+      std::max(1, std::min<int>(jobs, static_cast<int>((count + chunk - 1) / chunk)));
   std::vector<std::thread> workers;
   for (int t = 1; t < threads; ++t) workers.emplace_back(loop);
   loop();
@@ -88,19 +89,22 @@ struct PreviewRenderer::Impl {
   double cos_rotation = 1.0, sin_rotation = 0.0;
   int jobs = 1;
 
-  std::vector<std::uint8_t> object;        // per image pixel
-  std::vector<Rgb> fixed;                  // per image pixel: background or directional light
-  std::vector<std::uint32_t> object_index; // image pixel of each object pixel
-  std::vector<PixelSetup> setup;           // per object pixel
-  std::vector<double> sum;                 // per object pixel, RGB
-  std::vector<double> sum_sq;              // per object pixel, luminance²
+  std::vector<std::uint8_t> object;         // per image pixel
+  std::vector<Rgb> fixed;                   // per image pixel: background or directional light
+  std::vector<std::uint32_t> object_index;  // image pixel of each object pixel
+  std::vector<PixelSetup> setup;            // per object pixel
+  std::vector<double> sum;                  // per object pixel, RGB
+  std::vector<double> sum_sq;               // per object pixel, luminance²
   int passes = 0;
   bool exact = false;  // quadrature or light-only: one pass is the answer
   double seconds = 0.0;
 
   Impl(const BrdfSource& s, const EnvironmentMap& e, PreviewOptions o,
        std::shared_ptr<const BrdfSampler> sp)
-      : source(s), environment(e), options(std::move(o)), sampler(std::move(sp)),
+      : source(s),
+        environment(e),
+        options(std::move(o)),
+        sampler(std::move(sp)),
         scene(options.shape, options.mesh) {}
 
   Vec3 ToMap(const Vec3& w) const { return detail::RotateZ(w, cos_rotation, -sin_rotation); }
@@ -156,7 +160,8 @@ struct PreviewRenderer::Impl {
     const double half_fov = DegToRad(o.camera.fov_deg) * 0.5;
     // The unit bounding sphere's diameter spans `fill` of the frame height.
     const double ortho_half_height = 1.0 / o.camera.fill;
-    const double distance = perspective ? 1.0 / std::sin(std::atan(std::tan(half_fov) * o.camera.fill)) : 10.0;
+    const double distance =
+        perspective ? 1.0 / std::sin(std::atan(std::tan(half_fov) * o.camera.fill)) : 10.0;
     const double tan_half = std::tan(half_fov);
     const Vec3 eye = c * distance;
     Vec3 light_dir{};
@@ -166,40 +171,41 @@ struct PreviewRenderer::Impl {
     object.assign(pixels, 0);
     fixed.assign(pixels, Rgb{0, 0, 0});
     std::vector<PixelSetup> all(pixels);
-    ParallelChunks(static_cast<std::size_t>(o.height), 8, jobs, nullptr, [&](std::size_t y0, std::size_t y1) {
-      for (std::size_t y = y0; y < y1; ++y)
-        for (int x = 0; x < o.width; ++x) {
-          const double sx = ((x + 0.5) / o.width * 2.0 - 1.0) * aspect;
-          const double sy = 1.0 - (y + 0.5) / o.height * 2.0;
-          Vec3 origin, dir;
-          if (perspective) {
-            origin = eye;
-            dir = Normalize(forward + right * (sx * tan_half) + up * (sy * tan_half));
-          } else {
-            origin = eye + right * (sx * ortho_half_height) + up * (sy * ortho_half_height);
-            dir = forward;
-          }
-          const std::size_t p = y * o.width + x;
-          detail::Hit hit;
-          if (!scene.Intersect(origin, dir, &hit)) {
-            if (o.show_background) fixed[p] = environment.Radiance(ToMap(dir));
-            continue;
-          }
-          object[p] = 1;
-          PixelSetup& s = all[p];
-          s.position = hit.position;
-          s.geometric_normal = hit.geometric_normal;
-          s.frame = Frame::FromNormal(hit.normal);
-          s.wo = s.frame.ToLocal(dir * -1.0);
-          if (o.light && Dot(light_dir, hit.geometric_normal) > 0.0) {
-            const Vec3 wi = s.frame.ToLocal(light_dir);
-            if (wi.z > 0.0 && !scene.Occluded(ShadowOrigin(s), light_dir)) {
-              const Rgb f = source.Eval(wi, s.wo);
-              for (int k = 0; k < 3; ++k) fixed[p][k] = o.light->irradiance[k] * f[k] * wi.z;
+    ParallelChunks(
+        static_cast<std::size_t>(o.height), 8, jobs, nullptr, [&](std::size_t y0, std::size_t y1) {
+          for (std::size_t y = y0; y < y1; ++y)
+            for (int x = 0; x < o.width; ++x) {
+              const double sx = ((x + 0.5) / o.width * 2.0 - 1.0) * aspect;
+              const double sy = 1.0 - (y + 0.5) / o.height * 2.0;
+              Vec3 origin, dir;
+              if (perspective) {
+                origin = eye;
+                dir = Normalize(forward + right * (sx * tan_half) + up * (sy * tan_half));
+              } else {
+                origin = eye + right * (sx * ortho_half_height) + up * (sy * ortho_half_height);
+                dir = forward;
+              }
+              const std::size_t p = y * o.width + x;
+              detail::Hit hit;
+              if (!scene.Intersect(origin, dir, &hit)) {
+                if (o.show_background) fixed[p] = environment.Radiance(ToMap(dir));
+                continue;
+              }
+              object[p] = 1;
+              PixelSetup& s = all[p];
+              s.position = hit.position;
+              s.geometric_normal = hit.geometric_normal;
+              s.frame = Frame::FromNormal(hit.normal);
+              s.wo = s.frame.ToLocal(dir * -1.0);
+              if (o.light && Dot(light_dir, hit.geometric_normal) > 0.0) {
+                const Vec3 wi = s.frame.ToLocal(light_dir);
+                if (wi.z > 0.0 && !scene.Occluded(ShadowOrigin(s), light_dir)) {
+                  const Rgb f = source.Eval(wi, s.wo);
+                  for (int k = 0; k < 3; ++k) fixed[p][k] = o.light->irradiance[k] * f[k] * wi.z;
+                }
+              }
             }
-          }
-        }
-    });
+        });
     for (std::size_t p = 0; p < pixels; ++p)
       if (object[p]) {
         object_index.push_back(static_cast<std::uint32_t>(p));
@@ -388,14 +394,13 @@ struct PreviewRenderer::Impl {
 };
 
 PreviewRenderer::PreviewRenderer(const BrdfSource& source, const EnvironmentMap& environment,
-                                 PreviewOptions options,
-                                 std::shared_ptr<const BrdfSampler> sampler)
+                                 PreviewOptions options, std::shared_ptr<const BrdfSampler> sampler)
     : impl_(std::make_unique<Impl>(source, environment, std::move(options), std::move(sampler))) {
   const auto start = std::chrono::steady_clock::now();
   impl_->Validate();
   impl_->jobs = ResolveJobs(impl_->options.jobs);
-  const bool sampling = impl_->options.environment_lighting &&
-                        impl_->options.estimator != Estimator::kQuadrature;
+  const bool sampling =
+      impl_->options.environment_lighting && impl_->options.estimator != Estimator::kQuadrature;
   if (sampling) {
     if (impl_->sampler == nullptr) impl_->sampler = MakeBrdfSampler(source, impl_->jobs);
     impl_->environment_sampler = std::make_unique<EnvironmentSampler>(environment);

@@ -91,7 +91,7 @@ class GgxSampler final : public BrdfSampler {
 // direction where f_r > 0 has positive density, whatever the table missed.
 class TabulatedSampler final : public BrdfSampler {
  public:
-  static constexpr int kSlices = 23;         // θ_o = 0°, 4°, …, 88°
+  static constexpr int kSlices = 23;  // θ_o = 0°, 4°, …, 88°
   static constexpr double kSliceStepDeg = 4.0;
   static constexpr int kThetaCells = 64;
   static constexpr int kPhiCells = 64;
@@ -140,8 +140,10 @@ class TabulatedSampler final : public BrdfSampler {
     const Slices s = SlicesOf(wo);
     const Vec3 wd = ToSpecular(wo, wi);
     const double theta_d = ThetaOf(wd);
-    const int row = std::min(kThetaCells - 1, static_cast<int>(std::sqrt(theta_d / kPi) * kThetaCells));
-    const int column = std::min(kPhiCells - 1, static_cast<int>(PhiOf(wd) / (2.0 * kPi) * kPhiCells));
+    const int row =
+        std::min(kThetaCells - 1, static_cast<int>(std::sqrt(theta_d / kPi) * kThetaCells));
+    const int column =
+        std::min(kPhiCells - 1, static_cast<int>(PhiOf(wd) / (2.0 * kPi) * kPhiCells));
     const double cell_solid_angle =
         (std::cos(ThetaEdge(row)) - std::cos(ThetaEdge(row + 1))) * 2.0 * kPi / kPhiCells;
     auto table_pdf = [&](int k) {
@@ -200,7 +202,8 @@ class TabulatedSampler final : public BrdfSampler {
         if (!(wi.z > 0.0)) continue;
         const Rgb f = source.Eval(wi, wo);
         const double value = std::max(0.0, detail::Luminance(f)) * wi.z * solid_angle;
-        if (std::isfinite(value)) weights[static_cast<std::size_t>(row) * kPhiCells + column] = value;
+        if (std::isfinite(value))
+          weights[static_cast<std::size_t>(row) * kPhiCells + column] = value;
       }
     }
     return Distribution2D(weights, kThetaCells, kPhiCells);
@@ -239,7 +242,8 @@ struct EnvironmentSampler::Impl {
   Distribution2D table;
 };
 
-EnvironmentSampler::EnvironmentSampler(const EnvironmentMap& map) : impl_(std::make_unique<Impl>()) {
+EnvironmentSampler::EnvironmentSampler(const EnvironmentMap& map)
+    : impl_(std::make_unique<Impl>()) {
   impl_->width = map.width();
   impl_->height = map.height();
   std::vector<double> weights(static_cast<std::size_t>(map.width()) * map.height());
@@ -266,8 +270,8 @@ bool EnvironmentSampler::Sample(double u1, double u2, Vec3* w, double* pdf) cons
   const double sin_theta = std::sin(theta);
   if (!(sin_theta > 0.0)) return false;
   *w = SphericalDirection(theta, phi);
-  const double density_uv = impl_->table.CellProbability(row, column) *
-                            static_cast<double>(impl_->width) * impl_->height;
+  const double density_uv =
+      impl_->table.CellProbability(row, column) * static_cast<double>(impl_->width) * impl_->height;
   *pdf = density_uv / (2.0 * kPi * kPi * sin_theta);
   return true;
 }

@@ -148,7 +148,8 @@ bool Scene::Traverse(const Vec3& o, const Vec3& d, double t_max, Hit* hit) const
       for (std::uint32_t k = node.first; k < node.first + node.count; ++k) {
         const auto& t = triangles_[k];
         double u = 0, v = 0;
-        const double th = HitTriangle(o, d, positions_[t[0]], positions_[t[1]], positions_[t[2]], &u, &v);
+        const double th =
+            HitTriangle(o, d, positions_[t[0]], positions_[t[1]], positions_[t[2]], &u, &v);
         if (th < t_max) {
           if (kAnyHit) return true;
           t_max = th;
@@ -167,8 +168,10 @@ bool Scene::Traverse(const Vec3& o, const Vec3& d, double t_max, Hit* hit) const
   const auto& t = triangles_[best_tri];
   hit->t = t_max;
   hit->position = o + d * t_max;
-  Vec3 gn = Normalize(Cross(positions_[t[1]] - positions_[t[0]], positions_[t[2]] - positions_[t[0]]));
-  Vec3 sn = normals_[t[0]] * (1.0 - best_u - best_v) + normals_[t[1]] * best_u + normals_[t[2]] * best_v;
+  Vec3 gn =
+      Normalize(Cross(positions_[t[1]] - positions_[t[0]], positions_[t[2]] - positions_[t[0]]));
+  Vec3 sn =
+      normals_[t[0]] * (1.0 - best_u - best_v) + normals_[t[1]] * best_u + normals_[t[2]] * best_v;
   const double len = Length(sn);
   sn = len > 0.0 ? sn * (1.0 / len) : gn;
   // Two-sided: both normals face the ray's origin.

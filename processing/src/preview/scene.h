@@ -14,8 +14,8 @@ namespace brdf::preview::detail {
 struct Hit {
   double t = 0.0;
   Vec3 position;
-  Vec3 normal;           // shading normal, unit, on the side the ray came from
-  Vec3 geometric_normal; // unit, on the side the ray came from
+  Vec3 normal;            // shading normal, unit, on the side the ray came from
+  Vec3 geometric_normal;  // unit, on the side the ray came from
 };
 
 class Scene {

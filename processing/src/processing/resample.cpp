@@ -129,7 +129,7 @@ std::vector<LutInputProblem> FindLutInputProblems(const Measurement& m,
       const std::string text = e.what();
       const std::string prefix = Who(m) + ": ";
       add(text.find("duplicate") != std::string::npos ? Kind::kDuplicateThetaIn
-                                                       : Kind::kThetaInNotUniform,
+                                                      : Kind::kThetaInNotUniform,
           -1, text.compare(0, prefix.size(), prefix) == 0 ? text.substr(prefix.size()) : text);
     }
   }
@@ -162,14 +162,14 @@ std::vector<LutInputProblem> FindLutInputProblems(const Measurement& m,
     }
     for (const Defect& d : defects) {
       const Sample& x = s.samples[d.first];
-      const std::string values = "θout " + Num(x.theta_out_deg) + "°, φout " +
-                                 Num(x.phi_out_deg) + "°, rgb " + Num(x.rgb[0]) + " " +
-                                 Num(x.rgb[1]) + " " + Num(x.rgb[2]);
-      LutInputProblem* p = add(
-          Kind::kBadSamples, static_cast<int>(i),
-          name(i) + ": " + std::to_string(d.count) + " sample" + (d.count == 1 ? "" : "s") +
-              " with " + d.what + " (first: sample " + std::to_string(d.first) + ", " + values +
-              "); a sample without a usable value must be flagged invalid");
+      const std::string values = "θout " + Num(x.theta_out_deg) + "°, φout " + Num(x.phi_out_deg) +
+                                 "°, rgb " + Num(x.rgb[0]) + " " + Num(x.rgb[1]) + " " +
+                                 Num(x.rgb[2]);
+      LutInputProblem* p =
+          add(Kind::kBadSamples, static_cast<int>(i),
+              name(i) + ": " + std::to_string(d.count) + " sample" + (d.count == 1 ? "" : "s") +
+                  " with " + d.what + " (first: sample " + std::to_string(d.first) + ", " + values +
+                  "); a sample without a usable value must be flagged invalid");
       p->sample_count = d.count;
       p->first_sample = d.first;
     }

@@ -55,26 +55,28 @@ void CheckStructure(CaptureAssessment& a) {
                             "two chunks claim to be the same slice", repair});
     else if (index < 0 || static_cast<std::size_t>(index) >= slice_chunks)
       a.refusals.push_back(
-          {where, "a slice index below the number of slice chunks (" +
-                      std::to_string(slice_chunks) + ")",
+          {where,
+           "a slice index below the number of slice chunks (" + std::to_string(slice_chunks) + ")",
            "slice index " + std::to_string(index), "the file's slices are numbered wrong", repair});
   }
   if (r.finished && r.problems.empty()) {
     const std::string where = BytePosition(r.end_offset) + " (end chunk)";
     if (r.end_slice_count != static_cast<std::int64_t>(r.measurement.slices.size()))
-      a.refusals.push_back(
-          {where, "slice_count " + std::to_string(r.measurement.slices.size()) +
-                      " (the slices in the file)",
-           r.end_slice_count < 0 ? std::string("no slice count")
-                                 : "slice_count " + std::to_string(r.end_slice_count),
-           "the end chunk does not describe this file", repair});
+      a.refusals.push_back({where,
+                            "slice_count " + std::to_string(r.measurement.slices.size()) +
+                                " (the slices in the file)",
+                            r.end_slice_count < 0
+                                ? std::string("no slice count")
+                                : "slice_count " + std::to_string(r.end_slice_count),
+                            "the end chunk does not describe this file", repair});
     if (r.end_sample_count != static_cast<std::int64_t>(r.measurement.SampleCount()))
-      a.refusals.push_back(
-          {where, "sample_count " + std::to_string(r.measurement.SampleCount()) +
-                      " (the samples in the file)",
-           r.end_sample_count < 0 ? std::string("no sample count")
-                                  : "sample_count " + std::to_string(r.end_sample_count),
-           "the end chunk does not describe this file", repair});
+      a.refusals.push_back({where,
+                            "sample_count " + std::to_string(r.measurement.SampleCount()) +
+                                " (the samples in the file)",
+                            r.end_sample_count < 0
+                                ? std::string("no sample count")
+                                : "sample_count " + std::to_string(r.end_sample_count),
+                            "the end chunk does not describe this file", repair});
   }
 }
 
@@ -87,10 +89,12 @@ void CheckValues(CaptureAssessment& a) {
        processing::FindLutInputProblems(a.read.measurement, options)) {
     std::string where = "values";
     if (p.slice >= 0 && static_cast<std::size_t>(p.slice) < a.read.slice_offsets.size())
-      where = BytePosition(a.read.slice_offsets[static_cast<std::size_t>(p.slice)]) +
-              " (slice " + std::to_string(a.read.slice_indices[static_cast<std::size_t>(p.slice)]) +
-              ")";
-    a.refusals.push_back({where, "values a LUT can be built from", p.message, {},
+      where = BytePosition(a.read.slice_offsets[static_cast<std::size_t>(p.slice)]) + " (slice " +
+              std::to_string(a.read.slice_indices[static_cast<std::size_t>(p.slice)]) + ")";
+    a.refusals.push_back({where,
+                          "values a LUT can be built from",
+                          p.message,
+                          {},
                           Remedy{RemedyKind::kRecapture, a.path}});
   }
 }
@@ -106,7 +110,9 @@ const Measurement& CaptureAssessment::UsableMeasurement() const {
   return read.measurement;
 }
 
-CaptureAssessment AssessCapture(const std::string& path) { return AssessCapture(path, ReadBpc(path)); }
+CaptureAssessment AssessCapture(const std::string& path) {
+  return AssessCapture(path, ReadBpc(path));
+}
 
 CaptureAssessment AssessCapture(const std::string& path, BpcReadResult read) {
   CaptureAssessment a;
@@ -150,8 +156,8 @@ CaptureAssessment AssessCapture(const std::string& path, BpcReadResult read) {
     if (p.kind == BpcProblemKind::kTruncated) {
       if (p.slice_index >= 0) {
         a.refusals.push_back(CaptureRefusal{
-            BytePosition(p.offset) + " (slice " + std::to_string(p.slice_index) + ")",
-            p.expected, p.got,
+            BytePosition(p.offset) + " (slice " + std::to_string(p.slice_index) + ")", p.expected,
+            p.got,
             "the capture was interrupted inside slice " + std::to_string(p.slice_index) +
                 "; a LUT needs every slice; " + intact + " end at byte " +
                 std::to_string(r.valid_bytes),
@@ -184,7 +190,8 @@ CaptureAssessment AssessCapture(const std::string& path, BpcReadResult read) {
               (a.present_theta_in_deg.empty() ? std::string("none")
                                               : DegList(a.present_theta_in_deg) + "°") +
               " only (missing " + DegList(a.missing_theta_in_deg) + "°)",
-          {}, continue_remedy});
+          {},
+          continue_remedy});
     } else {
       a.warnings.push_back(
           path + ": warning: no intact end chunk (" +
@@ -220,9 +227,9 @@ RepairReport RepairCapture(const std::string& input, const std::string& output, 
     throw InvalidArgument(output + ": already exists", Remedy{RemedyKind::kForceOverwrite, output});
   CaptureAssessment a = AssessCapture(input);
   const BpcReadResult& r = a.read;
-  const bool damaged = !r.problems.empty() ||
-                       std::any_of(r.measurement.slices.begin(), r.measurement.slices.end(),
-                                   [](const Slice& s) { return !s.complete; });
+  const bool damaged =
+      !r.problems.empty() || std::any_of(r.measurement.slices.begin(), r.measurement.slices.end(),
+                                         [](const Slice& s) { return !s.complete; });
   if (r.finished && !damaged)
     throw InvalidArgument(input + ": an intact, finished capture (" +
                           SlicesText(r.measurement.slices.size()) + "); nothing to repair");
@@ -237,15 +244,14 @@ RepairReport RepairCapture(const std::string& input, const std::string& output, 
     d.offset = p.offset;
     d.size = p.size;
     d.slice_index = p.slice_index;
-    d.reason = std::string(p.kind == BpcProblemKind::kCorrupt ? "corrupt chunk"
-                                                               : "cut inside a chunk") +
-               ": expected " + p.expected + ", got " + p.got;
+    d.reason =
+        std::string(p.kind == BpcProblemKind::kCorrupt ? "corrupt chunk" : "cut inside a chunk") +
+        ": expected " + p.expected + ", got " + p.got;
     report.dropped.push_back(std::move(d));
   }
   for (const BpcProblem& p : r.problems)
     if (p.kind == BpcProblemKind::kTrailingData)
-      report.dropped.push_back({p.offset, p.size, -1, std::nullopt,
-                                "bytes after the end chunk"});
+      report.dropped.push_back({p.offset, p.size, -1, std::nullopt, "bytes after the end chunk"});
 
   // The header keeps what the capture started with (the settings a resume compares); the end
   // chunk's metadata, if any, is not carried over: the repaired capture is unfinished again.

@@ -95,8 +95,7 @@ const char* FileKindName(FileKind kind) {
 FileKind DetectFileKind(const std::string& path) {
   std::error_code ec;
   const fs::file_status status = fs::status(path, ec);
-  if (ec || status.type() == fs::file_type::not_found)
-    throw IoError(path + ": no such file");
+  if (ec || status.type() == fs::file_type::not_found) throw IoError(path + ": no such file");
   if (status.type() != fs::file_type::regular) CheckRegularFile(path);  // names what it is
   const std::uint64_t size = fs::file_size(path, ec);
   if (ec) throw IoError(path + ": cannot read its size: " + ec.message());
@@ -113,8 +112,7 @@ FileKind DetectFileKind(const std::string& path) {
 
   // 2. JSON.
   const std::size_t first = head.find_first_not_of(" \t\r\n");
-  const bool json_text =
-      first != std::string::npos && (head[first] == '{' || head[first] == '[');
+  const bool json_text = first != std::string::npos && (head[first] == '{' || head[first] == '[');
   if (ext == ".json" || json_text) return ClassifyJson(path);
 
   // 3. A binary format's extension without its magic: that reader names the damage.

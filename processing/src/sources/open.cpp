@@ -33,8 +33,9 @@ std::string LowerExtension(const std::string& path) {
 }
 
 std::string ExtrapolationIgnored(const std::string& path) {
-  return path + ": warning: the extrapolation given on the command line is ignored: it is baked "
-                "into an exported LUT";
+  return path +
+         ": warning: the extrapolation given on the command line is ignored: it is baked "
+         "into an exported LUT";
 }
 
 // A noise-free capture of an evaluable file, named after it.
@@ -88,8 +89,7 @@ PreparedMeasurement PrepareMeasurement(
     case FileKind::kCapture:
       out.measurement = LoadCaptureForLut(path, &out.warnings);
       break;
-    case FileKind::kMaterial:
-    {
+    case FileKind::kMaterial: {
       const Material material = LoadMaterialFile(path);
       out.measurement = CaptureFile(AnalyticBrdf(material), path, kind);
       out.measurement.metadata.extra["model"] = std::string(ModelName(material.model));
@@ -116,8 +116,9 @@ PreparedMeasurement PrepareMeasurement(
       break;
     }
     default:
-      throw InvalidArgument(path + ": expected a capture (.bpc), a material file or a measured "
-                                   "table, got a " +
+      throw InvalidArgument(path +
+                            ": expected a capture (.bpc), a material file or a measured "
+                            "table, got a " +
                             std::string(FileKindName(kind)));
   }
   out.extrapolation = ChooseExtrapolation(path, kind, command_line, &out.warnings);
@@ -339,8 +340,8 @@ std::optional<std::string> SaturationNote(
   std::string per_slice;
   for (const exporter::SaturatedCount& c : *counts) {
     total += c.count;
-    per_slice += (per_slice.empty() ? "θin " : ", ") + Deg(c.theta_in_deg) + "°: " +
-                 std::to_string(c.count);
+    per_slice +=
+        (per_slice.empty() ? "θin " : ", ") + Deg(c.theta_in_deg) + "°: " + std::to_string(c.count);
   }
   if (total == 0) return std::nullopt;
   return path + ": " + std::to_string(total) + " saturated sample" + (total == 1 ? "" : "s") +

@@ -76,9 +76,9 @@ enum class NextStep {
 // Instrument states the firmware reports with an error code; each has its own remedy.
 enum class InstrumentProblem {
   kNone,
-  kLampFailure,       // the light source failed: replace or reseat the lamp
+  kLampFailure,         // the light source failed: replace or reseat the lamp
   kSampleNotInContact,  // the sample is not seated on the measurement port
-  kOverTemperature,   // the detector is too warm: let it cool
+  kOverTemperature,     // the detector is too warm: let it cool
 };
 
 struct SessionStart {

@@ -92,7 +92,7 @@ struct DarkCalibration {
 struct WhiteCalibration {
   double theta_in_deg = 0;
   double exposure_ms = 0;
-  double nd_transmittance = 1;  // the ND filter the panel was read through (1 = open)
+  double nd_transmittance = 1;     // the ND filter the panel was read through (1 = open)
   std::array<double, 3> counts{};  // dark not subtracted
   int frames = 0;
   std::string time;  // ISO 8601 UTC

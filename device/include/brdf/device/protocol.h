@@ -47,7 +47,8 @@ inline constexpr std::uint16_t kProtocolMajor = 1;
 inline constexpr std::uint16_t kProtocolMinor = 1;
 
 // Largest number of samples one kRowData frame carries; longer rows are split into segments.
-// 180 samples (one row at 2° azimuth steps, or half a row at 1°) are 2,357 payload bytes (protocol 1.1).
+// 180 samples (one row at 2° azimuth steps, or half a row at 1°) are 2,357 payload bytes
+// (protocol 1.1).
 inline constexpr std::size_t kMaxSamplesPerRowFrame = 180;
 
 enum class MessageType : std::uint8_t {
@@ -97,7 +98,7 @@ struct DecodeResult {
   // kComplete: the frame's length in bytes. kInvalid: how many leading bytes to discard (at
   // least 1; up to the next possible sync byte). kNeedMore: 0.
   std::size_t consumed = 0;
-  Frame frame;           // kComplete only
+  Frame frame;            // kComplete only
   std::uint32_t crc = 0;  // kComplete only: the frame's CRC-32 (identifies a repeated frame)
   std::string reason;    // kInvalid only: "CRC-32: expected 0x…, got 0x…", "no sync bytes", …
   bool corrupt = false;  // kInvalid only: a frame header was found but its content is damaged

@@ -190,7 +190,7 @@ class SimulatedFirmware {
   std::uint8_t sequence_ = 0;
   bool link_up_ = true;
   bool stalled_ = false;
-  bool hung_ = false;  // kTimeout: silent until ABORT
+  bool hung_ = false;                     // kTimeout: silent until ABORT
   std::vector<std::uint8_t> held_frame_;  // kReorder: frame N, sent after frame N+1
   ExposureSetting exposure_;
   std::mt19937_64 rng_;

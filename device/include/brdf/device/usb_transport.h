@@ -34,9 +34,9 @@ enum class AccessProblem {
 struct FoundInstrument {
   DeviceSpec::Kind kind = DeviceSpec::Kind::kUsb;  // kUsb or kHid
   std::uint16_t vendor_id = 0, product_id = 0;
-  std::string model;    // from the model table
-  std::string serial;   // the USB serial-number string; empty when it could not be read
-  std::string bus_path;  // "bus 001 device 002" (USB) or hidapi's path ("1-1:1.0")
+  std::string model;             // from the model table
+  std::string serial;            // the USB serial-number string; empty when it could not be read
+  std::string bus_path;          // "bus 001 device 002" (USB) or hidapi's path ("1-1:1.0")
   std::string firmware_version;  // from IDENTIFY when `identify` was asked and it answered
   AccessProblem problem = AccessProblem::kNone;
   std::string problem_detail;  // the library's own words, for the log line

@@ -27,9 +27,9 @@
 #include <vector>
 
 #include "brdf/core/lut.h"
-#include "brdf/image_io/image_io.h"
 #include "brdf/exporter/metadata.h"
 #include "brdf/exporter/packed_volume.h"
+#include "brdf/image_io/image_io.h"
 
 namespace brdf::exporter {
 

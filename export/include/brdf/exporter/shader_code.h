@@ -29,8 +29,9 @@
 // directional light of irradiance-at-normal-incidence E is f_r · E · max(n·l, 0).
 // Above the last measured θin (60° for the reference instrument) the clamp-to-edge w axis
 // selects the last slice, read at the ω_d of the actual θin (the lobe keeps following the
-// mirror direction; `brdf eval` of a LUT does the same); below the first slice, the first. Light below the horizon (n·l ≤ 0) returns the value for θin = 90° clamped the same
-// way; the caller's max(n·l, 0) makes it contribute nothing.
+// mirror direction; `brdf eval` of a LUT does the same); below the first slice, the first. Light
+// below the horizon (n·l ≤ 0) returns the value for θin = 90° clamped the same way; the caller's
+// max(n·l, 0) makes it contribute nothing.
 //
 // Entry points in the generated code (same names and argument order in every language):
 //   MeasuredBrdfCoords(sin_in, cos_in, v_local, cell_texels) → uvw     (pure arithmetic)
@@ -54,11 +55,11 @@ enum class ShaderLanguage {
 
 // The constants the lookup needs.
 struct ShaderLutLayout {
-  double theta_in0_deg = 0;   // θin of slice 0
-  double delta_in_deg = 20;   // Δin (any positive value for a single slice)
-  int slices = 4;             // K
-  int texture_width = 361;    // W: 361 for a LUT, Cm·361 for an atlas
-  int texture_height = 181;   // H: 181 for a LUT, Rm·181 for an atlas
+  double theta_in0_deg = 0;  // θin of slice 0
+  double delta_in_deg = 20;  // Δin (any positive value for a single slice)
+  int slices = 4;            // K
+  int texture_width = 361;   // W: 361 for a LUT, Cm·361 for an atlas
+  int texture_height = 181;  // H: 181 for a LUT, Rm·181 for an atlas
 };
 
 // The layout of a single LUT with this θin list. Throws InvalidArgument for an empty list.

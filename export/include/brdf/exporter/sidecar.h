@@ -55,7 +55,7 @@ struct SidecarInfo {
   std::uint32_t payload_crc32 = 0;
   std::optional<ExtrapolationInfo> extrapolation;
   std::optional<std::vector<SaturatedCount>> saturated_samples;  // absent: not recorded
-  std::vector<std::string> fitted_models_json;  // each model as compact JSON text
+  std::vector<std::string> fitted_models_json;                   // each model as compact JSON text
   std::string tool_version;
   std::vector<std::string> files;  // companion file names
 };

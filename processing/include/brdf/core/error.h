@@ -28,14 +28,14 @@ namespace brdf {
 // tool: "run 'brdf repair cap.bpc --out FIXED.bpc'").
 enum class RemedyKind {
   kNone,
-  kResumeCapture,   // continue the interrupted capture `file` (its first `valid_bytes` bytes are
-                    // kept); `theta_in_deg` lists the slices still to capture
-  kRepairCapture,   // write the intact slices of `file` to a new capture, then resume that one
-  kRecapture,       // the data is lost (a slice stopped mid-way, damage beyond repair)
-  kForceOverwrite,  // `file` exists and would be replaced only when the user insists
-  kAllowBtdf,       // `file` holds transmission data, accepted only on request
-  kNameFormat,      // the format of `file` could not be recognised; the user may name it
-  kCaptureEvaluable,  // `file` is an evaluable BRDF (RGL, MERL): capture it virtually
+  kResumeCapture,      // continue the interrupted capture `file` (its first `valid_bytes` bytes are
+                       // kept); `theta_in_deg` lists the slices still to capture
+  kRepairCapture,      // write the intact slices of `file` to a new capture, then resume that one
+  kRecapture,          // the data is lost (a slice stopped mid-way, damage beyond repair)
+  kForceOverwrite,     // `file` exists and would be replaced only when the user insists
+  kAllowBtdf,          // `file` holds transmission data, accepted only on request
+  kNameFormat,         // the format of `file` could not be recognised; the user may name it
+  kCaptureEvaluable,   // `file` is an evaluable BRDF (RGL, MERL): capture it virtually
   kEvaluateSingleLut,  // `file` is an atlas; evaluate one material's own LUT
 };
 

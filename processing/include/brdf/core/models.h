@@ -14,13 +14,14 @@
 //   lambert                rho                                 ρ/π
 //   lafortune              kd, ks, n                           kd/π + ks·(n+2)/(2π)·max(v·r, 0)^n
 //   blinn-phong            kd, ks, n                           kd/π + ks·(n+8)/(8π)·max(n·h, 0)^n
-//   ggx                    kd, f0, alpha                       Cook-Torrance/Walter, Smith G, Schlick F
-//   ward                   rho_d, rho_s, alpha                 ρd/π + ρs·exp(−tan²θh/α²)/(4πα²√(cosθi cosθo))
-//   unreal-defaultlit      base_color, metallic, specular, roughness   (UE DefaultLit, below)
-//   unity-hdrp-lit         base_color, metallic, smoothness            (HDRP Lit, metallic)
-//   unity-hdrp-lit-specular base_color, specular_color, smoothness     (HDRP Lit, specular colour)
-//   unity-urp-lit          base_color, metallic, smoothness            (URP Lit, metallic)
-//   unity-urp-lit-specular base_color, specular_color, smoothness      (URP Lit, specular setup)
+//   ggx                    kd, f0, alpha                       Cook-Torrance/Walter, Smith G,
+//   Schlick F ward                   rho_d, rho_s, alpha                 ρd/π +
+//   ρs·exp(−tan²θh/α²)/(4πα²√(cosθi cosθo)) unreal-defaultlit      base_color, metallic, specular,
+//   roughness   (UE DefaultLit, below) unity-hdrp-lit         base_color, metallic, smoothness
+//   (HDRP Lit, metallic) unity-hdrp-lit-specular base_color, specular_color, smoothness     (HDRP
+//   Lit, specular colour) unity-urp-lit          base_color, metallic, smoothness            (URP
+//   Lit, metallic) unity-urp-lit-specular base_color, specular_color, smoothness      (URP Lit,
+//   specular setup)
 // In the legacy models (lambert … ward) every RGB channel is independent: kd, ks and the lobe
 // shape (n or alpha) may differ per channel. The engine models have one roughness for all
 // channels, as the engines do.
@@ -71,8 +72,8 @@ inline constexpr int kMaxModelValues = 9;
 
 // One named parameter of a model.
 struct ParameterInfo {
-  std::string_view name;  // material-file member ("kd", "base_color")
-  bool rgb = true;        // three values (red, green, blue) or one
+  std::string_view name;    // material-file member ("kd", "base_color")
+  bool rgb = true;          // three values (red, green, blue) or one
   double min = 0, max = 1;  // closed valid range (also the fitter's bounds)
   double start = 0.5;       // the fitter's default start
   // The fitter searches this parameter in log space (exponents and widths spanning decades).
@@ -219,12 +220,10 @@ std::array<T, 3> UnrealDefaultLit(const ShadingGeometry& g, const T* p) {
   const T a = sqrt(a2);
   const T d = (g.n_dot_h * a2 - g.n_dot_h) * g.n_dot_h + T(1);
   const T dist = a2 / (T(kPi) * d * d);
-  const T vis =
-      T(0.5) / (no_l * (no_v * (T(1) - a) + a) + no_v * (no_l * (T(1) - a) + a));
+  const T vis = T(0.5) / (no_l * (no_v * (T(1) - a) + a) + no_v * (no_l * (T(1) - a) + a));
   const double fc = Pow5(1.0 - g.v_dot_h);
   std::array<T, 3> f0;
-  for (int c = 0; c < 3; ++c)
-    f0[c] = T(0.08) * specular * (T(1) - metallic) + p[c] * metallic;
+  for (int c = 0; c < 3; ++c) f0[c] = T(0.08) * specular * (T(1) - metallic) + p[c] * metallic;
   T f90 = T(50) * f0[1];
   if (f90 > T(1)) f90 = T(1);
   if (f90 < T(0)) f90 = T(0);
@@ -239,19 +238,18 @@ std::array<T, 3> UnrealDefaultLit(const ShadingGeometry& g, const T* p) {
 // Unity HDRP Lit (com.unity.render-pipelines.high-definition Runtime/Material/Lit/Lit.hlsl,
 // ConvertSurfaceDataToBSDFData and BSDF(); terms from com.unity.render-pipelines.core
 // ShaderLibrary/BSDF.hlsl and CommonMaterial.hlsl):
-//   perceptualRoughness = 1 − smoothness, α = perceptualRoughness² (PerceptualRoughnessToRoughness);
-//   metallic: diffuseColor = ComputeDiffuseColor = baseColor·(1 − metallic), fresnel0 =
-//   ComputeFresnel0(baseColor, metallic, 0.04) = lerp(0.04, baseColor, metallic);
-//   specular colour: fresnel0 = specularColor, diffuseColor = baseColor·(1 − max(specularColor))
-//   (the Lit shader's default "Energy Conserving Specular Color");
-//   F = F_Schlick(fresnel0, LdotH) (f90 = 1); D_GGX(NdotH, α) = α² / (π s²),
-//   s = (NdotH·α² − NdotH)·NdotH + 1; V_SmithJointGGX (exact height-correlated Smith):
-//   0.5 / (NdotL·√((−NdotV·α² + NdotV)·NdotV + α²) + NdotV·√((−NdotL·α² + NdotL)·NdotL + α²));
-//   DisneyDiffuse(NdotV, NdotL, LdotV, perceptualRoughness) = (1/π)·F_Schlick(1, fd90, NdotL)·
-//   F_Schlick(1, fd90, NdotV) / 1.03571, fd90 = 0.5 + perceptualRoughness·(1 + LdotV);
-//   NdotV clamped to ≥ 0.0001 (ClampNdotV); α ≥ 1e-4, the clamp a punctual light applies with
-//   its default maximum smoothness 0.99 (ClampRoughness with the light's minRoughness).
-//   f_r = diffuseColor·DisneyDiffuse + F·D·V.
+//   perceptualRoughness = 1 − smoothness, α = perceptualRoughness²
+//   (PerceptualRoughnessToRoughness); metallic: diffuseColor = ComputeDiffuseColor = baseColor·(1 −
+//   metallic), fresnel0 = ComputeFresnel0(baseColor, metallic, 0.04) = lerp(0.04, baseColor,
+//   metallic); specular colour: fresnel0 = specularColor, diffuseColor = baseColor·(1 −
+//   max(specularColor)) (the Lit shader's default "Energy Conserving Specular Color"); F =
+//   F_Schlick(fresnel0, LdotH) (f90 = 1); D_GGX(NdotH, α) = α² / (π s²), s = (NdotH·α² −
+//   NdotH)·NdotH + 1; V_SmithJointGGX (exact height-correlated Smith): 0.5 / (NdotL·√((−NdotV·α² +
+//   NdotV)·NdotV + α²) + NdotV·√((−NdotL·α² + NdotL)·NdotL + α²)); DisneyDiffuse(NdotV, NdotL,
+//   LdotV, perceptualRoughness) = (1/π)·F_Schlick(1, fd90, NdotL)· F_Schlick(1, fd90, NdotV)
+//   / 1.03571, fd90 = 0.5 + perceptualRoughness·(1 + LdotV); NdotV clamped to ≥ 0.0001
+//   (ClampNdotV); α ≥ 1e-4, the clamp a punctual light applies with its default maximum smoothness
+//   0.99 (ClampRoughness with the light's minRoughness). f_r = diffuseColor·DisneyDiffuse + F·D·V.
 // p = {base r, g, b, metallic, smoothness} or {base r, g, b, spec r, g, b, smoothness}.
 template <class T>
 std::array<T, 3> UnityHdrpLit(const ShadingGeometry& g, const T* p, bool specular_color) {

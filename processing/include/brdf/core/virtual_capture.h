@@ -24,9 +24,9 @@ namespace brdf {
 
 struct CaptureGeometry {
   std::vector<double> theta_in_deg = {0, 20, 40, 60};  // light polar angles, φin = 0
-  double theta_out_max_deg = 75;                        // inclusive
-  double theta_out_step_deg = 1;                        // θout = 0, step, 2·step, … ≤ max
-  double phi_out_step_deg = 1;                          // φout = 0, step, … < 360
+  double theta_out_max_deg = 75;                       // inclusive
+  double theta_out_step_deg = 1;                       // θout = 0, step, 2·step, … ≤ max
+  double phi_out_step_deg = 1;                         // φout = 0, step, … < 360
 
   // The θout and φout values of one slice, in capture order (θout rows, φout within a row).
   std::vector<double> ThetaOutDeg() const;

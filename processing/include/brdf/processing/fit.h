@@ -53,8 +53,8 @@ struct FitOptions {
   // Samples with θout above this are left out (counted in FitReport::excluded_theta_out).
   // Unset: everything measured.
   std::optional<double> max_theta_out_deg;
-  int starts = 2;           // candidates of the sweep refined on all samples (≥ 1)
-  int threads = 1;          // Ceres' threads for residuals and Jacobians (≥ 1)
+  int starts = 2;            // candidates of the sweep refined on all samples (≥ 1)
+  int threads = 1;           // Ceres' threads for residuals and Jacobians (≥ 1)
   int max_iterations = 100;  // per refinement
   // A start of the same model instead of the sweep (its values are clamped into range).
   std::optional<Material> start;
@@ -78,7 +78,7 @@ struct FitReport {
   // result is still the best found) or "failed" (no usable result).
   std::string status;
   bool converged = false;
-  std::string message;  // Ceres' termination message of the winning refinement
+  std::string message;                      // Ceres' termination message of the winning refinement
   double initial_cost = 0, final_cost = 0;  // in the loss above, at the winning start and end
   double rmse = 0;                          // over all slices, as SliceFitError::rmse
   double median_relative_error = 0;
@@ -87,9 +87,9 @@ struct FitReport {
   int starts = 0;                     // refinements run
   double seconds = 0;                 // wall time of the whole fit, sweep included
   std::size_t samples_used = 0;
-  std::size_t excluded_invalid = 0;     // flagged invalid or not finite
-  std::size_t excluded_saturated = 0;   // flagged saturated (and not invalid)
-  std::size_t excluded_theta_out = 0;   // beyond max_theta_out_deg or at/below the horizon
+  std::size_t excluded_invalid = 0;    // flagged invalid or not finite
+  std::size_t excluded_saturated = 0;  // flagged saturated (and not invalid)
+  std::size_t excluded_theta_out = 0;  // beyond max_theta_out_deg or at/below the horizon
   // False when the data has a feature the model cannot represent; `warnings` says which.
   bool representable = true;
   // Largest difference in rg chromaticity between measurement and fit over the (θin, θh)
@@ -133,8 +133,8 @@ FitReport EvaluateFit(const Measurement& measurement, const Material& material,
 struct AutoExtrapolationResult {
   ExtrapolationParams params;
   double theta_b_deg = 0;
-  double band_rmse = 0;        // RMS error over the band with params, 1/sr
-  double band_rmse_clamp = 0;  // the same with p = 1 (clamping), for comparison
+  double band_rmse = 0;          // RMS error over the band with params, 1/sr
+  double band_rmse_clamp = 0;    // the same with p = 1 (clamping), for comparison
   std::optional<FitResult> fit;  // the GGX fit used, when ChooseExtrapolationAuto made it
 };
 AutoExtrapolationResult FitExtrapolationToModel(const Measurement& measurement,

@@ -116,7 +116,7 @@ enum class Shape { kSphere, kPlane, kMesh };
 // averages of the adjacent face normals.
 struct Mesh {
   std::vector<Vec3> positions;
-  std::vector<Vec3> normals;                    // same size as positions
+  std::vector<Vec3> normals;  // same size as positions
   std::vector<std::array<std::uint32_t, 3>> triangles;
 };
 // Reads an ASCII or binary little-endian PLY (vertex x, y, z, optional nx, ny, nz; faces as
@@ -162,7 +162,7 @@ enum class ToneMapCurve {
 
 struct PreviewOptions {
   Shape shape = Shape::kSphere;
-  const Mesh* mesh = nullptr;  // kMesh: the mesh (must outlive the renderer)
+  const Mesh* mesh = nullptr;     // kMesh: the mesh (must outlive the renderer)
   int width = 512, height = 512;  // pixels
   Camera camera;
   double environment_rotation_deg = 0.0;  // turns the map about +z
@@ -178,8 +178,8 @@ struct PreviewOptions {
   int samples_per_pixel = 64;
   double target_relative_rms = 0.0;
   int max_samples_per_pixel = 65536;
-  int jobs = 0;                // worker threads; 0 = hardware threads
-  std::uint64_t seed = 1;      // same seed, same options → the same image
+  int jobs = 0;            // worker threads; 0 = hardware threads
+  std::uint64_t seed = 1;  // same seed, same options → the same image
   // kQuadrature: each map pixel is split into n × n parts (midpoint rule in solid angle).
   int quadrature_subdivisions = 2;
   // Called after every pass from the calling thread: passes done, the current estimate of the
@@ -193,10 +193,10 @@ struct PreviewOptions {
 // A linear HDR image and what produced it.
 struct PreviewImage {
   int width = 0, height = 0;
-  std::vector<float> rgb;             // width·height·3, row 0 at the top, linear radiance
-  std::vector<std::uint8_t> object;   // width·height: 1 where the camera ray hits the object
-  int samples_per_pixel = 0;          // passes accumulated
-  double relative_rms_estimate = 0.0; // EstimatedRelativeRms() when the image was taken
+  std::vector<float> rgb;              // width·height·3, row 0 at the top, linear radiance
+  std::vector<std::uint8_t> object;    // width·height: 1 where the camera ray hits the object
+  int samples_per_pixel = 0;           // passes accumulated
+  double relative_rms_estimate = 0.0;  // EstimatedRelativeRms() when the image was taken
   double seconds = 0.0;
   const float* Pixel(int x, int y) const {
     return &rgb[(static_cast<std::size_t>(y) * width + x) * 3];
@@ -306,8 +306,8 @@ std::vector<std::uint8_t> ToneMap(const PreviewImage& image, double exposure_ev 
 // Writes `image` by extension: .exr (float RGB, linear radiance, no tone map; header attributes
 // name the source, map and samples) or .png (ToneMap with the given exposure and curve).
 // Written atomically. Throws InvalidArgument for another extension, IoError when writing fails.
-void WritePreviewImage(const std::string& path, const PreviewImage& image,
-                       double exposure_ev = 0.0, ToneMapCurve curve = ToneMapCurve::kClamp,
+void WritePreviewImage(const std::string& path, const PreviewImage& image, double exposure_ev = 0.0,
+                       ToneMapCurve curve = ToneMapCurve::kClamp,
                        const std::vector<std::pair<std::string, std::string>>& attributes = {});
 
 }  // namespace brdf::preview

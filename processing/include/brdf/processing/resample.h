@@ -105,10 +105,10 @@ struct LutInputProblem {
     kDegenerateRange,    // every valid sample at θout = 0: nothing to interpolate over
   };
   Kind kind = Kind::kNoSlices;
-  int slice = -1;                    // index into measurement.slices; -1 for the whole
-  double theta_in_deg = 0;           // of `slice`
-  std::size_t sample_count = 0;      // kBadSamples: how many samples of the slice
-  std::size_t first_sample = 0;      // kBadSamples: index of the first one
+  int slice = -1;                // index into measurement.slices; -1 for the whole
+  double theta_in_deg = 0;       // of `slice`
+  std::size_t sample_count = 0;  // kBadSamples: how many samples of the slice
+  std::size_t first_sample = 0;  // kBadSamples: index of the first one
   std::string message;  // one sentence without the file name: "slice 2 (θin = 40°): 3 samples
                         // with red value not a finite number (first: sample 17)"
 };

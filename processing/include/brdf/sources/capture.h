@@ -44,12 +44,12 @@ struct CaptureAssessment {
   BpcReadResult read;  // everything ReadBpc found (intact slices, problems, valid bytes)
   // The θin plan: recorded in the metadata, else the reference instrument's.
   std::vector<double> planned_theta_in_deg;
-  bool plan_recorded = false;                  // planned_theta_in_deg came from the file
-  std::vector<double> present_theta_in_deg;    // intact, complete slices, in file order
-  std::vector<double> missing_theta_in_deg;    // planned but not present (in plan order)
-  std::optional<CaptureRefusal> refusal;       // the first of `refusals`, if any
-  std::vector<CaptureRefusal> refusals;        // every reason the capture cannot become a LUT
-  std::vector<std::string> warnings;           // full sentences starting with the path
+  bool plan_recorded = false;                // planned_theta_in_deg came from the file
+  std::vector<double> present_theta_in_deg;  // intact, complete slices, in file order
+  std::vector<double> missing_theta_in_deg;  // planned but not present (in plan order)
+  std::optional<CaptureRefusal> refusal;     // the first of `refusals`, if any
+  std::vector<CaptureRefusal> refusals;      // every reason the capture cannot become a LUT
+  std::vector<std::string> warnings;         // full sentences starting with the path
 
   bool usable() const { return !refusal.has_value(); }
   // read.measurement when usable; throws the refusal's FormatError otherwise.
@@ -68,11 +68,11 @@ Measurement LoadCaptureForLut(const std::string& path, std::vector<std::string>*
 
 // What RepairCapture dropped from the damaged file.
 struct DroppedPart {
-  std::uint64_t offset = 0;   // byte offset of the dropped region in the damaged file
-  std::uint64_t size = 0;     // its length in bytes
-  int slice_index = -1;       // the file's slice index, -1 when not a slice or not known
+  std::uint64_t offset = 0;            // byte offset of the dropped region in the damaged file
+  std::uint64_t size = 0;              // its length in bytes
+  int slice_index = -1;                // the file's slice index, -1 when not a slice or not known
   std::optional<double> theta_in_deg;  // when the slice's θin is known (an incomplete slice)
-  std::string reason;         // "corrupt chunk: expected ..., got ...", "slice incomplete", ...
+  std::string reason;  // "corrupt chunk: expected ..., got ...", "slice incomplete", ...
 };
 
 struct RepairReport {

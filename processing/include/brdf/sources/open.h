@@ -112,10 +112,10 @@ struct OpenOptions {
 
 // How OpenBrdf evaluates the file.
 enum class Evaluation {
-  kAnalytic,      // a material file: the model's formula
+  kAnalytic,          // a material file: the model's formula
   kMeasuredDatabase,  // RGL / MERL: the database's own interpolation
-  kResampledLut,  // a capture or table, resampled into the float LUT (the convert path)
-  kExportedLut,   // an exported texture, RGB9E5 values as stored
+  kResampledLut,      // a capture or table, resampled into the float LUT (the convert path)
+  kExportedLut,       // an exported texture, RGB9E5 values as stored
 };
 
 struct OpenedSource {
@@ -126,7 +126,7 @@ struct OpenedSource {
   // when the source covers every θin itself.
   std::vector<double> measured_theta_in_deg;
   std::optional<ExtrapolationChoice> extrapolation;  // kResampledLut: what filled θout > θb
-  std::vector<std::string> warnings;  // full sentences starting with the path
+  std::vector<std::string> warnings;                 // full sentences starting with the path
 
   // A warning sentence when a query with light polar angle `theta_in_deg` lies outside the
   // measured θin range (answered from the nearest slice, clamp-to-edge), else nullopt.

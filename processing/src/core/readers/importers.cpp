@@ -143,9 +143,9 @@ Measurement ImportFile(const std::string& path, ImportFormat format, const Impor
     case ImportFormat::kMerl:
       // Evaluable formats need a virtual capture (brdf/core/virtual_capture.h), which the
       // caller chooses the geometry of.
-      throw InvalidArgument(path + ": " + ImportFormatName(format) +
-                                " files are evaluable BRDFs, not point clouds",
-                            Remedy{RemedyKind::kCaptureEvaluable, path});
+      throw InvalidArgument(
+          path + ": " + ImportFormatName(format) + " files are evaluable BRDFs, not point clouds",
+          Remedy{RemedyKind::kCaptureEvaluable, path});
     case ImportFormat::kAuto:
       break;
   }

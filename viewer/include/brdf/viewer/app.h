@@ -31,10 +31,10 @@ Mode ModeFromName(const std::string& name);
 
 // One source as the window receives it: either opened, or the reason it could not be.
 struct LoadedSource {
-  std::string path;                  // as the user typed it
-  std::optional<ViewSource> view;    // lobes and slices
+  std::string path;                        // as the user typed it
+  std::optional<ViewSource> view;          // lobes and slices
   std::shared_ptr<const BrdfSource> brdf;  // what the preview renders (may be null)
-  std::string error;                 // non-empty when opening failed
+  std::string error;                       // non-empty when opening failed
 };
 
 struct ViewerOptions {
@@ -56,8 +56,8 @@ struct ViewerOptions {
 };
 
 struct ViewerResult {
-  bool ok = true;        // false when a source failed to open or the screenshot failed
-  std::string message;   // what to tell the user on failure (one line)
+  bool ok = true;               // false when a source failed to open or the screenshot failed
+  std::string message;          // what to tell the user on failure (one line)
   bool display_failed = false;  // the X display could not be opened (worth another try)
 };
 

@@ -1,9 +1,9 @@
 // The reflection lobe of a ViewSource as a triangle mesh, and the camera that frames it.
 //
 // The lobe is a deformed hemisphere over the outgoing directions ω_out(θo, φo) of the local
-// frame (docs/design.md §4: z is the normal, directions point away from the surface, the light is at
-// (θin, φin = 0), i.e. in the +x half of the xz-plane, so the mirror direction is
-// (θin, 180°)). The vertex in direction ω_out sits at distance r(ω_out) from the origin:
+// frame (docs/design.md §4: z is the normal, directions point away from the surface, the light is
+// at (θin, φin = 0), i.e. in the +x half of the xz-plane, so the mirror direction is (θin, 180°)).
+// The vertex in direction ω_out sits at distance r(ω_out) from the origin:
 //   linear scale: r = q,  log scale: r = max(0, log10(q / q_floor))  (in decades),
 // where q = f_r (1/sr, not multiplied by cosθ) or, with `cosine_weighted`, f_r·cosθo, of the
 // chosen channel. f_r is the LUT sampled as a GPU samples it (brdf::Lut::SampleAngles), so for
@@ -28,15 +28,15 @@ double ChannelValue(const float* rgb, Channel channel);
 enum class RadiusScale { kLinear, kLog };
 
 struct LobeOptions {
-  double theta_in_deg = 0;        // light polar angle, any value in [0°, 90°)
+  double theta_in_deg = 0;  // light polar angle, any value in [0°, 90°)
   Channel channel = Channel::kLuminance;
-  bool cosine_weighted = false;   // radius from f_r·cosθo instead of f_r
+  bool cosine_weighted = false;  // radius from f_r·cosθo instead of f_r
   RadiusScale scale = RadiusScale::kLinear;
   // Log scale only: q_floor in the units of q (1/sr). 0 picks 10^-3 of the mesh's largest q;
   // the viewer passes one floor for both sources of a comparison so their radii agree.
   double log_floor = 0;
-  int theta_rows = 90;   // rows of vertices from θo = 0° to 90° (row t at θo = t·90°/theta_rows)
-  int phi_columns = 180; // columns at φo = c·360°/phi_columns
+  int theta_rows = 90;  // rows of vertices from θo = 0° to 90° (row t at θo = t·90°/theta_rows)
+  int phi_columns = 180;  // columns at φo = c·360°/phi_columns
 
   // Throws InvalidArgument naming the bad field.
   void Validate() const;

@@ -1,9 +1,9 @@
 // The LUT slices as heat-map images, and what lies under the cursor.
 //
-// Slice k of the LUT (docs/design.md §5) is an equirectangular image in the specular frame of θin,k:
-// column i at φd = i·1° (i = 0…360, column 360 repeats column 0), row j at θd = j·1° (j = 0…180,
-// row 0 at the top, θd = 0 is the mirror direction). A probe maps a texel back to the outgoing
-// direction it holds, ω_out = S(θin)·ω_d (brdf::SpecularFrame), in the measurement frame.
+// Slice k of the LUT (docs/design.md §5) is an equirectangular image in the specular frame of
+// θin,k: column i at φd = i·1° (i = 0…360, column 360 repeats column 0), row j at θd = j·1° (j =
+// 0…180, row 0 at the top, θd = 0 is the mirror direction). A probe maps a texel back to the
+// outgoing direction it holds, ω_out = S(θin)·ω_d (brdf::SpecularFrame), in the measurement frame.
 // No VTK here.
 #pragma once
 
@@ -28,10 +28,10 @@ struct SliceImage {
 SliceImage BuildSliceImage(const ViewSource& source, int slice, Channel channel);
 
 struct SliceProbe {
-  int i = 0, j = 0;                // nearest texel (column, row)
-  double phi_d_deg = 0, theta_d_deg = 0;  // its centre
-  std::array<float, 3> rgb{};      // the texel, f_r in 1/sr
-  double value = 0;                // the channel value
+  int i = 0, j = 0;                           // nearest texel (column, row)
+  double phi_d_deg = 0, theta_d_deg = 0;      // its centre
+  std::array<float, 3> rgb{};                 // the texel, f_r in 1/sr
+  double value = 0;                           // the channel value
   double theta_out_deg = 0, phi_out_deg = 0;  // the outgoing direction it holds
   // θout > 90°: below the horizon, the texel holds the value at θout = 90° (edge extension).
   bool below_horizon = false;

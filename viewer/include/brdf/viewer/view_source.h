@@ -1,5 +1,6 @@
-// What the viewer shows of one BRDF source: its LUT (docs/design.md §5, the asset an engine samples)
-// and, when the source was a measurement, which outgoing directions were actually measured.
+// What the viewer shows of one BRDF source: its LUT (docs/design.md §5, the asset an engine
+// samples) and, when the source was a measurement, which outgoing directions were actually
+// measured.
 //
 // Every picture in brdf-view (lobes, slice heat maps) is drawn from the LUT and sampled the way
 // a GPU samples it (brdf::Lut::SampleAngles: trilinear in the specular frame, so a θin between
@@ -70,8 +71,8 @@ ViewSource ViewSourceFromMeasurement(const Measurement& measurement,
 ViewSource ViewSourceFromLut(Lut lut, std::string name, double theta_b_deg = 90);
 
 // Any evaluable BRDF (RGL, MERL, a fit): captured noise-free on the reference instrument's
-// geometry (θin 0/20/40/60°, θout 0–75°, φout 0–359° at 1°, docs/design.md §1) and resampled with the
-// default §6 parameters, i.e. exactly the LUT `brdf convert` would make from that capture.
+// geometry (θin 0/20/40/60°, θout 0–75°, φout 0–359° at 1°, docs/design.md §1) and resampled with
+// the default §6 parameters, i.e. exactly the LUT `brdf convert` would make from that capture.
 ViewSource ViewSourceFromBrdf(const BrdfSource& source, std::string name);
 
 }  // namespace brdf::viewer

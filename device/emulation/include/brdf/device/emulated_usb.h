@@ -49,9 +49,9 @@ class EmulatedUsbInstrument {
 
   // The --device spec that opens this instrument (VID:PID:SERIAL).
   DeviceSpec Spec() const;
-  std::uint64_t halts_cleared() const;    // CLEAR_HALT requests received
-  std::uint64_t in_transfers() const;     // IN URBs completed with data
-  std::uint64_t frames_sent() const;      // firmware frames
+  std::uint64_t halts_cleared() const;  // CLEAR_HALT requests received
+  std::uint64_t in_transfers() const;   // IN URBs completed with data
+  std::uint64_t frames_sent() const;    // firmware frames
   // Simulates pulling the cable: the device vanishes from the bus.
   void Unplug();
 

@@ -85,10 +85,9 @@ std::vector<std::string> EngineOutputPaths(const std::string& out_dir, const std
 // beside the prefix (<dir of prefix>/<engine>/<stem of prefix>.*), with shaders addressing
 // cells (MeasuredBrdfCell with the cell origin the manifest lists per material).
 // Returns every path written. Throws InvalidArgument / IoError.
-std::vector<std::string> WriteAtlasWithEngines(const std::string& prefix,
-                                               const std::vector<exporter::AtlasMaterial>& materials,
-                                               const exporter::ExrOptions& exr_options,
-                                               const EngineSet& engines);
+std::vector<std::string> WriteAtlasWithEngines(
+    const std::string& prefix, const std::vector<exporter::AtlasMaterial>& materials,
+    const exporter::ExrOptions& exr_options, const EngineSet& engines);
 
 // The RGBA16F payload of the Unreal DDS: every RGB9E5 word decoded and converted to IEEE
 // half (exact: a decoded RGB9E5 value has at most 9 significant bits and is ≤ 65408, both
