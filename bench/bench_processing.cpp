@@ -100,17 +100,18 @@ BENCHMARK(BM_ResampleGridDefault)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_ResampleScatteredSingleThread)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_ResampleScatteredDefault)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-// Point evaluation of a capture, as `brdf eval` and the viewer do it.
-void BM_MeasurementBrdfEval(benchmark::State& state) {
-  const brdf::processing::MeasurementBrdf brdf(GridCapture());
+// Point evaluation of a capture through its LUT, as `brdf eval`, the preview and the viewer
+// do it (processing::MeasurementAsBrdf).
+void BM_MeasurementAsBrdfEval(benchmark::State& state) {
+  const brdf::LutBrdf brdf = brdf::processing::MeasurementAsBrdf(GridCapture());
   std::mt19937_64 rng(2);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   for (auto _ : state) {
-    const brdf::Rgb f = brdf.EvalAngles(60.0 * u(rng), 85.0 * u(rng), 360.0 * u(rng));
+    const auto f = brdf.lut().SampleAngles(60.0 * u(rng), 85.0 * u(rng), 360.0 * u(rng));
     benchmark::DoNotOptimize(f);
   }
 }
-BENCHMARK(BM_MeasurementBrdfEval);
+BENCHMARK(BM_MeasurementAsBrdfEval);
 
 }  // namespace
 

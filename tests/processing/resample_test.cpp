@@ -381,11 +381,12 @@ TEST(ResampleRegularGrid, PoleSamplesAreAveragedIntoOneDirection) {
       EXPECT_NEAR(lut.Texel(0, 0, i)[c], mean[c], 1e-6 * mean[c]);
       EXPECT_NEAR(lut.Texel(0, 1, i)[c], rho_pi[c], 1e-6 * rho_pi[c]);
     }
-  const MeasurementBrdf brdf(meas);
+  const LutBrdf brdf = MeasurementAsBrdf(meas);
   for (double phi = 0; phi < 360; phi += 7.5)
     for (int c = 0; c < 3; ++c) {
-      EXPECT_NEAR(brdf.EvalAngles(0, 1e-9, phi)[c], mean[c], 1e-6 * mean[c]) << phi;
-      EXPECT_NEAR(brdf.EvalAngles(0, 0.5, phi)[c], 0.5 * (mean[c] + rho_pi[c]), 1e-6 * mean[c]);
+      EXPECT_NEAR(brdf.lut().SampleAngles(0, 1e-9, phi)[c], mean[c], 1e-6 * mean[c]) << phi;
+      EXPECT_NEAR(brdf.lut().SampleAngles(0, 0.5, phi)[c], 0.5 * (mean[c] + rho_pi[c]),
+                  1e-6 * mean[c]);
     }
 }
 
@@ -394,15 +395,16 @@ TEST(ResampleScattered, HasNoSeamOrPoleDiscontinuity) {
   scattered.allow_regular_grid = false;
   const Material m = test::GgxAlpha03();
   for (const Measurement& meas : {test::ScatteredCapture(m, 76 * 360, 3), test::GridCapture(m)}) {
-    const MeasurementBrdf brdf(meas, {}, scattered);
+    const LutBrdf brdf = MeasurementAsBrdf(meas, {}, scattered);
     for (double ti : {0.0, 20.0, 60.0}) {
       for (double theta = 1; theta < 75; theta += 3.7) {
-        const Rgb a = brdf.EvalAngles(ti, theta, 359.9999), b = brdf.EvalAngles(ti, theta, 0.0001);
+        const auto a = brdf.lut().SampleAngles(ti, theta, 359.9999);
+        const auto b = brdf.lut().SampleAngles(ti, theta, 0.0001);
         for (int c = 0; c < 3; ++c) EXPECT_NEAR(a[c], b[c], 1e-4 * a[c]) << ti << " " << theta;
       }
-      const Rgb pole = brdf.EvalAngles(ti, 0.0, 0.0);
+      const auto pole = brdf.lut().SampleAngles(ti, 0.0, 0.0);
       for (double phi = 0; phi < 360; phi += 10) {
-        const Rgb near_pole = brdf.EvalAngles(ti, 1e-5, phi);
+        const auto near_pole = brdf.lut().SampleAngles(ti, 1e-5, phi);
         for (int c = 0; c < 3; ++c)
           EXPECT_NEAR(near_pole[c], pole[c], 1e-4 * pole[c]) << ti << " " << phi;
       }

@@ -118,6 +118,32 @@ TEST_F(SourcesCli, BeyondTheLastSliceClampsWithAWarning) {
   EXPECT_EQ(err.find("outside"), std::string::npos) << err;
 }
 
+// Light beyond the last slice, view inside the measured range: reciprocity (docs/design.md §5)
+// answers from measured slices, the same for the capture and its exported texture, without a
+// warning. The expected value is the material's own for the pair, which the capture holds in
+// its 40° slice at θout = 70° (measured, θout ≤ 75°), within the resampling error.
+TEST_F(SourcesCli, BeyondTheLastSliceWithTheViewInsideUsesReciprocity) {
+  const Analytic m = Ggx03();
+  const fs::path bpc = WriteCapture("ggx", CaptureOf(m, {0, 20, 40, 60}));
+  std::string err;
+  const auto got = Eval(bpc, "70,0", "40,180", &err);
+  EXPECT_EQ(err.find("outside"), std::string::npos) << err;
+  const auto exchanged = Eval(bpc, "40,180", "70,0", &err);
+  const auto truth = m.FAngles(70, 40, 180);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(got[c], exchanged[c], 1e-7 * exchanged[c]) << c;
+    EXPECT_NEAR(got[c], truth[c], 0.02 * truth[c]) << c;
+  }
+  ASSERT_EQ(RunTool("convert " + Quote(bpc) + " --out " + Quote(dir_ / "luts") +
+                        " --formats ktx2,json --quiet",
+                    dir_)
+                .exit_code,
+            0);
+  const auto lut = Eval(dir_ / "luts" / "ggx.ktx2", "70,0", "40,180", &err);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(lut[c], got[c], Rgb9e5Step(2 * got[0])) << c;
+  EXPECT_EQ(err.find("outside"), std::string::npos) << err;
+}
+
 // `brdf repair` then `brdf capture --resume` gives, slice for slice and value for value, the
 // capture an uninterrupted run with the same seed makes.
 class Repair : public SourcesCli {

@@ -92,7 +92,7 @@ int RunEval(const EvalOptions& options) {
   for (const std::string& w : source.warnings) std::fprintf(stderr, "%s\n", w.c_str());
   std::set<double> warned_theta_in;  // one warning per θin beyond the measured range
   for (const Pair& p : pairs) {
-    if (const auto w = source.BeyondMeasuredWarning(p.theta_in_deg, options.file))
+    if (const auto w = source.BeyondMeasuredWarning(p.theta_in_deg, p.theta_out_deg, options.file))
       if (warned_theta_in.insert(p.theta_in_deg).second) std::fprintf(stderr, "%s\n", w->c_str());
     const Vec3 wi = SphericalDirectionDeg(p.theta_in_deg, p.phi_in_deg);
     const Vec3 wo = SphericalDirectionDeg(p.theta_out_deg, p.phi_out_deg);

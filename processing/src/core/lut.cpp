@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "brdf/core/geometry.h"
+#include "brdf/core/lut_brdf.h"
 
 namespace brdf {
 namespace {
@@ -67,8 +68,25 @@ double Lut::SliceCoordinate(double theta_in) const {
   return static_cast<double>(i - 1) + (theta_in - a) / (b - a);
 }
 
+bool Lut::ExchangesLightAndView(double theta_in, double theta_out_deg) const {
+  if (theta_in_deg.empty()) return false;
+  const double lo = theta_in_deg.front(), hi = theta_in_deg.back();
+  // Within 1e-6° of the range counts as inside: a measured slice is answered from itself.
+  constexpr double kTolDeg = 1e-6;
+  const auto outside = [&](double t) { return std::max({lo - t, t - hi, 0.0}); };
+  const double d_in = outside(theta_in);
+  return d_in > kTolDeg && outside(theta_out_deg) < d_in;
+}
+
 std::array<float, 3> Lut::SampleAngles(double theta_in, double theta_out_deg,
                                        double phi_out_deg) const {
+  if (ExchangesLightAndView(theta_in, theta_out_deg))
+    return SampleTexture(theta_out_deg, theta_in, -phi_out_deg);
+  return SampleTexture(theta_in, theta_out_deg, phi_out_deg);
+}
+
+std::array<float, 3> Lut::SampleTexture(double theta_in, double theta_out_deg,
+                                        double phi_out_deg) const {
   const Vec3 w_out = SphericalDirectionDeg(theta_out_deg, phi_out_deg);
   const Vec3 w_d = SpecularFrame::FromThetaInDeg(theta_in).ToSpecular(w_out);
   const double theta_d = RadToDeg(ThetaOf(w_d));
@@ -78,6 +96,17 @@ std::array<float, 3> Lut::SampleAngles(double theta_in, double theta_out_deg,
   const double v = (theta_d / kTexelDeg + 0.5) / kHeight;
   const double w = (k + 0.5) / slices();
   return SampleTrilinear(u, v, w);
+}
+
+Rgb LutBrdf::Eval(const Vec3& wi, const Vec3& wo) const {
+  if (!(wi.z > 0.0) || !(wo.z > 0.0)) return {0.0, 0.0, 0.0};
+  const double theta_in_deg = RadToDeg(ThetaOf(wi));
+  // Isotropic: only φout − φin matters, and the LUT stores the light at φin = 0.
+  const double phi_deg = std::hypot(wi.x, wi.y) > 0.0
+                             ? WrapDeg360(RadToDeg(PhiOf(wo)) - RadToDeg(PhiOf(wi)))
+                             : RadToDeg(PhiOf(wo));
+  const std::array<float, 3> f = lut_.SampleAngles(theta_in_deg, RadToDeg(ThetaOf(wo)), phi_deg);
+  return {f[0], f[1], f[2]};
 }
 
 }  // namespace brdf

@@ -1,5 +1,5 @@
 # brdf::processing: resampling to the LUT grid (docs/design.md §5), grazing extrapolation (docs/design.md §6)
-# and the interpolated-capture BrdfSource. Fitting (Ceres) joins this target later.
+# and a measurement evaluated through its LUT (measurement_brdf.h). Fitting (Ceres) joins this target later.
 add_library(brdf_processing
   ${CMAKE_CURRENT_LIST_DIR}/extrapolation.cpp
   ${CMAKE_CURRENT_LIST_DIR}/slice_interpolator.cpp

@@ -1,5 +1,5 @@
-// Interpolation of one measurement slice over the outgoing direction, shared by BuildLut and
-// MeasurementBrdf so a LUT texel and `brdf eval` of its capture can never disagree.
+// Interpolation of one measurement slice over the outgoing direction, used by BuildLut (every
+// evaluation of a capture goes through the LUT it builds, measurement_brdf.h).
 // The methods are described in resample.h and docs/resampling.md.
 #pragma once
 
@@ -136,17 +136,5 @@ class SliceInterpolator {
   Rgb horizon_mean_{};
   SliceResampleReport report_;
 };
-
-// Evaluates the docs/design.md §6 model for one slice: interpolated inside [0, θb], extrapolated
-// from the horizon ring up to 90°, the 90° value beyond. `factor_90` is ExtrapolationFactor(90°).
-inline Rgb SliceValue(const SliceInterpolator& slice, double theta_b_deg,
-                      const ExtrapolationParams& params, double theta_out_deg, double phi_out_deg) {
-  if (theta_out_deg <= theta_b_deg)
-    return slice.At(theta_out_deg, phi_out_deg, SphericalDirectionDeg(theta_out_deg, phi_out_deg));
-  const double f = ExtrapolationFactor(std::fmin(theta_out_deg, 90.0), theta_b_deg, params);
-  Rgb v = slice.Horizon(phi_out_deg);
-  for (double& c : v) c *= f;
-  return v;
-}
 
 }  // namespace brdf::processing::internal

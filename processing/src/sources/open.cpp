@@ -11,6 +11,7 @@
 #include "brdf/core/rgl.h"
 #include "brdf/core/virtual_capture.h"
 #include "brdf/exporter/packed_volume.h"
+#include "brdf/processing/measurement_brdf.h"
 #include "brdf/sources/capture.h"
 #include "text.h"
 
@@ -214,26 +215,23 @@ OpenedTexture OpenExportedTexture(const std::string& path) {
   return out;
 }
 
-Rgb LutBrdf::Eval(const Vec3& wi, const Vec3& wo) const {
-  if (!(wi.z > 0.0) || !(wo.z > 0.0)) return {0.0, 0.0, 0.0};
-  const double theta_in_deg = RadToDeg(ThetaOf(wi));
-  // Isotropic: only φout − φin matters, and the LUT stores the light at φin = 0.
-  const double phi_deg = std::hypot(wi.x, wi.y) > 0.0
-                             ? WrapDeg360(RadToDeg(PhiOf(wo)) - RadToDeg(PhiOf(wi)))
-                             : RadToDeg(PhiOf(wo));
-  const std::array<float, 3> f = lut_.SampleAngles(theta_in_deg, RadToDeg(ThetaOf(wo)), phi_deg);
-  return {f[0], f[1], f[2]};
-}
-
 std::optional<std::string> OpenedSource::BeyondMeasuredWarning(double theta_in_deg,
+                                                               double theta_out_deg,
                                                                const std::string& path) const {
   if (measured_theta_in_deg.empty()) return std::nullopt;
   const double lo = measured_theta_in_deg.front(), hi = measured_theta_in_deg.back();
   constexpr double kTolDeg = 1e-6;
-  if (theta_in_deg >= lo - kTolDeg && theta_in_deg <= hi + kTolDeg) return std::nullopt;
-  const double nearest = theta_in_deg < lo ? lo : hi;
+  const auto inside = [&](double t) { return t >= lo - kTolDeg && t <= hi + kTolDeg; };
+  if (inside(theta_in_deg)) return std::nullopt;
+  // The light polar angle the LUT is read at after the reciprocity step (Lut::SampleAngles).
+  const auto* lut = dynamic_cast<const LutBrdf*>(brdf.get());
+  const bool exchanged = lut && lut->lut().ExchangesLightAndView(theta_in_deg, theta_out_deg);
+  const double light = exchanged ? theta_out_deg : theta_in_deg;
+  if (inside(light)) return std::nullopt;  // reciprocity: a measured slice answers
+  const double nearest = light < lo ? lo : hi;
   return path + ": warning: θin " + Deg(theta_in_deg) + "° is outside the measured range " +
-         Deg(lo) + "°–" + Deg(hi) + "°: the value is the θin " + Deg(nearest) +
+         Deg(lo) + "°–" + Deg(hi) + "° and so is θout " + Deg(theta_out_deg) +
+         "°: the value is the θin " + Deg(nearest) +
          "° slice's at the same specular-frame angles (clamped, not measured)";
 }
 
@@ -261,13 +259,12 @@ OpenedSource OpenBrdf(const std::string& path, const OpenOptions& options) {
       PreparedMeasurement p =
           PrepareMeasurement(path, out.kind, options.extrapolation, /*allow_btdf=*/true);
       out.warnings = std::move(p.warnings);
-      processing::ResampleOptions resample = options.resample;
-      resample.require_uniform_theta_in = false;  // tables measured at any θin evaluate too
-      Lut lut = processing::BuildLut(p.measurement, p.extrapolation.params, resample);
-      out.measured_theta_in_deg = lut.theta_in_deg;
+      auto brdf = std::make_unique<LutBrdf>(processing::MeasurementAsBrdf(
+          p.measurement, p.extrapolation.params, options.resample, OutputNameOf(path)));
+      out.measured_theta_in_deg = brdf->lut().theta_in_deg;
       out.extrapolation = p.extrapolation;
       out.evaluation = Evaluation::kResampledLut;
-      out.brdf = std::make_unique<LutBrdf>(std::move(lut), OutputNameOf(path));
+      out.brdf = std::move(brdf);
       return out;
     }
     case FileKind::kKtx2:

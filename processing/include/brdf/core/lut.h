@@ -38,13 +38,28 @@ struct Lut {
   // u = (φd/1° + 0.5)/361, v = (θd/1° + 0.5)/181, w = (θin/Δin + 0.5)/K, trilinear filtering,
   // clamp-to-edge addressing.
   std::array<float, 3> SampleTrilinear(double u, double v, double w) const;
-  // The same lookup from angles (degrees): ω_out given by (θout, φout), light at (θin, 0).
-  // θin between two slices interpolates linearly between them at the same specular-frame
-  // coordinates (θd, φd); θin outside [θin,0, θin,K−1] takes the nearest slice (clamp-to-edge).
-  // A θin list that is not k·Δin (an evaluation-only LUT, see processing::ResampleOptions) is
-  // interpolated the same way between its neighbouring entries.
+  // The BRDF the LUT stands for, from angles (degrees): light at (θin, 0), ω_out given by
+  // (θout, φout). This is the one evaluation rule of docs/design.md §5 that `brdf eval`, the
+  // preview, the viewer and the shipped shaders all apply:
+  //  1. Reciprocity beyond the measured θin range: when ExchangesLightAndView(θin, θout), the
+  //     query is answered as the one with light and view exchanged, f(θout → θin) with the
+  //     relative azimuth −φout (f(ωi, ωo) = f(ωo, ωi)). For a light beyond the last slice and
+  //     a view inside the measured θin range this reads a measured value instead of a clamped
+  //     one.
+  //  2. The texture lookup: ω_d = S(θin)·ω_out, then SampleTrilinear at the centre-exact
+  //     coordinates above. θin between two slices interpolates linearly between them at the
+  //     same specular-frame coordinates (θd, φd); θin outside [θin,0, θin,K−1] takes the
+  //     nearest slice (clamp-to-edge). A θin list that is not k·Δin (an evaluation-only LUT,
+  //     see processing::ResampleOptions) is interpolated the same way between its neighbours.
   std::array<float, 3> SampleAngles(double theta_in_deg, double theta_out_deg,
                                     double phi_out_deg) const;
+  // Step 1 of SampleAngles: true when θin lies outside [θin,0, θin,K−1] and θout lies nearer to
+  // that range than θin does (inside it, or outside by less). For a k·Δin LUT that is
+  // θin > θin,K−1 and θout < θin.
+  bool ExchangesLightAndView(double theta_in_deg, double theta_out_deg) const;
+  // Step 2 alone: the texture lookup at (θin, θout, φout), no exchange.
+  std::array<float, 3> SampleTexture(double theta_in_deg, double theta_out_deg,
+                                     double phi_out_deg) const;
   // The fractional slice coordinate of `theta_in_deg` (k + t), before clamping: θin/Δin for a
   // k·Δin list, piecewise linear between entries otherwise.
   double SliceCoordinate(double theta_in_deg) const;

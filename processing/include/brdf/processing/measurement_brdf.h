@@ -1,55 +1,34 @@
-// A captured measurement evaluated as a continuous BRDF without the LUT's 1° texel grid (the
-// viewer, comparisons against exported LUTs). `brdf eval` does not use it: it evaluates
-// captures through the float LUT (brdf::sources::OpenBrdf), which interpolates between θin in
-// the specular frame; this class still interpolates at fixed ω_out (see below).
+// A captured measurement (or an imported table) evaluated as a BrdfSource, through the one
+// evaluation path of measured data: the float LUT that `brdf convert` builds
+// (BuildLut, resample.h), sampled by Lut::SampleAngles (brdf/core/lut_brdf.h). So `brdf eval`
+// and `brdf preview` of a capture, its exported texture (up to the RGB9E5 rounding of the
+// texels), the viewer and every test that evaluates a capture get the same value.
 //
-// MeasurementBrdf interpolates the point cloud exactly as BuildLut (resample.h) does: within a
-// slice the same regular-grid or scattered interpolation over (θout, φout), the docs/design.md §6
-// extrapolation between θb and 90°. Across incidence angles it uses the slice whose θin equals
-// the light's polar angle (within 1e-6°), otherwise it interpolates linearly in θin between the
-// two neighbouring slices; outside the measured θin range it uses the nearest slice (no
-// extrapolation in θin). Unlike BuildLut it accepts any set of distinct θin values.
-//
-// The material is assumed isotropic: only φout − φin matters. Directions are unit vectors in
-// the local frame (z = normal) pointing away from the surface; `wi` towards the light, `wo`
-// towards the viewer. Values are f_r in 1/sr, linear RGB, not multiplied by cosθ, and 0 when
-// either direction is at or below the horizon (the BrdfSource contract). The object is
-// immutable after construction and safe to evaluate from many threads; copies share the data.
+// What that value is (docs/design.md §5, §6):
+//  - at a measured θin: the slice's samples interpolated at the LUT's 1° texel centres of the
+//    specular frame (regular-grid bilinear or scattered moving least squares, resample.h), then
+//    bilinear between texels; the §6 extrapolation between θb and 90°;
+//  - between measured θin: linear in θin at the same specular-frame coordinates (θd, φd), so a
+//    glossy peak moves with the mirror direction instead of fading between two positions;
+//  - θin outside the measured range: reciprocity when the view lies nearer to the range (light
+//    and view exchanged), otherwise the nearest slice at the same (θd, φd).
 #pragma once
 
-#include <memory>
 #include <string>
-#include <vector>
 
-#include "brdf/core/brdf_source.h"
+#include "brdf/core/lut_brdf.h"
 #include "brdf/core/measurement.h"
 #include "brdf/processing/extrapolation.h"
 #include "brdf/processing/resample.h"
 
 namespace brdf::processing {
 
-class MeasurementBrdf final : public BrdfSource {
- public:
-  // Builds the per-slice interpolators (the same validation as BuildLut except the uniform
-  // θin requirement: distinct finite θin in [0°, 90°), a valid sample in every slice).
-  // `name` defaults to the measurement's sample name. Throws InvalidArgument.
-  explicit MeasurementBrdf(const Measurement& measurement, const ExtrapolationParams& params = {},
-                           const ResampleOptions& options = {}, std::string name = {});
-
-  Rgb Eval(const Vec3& wi, const Vec3& wo) const override;
-  std::string Name() const override;
-
-  // The same value from angles in degrees, light at (θin, φin = 0), viewer at (θout, φout).
-  // θout beyond 90° returns the horizon value (the LUT's edge extension), not 0.
-  Rgb EvalAngles(double theta_in_deg, double theta_out_deg, double phi_out_deg) const;
-
-  double theta_b_deg() const;
-  std::vector<double> theta_in_deg() const;  // ascending
-
- private:
-  struct Impl;
-  std::shared_ptr<const Impl> impl_;
-  std::string name_;
-};
+// Resamples `measurement` with BuildLut(measurement, params, options) and wraps the LUT. Unlike
+// the exported textures it accepts any set of distinct θin in [0°, 90°) (options'
+// require_uniform_theta_in is ignored: an evaluation-only LUT, interpolated between its
+// neighbouring θin). `name` defaults to the measurement's sample name. Throws InvalidArgument
+// (BuildLut's requirements).
+LutBrdf MeasurementAsBrdf(const Measurement& measurement, const ExtrapolationParams& params = {},
+                          ResampleOptions options = {}, std::string name = {});
 
 }  // namespace brdf::processing

@@ -13,10 +13,13 @@
 // only by the RGB9E5 rounding of the texture, and between measured θin both interpolate
 // linearly in the specular frame (the same (θd, φd) in the two neighbouring slices).
 //
-// θin outside the measured range (one rule for captures, LUTs and eval): the value of the
+// θin outside the measured range (one rule for captures, LUTs and eval, Lut::SampleAngles):
+// when the view's polar angle is nearer to the measured range than the light's, light and view
+// are exchanged (reciprocity, f(ωi, ωo) = f(ωo, ωi)), so a light beyond the last slice seen
+// from inside the range gets a measured value; when both lie beyond it, the value of the
 // nearest measured slice at the same specular-frame coordinates (θd, φd), as the GPU's
 // clamp-to-edge along w gives it. OpenedSource::BeyondMeasuredWarning says when a query is
-// answered that way.
+// answered that way (clamped, not measured).
 //
 // Every function throws brdf::Error subclasses whose message starts with the file's path; what
 // the user can do is in Error::remedy(). Nothing here prints.
@@ -29,6 +32,7 @@
 
 #include "brdf/core/brdf_source.h"
 #include "brdf/core/lut.h"
+#include "brdf/core/lut_brdf.h"
 #include "brdf/core/measurement.h"
 #include "brdf/exporter/atlas.h"
 #include "brdf/exporter/sidecar.h"
@@ -87,20 +91,8 @@ struct OpenedTexture {
 // that texture. Throws IoError / FormatError / InvalidArgument (another kind of file).
 OpenedTexture OpenExportedTexture(const std::string& path);
 
-// A LUT sampled exactly as a GPU samples the 3D texture (Lut::SampleAngles). The light's
-// azimuth is folded into φout (isotropic LUT, light stored at φin = 0). Zero when either
-// direction is at or below the horizon (the BrdfSource contract).
-class LutBrdf final : public BrdfSource {
- public:
-  LutBrdf(Lut lut, std::string name) : lut_(std::move(lut)), name_(std::move(name)) {}
-  Rgb Eval(const Vec3& wi, const Vec3& wo) const override;
-  std::string Name() const override { return name_; }
-  const Lut& lut() const { return lut_; }
-
- private:
-  Lut lut_;
-  std::string name_;
-};
+// A LUT evaluated by the one rule of docs/design.md §5 (brdf/core/lut_brdf.h).
+using brdf::LutBrdf;
 
 struct OpenOptions {
   // §6 parameters from the command line (captures and tables; ignored with a warning for
@@ -128,9 +120,11 @@ struct OpenedSource {
   std::optional<ExtrapolationChoice> extrapolation;  // kResampledLut: what filled θout > θb
   std::vector<std::string> warnings;                 // full sentences starting with the path
 
-  // A warning sentence when a query with light polar angle `theta_in_deg` lies outside the
-  // measured θin range (answered from the nearest slice, clamp-to-edge), else nullopt.
-  std::optional<std::string> BeyondMeasuredWarning(double theta_in_deg,
+  // A warning sentence when a query with light polar angle `theta_in_deg` and view polar angle
+  // `theta_out_deg` is answered from the nearest slice (clamp-to-edge) because both lie
+  // outside the measured θin range, else nullopt (also when reciprocity answers it from
+  // measured slices).
+  std::optional<std::string> BeyondMeasuredWarning(double theta_in_deg, double theta_out_deg,
                                                    const std::string& path) const;
 };
 
