@@ -140,6 +140,9 @@ TEST(MeasurementAsBrdf, UsesReciprocityForLightBeyondTheLastSlice) {
   EXPECT_FALSE(lut.ExchangesLightAndView(70, 85));
   EXPECT_FALSE(lut.ExchangesLightAndView(60, 10));
   EXPECT_FALSE(lut.ExchangesLightAndView(30, 80));
+  // Within 0.001° of the last slice is that slice (float32 noise of a measured 60°).
+  EXPECT_FALSE(lut.ExchangesLightAndView(60.0005, 10));
+  EXPECT_TRUE(lut.ExchangesLightAndView(60.002, 10));
 }
 
 TEST(MeasurementAsBrdf, AcceptsAnyDistinctThetaIn) {

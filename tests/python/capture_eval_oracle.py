@@ -122,7 +122,7 @@ class Capture:
         def outside(t):
             return max(lo - t, t - hi, 0.0)
 
-        if outside(ti) > 1e-6 and outside(to) < outside(ti):
+        if outside(ti) > 1e-3 and outside(to) < outside(ti):  # §5: within 1e-3° is inside
             return self.lookup(to, ti, -po)
         return self.lookup(ti, to, po)
 

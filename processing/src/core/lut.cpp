@@ -71,11 +71,9 @@ double Lut::SliceCoordinate(double theta_in) const {
 bool Lut::ExchangesLightAndView(double theta_in, double theta_out_deg) const {
   if (theta_in_deg.empty()) return false;
   const double lo = theta_in_deg.front(), hi = theta_in_deg.back();
-  // Within 1e-6° of the range counts as inside: a measured slice is answered from itself.
-  constexpr double kTolDeg = 1e-6;
   const auto outside = [&](double t) { return std::max({lo - t, t - hi, 0.0}); };
   const double d_in = outside(theta_in);
-  return d_in > kTolDeg && outside(theta_out_deg) < d_in;
+  return d_in > kThetaInToleranceDeg && outside(theta_out_deg) < d_in;
 }
 
 std::array<float, 3> Lut::SampleAngles(double theta_in, double theta_out_deg,

@@ -220,7 +220,7 @@ std::optional<std::string> OpenedSource::BeyondMeasuredWarning(double theta_in_d
                                                                const std::string& path) const {
   if (measured_theta_in_deg.empty()) return std::nullopt;
   const double lo = measured_theta_in_deg.front(), hi = measured_theta_in_deg.back();
-  constexpr double kTolDeg = 1e-6;
+  constexpr double kTolDeg = Lut::kThetaInToleranceDeg;
   const auto inside = [&](double t) { return t >= lo - kTolDeg && t <= hi + kTolDeg; };
   if (inside(theta_in_deg)) return std::nullopt;
   // The light polar angle the LUT is read at after the reciprocity step (Lut::SampleAngles).
