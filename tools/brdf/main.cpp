@@ -120,7 +120,9 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   eval_cmd->footer(
       "Captures are interpolated as 'brdf convert' resamples them; exported LUTs are sampled "
-      "as a GPU samples the 3D texture (centre-exact coordinates, trilinear, clamp-to-edge).\n");
+      "as a GPU samples the 3D texture (centre-exact coordinates, trilinear, clamp-to-edge). "
+      "A light beyond the measured θin range with the view nearer to it is answered with light "
+      "and view exchanged (reciprocity, docs/design.md §5).\n");
   eval_cmd->callback([&] {
     if (eval_in.empty() && eval.pairs.empty())
       throw CLI::RequiredError("--in and --out (or --pairs)");

@@ -7,9 +7,10 @@
 //  - ChooseExtrapolation: the §6 parameters that apply to one input.
 //
 // One evaluation path. A capture (or an imported table) is evaluated by resampling it into the
-// float LUT exactly as `brdf convert` does (processing::BuildLut) and sampling that LUT exactly
-// as a GPU samples the exported texture (Lut::SampleAngles: centre-exact texel coordinates,
-// trilinear, clamp-to-edge). So `brdf eval CAPTURE` and `brdf eval` of its exported LUT differ
+// float LUT exactly as `brdf convert` does (processing::MeasurementAsBrdf) and reading that LUT
+// by the rule of docs/design.md §5 the shaders follow (Lut::SampleAngles: the reciprocity step
+// below, then centre-exact texel coordinates, trilinear, clamp-to-edge). So `brdf eval CAPTURE`,
+// `brdf preview CAPTURE` and `brdf eval` of its exported LUT differ
 // only by the RGB9E5 rounding of the texture, and between measured θin both interpolate
 // linearly in the specular frame (the same (θd, φd) in the two neighbouring slices).
 //
