@@ -22,8 +22,9 @@ constexpr std::string_view kTemplate =
 // = f_r * light * max(dot(n, l), 0). n, l, v: unit vectors pointing away from the surface, all
 // in one frame (world, view or tangent space). Sampler: linear filtering, clamp-to-edge on all
 // three axes, no mipmaps, no sRGB decode.
-// Above the last measured theta_in the w axis clamps to the last slice, read at the w_d of the
-// actual theta_in (the lobe follows the mirror direction);
+// Outside the measured theta_in range (docs/design.md §5): a light with the view nearer to the
+// range is read with light and view exchanged (reciprocity, f(l, v) = f(v, l)); otherwise the
+// w axis clamps to the last slice, read at the w_d of the actual theta_in;
 // light below the horizon gives the theta_in = 90 deg value, zeroed by the max(dot(n, l), 0).
 // Texel centres (centre-exact): u = (x0 + phi_d/1deg + 0.5)/W, v = (y0 + theta_d/1deg + 0.5)/H,
 // w = ((theta_in - THETA_IN0)/DELTA_IN + 0.5)/K, with (x0, y0) the material's cell origin in
@@ -62,8 +63,30 @@ FLOAT3 MeasuredBrdfCoords(float sin_in, float cos_in, FLOAT3 v_local, FLOAT2 cel
   return FLOAT3(tex_u, tex_v, tex_w);
 }
 
-// Tangent space (z = the normal; x and y any tangent basis): l_ts and v_ts unit vectors.
-FLOAT3 MeasuredBrdfTangent(@LUT_PARAM@FLOAT2 cell_texels, FLOAT3 l_ts, FLOAT3 v_ts) {
+// How far theta (degrees) lies outside the measured theta_in range, 0 inside it.
+float MeasuredBrdfOutside(float theta_deg) {
+  float last_deg = MEASURED_BRDF_THETA_IN0_DEG +
+                   (MEASURED_BRDF_SLICES - 1.0) * MEASURED_BRDF_DELTA_IN_DEG;
+  return max(max(MEASURED_BRDF_THETA_IN0_DEG - theta_deg, theta_deg - last_deg), 0.0);
+}
+
+// docs/design.md §5, reciprocity: true when the light (cos, sin of its polar angle) lies
+// outside the measured theta_in range by more than 0.001 deg and the view lies nearer to it;
+// the lookup then reads light and view exchanged.
+bool MeasuredBrdfExchanges(float cos_l, float sin_l, float cos_v, float sin_v) {
+  float out_l = MeasuredBrdfOutside(ATAN2(sin_l, cos_l) * MEASURED_BRDF_DEG_PER_RAD);
+  float out_v = MeasuredBrdfOutside(ATAN2(sin_v, cos_v) * MEASURED_BRDF_DEG_PER_RAD);
+  return out_l > 0.001 && out_v < out_l;
+}
+
+// Tangent space (z = the normal; x and y any tangent basis): l_in and v_in unit vectors.
+FLOAT3 MeasuredBrdfTangent(@LUT_PARAM@FLOAT2 cell_texels, FLOAT3 l_in, FLOAT3 v_in) {
+  FLOAT3 l_ts = l_in;
+  FLOAT3 v_ts = v_in;
+  if (MeasuredBrdfExchanges(l_in.z, length(l_in.xy), v_in.z, length(v_in.xy))) {
+    l_ts = v_in;
+    v_ts = l_in;
+  }
   float sin_in = length(l_ts.xy);
   FLOAT2 x_axis = FLOAT2(1.0, 0.0);
   if (sin_in > 0.000001) {
@@ -77,7 +100,15 @@ FLOAT3 MeasuredBrdfTangent(@LUT_PARAM@FLOAT2 cell_texels, FLOAT3 l_ts, FLOAT3 v_
 
 // Any space: the tangent frame of the light (paper 5.1): z = n, x = l projected onto the
 // tangent plane (phi_in = 0), y = z cross x.
-FLOAT3 MeasuredBrdfCell(@LUT_PARAM@FLOAT2 cell_texels, FLOAT3 n, FLOAT3 l, FLOAT3 v) {
+FLOAT3 MeasuredBrdfCell(@LUT_PARAM@FLOAT2 cell_texels, FLOAT3 n, FLOAT3 l_in, FLOAT3 v_in) {
+  FLOAT3 l = l_in;
+  FLOAT3 v = v_in;
+  float cos_v = dot(n, v_in);
+  if (MeasuredBrdfExchanges(dot(n, l_in), length(l_in - n * dot(n, l_in)), cos_v,
+                            length(v_in - n * cos_v))) {
+    l = v_in;
+    v = l_in;
+  }
   float cos_in = dot(n, l);
   FLOAT3 l_tangent = l - n * cos_in;
   float sin_in = length(l_tangent);

@@ -145,8 +145,9 @@ def ktx2_words(path):
 
 def gen_pairs(count, seed, angles_out, nlv_out):
     rng = np.random.default_rng(seed)
-    # θin over the measured slices and beyond the last (the clamp rule), θout into the
-    # extrapolated band; random azimuths and a random rotation of the whole frame.
+    # θin over the measured slices and beyond the last (exchanged with the view by reciprocity
+    # when the view is nearer the measured range, else clamped to the last slice), θout into
+    # the extrapolated band; random azimuths and a random rotation of the whole frame.
     theta_in = rng.uniform(0.0, 85.0, count)
     theta_out = rng.uniform(0.0, 85.0, count)
     phi_in = rng.uniform(0.0, 360.0, count)
