@@ -22,10 +22,13 @@
 #include "brdf/core/measurement.h"
 #include "brdf/viewer/app.h"
 #include "open_source.h"
+#include "startup_clock.h"
 
 namespace {
 
 constexpr const char* kXvfbGuard = "BRDF_VIEW_UNDER_XVFB";
+// Set (to anything non-empty) to print start-up milestones on stderr (docs/benchmarks.md).
+constexpr const char* kTimingVariable = "BRDF_VIEW_TIMING";
 // Exit code of a run under xvfb-run whose display could not be opened: concurrent
 // `xvfb-run -a` calls sometimes pick the same display number, so the parent tries again.
 constexpr int kDisplayRetry = 75;
@@ -158,6 +161,9 @@ int Finish(int code) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  const char* timing_variable = std::getenv(kTimingVariable);
+  const bool timing = timing_variable != nullptr && *timing_variable != '\0';
+  if (timing) brdf::view_tool::PrintMilestone("main");
   CLI::App app{
       "brdf-view: reflection lobes, LUT slice heat maps and environment-lit previews of any "
       "BRDF the toolchain reads (capture, material, exported LUT, RGL, MERL, tables)"};
@@ -214,6 +220,7 @@ int main(int argc, char** argv) {
   options.log_scale = log_scale;
   options.cosine_weighted = cosine_weighted;
   options.all_slices = all_slices;
+  if (timing) options.on_milestone = brdf::view_tool::PrintMilestone;
 
   const std::string display_problem = brdf::viewer::DisplayProblem();
   if (!display_problem.empty()) {
@@ -255,6 +262,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "brdf-view: error: --compare: %s\n", second->error.c_str());
     }
     const bool compare_failed = second && !second->error.empty();
+    if (timing) brdf::view_tool::PrintMilestone("sources opened");
     const brdf::viewer::ViewerResult result =
         brdf::viewer::RunViewer(options, std::move(primary), std::move(second));
     if (!result.ok) {

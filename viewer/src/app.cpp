@@ -191,6 +191,13 @@ vtkStandardNewMacro(ViewerStyle)
   void ShowPreviewImage();
   void UpdateText();
   bool WriteScreenshot(const std::string& path, std::string* error);
+  // Reports a milestone once the X server has processed everything sent so far (so a frame
+  // that was just swapped is on screen, not still in Xlib's output buffer).
+  void Milestone(const char* what) {
+    if (!options_.on_milestone) return;
+    XSync(display_, False);
+    options_.on_milestone(what);
+  }
   void AddProp(vtkProp* prop) {
     renderer_->AddViewProp(prop);
     scene_.emplace_back(prop);
@@ -209,6 +216,7 @@ vtkStandardNewMacro(ViewerStyle)
   bool compare_wireframe_ = true;
   bool show_help_ = false;
   bool interactive_ = false;  // a window with an interactor (false for a screenshot run)
+  bool first_frame_reported_ = false;
   int current_slice_ = 0;
   double scale_max_ = 1;  // colour scale and log floor for the lobe (fixed while θin moves)
   double arrow_length_ = 1;
@@ -847,6 +855,10 @@ void App::OnMouseMove(int x, int y) {
 
 bool App::WriteScreenshot(const std::string& path, std::string* error) {
   window_->Render();
+  if (!first_frame_reported_) {
+    first_frame_reported_ = true;
+    Milestone("first frame");
+  }
   vtkNew<vtkWindowToImageFilter> grab;
   grab->SetInput(window_);
   grab->SetInputBufferTypeToRGB();
@@ -977,6 +989,7 @@ ViewerResult App::Run() {
     }
   }
   Rebuild(true);
+  Milestone("scene");
 
   ViewerResult result;
   if (!primary_.error.empty()) {
@@ -1000,6 +1013,7 @@ ViewerResult App::Run() {
       result.ok = false;
       result.message = error;
     }
+    Milestone("screenshot");
     return result;
   }
   timer_callback_->SetClientData(this);
@@ -1008,6 +1022,8 @@ ViewerResult App::Run() {
   interactor_->AddObserver(vtkCommand::TimerEvent, timer_callback_);
   interactor_->CreateRepeatingTimer(30);
   window_->Render();
+  first_frame_reported_ = true;
+  Milestone("first frame");
   interactor_->Start();
   return result;
 }

@@ -15,6 +15,7 @@
 //   preview: arrow keys or a mouse drag orbit the camera; the picture refines while idle
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -50,6 +51,10 @@ struct ViewerOptions {
   // `<screenshot>.json` beside it records the camera (position, focal point, view up, vertical
   // view angle in degrees) and the image size, so a report (or a test) can tell what is where.
   std::string screenshot_path;
+  // Called (on the calling thread) when the run reaches a milestone: "scene" (the first
+  // picture's actors are built, nothing drawn yet), "first frame" (the first picture has been rendered and the X server has it, i.e.
+  // it is on screen), "screenshot" (the PNG is written). For start-up timing; may be empty.
+  std::function<void(const char* milestone)> on_milestone;
 
   // Throws InvalidArgument naming the bad field (size outside 64…8192, θin outside [0°, 90°)).
   void Validate() const;
