@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -32,6 +33,8 @@
 #include <vtkLookupTable.h>
 #include <vtkNew.h>
 #include <vtkObjectFactory.h>
+#include <vtkOpenGLRenderWindow.h>
+#include <vtkOpenGLState.h>
 #include <vtkPNGWriter.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
@@ -85,6 +88,18 @@ void StyleText(vtkTextProperty* p, int size, double r, double g, double b) {
   p->SetFontSize(size);
   p->SetColor(r, g, b);
   p->SetShadow(0);
+}
+
+// Whether an OpenGL renderer string (glGetString(GL_RENDERER)) names a rasteriser that runs on
+// the CPU: Mesa's llvmpipe, softpipe and the classic swrast.
+bool IsSoftwareRenderer(const std::string& renderer) {
+  std::string lower = renderer;
+  std::transform(lower.begin(), lower.end(), lower.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  for (const char* name : {"llvmpipe", "softpipe", "swrast", "software rasterizer"}) {
+    if (lower.find(name) != std::string::npos) return true;
+  }
+  return false;
 }
 
 std::string Fixed(double v, int digits) {
@@ -863,6 +878,8 @@ bool App::WriteScreenshot(const std::string& path, std::string* error) {
   grab->SetInput(window_);
   grab->SetInputBufferTypeToRGB();
   grab->ReadFrontBufferOff();
+  // The frame rendered just above is the picture: without this the filter renders it again.
+  grab->ShouldRerenderOff();
   grab->Update();
   vtkNew<vtkPNGWriter> writer;
   writer->SetFileName(path.c_str());
@@ -906,6 +923,13 @@ ViewerResult App::Run() {
   window_->SetSize(options_.width, options_.height);
   window_->SetWindowName("brdf-view");
   window_->AddRenderer(renderer_);
+  if (auto* gl = vtkOpenGLRenderWindow::SafeDownCast(window_)) {
+    gl->Initialize();  // the X window and the GL context
+    // VTK renders into an 8× multisampled framebuffer by default. On a GPU that is free; on a
+    // CPU rasteriser (Mesa llvmpipe, e.g. under Xvfb) it shades every pixel up to 8 times and
+    // made each frame cost ≈ 100 ms of CPU more (docs/benchmarks.md, viewer start-up).
+    if (IsSoftwareRenderer(gl->GetState()->GetRenderer())) window_->SetMultiSamples(0);
+  }
   const bool headless = !options_.screenshot_path.empty();
   interactive_ = !headless;
   // No off-screen rendering for screenshots: VTK 9.1's X interactor crashes (XSync on a null
