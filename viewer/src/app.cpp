@@ -44,6 +44,7 @@
 #include <vtkProperty.h>
 #include <vtkProperty2D.h>
 #include <vtkRegularPolygonSource.h>
+#include <vtkRenderStepsPass.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderWindowInteractor.h>
 #include <vtkRenderer.h>
@@ -883,6 +884,9 @@ bool App::WriteScreenshot(const std::string& path, std::string* error) {
   grab->Update();
   vtkNew<vtkPNGWriter> writer;
   writer->SetFileName(path.c_str());
+  // zlib level 1: a third of the default level's time for a picture that is mostly flat
+  // background (docs/benchmarks.md, viewer start-up).
+  writer->SetCompressionLevel(1);
   writer->SetInputConnection(grab->GetOutputPort());
   writer->Write();
   if (writer->GetErrorCode() != 0 || !std::filesystem::exists(path)) {
@@ -919,6 +923,13 @@ bool App::WriteScreenshot(const std::string& path, std::string* error) {
 
 ViewerResult App::Run() {
   renderer_->SetBackground(kBackground[0], kBackground[1], kBackground[2]);
+  // VTK's standard sequence of passes, with plain alpha blending for translucent surfaces (the
+  // extrapolated band, the mirror arrow). Without a pass of its own the renderer blends them
+  // order-independently, which costs extra framebuffers, a full-window compositing pass and,
+  // on a CPU rasteriser, ≈ 15 ms of shader compilation before the first frame; blending in
+  // drawing order looks the same for these few thin or nested surfaces.
+  vtkNew<vtkRenderStepsPass> passes;
+  renderer_->SetPass(passes);
   window_->SetDisplayId(display_);
   window_->SetSize(options_.width, options_.height);
   window_->SetWindowName("brdf-view");
@@ -930,6 +941,7 @@ ViewerResult App::Run() {
     // made each frame cost ≈ 100 ms of CPU more (docs/benchmarks.md, viewer start-up).
     if (IsSoftwareRenderer(gl->GetState()->GetRenderer())) window_->SetMultiSamples(0);
   }
+  Milestone("window");
   const bool headless = !options_.screenshot_path.empty();
   interactive_ = !headless;
   // No off-screen rendering for screenshots: VTK 9.1's X interactor crashes (XSync on a null

@@ -51,7 +51,8 @@ struct ViewerOptions {
   // `<screenshot>.json` beside it records the camera (position, focal point, view up, vertical
   // view angle in degrees) and the image size, so a report (or a test) can tell what is where.
   std::string screenshot_path;
-  // Called (on the calling thread) when the run reaches a milestone: "scene" (the first
+  // Called (on the calling thread) when the run reaches a milestone: "window" (the X window
+  // and its OpenGL context exist), "scene" (the first
   // picture's actors are built, nothing drawn yet), "first frame" (the first picture has been rendered and the X server has it, i.e.
   // it is on screen), "screenshot" (the PNG is written). For start-up timing; may be empty.
   std::function<void(const char* milestone)> on_milestone;
