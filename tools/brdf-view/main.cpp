@@ -255,16 +255,21 @@ int main(int argc, char** argv) {
   }
 
   try {
-    brdf::viewer::LoadedSource primary = brdf::view_tool::OpenViewSource(source);
-    std::optional<brdf::viewer::LoadedSource> second;
-    if (!compare.empty()) second = brdf::view_tool::OpenViewSource(compare);
-    if (second && !second->error.empty()) {
-      std::fprintf(stderr, "brdf-view: error: --compare: %s\n", second->error.c_str());
+    // Both sources open on threads of their own while the window is being created.
+    bool compare_failed = false;
+    brdf::viewer::SourceOpener open_compare;
+    if (!compare.empty()) {
+      open_compare = [&compare, &compare_failed] {
+        brdf::viewer::LoadedSource second = brdf::view_tool::OpenViewSource(compare);
+        if (!second.error.empty()) {
+          compare_failed = true;
+          std::fprintf(stderr, "brdf-view: error: --compare: %s\n", second.error.c_str());
+        }
+        return second;
+      };
     }
-    const bool compare_failed = second && !second->error.empty();
-    if (timing) brdf::view_tool::PrintMilestone("sources opened");
-    const brdf::viewer::ViewerResult result =
-        brdf::viewer::RunViewer(options, std::move(primary), std::move(second));
+    const brdf::viewer::ViewerResult result = brdf::viewer::RunViewer(
+        options, [&source] { return brdf::view_tool::OpenViewSource(source); }, open_compare);
     if (!result.ok) {
       if (result.display_failed && std::getenv(kXvfbGuard) != nullptr) {
         return Finish(kDisplayRetry);  // the parent starts another Xvfb

@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <sstream>
 #include <vector>
 
@@ -150,12 +151,14 @@ vtkStandardNewMacro(ViewerStyle)
 
     class App {
  public:
-  App(const ViewerOptions& options, LoadedSource primary, std::optional<LoadedSource> compare,
-      Display* display)
+  // The sources may still be opening on another thread: Run() creates the window first and
+  // waits for them only when the scene needs them.
+  App(const ViewerOptions& options, std::future<LoadedSource> primary,
+      std::optional<std::future<LoadedSource>> compare, Display* display)
       : display_(display),
         options_(options),
-        primary_(std::move(primary)),
-        compare_(std::move(compare)),
+        pending_primary_(std::move(primary)),
+        pending_compare_(std::move(compare)),
         mode_(options.mode),
         theta_in_deg_(options.theta_in_deg),
         channel_(static_cast<Channel>(std::clamp(options.channel, 0, 3))),
@@ -221,6 +224,8 @@ vtkStandardNewMacro(ViewerStyle)
 
   Display* display_;  // owned by RunViewer, outlives every VTK object here
   ViewerOptions options_;
+  std::future<LoadedSource> pending_primary_;
+  std::optional<std::future<LoadedSource>> pending_compare_;
   LoadedSource primary_;
   std::optional<LoadedSource> compare_;
   Mode mode_;
@@ -942,6 +947,9 @@ ViewerResult App::Run() {
     if (IsSoftwareRenderer(gl->GetState()->GetRenderer())) window_->SetMultiSamples(0);
   }
   Milestone("window");
+  primary_ = pending_primary_.get();
+  if (pending_compare_) compare_ = pending_compare_->get();
+  Milestone("sources opened");
   const bool headless = !options_.screenshot_path.empty();
   interactive_ = !headless;
   // No off-screen rendering for screenshots: VTK 9.1's X interactor crashes (XSync on a null
@@ -1104,11 +1112,17 @@ std::string DisplayProblem() {
   return {};
 }
 
-ViewerResult RunViewer(const ViewerOptions& options, LoadedSource primary,
-                       std::optional<LoadedSource> compare) {
+ViewerResult RunViewer(const ViewerOptions& options, const SourceOpener& open_primary,
+                       const SourceOpener& open_compare) {
   options.Validate();
-  const std::string problem = DisplayProblem();
-  if (!problem.empty()) return {false, problem, true};
+  const char* display_name = std::getenv("DISPLAY");
+  if (display_name == nullptr || *display_name == '\0') return {false, DisplayProblem(), true};
+  // Opening the sources (reading, resampling the LUT: CPU work, no X or GL) runs on its own
+  // thread while this one connects to the X server and creates the window and its OpenGL
+  // context, the two longest steps before the first frame.
+  std::future<LoadedSource> primary = std::async(std::launch::async, open_primary);
+  std::optional<std::future<LoadedSource>> compare;
+  if (open_compare) compare = std::async(std::launch::async, open_compare);
   // The window gets a display connection opened here. Left to itself, VTK 9.1's X interactor
   // opens one in Initialize and uses it without checking; under a freshly started Xvfb that
   // open sometimes failed and the program crashed (XSync on a null display). A few retries
@@ -1119,7 +1133,7 @@ ViewerResult RunViewer(const ViewerOptions& options, LoadedSource primary,
     if (display == nullptr) usleep(100000);
   }
   if (display == nullptr) {
-    return {false, std::string("cannot open the X display '") + std::getenv("DISPLAY") + "'", true};
+    return {false, std::string("cannot open the X display '") + display_name + "'", true};
   }
   ViewerResult result;
   {

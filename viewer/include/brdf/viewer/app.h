@@ -71,9 +71,16 @@ struct ViewerResult {
 // or the display named cannot be opened). VTK on Debian needs X for any rendering.
 std::string DisplayProblem();
 
+// Opens one source (never throws: a failure is LoadedSource::error). Called on a thread of its
+// own, so it must not touch X or VTK.
+using SourceOpener = std::function<LoadedSource()>;
+
 // Opens the window (or renders the screenshot). Blocks until the user closes the window.
+// The sources are opened on other threads while the window and its OpenGL context are
+// created, so that neither waits for the other before the first frame; `open_compare` may be
+// empty (no second source). Both openers have returned when RunViewer returns.
 // Throws InvalidArgument for bad options; rendering problems come back in the result.
-ViewerResult RunViewer(const ViewerOptions& options, LoadedSource primary,
-                       std::optional<LoadedSource> compare);
+ViewerResult RunViewer(const ViewerOptions& options, const SourceOpener& open_primary,
+                       const SourceOpener& open_compare);
 
 }  // namespace brdf::viewer
