@@ -221,6 +221,12 @@ int main(int argc, char** argv) {
   options.cosine_weighted = cosine_weighted;
   options.all_slices = all_slices;
   if (timing) options.on_milestone = brdf::view_tool::PrintMilestone;
+  // A screenshot is one small frame: Mesa's CPU rasteriser (llvmpipe, e.g. under Xvfb) then
+  // spends more time handing it to its worker threads and waiting for them to be scheduled
+  // than drawing it, most of all on a busy machine (docs/benchmarks.md, viewer start-up).
+  // LP_NUM_THREADS=0 (a documented Mesa variable) draws on the calling thread; the user's own
+  // setting wins, and other OpenGL drivers ignore it.
+  if (!screenshot.empty()) setenv("LP_NUM_THREADS", "0", /*overwrite=*/0);
 
   const std::string display_problem = brdf::viewer::DisplayProblem();
   if (!display_problem.empty()) {
