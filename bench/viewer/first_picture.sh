@@ -6,6 +6,9 @@
 #                 first frame rendered and processed by the X server, as the program reports it
 #                 with BRDF_VIEW_TIMING=1 (wall and CPU of all its threads; 10 ms resolution for
 #                 the start). The window is closed (SIGTERM) as soon as that line appears.
+#   first frame, cold shader cache   the same with MESA_SHADER_CACHE_DISABLE=true: Mesa compiles
+#                 every shader as on the first run after installing (or after a driver update);
+#                 the other cases run with the cache in ~/.cache/mesa_shader_cache warm.
 #   lobe / slices the whole `--screenshot` run (process start to exit, PNG written), measured
 #                 from outside with /usr/bin/time: wall and user + system CPU.
 #   window only   a screenshot of a file that does not exist: process start, window, text, one
@@ -35,10 +38,10 @@ time_ms() {  # runs "$@" once, prints wall and CPU (user + system) milliseconds
   /usr/bin/time -f "%e %U %S" -o "$tmp/time.txt" "$@" >/dev/null 2>&1 || true
   tail -n 1 "$tmp/time.txt" | awk '{printf "%d %d\n", $1 * 1000, ($2 + $3) * 1000}'
 }
-first_frame_ms() {  # $1 = brdf-view; prints the wall and CPU ms it reports at its first frame
+first_frame_ms() {  # $1 = brdf-view [$2 = VAR=value]; prints the wall and CPU ms it reports
   local log=$tmp/first_frame.txt
   : > "$log"
-  BRDF_VIEW_TIMING=1 "$1" "$gold" --mode lobe --theta-in 30 > /dev/null 2> "$log" &
+  env BRDF_VIEW_TIMING=1 ${2:-} "$1" "$gold" --mode lobe --theta-in 30 > /dev/null 2> "$log" &
   local pid=$!
   for _ in $(seq 1500); do
     grep -q "first frame" "$log" && break
@@ -50,7 +53,7 @@ first_frame_ms() {  # $1 = brdf-view; prints the wall and CPU ms it reports at i
   # "brdf-view: timing: first frame at 734 ms wall, 301 ms CPU after process start"
   awk '/first frame/ {print $6, $9; found = 1} END {if (!found) print "-1 -1"}' "$log"
 }
-cases="first_frame lobe slices window_only"
+cases="first_frame first_frame_cold lobe slices window_only"
 echo "load average before: $(cut -d' ' -f1-3 /proc/loadavg)"
 for i in $(seq "$runs"); do
   for name in $cases; do
@@ -58,6 +61,7 @@ for i in $(seq "$runs"); do
       view=${views[$which]}
       case $name in
         first_frame) first_frame_ms "$view" ;;
+        first_frame_cold) first_frame_ms "$view" MESA_SHADER_CACHE_DISABLE=true ;;
         lobe) time_ms "$view" "$gold" --mode lobe --theta-in 30 --screenshot "$tmp/a.png" ;;
         slices) time_ms "$view" "$gold" --mode slices --screenshot "$tmp/b.png" ;;
         window_only) time_ms "$view" "$tmp/missing.bpc" --screenshot "$tmp/c.png" ;;
@@ -68,7 +72,7 @@ for i in $(seq "$runs"); do
 done
 echo "load average after:  $(cut -d' ' -f1-3 /proc/loadavg)"
 report() {  # $1 = label, $2 = file
-  printf '%-26s median wall %5d ms, CPU %5d ms over %d runs\n' "$1" \
+  printf '%-30s median wall %5d ms, CPU %5d ms over %d runs\n' "$1" \
     "$(cut -d' ' -f1 "$2" | median)" "$(cut -d' ' -f2 "$2" | median)" "$runs"
 }
 for name in $cases; do

@@ -51,10 +51,12 @@ struct ViewerOptions {
   // `<screenshot>.json` beside it records the camera (position, focal point, view up, vertical
   // view angle in degrees) and the image size, so a report (or a test) can tell what is where.
   std::string screenshot_path;
-  // Called (on the calling thread) when the run reaches a milestone: "window" (the X window
-  // and its OpenGL context exist), "scene" (the first
-  // picture's actors are built, nothing drawn yet), "first frame" (the first picture has been rendered and the X server has it, i.e.
-  // it is on screen), "screenshot" (the PNG is written). For start-up timing; may be empty.
+  // Called on the calling thread when the run reaches a milestone, in this order: "window"
+  // (the X window and its OpenGL context exist), "sources opened" (both sources are open or
+  // have failed), "scene" (the first picture's actors are built, nothing drawn yet), "first
+  // frame" (the first picture is rendered and the X server has processed it: in a window it is
+  // on screen; for a screenshot it is in VTK's off-screen framebuffer), "screenshot" (the PNG
+  // and its camera file are written). For start-up timing (docs/benchmarks.md); may be empty.
   std::function<void(const char* milestone)> on_milestone;
 
   // Throws InvalidArgument naming the bad field (size outside 64…8192, θin outside [0°, 90°)).
