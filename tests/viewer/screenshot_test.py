@@ -318,15 +318,21 @@ def case_interactive_inner(brdf_view, source_dir, tmp):
             proc.wait()
 
 
-def case_interactive(brdf_view, source_dir, tmp):
+def run_inner_under_xvfb(inner_case, brdf_view, source_dir):
+    """Runs this script's `inner_case` under one xvfb-run (an X display that already exists
+    when brdf-view starts)."""
     env = dict(os.environ)
     env.pop("DISPLAY", None)
     proc = subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1280x1024x24", sys.executable,
-                           os.path.abspath(__file__), "interactive_inner", brdf_view, source_dir],
+                           os.path.abspath(__file__), inner_case, brdf_view, source_dir],
                           env=env, capture_output=True, text=True, timeout=150)
     sys.stdout.write(proc.stdout)
     if "PASS" not in proc.stdout:
-        fail(f"interactive run failed (exit {proc.returncode}): {proc.stderr}")
+        fail(f"{inner_case} failed (exit {proc.returncode}): {proc.stderr}")
+
+
+def case_interactive(brdf_view, source_dir, tmp):
+    run_inner_under_xvfb("interactive_inner", brdf_view, source_dir)
 
 
 def case_no_display(brdf_view, source_dir, tmp):
@@ -346,6 +352,115 @@ def case_no_display(brdf_view, source_dir, tmp):
     print("no display: " + lines[0])
 
 
+MILESTONES = ["main", "window", "sources opened", "scene", "first frame"]
+
+
+def parse_timing(stderr):
+    """{milestone: (wall_ms, cpu_ms)} from brdf-view's BRDF_VIEW_TIMING lines."""
+    import re
+    found = {}
+    for line in stderr.splitlines():
+        m = re.fullmatch(r"brdf-view: timing: (.+) at (-?\d+) ms wall, (\d+) ms CPU after "
+                         r"process start", line.strip())
+        if m:
+            found[m.group(1)] = (int(m.group(2)), int(m.group(3)))
+    return found
+
+
+def check_milestones(found, names, external_wall_ms, what):
+    missing = [n for n in names if n not in found]
+    if missing:
+        fail(f"{what}: no timing line for {missing}; got {found}")
+    # Later milestones never come earlier, in wall or CPU time (10 ms clock ticks for the start).
+    for a, b in zip(names, names[1:]):
+        if found[b][0] < found[a][0] or found[b][1] < found[a][1]:
+            fail(f"{what}: '{b}' {found[b]} reported before '{a}' {found[a]}")
+    # The process started after this script started it, and the line was read after the
+    # program wrote it: the reported time cannot exceed the time measured here (+1 tick).
+    last = found[names[-1]][0]
+    if not 0 < last <= external_wall_ms + 10:
+        fail(f"{what}: '{names[-1]}' at {last} ms after process start, but only "
+             f"{external_wall_ms:.0f} ms passed between starting it and reading the line")
+    # ...nor fall far short of it (a wrong clock or reference would be off by far more).
+    if last < external_wall_ms - 500:
+        fail(f"{what}: '{names[-1]}' at {last} ms, {external_wall_ms:.0f} ms measured outside")
+
+
+def case_startup_timing_inner(brdf_view, source_dir, tmp):
+    """Runs with DISPLAY set (under xvfb-run): the start-up milestones against outside clocks."""
+    import time
+    gold = os.path.join(source_dir, "data-samples", "materials", "gold.json")
+    env = dict(os.environ, BRDF_VIEW_TIMING="1")
+    # A window on the running display: read stderr until the first frame is reported.
+    t0 = time.monotonic()
+    proc = subprocess.Popen([brdf_view, gold, "--size", "640x480"], cwd=tmp, env=env,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    lines = []
+    try:
+        for line in proc.stderr:
+            lines.append(line)
+            if "first frame" in line:
+                break
+        t1 = time.monotonic()
+        found = parse_timing("".join(lines))
+        check_milestones(found, MILESTONES, (t1 - t0) * 1000, "window")
+        shown = xdo("search", "--onlyvisible", "--limit", "1", "--name", "brdf-view")
+        if not shown.stdout.strip():
+            fail("first frame reported but no brdf-view window is mapped")
+        xdo("key", "--window", shown.stdout.split()[0], "q")
+        _, status, usage = os.wait4(proc.pid, 0)
+        proc.returncode = os.waitstatus_to_exitcode(status)
+    finally:
+        if proc.returncode is None:
+            proc.kill()
+            proc.wait()
+    if proc.returncode != 0:
+        fail(f"brdf-view exited {proc.returncode} after q")
+    # CPU so far at the first frame cannot exceed what the kernel counted for the whole run.
+    total_cpu_ms = (usage.ru_utime + usage.ru_stime) * 1000
+    if found["first frame"][1] > total_cpu_ms + 10:
+        fail(f"first frame at {found['first frame'][1]} ms CPU, whole run {total_cpu_ms:.0f} ms")
+    print(f"window: {found}, whole run {total_cpu_ms:.0f} ms CPU")
+    # A screenshot run reports the same milestones, then the written picture.
+    shot = os.path.join(tmp, "timed.png")
+    t0 = time.monotonic()
+    run = subprocess.run([brdf_view, gold, "--size", "640x480", "--screenshot", shot], cwd=tmp,
+                         env=env, capture_output=True, text=True, timeout=120)
+    t1 = time.monotonic()
+    if run.returncode != 0:
+        fail(f"timed screenshot exited {run.returncode}: {run.stderr}")
+    found = parse_timing(run.stderr)
+    check_milestones(found, MILESTONES + ["screenshot"], (t1 - t0) * 1000, "screenshot")
+    check_not_blank(read_png(shot, 640, 480), 0.01)
+    # Without the variable the program prints nothing about timing.
+    run = subprocess.run([brdf_view, gold, "--size", "640x480", "--screenshot", shot], cwd=tmp,
+                         capture_output=True, text=True, timeout=120,
+                         env={k: v for k, v in os.environ.items() if k != "BRDF_VIEW_TIMING"})
+    if run.returncode != 0 or "timing" in run.stderr:
+        fail(f"untimed screenshot: exit {run.returncode}, stderr {run.stderr!r}")
+    print(f"screenshot: {found}")
+
+
+def case_startup_timing(brdf_view, source_dir, tmp):
+    run_inner_under_xvfb("startup_timing_inner", brdf_view, source_dir)
+
+
+def case_compare_error(brdf_view, source_dir, tmp):
+    """A second source that fails to open (it opens on its own thread): one line naming it,
+    exit code 1, and the first source still drawn."""
+    width, height = 640, 480
+    shot = os.path.join(tmp, "compare.png")
+    gold = os.path.join(source_dir, "data-samples", "materials", "gold.json")
+    missing = os.path.join(tmp, "no-such-fit.json")
+    proc = run_view(brdf_view, [gold, "--compare", missing, "--size", f"{width}x{height}",
+                                "--screenshot", shot], tmp, expect_rc=1)
+    lines = [l for l in proc.stderr.splitlines() if l.strip()]
+    if len(lines) != 1 or "no-such-fit.json" not in lines[0] or "--compare" not in lines[0]:
+        fail(f"expected one line naming the --compare file, got: {proc.stderr!r}")
+    check_not_blank(read_png(shot, width, height), 0.01)
+    print("compare error: " + lines[0])
+
+
 CASES = {
     "lobe_lambert": case_lobe_lambert,
     "lobe_glossy": case_lobe_glossy,
@@ -355,6 +470,9 @@ CASES = {
     "no_display": case_no_display,
     "interactive": case_interactive,
     "interactive_inner": case_interactive_inner,
+    "startup_timing": case_startup_timing,
+    "startup_timing_inner": case_startup_timing_inner,
+    "compare_error": case_compare_error,
 }
 
 if __name__ == "__main__":

@@ -22,10 +22,13 @@
 #include "brdf/core/measurement.h"
 #include "brdf/viewer/app.h"
 #include "open_source.h"
+#include "startup_clock.h"
 
 namespace {
 
 constexpr const char* kXvfbGuard = "BRDF_VIEW_UNDER_XVFB";
+// Set (to anything non-empty) to print start-up milestones on stderr (docs/benchmarks.md).
+constexpr const char* kTimingVariable = "BRDF_VIEW_TIMING";
 // Exit code of a run under xvfb-run whose display could not be opened: concurrent
 // `xvfb-run -a` calls sometimes pick the same display number, so the parent tries again.
 constexpr int kDisplayRetry = 75;
@@ -158,6 +161,9 @@ int Finish(int code) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  const char* timing_variable = std::getenv(kTimingVariable);
+  const bool timing = timing_variable != nullptr && *timing_variable != '\0';
+  if (timing) brdf::view_tool::PrintMilestone("main");
   CLI::App app{
       "brdf-view: reflection lobes, LUT slice heat maps and environment-lit previews of any "
       "BRDF the toolchain reads (capture, material, exported LUT, RGL, MERL, tables)"};
@@ -214,6 +220,13 @@ int main(int argc, char** argv) {
   options.log_scale = log_scale;
   options.cosine_weighted = cosine_weighted;
   options.all_slices = all_slices;
+  if (timing) options.on_milestone = brdf::view_tool::PrintMilestone;
+  // A screenshot is one small frame: Mesa's CPU rasteriser (llvmpipe, e.g. under Xvfb) then
+  // spends more time handing it to its worker threads and waiting for them to be scheduled
+  // than drawing it, most of all on a busy machine (docs/benchmarks.md, viewer start-up).
+  // LP_NUM_THREADS=0 (a documented Mesa variable) draws on the calling thread; the user's own
+  // setting wins, and other OpenGL drivers ignore it.
+  if (!screenshot.empty()) setenv("LP_NUM_THREADS", "0", /*overwrite=*/0);
 
   const std::string display_problem = brdf::viewer::DisplayProblem();
   if (!display_problem.empty()) {
@@ -248,15 +261,21 @@ int main(int argc, char** argv) {
   }
 
   try {
-    brdf::viewer::LoadedSource primary = brdf::view_tool::OpenViewSource(source);
-    std::optional<brdf::viewer::LoadedSource> second;
-    if (!compare.empty()) second = brdf::view_tool::OpenViewSource(compare);
-    if (second && !second->error.empty()) {
-      std::fprintf(stderr, "brdf-view: error: --compare: %s\n", second->error.c_str());
+    // Both sources open on threads of their own while the window is being created.
+    bool compare_failed = false;
+    brdf::viewer::SourceOpener open_compare;
+    if (!compare.empty()) {
+      open_compare = [&compare, &compare_failed] {
+        brdf::viewer::LoadedSource second = brdf::view_tool::OpenViewSource(compare);
+        if (!second.error.empty()) {
+          compare_failed = true;
+          std::fprintf(stderr, "brdf-view: error: --compare: %s\n", second.error.c_str());
+        }
+        return second;
+      };
     }
-    const bool compare_failed = second && !second->error.empty();
-    const brdf::viewer::ViewerResult result =
-        brdf::viewer::RunViewer(options, std::move(primary), std::move(second));
+    const brdf::viewer::ViewerResult result = brdf::viewer::RunViewer(
+        options, [&source] { return brdf::view_tool::OpenViewSource(source); }, open_compare);
     if (!result.ok) {
       if (result.display_failed && std::getenv(kXvfbGuard) != nullptr) {
         return Finish(kDisplayRetry);  // the parent starts another Xvfb

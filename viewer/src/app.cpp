@@ -6,11 +6,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <future>
 #include <sstream>
 #include <vector>
 
@@ -32,6 +34,8 @@
 #include <vtkLookupTable.h>
 #include <vtkNew.h>
 #include <vtkObjectFactory.h>
+#include <vtkOpenGLRenderWindow.h>
+#include <vtkOpenGLState.h>
 #include <vtkPNGWriter.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
@@ -41,6 +45,7 @@
 #include <vtkProperty.h>
 #include <vtkProperty2D.h>
 #include <vtkRegularPolygonSource.h>
+#include <vtkRenderStepsPass.h>
 #include <vtkRenderWindow.h>
 #include <vtkRenderWindowInteractor.h>
 #include <vtkRenderer.h>
@@ -52,6 +57,7 @@
 #include <vtkTextProperty.h>
 #include <vtkTransform.h>
 #include <vtkTransformPolyDataFilter.h>
+#include <vtkUnsignedCharArray.h>
 #include <vtkWindowToImageFilter.h>
 
 #include "brdf/core/error.h"
@@ -85,6 +91,18 @@ void StyleText(vtkTextProperty* p, int size, double r, double g, double b) {
   p->SetFontSize(size);
   p->SetColor(r, g, b);
   p->SetShadow(0);
+}
+
+// Whether an OpenGL renderer string (glGetString(GL_RENDERER)) names a rasteriser that runs on
+// the CPU: Mesa's llvmpipe, softpipe and the classic swrast.
+bool IsSoftwareRenderer(const std::string& renderer) {
+  std::string lower = renderer;
+  std::transform(lower.begin(), lower.end(), lower.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  for (const char* name : {"llvmpipe", "softpipe", "swrast", "software rasterizer"}) {
+    if (lower.find(name) != std::string::npos) return true;
+  }
+  return false;
 }
 
 std::string Fixed(double v, int digits) {
@@ -134,12 +152,14 @@ vtkStandardNewMacro(ViewerStyle)
 
     class App {
  public:
-  App(const ViewerOptions& options, LoadedSource primary, std::optional<LoadedSource> compare,
-      Display* display)
+  // The sources may still be opening on another thread: Run() creates the window first and
+  // waits for them only when the scene needs them.
+  App(const ViewerOptions& options, std::future<LoadedSource> primary,
+      std::optional<std::future<LoadedSource>> compare, Display* display)
       : display_(display),
         options_(options),
-        primary_(std::move(primary)),
-        compare_(std::move(compare)),
+        pending_primary_(std::move(primary)),
+        pending_compare_(std::move(compare)),
         mode_(options.mode),
         theta_in_deg_(options.theta_in_deg),
         channel_(static_cast<Channel>(std::clamp(options.channel, 0, 3))),
@@ -191,6 +211,13 @@ vtkStandardNewMacro(ViewerStyle)
   void ShowPreviewImage();
   void UpdateText();
   bool WriteScreenshot(const std::string& path, std::string* error);
+  // Reports a milestone once the X server has processed everything sent so far (so a frame
+  // that was just swapped is on screen, not still in Xlib's output buffer).
+  void Milestone(const char* what) {
+    if (!options_.on_milestone) return;
+    XSync(display_, False);
+    options_.on_milestone(what);
+  }
   void AddProp(vtkProp* prop) {
     renderer_->AddViewProp(prop);
     scene_.emplace_back(prop);
@@ -198,6 +225,8 @@ vtkStandardNewMacro(ViewerStyle)
 
   Display* display_;  // owned by RunViewer, outlives every VTK object here
   ViewerOptions options_;
+  std::future<LoadedSource> pending_primary_;
+  std::optional<std::future<LoadedSource>> pending_compare_;
   LoadedSource primary_;
   std::optional<LoadedSource> compare_;
   Mode mode_;
@@ -209,6 +238,7 @@ vtkStandardNewMacro(ViewerStyle)
   bool compare_wireframe_ = true;
   bool show_help_ = false;
   bool interactive_ = false;  // a window with an interactor (false for a screenshot run)
+  bool first_frame_reported_ = false;
   int current_slice_ = 0;
   double scale_max_ = 1;  // colour scale and log floor for the lobe (fixed while θin moves)
   double arrow_length_ = 1;
@@ -412,11 +442,27 @@ void App::AddArrow(const Vec3& direction, double length, const double color[3], 
   vtkNew<vtkTransformPolyDataFilter> filter;
   filter->SetTransform(transform);
   filter->SetInputConnection(arrow->GetOutputPort());
+  // Point normals and a colour per point, like the lobe's meshes: VTK then draws arrows and
+  // lobes with one shader program, one fewer for the OpenGL driver to compile before the first
+  // frame (≈ 50 ms of CPU on a CPU rasteriser without a warm shader cache).
+  vtkNew<vtkPolyDataNormals> normals;
+  normals->SetInputConnection(filter->GetOutputPort());
+  normals->Update();
+  vtkNew<vtkPolyData> poly;
+  poly->ShallowCopy(normals->GetOutput());
+  vtkNew<vtkUnsignedCharArray> rgb;
+  rgb->SetNumberOfComponents(3);
+  rgb->SetNumberOfTuples(poly->GetNumberOfPoints());
+  for (int c = 0; c < 3; ++c) {
+    rgb->FillComponent(c, std::round(255.0 * std::clamp(color[c], 0.0, 1.0)));
+  }
+  poly->GetPointData()->SetScalars(rgb);
   vtkNew<vtkPolyDataMapper> mapper;
-  mapper->SetInputConnection(filter->GetOutputPort());
+  mapper->SetInputData(poly);
+  mapper->SetColorModeToDirectScalars();
+  mapper->SetScalarModeToUsePointData();
   vtkNew<vtkActor> actor;
   actor->SetMapper(mapper);
-  actor->GetProperty()->SetColor(color[0], color[1], color[2]);
   actor->GetProperty()->SetAmbient(0.5);
   actor->GetProperty()->SetOpacity(opacity);
   AddProp(actor);
@@ -847,13 +893,22 @@ void App::OnMouseMove(int x, int y) {
 
 bool App::WriteScreenshot(const std::string& path, std::string* error) {
   window_->Render();
+  if (!first_frame_reported_) {
+    first_frame_reported_ = true;
+    Milestone("first frame");
+  }
   vtkNew<vtkWindowToImageFilter> grab;
   grab->SetInput(window_);
   grab->SetInputBufferTypeToRGB();
   grab->ReadFrontBufferOff();
+  // The frame rendered just above is the picture: without this the filter renders it again.
+  grab->ShouldRerenderOff();
   grab->Update();
   vtkNew<vtkPNGWriter> writer;
   writer->SetFileName(path.c_str());
+  // zlib level 1: a third of the default level's time for a picture that is mostly flat
+  // background (docs/benchmarks.md, viewer start-up).
+  writer->SetCompressionLevel(1);
   writer->SetInputConnection(grab->GetOutputPort());
   writer->Write();
   if (writer->GetErrorCode() != 0 || !std::filesystem::exists(path)) {
@@ -890,17 +945,37 @@ bool App::WriteScreenshot(const std::string& path, std::string* error) {
 
 ViewerResult App::Run() {
   renderer_->SetBackground(kBackground[0], kBackground[1], kBackground[2]);
+  // VTK's standard sequence of passes, with plain alpha blending for translucent surfaces (the
+  // extrapolated band, the mirror arrow). Without a pass of its own the renderer blends them
+  // order-independently, which costs extra framebuffers, a full-window compositing pass and,
+  // on a CPU rasteriser, ≈ 15 ms of shader compilation before the first frame; blending in
+  // drawing order looks the same for these few thin or nested surfaces.
+  vtkNew<vtkRenderStepsPass> passes;
+  renderer_->SetPass(passes);
   window_->SetDisplayId(display_);
   window_->SetSize(options_.width, options_.height);
   window_->SetWindowName("brdf-view");
   window_->AddRenderer(renderer_);
   const bool headless = !options_.screenshot_path.empty();
+  // A screenshot renders into VTK's own framebuffers and reads the picture from there: no
+  // window is mapped and nothing is copied to it (on a CPU rasteriser that copy, colour plus a
+  // depth pass with a shader of its own, cost ≈ 15 % of the run). It still needs an X display
+  // for the OpenGL context. Only interactive runs create the X interactor (VTK 9.1's crashed
+  // in its Initialize, XSync on a null display, with an off-screen window and sometimes under
+  // Xvfb), and the slider widget is only attached to it.
+  if (headless) window_->SetOffScreenRendering(1);
+  if (auto* gl = vtkOpenGLRenderWindow::SafeDownCast(window_)) {
+    gl->Initialize();  // the X window and the GL context
+    // VTK renders into an 8× multisampled framebuffer by default. On a GPU that is free; on a
+    // CPU rasteriser (Mesa llvmpipe, e.g. under Xvfb) it shades every pixel up to 8 times and
+    // made each frame cost ≈ 100 ms of CPU more (docs/benchmarks.md, viewer start-up).
+    if (IsSoftwareRenderer(gl->GetState()->GetRenderer())) window_->SetMultiSamples(0);
+  }
+  Milestone("window");
+  primary_ = pending_primary_.get();
+  if (pending_compare_) compare_ = pending_compare_->get();
+  Milestone("sources opened");
   interactive_ = !headless;
-  // No off-screen rendering for screenshots: VTK 9.1's X interactor crashes (XSync on a null
-  // display) with an off-screen window, and the slider widget needs the interactor. Under
-  // xvfb-run the window is invisible anyway.
-  // A screenshot needs no interactor; VTK 9.1's X interactor sometimes crashed in its
-  // Initialize (XSync) under Xvfb, so headless runs never create one.
   if (!headless) interactor_->SetRenderWindow(window_);
   style_->app = this;
   interactor_->SetInteractorStyle(style_);
@@ -977,6 +1052,7 @@ ViewerResult App::Run() {
     }
   }
   Rebuild(true);
+  Milestone("scene");
 
   ViewerResult result;
   if (!primary_.error.empty()) {
@@ -1000,6 +1076,7 @@ ViewerResult App::Run() {
       result.ok = false;
       result.message = error;
     }
+    Milestone("screenshot");
     return result;
   }
   timer_callback_->SetClientData(this);
@@ -1008,6 +1085,8 @@ ViewerResult App::Run() {
   interactor_->AddObserver(vtkCommand::TimerEvent, timer_callback_);
   interactor_->CreateRepeatingTimer(30);
   window_->Render();
+  first_frame_reported_ = true;
+  Milestone("first frame");
   interactor_->Start();
   return result;
 }
@@ -1052,11 +1131,17 @@ std::string DisplayProblem() {
   return {};
 }
 
-ViewerResult RunViewer(const ViewerOptions& options, LoadedSource primary,
-                       std::optional<LoadedSource> compare) {
+ViewerResult RunViewer(const ViewerOptions& options, const SourceOpener& open_primary,
+                       const SourceOpener& open_compare) {
   options.Validate();
-  const std::string problem = DisplayProblem();
-  if (!problem.empty()) return {false, problem, true};
+  const char* display_name = std::getenv("DISPLAY");
+  if (display_name == nullptr || *display_name == '\0') return {false, DisplayProblem(), true};
+  // Opening the sources (reading, resampling the LUT: CPU work, no X or GL) runs on its own
+  // thread while this one connects to the X server and creates the window and its OpenGL
+  // context, the two longest steps before the first frame.
+  std::future<LoadedSource> primary = std::async(std::launch::async, open_primary);
+  std::optional<std::future<LoadedSource>> compare;
+  if (open_compare) compare = std::async(std::launch::async, open_compare);
   // The window gets a display connection opened here. Left to itself, VTK 9.1's X interactor
   // opens one in Initialize and uses it without checking; under a freshly started Xvfb that
   // open sometimes failed and the program crashed (XSync on a null display). A few retries
@@ -1067,7 +1152,7 @@ ViewerResult RunViewer(const ViewerOptions& options, LoadedSource primary,
     if (display == nullptr) usleep(100000);
   }
   if (display == nullptr) {
-    return {false, std::string("cannot open the X display '") + std::getenv("DISPLAY") + "'", true};
+    return {false, std::string("cannot open the X display '") + display_name + "'", true};
   }
   ViewerResult result;
   {

@@ -15,6 +15,7 @@
 //   preview: arrow keys or a mouse drag orbit the camera; the picture refines while idle
 #pragma once
 
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -50,6 +51,13 @@ struct ViewerOptions {
   // `<screenshot>.json` beside it records the camera (position, focal point, view up, vertical
   // view angle in degrees) and the image size, so a report (or a test) can tell what is where.
   std::string screenshot_path;
+  // Called on the calling thread when the run reaches a milestone, in this order: "window"
+  // (the X window and its OpenGL context exist), "sources opened" (both sources are open or
+  // have failed), "scene" (the first picture's actors are built, nothing drawn yet), "first
+  // frame" (the first picture is rendered and the X server has processed it: in a window it is
+  // on screen; for a screenshot it is in VTK's off-screen framebuffer), "screenshot" (the PNG
+  // and its camera file are written). For start-up timing (docs/benchmarks.md); may be empty.
+  std::function<void(const char* milestone)> on_milestone;
 
   // Throws InvalidArgument naming the bad field (size outside 64…8192, θin outside [0°, 90°)).
   void Validate() const;
@@ -65,9 +73,16 @@ struct ViewerResult {
 // or the display named cannot be opened). VTK on Debian needs X for any rendering.
 std::string DisplayProblem();
 
+// Opens one source (never throws: a failure is LoadedSource::error). Called on a thread of its
+// own, so it must not touch X or VTK.
+using SourceOpener = std::function<LoadedSource()>;
+
 // Opens the window (or renders the screenshot). Blocks until the user closes the window.
+// The sources are opened on other threads while the window and its OpenGL context are
+// created, so that neither waits for the other before the first frame; `open_compare` may be
+// empty (no second source). Both openers have returned when RunViewer returns.
 // Throws InvalidArgument for bad options; rendering problems come back in the result.
-ViewerResult RunViewer(const ViewerOptions& options, LoadedSource primary,
-                       std::optional<LoadedSource> compare);
+ViewerResult RunViewer(const ViewerOptions& options, const SourceOpener& open_primary,
+                       const SourceOpener& open_compare);
 
 }  // namespace brdf::viewer
