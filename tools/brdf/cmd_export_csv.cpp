@@ -4,12 +4,14 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <vector>
 
 #include "brdf/core/bpc.h"
 #include "brdf/core/csv.h"
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
 #include "brdf/core/measurement.h"
+#include "brdf/sources/capture.h"
 #include "cli_support.h"
 #include "commands.h"
 
@@ -47,9 +49,12 @@ int RunExportCsv(const ExportCsvOptions& options) {
                           ": export-csv reads .bpc captures (bring other formats in with "
                           "`brdf import` first)");
   CheckOutputPath(options.out, options.file, ".csv", options.force);
-  // Strict: a damaged capture is refused with the first problem (offset and slice); an
-  // unfinished but intact one is exported with its incomplete slices marked.
-  const Measurement m = LoadBpc(options.file);
+  // The capture rule of every command (brdf/sources/capture.h), for a copy: damage and
+  // inconsistent structure are refused as convert refuses them; an unfinished capture is
+  // exported with its incomplete slices marked; a cut end chunk or bytes after it are warnings.
+  std::vector<std::string> warnings;
+  const Measurement m = sources::LoadCaptureForCopy(options.file, &warnings);
+  for (const std::string& w : warnings) std::fprintf(stderr, "%s\n", w.c_str());
   CheckFinite(m, options.file);
   const std::string text = FormatCsv(m);
   // What is written must read back: a value outside the CSV's validated ranges (θout > 90°,
