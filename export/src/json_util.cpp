@@ -65,12 +65,14 @@ ordered_json PayloadJson(const PackedVolume& payload) {
 }
 
 ordered_json ParseEmbeddedJson(const std::string& text, const std::string& what) {
+  // The text comes from the caller (a fitted model to record), not from a file: a bad one is
+  // a bad argument, described as a file's JSON would be.
   try {
     return ordered_json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
-    throw JsonSyntaxError(what, text, e.byte);
+    throw InvalidArgument(JsonSyntaxError(what, text, e.byte).what());
   } catch (const nlohmann::json::out_of_range&) {
-    throw JsonNumberTooLargeError(what, text);
+    throw InvalidArgument(JsonNumberTooLargeError(what, text).what());
   }
 }
 

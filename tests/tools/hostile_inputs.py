@@ -957,6 +957,14 @@ def check_agreement(variant, results, work, index, findings):
         if code == 0 and ocode != 0 and not warned:
             findings.append(f"{where}: info accepts it without a warning but {other} refuses: "
                             f"{oerr.strip()[:250]}")
+    # The capture-only commands: export-csv copies what info accepts (unless CSV cannot hold a
+    # value), and repair acts on what info says to repair.
+    csv = results.get("export-csv")
+    if csv and code == 0 and csv[0] != 0 and "CSV" not in csv[2]:
+        findings.append(f"{where}: info accepts it but export-csv refuses: {csv[2].strip()[:250]}")
+    repair = results.get("repair")
+    if repair and "brdf repair" in out and "nothing to repair" in repair[2]:
+        findings.append(f"{where}: info advises 'brdf repair' but repair finds nothing to repair")
     if code == 0 and results.get("convert", (None,))[0] == 0:
         sidecar = os.path.join(work, "out", f"{index:04d}", "conv",
                                os.path.splitext(os.path.basename(variant.path))[0] + ".json")
