@@ -291,5 +291,37 @@ TEST_F(HostileCaptures, InconsistentChunksAreRefusedAlikeAndRepaired) {
   }
 }
 
+// Defect 9: export-csv went by the file name: a capture saved as "cap.dat" was refused, and a
+// KTX2 texture saved as "x.bpc" (which info describes as a texture) was read as a capture with a
+// damaged magic. It recognises files by content like every other command.
+TEST_F(HostileCaptures, ExportCsvRecognisesCapturesByContent) {
+  const fs::path renamed = Write("cap.dat", bytes_);
+  const ToolRun ok = Run("export-csv " + Quote(renamed) + " --out " + Quote(dir_ / "dat.csv"));
+  EXPECT_EQ(ok.exit_code, 0) << ok.err;
+  EXPECT_EQ(CsvRows(dir_ / "dat.csv"), samples_);
+  ASSERT_EQ(Run("convert " + Quote(dir_ / "cap.bpc") + " --quiet --formats ktx2 --out " +
+                Quote(dir_ / "lut"))
+                .exit_code,
+            0);
+  const fs::path texture = Write("texture.bpc", ReadAll(dir_ / "lut" / "cap.ktx2"));
+  const std::string err =
+      OneCleanLine(Run("export-csv " + Quote(texture) + " --out " + Quote(dir_ / "t.csv")));
+  EXPECT_NE(err.find(texture.string() + ": a KTX2 texture"), std::string::npos) << err;
+}
+
+// Defect 10: export-csv of a capture without slices (cut right after its header) blamed the
+// output it had not written ("h.csv: line 39: expected at least one data row after the
+// header"). It names the capture, the byte where its slices should start and how to continue.
+TEST_F(HostileCaptures, ExportCsvOfAnEmptyCaptureNamesTheCapture) {
+  const fs::path head = Write("head.bpc", bytes_.substr(0, slices_[0].offset));
+  const std::string err =
+      OneCleanLine(Run("export-csv " + Quote(head) + " --out " + Quote(dir_ / "h.csv")));
+  EXPECT_NE(err.find(head.string() + ": byte " + std::to_string(slices_[0].offset) + ": "),
+            std::string::npos)
+      << err;
+  EXPECT_EQ(err.find("h.csv"), std::string::npos) << err;
+  EXPECT_NE(err.find("--resume"), std::string::npos) << err;
+}
+
 }  // namespace
 }  // namespace brdf::tooltest

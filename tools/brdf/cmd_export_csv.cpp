@@ -6,12 +6,12 @@
 #include <string>
 #include <vector>
 
-#include "brdf/core/bpc.h"
 #include "brdf/core/csv.h"
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
 #include "brdf/core/measurement.h"
 #include "brdf/sources/capture.h"
+#include "brdf/sources/detect.h"
 #include "cli_support.h"
 #include "commands.h"
 
@@ -44,9 +44,11 @@ void CheckFinite(const Measurement& m, const std::string& file) {
 }  // namespace
 
 int RunExportCsv(const ExportCsvOptions& options) {
-  if (LowerExtension(options.file) != ".bpc")
-    throw InvalidArgument(options.file +
-                          ": export-csv reads .bpc captures (bring other formats in with "
+  // By content, as every command recognises a file (a capture under another name is one).
+  const sources::FileKind kind = sources::DetectFileKind(options.file);
+  if (kind != sources::FileKind::kCapture)
+    throw InvalidArgument(options.file + ": a " + sources::FileKindName(kind) +
+                          "; export-csv reads .bpc captures (bring other formats in with "
                           "`brdf import` first)");
   CheckOutputPath(options.out, options.file, ".csv", options.force);
   // The capture rule of every command (brdf/sources/capture.h), for a copy: damage and
@@ -54,7 +56,6 @@ int RunExportCsv(const ExportCsvOptions& options) {
   // exported with its incomplete slices marked; a cut end chunk or bytes after it are warnings.
   std::vector<std::string> warnings;
   const Measurement m = sources::LoadCaptureForCopy(options.file, &warnings);
-  for (const std::string& w : warnings) std::fprintf(stderr, "%s\n", w.c_str());
   CheckFinite(m, options.file);
   const std::string text = FormatCsv(m);
   // What is written must read back: a value outside the CSV's validated ranges (θout > 90°,
@@ -65,6 +66,8 @@ int RunExportCsv(const ExportCsvOptions& options) {
     throw InvalidArgument(options.file + " cannot be written as a CSV point cloud: " + e.what());
   }
   WriteFileAtomically(options.out, text);
+  // Warnings after the work: a refusal stays the one line on stderr.
+  for (const std::string& w : warnings) std::fprintf(stderr, "%s\n", w.c_str());
   std::printf("%s -> %s: %zu slices, %zu samples\n", options.file.c_str(), options.out.c_str(),
               m.slices.size(), m.SampleCount());
   return 0;

@@ -226,10 +226,12 @@ Measurement LoadCaptureForLut(const std::string& path, std::vector<std::string>*
 
 Measurement LoadCaptureForCopy(const std::string& path, std::vector<std::string>* warnings) {
   CaptureAssessment a = AssessCapture(path);
+  const bool empty = a.read.measurement.SampleCount() == 0;
   for (const CaptureRefusal& refusal : a.refusals)
     if (refusal.cause == CaptureRefusal::Cause::kDamage ||
-        refusal.cause == CaptureRefusal::Cause::kStructure)
-      throw refusal.ToError(path);
+        refusal.cause == CaptureRefusal::Cause::kStructure ||
+        (empty && refusal.cause == CaptureRefusal::Cause::kMissingSlices))
+      throw refusal.ToError(path);  // nothing to copy from an unfinished capture: resume it
   if (warnings) {
     warnings->insert(warnings->end(), a.warnings.begin(), a.warnings.end());
     if (!a.read.finished && !a.missing_theta_in_deg.empty())

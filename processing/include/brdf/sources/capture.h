@@ -79,7 +79,8 @@ Measurement LoadCaptureForLut(const std::string& path, std::vector<std::string>*
 // The same assessment for a command that copies every sample instead of building a LUT
 // (`brdf export-csv`): refused for damage and inconsistent structure exactly as AssessCapture
 // refuses (the first such refusal, thrown as its FormatError); an incomplete slice and planned
-// slices not captured yet are kept (with a warning for the latter), as are values a LUT could
+// slices not captured yet are kept (with a warning for the latter; an unfinished capture without
+// any sample is refused with the resume remedy), as are values a LUT could
 // not be built from (the caller's format decides whether it can hold them). A cut or missing end
 // chunk and bytes after it give AssessCapture's warnings.
 Measurement LoadCaptureForCopy(const std::string& path, std::vector<std::string>* warnings);
