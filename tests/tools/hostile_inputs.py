@@ -960,7 +960,7 @@ def check_agreement(variant, results, work, index, findings):
     # The capture-only commands: export-csv copies what info accepts (unless CSV cannot hold a
     # value), and repair acts on what info says to repair.
     csv = results.get("export-csv")
-    if csv and code == 0 and csv[0] != 0 and "CSV" not in csv[2]:
+    if csv and code == 0 and doc.get("format") == "bpc" and csv[0] != 0 and "CSV" not in csv[2]:
         findings.append(f"{where}: info accepts it but export-csv refuses: {csv[2].strip()[:250]}")
     repair = results.get("repair")
     if repair and "brdf repair" in out and "nothing to repair" in repair[2]:

@@ -192,10 +192,11 @@ CaptureAssessment AssessCapture(const std::string& path, BpcReadResult read) {
       a.refusals.push_back(CaptureRefusal{
           BytePosition(r.valid_bytes),
           "slices for every planned θin (" + DegList(a.planned_theta_in_deg) + "°)",
-          "the end of an unfinished capture with θin " +
-              (a.present_theta_in_deg.empty() ? std::string("none")
-                                              : DegList(a.present_theta_in_deg) + "°") +
-              " only (missing " + DegList(a.missing_theta_in_deg) + "°)",
+          "the end of an unfinished capture " +
+              (a.present_theta_in_deg.empty()
+                   ? std::string("without any slice")
+                   : "with θin " + DegList(a.present_theta_in_deg) + "° only") +
+              " (missing " + DegList(a.missing_theta_in_deg) + "°)",
           {},
           continue_remedy, CaptureRefusal::Cause::kMissingSlices});
     } else {
