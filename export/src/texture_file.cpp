@@ -40,19 +40,19 @@ void FinishLoadedTexture(LoadedTexture& t) {
   // Metadata read beside a DDS is named by its own file, embedded metadata by the texture's.
   const bool beside = !t.metadata_file.empty();
   if (!t.sidecar_json.empty()) {
-    const SidecarInfo info = ParseSidecarJson(
-        t.sidecar_json, beside ? t.metadata_file : t.file + " (embedded sidecar)");
-    CheckRecordedPayload(t, beside ? "sidecar " + t.metadata_file : "embedded sidecar",
-                         info.width, info.height, info.slices, info.payload_bytes,
-                         info.payload_crc32);
+    const SidecarInfo info =
+        ParseSidecarJson(t.sidecar_json, beside ? t.metadata_file : t.file + " (embedded sidecar)");
+    CheckRecordedPayload(t, beside ? "sidecar " + t.metadata_file : "embedded sidecar", info.width,
+                         info.height, info.slices, info.payload_bytes, info.payload_crc32);
     t.theta_in_deg = info.theta_in_deg;
     t.theta_in_from_metadata = true;
   } else if (!t.atlas_manifest_json.empty()) {
     const AtlasManifest m = ParseAtlasManifest(
         t.atlas_manifest_json, beside ? t.metadata_file : t.file + " (embedded manifest)");
-    CheckRecordedPayload(t, beside ? "atlas manifest " + t.metadata_file : "embedded atlas manifest",
-                         m.texture_width, m.texture_height,
-                         static_cast<int>(m.theta_in_deg.size()), m.payload_bytes, m.payload_crc32);
+    CheckRecordedPayload(t,
+                         beside ? "atlas manifest " + t.metadata_file : "embedded atlas manifest",
+                         m.texture_width, m.texture_height, static_cast<int>(m.theta_in_deg.size()),
+                         m.payload_bytes, m.payload_crc32);
     t.theta_in_deg = m.theta_in_deg;
     t.theta_in_from_metadata = true;
   } else if (t.theta_in_deg.size() != static_cast<std::size_t>(t.volume.depth)) {

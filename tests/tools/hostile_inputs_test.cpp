@@ -16,7 +16,8 @@
 namespace brdf::tooltest {
 namespace {
 
-const std::string kGoldMaterial = std::string(BRDF_SOURCE_DIR) + "/data-samples/materials/gold.json";
+const std::string kGoldMaterial =
+    std::string(BRDF_SOURCE_DIR) + "/data-samples/materials/gold.json";
 
 class HostileInputs : public ToolTest {
  protected:
@@ -83,10 +84,10 @@ TEST_F(HostileInputs, DdsUnderAJsonNameIsNotItsOwnSidecar) {
 // sidecar)" with the parser's text. The error names the sidecar file and where it breaks: the
 // text is cut after `{"kind": ` (line 1, column 10, the end of the text).
 TEST_F(HostileInputs, BrokenSidecarBesideADdsIsNamed) {
-  ASSERT_EQ(Run("convert " + Quote(kGoldMaterial) + " --quiet --formats dds --out " +
-                Quote(dir_ / "lut"))
-                .exit_code,
-            0);
+  ASSERT_EQ(
+      Run("convert " + Quote(kGoldMaterial) + " --quiet --formats dds --out " + Quote(dir_ / "lut"))
+          .exit_code,
+      0);
   const fs::path sidecar = dir_ / "lut" / "gold.json";
   WriteText(sidecar, "{\"kind\": ");
   const std::string err = OneCleanLine(Run("info " + Quote(dir_ / "lut" / "gold.dds")));
@@ -193,17 +194,17 @@ std::string Rewrite(const std::string& bytes, const Chunk& c, std::uint32_t inde
   const std::string joined = head + payload;
   PutU32(head, 16, ZlibCrc(joined, 24, payload.size()));
   PutU32(head, 20, ZlibCrc(head, 0, 20));
-  return bytes.substr(0, c.offset) + head + payload +
-         bytes.substr(c.offset + 24 + c.payload_size);
+  return bytes.substr(0, c.offset) + head + payload + bytes.substr(c.offset + 24 + c.payload_size);
 }
 
 class HostileCaptures : public HostileInputs {
  protected:
   void SetUp() override {
     HostileInputs::SetUp();
-    const ToolRun r = Run("capture --device sim --material gold --sample s --theta-in 0,30,60 "
-                          "--theta-out-step 5 --phi-out-step 10 --noise 0 --quiet --out " +
-                          Quote(dir_ / "cap.bpc"));
+    const ToolRun r =
+        Run("capture --device sim --material gold --sample s --theta-in 0,30,60 "
+            "--theta-out-step 5 --phi-out-step 10 --noise 0 --quiet --out " +
+            Quote(dir_ / "cap.bpc"));
     ASSERT_EQ(r.exit_code, 0) << r.err;
     bytes_ = ReadAll(dir_ / "cap.bpc");
     for (const Chunk& c : Chunks(bytes_)) {
@@ -262,14 +263,13 @@ TEST_F(HostileCaptures, ExportCsvAcceptsWhatConvertAcceptsWithAWarning) {
 // repair", so the advice led nowhere. Now export-csv refuses them as info does, and repair
 // writes the slices to a capture that info accepts again.
 TEST_F(HostileCaptures, InconsistentChunksAreRefusedAlikeAndRepaired) {
-  nlohmann::json end =
-      nlohmann::json::parse(bytes_.substr(end_.offset + 24, end_.payload_size));
+  nlohmann::json end = nlohmann::json::parse(bytes_.substr(end_.offset + 24, end_.payload_size));
   ASSERT_EQ(end["sample_count"].get<std::uint64_t>(), samples_);
   end["sample_count"] = samples_ - 1;
   const std::string slice1 = bytes_.substr(slices_[1].offset + 24, slices_[1].payload_size);
   for (const auto& [name, bytes] :
-       {std::pair<std::string, std::string>{"lying_end.bpc", Rewrite(bytes_, end_, 0xFFFFFFFF,
-                                                                      end.dump())},
+       {std::pair<std::string, std::string>{"lying_end.bpc",
+                                            Rewrite(bytes_, end_, 0xFFFFFFFF, end.dump())},
         {"dup_index.bpc", Rewrite(bytes_, slices_[1], 0, slice1)}}) {
     SCOPED_TRACE(name);
     const fs::path cap = Write(name, bytes);

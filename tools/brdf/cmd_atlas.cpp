@@ -41,7 +41,8 @@ int RunAtlas(const AtlasOptions& options) {
 
   DiscoveredInputs found = DiscoverInputs(options.inputs, InputKinds{.exported_luts = true});
   if (found.inputs.empty() && found.failures.empty()) {
-    throw InvalidArgument("no captures, material files or exported LUTs found in " + JoinArguments(options.inputs));
+    throw InvalidArgument("no captures, material files or exported LUTs found in " +
+                          JoinArguments(options.inputs));
   }
 
   std::vector<std::string> outputs = {options.out + ".ktx2", options.out + ".dds",

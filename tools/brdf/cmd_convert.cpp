@@ -106,7 +106,8 @@ int RunConvert(const ConvertOptions& options) {
 
   DiscoveredInputs found = DiscoverInputs(options.inputs);
   if (found.inputs.empty() && found.failures.empty()) {
-    throw InvalidArgument("no captures (.bpc) or material files (.json) found in " + JoinArguments(options.inputs));
+    throw InvalidArgument("no captures (.bpc) or material files (.json) found in " +
+                          JoinArguments(options.inputs));
   }
   const fs::path out_dir(options.out);
   std::error_code ec;

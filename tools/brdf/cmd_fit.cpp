@@ -118,7 +118,8 @@ int RunFit(const FitCommandOptions& options) {
     }
   }
   if (inputs.empty() && failures.empty()) {
-    throw InvalidArgument("no captures, material files or measured BRDF files found in " + JoinArguments(options.inputs));
+    throw InvalidArgument("no captures, material files or measured BRDF files found in " +
+                          JoinArguments(options.inputs));
   }
 
   // Output names: one input and one model write --out itself.

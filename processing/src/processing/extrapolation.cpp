@@ -9,8 +9,8 @@
 #include <string>
 
 #include "brdf/core/error.h"
-#include "brdf/core/json_error.h"
 #include "brdf/core/file_util.h"
+#include "brdf/core/json_error.h"
 
 namespace brdf::processing {
 namespace {

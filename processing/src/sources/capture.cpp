@@ -64,23 +64,21 @@ void CheckStructure(CaptureAssessment& a) {
   if (r.finished && r.problems.empty()) {
     const std::string where = BytePosition(r.end_offset) + " (end chunk)";
     if (r.end_slice_count != static_cast<std::int64_t>(r.measurement.slices.size()))
-      a.refusals.push_back({where,
-                            "slice_count " + std::to_string(r.measurement.slices.size()) +
-                                " (the slices in the file)",
-                            r.end_slice_count < 0
-                                ? std::string("no slice count")
-                                : "slice_count " + std::to_string(r.end_slice_count),
-                            "the end chunk does not describe this file", repair,
-                            CaptureRefusal::Cause::kStructure});
+      a.refusals.push_back(
+          {where,
+           "slice_count " + std::to_string(r.measurement.slices.size()) +
+               " (the slices in the file)",
+           r.end_slice_count < 0 ? std::string("no slice count")
+                                 : "slice_count " + std::to_string(r.end_slice_count),
+           "the end chunk does not describe this file", repair, CaptureRefusal::Cause::kStructure});
     if (r.end_sample_count != static_cast<std::int64_t>(r.measurement.SampleCount()))
-      a.refusals.push_back({where,
-                            "sample_count " + std::to_string(r.measurement.SampleCount()) +
-                                " (the samples in the file)",
-                            r.end_sample_count < 0
-                                ? std::string("no sample count")
-                                : "sample_count " + std::to_string(r.end_sample_count),
-                            "the end chunk does not describe this file", repair,
-                            CaptureRefusal::Cause::kStructure});
+      a.refusals.push_back(
+          {where,
+           "sample_count " + std::to_string(r.measurement.SampleCount()) +
+               " (the samples in the file)",
+           r.end_sample_count < 0 ? std::string("no sample count")
+                                  : "sample_count " + std::to_string(r.end_sample_count),
+           "the end chunk does not describe this file", repair, CaptureRefusal::Cause::kStructure});
   }
 }
 
@@ -189,16 +187,17 @@ CaptureAssessment AssessCapture(const std::string& path, BpcReadResult read) {
   CheckValues(a);
   if (!r.finished && a.refusals.empty()) {
     if (!a.missing_theta_in_deg.empty()) {
-      a.refusals.push_back(CaptureRefusal{
-          BytePosition(r.valid_bytes),
-          "slices for every planned θin (" + DegList(a.planned_theta_in_deg) + "°)",
-          "the end of an unfinished capture " +
-              (a.present_theta_in_deg.empty()
-                   ? std::string("without any slice")
-                   : "with θin " + DegList(a.present_theta_in_deg) + "° only") +
-              " (missing " + DegList(a.missing_theta_in_deg) + "°)",
-          {},
-          continue_remedy, CaptureRefusal::Cause::kMissingSlices});
+      a.refusals.push_back(
+          CaptureRefusal{BytePosition(r.valid_bytes),
+                         "slices for every planned θin (" + DegList(a.planned_theta_in_deg) + "°)",
+                         "the end of an unfinished capture " +
+                             (a.present_theta_in_deg.empty()
+                                  ? std::string("without any slice")
+                                  : "with θin " + DegList(a.present_theta_in_deg) + "° only") +
+                             " (missing " + DegList(a.missing_theta_in_deg) + "°)",
+                         {},
+                         continue_remedy,
+                         CaptureRefusal::Cause::kMissingSlices});
     } else {
       a.warnings.push_back(
           path + ": warning: no intact end chunk (" +
@@ -288,10 +287,9 @@ RepairReport RepairCapture(const std::string& input, const std::string& output, 
   for (const CaptureRefusal& refusal : a.refusals)
     if (refusal.cause == CaptureRefusal::Cause::kStructure && r.finished &&
         refusal.position.find("end chunk") != std::string::npos)
-      report.dropped.push_back({r.end_offset,
-                                r.valid_bytes > r.end_offset ? r.valid_bytes - r.end_offset : 0,
-                                -1, std::nullopt,
-                                "end chunk: expected " + refusal.expected + ", got " + refusal.got});
+      report.dropped.push_back(
+          {r.end_offset, r.valid_bytes > r.end_offset ? r.valid_bytes - r.end_offset : 0, -1,
+           std::nullopt, "end chunk: expected " + refusal.expected + ", got " + refusal.got});
 
   // The header keeps what the capture started with (the settings a resume compares); the end
   // chunk's metadata, if any, is not carried over: the repaired capture is unfinished again.
