@@ -904,6 +904,8 @@ def check_run(variant, command, code, out, err, findings):
             name = "resume.bpc"  # the copy the resume appends to
         if variant.path not in err and name not in err:
             findings.append(f"{where}: error does not name the file: {err.strip()[:300]}")
+        if "valid JSON" in err and not re.search(r"line \d+, column \d+", err):
+            findings.append(f"{where}: JSON error without line and column: {err.strip()[:300]}")
         if position_expected(variant, command) and code == 1 and not has_position(err, name):
             findings.append(f"{where}: error names no position: {err.strip()[:300]}")
     if command == "eval" and code == 0:
