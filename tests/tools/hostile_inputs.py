@@ -979,6 +979,22 @@ def check_agreement(variant, results, work, index, findings):
         if info_theta is not None and info_theta != conv_theta:
             findings.append(f"{where}: info reports θin {info_theta}, convert's sidecar "
                             f"{conv_theta}")
+        # Saturated samples per slice: info's flag counts against the sidecar's record.
+        side = json.load(open(sidecar))
+        if isinstance(doc.get("slices"), list) and isinstance(side.get("saturated_samples"), list):
+            info_sat = sorted((round(float(x["theta_in_deg"]), 6), x["flag_counts"]["saturated"])
+                              for x in doc["slices"])
+            side_sat = sorted((round(float(x["theta_in_deg"]), 6), x["count"])
+                              for x in side["saturated_samples"])
+            if info_sat != side_sat:
+                findings.append(f"{where}: info counts saturated samples {info_sat}, convert's "
+                                f"sidecar {side_sat}")
+    if code == 0 and csv and csv[0] == 0 and isinstance(doc.get("sample_count"), int):
+        rows = sum(1 for line in open(os.path.join(work, "out", f"{index:04d}", "e.csv"))
+                   if line[:1].isdigit())
+        if rows != doc["sample_count"]:
+            findings.append(f"{where}: info reports {doc['sample_count']} samples, export-csv "
+                            f"wrote {rows}")
 
 
 def main():
