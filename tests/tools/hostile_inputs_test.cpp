@@ -323,5 +323,24 @@ TEST_F(HostileCaptures, ExportCsvOfAnEmptyCaptureNamesTheCapture) {
   EXPECT_NE(err.find("--resume"), std::string::npos) << err;
 }
 
+// Defect 11: a damaged .exr environment map was refused with OpenEXR's sentence that repeats
+// the file name ("x.exr: EXR content: expected a readable OpenEXR image, got Cannot read image
+// file "x.exr". Early end of file: ..."). The line names the file once.
+TEST_F(HostileInputs, DamagedExrNamesTheFileOnce) {
+  ASSERT_EQ(Run("convert " + Quote(kGoldMaterial) + " --quiet --formats exr --out " +
+                Quote(dir_ / "lut"))
+                .exit_code,
+            0);
+  const fs::path cut = dir_ / "cut.exr";
+  WriteText(cut, ReadAll(dir_ / "lut" / "gold.exr").substr(0, 1));
+  const std::string err =
+      OneCleanLine(Run("preview " + Quote(kGoldMaterial) + " --env " + Quote(cut) +
+                       " --size 8 --spp 1 --quiet --out " + Quote(dir_ / "p.png")));
+  const std::size_t first = err.find(cut.string());
+  ASSERT_NE(first, std::string::npos) << err;
+  EXPECT_EQ(err.find(cut.string(), first + 1), std::string::npos) << err;
+  EXPECT_NE(err.find("expected a readable OpenEXR image, got "), std::string::npos) << err;
+}
+
 }  // namespace
 }  // namespace brdf::tooltest
