@@ -327,10 +327,10 @@ TEST_F(HostileCaptures, ExportCsvOfAnEmptyCaptureNamesTheCapture) {
 // the file name ("x.exr: EXR content: expected a readable OpenEXR image, got Cannot read image
 // file "x.exr". Early end of file: ..."). The line names the file once.
 TEST_F(HostileInputs, DamagedExrNamesTheFileOnce) {
-  ASSERT_EQ(Run("convert " + Quote(kGoldMaterial) + " --quiet --formats exr --out " +
-                Quote(dir_ / "lut"))
-                .exit_code,
-            0);
+  ASSERT_EQ(
+      Run("convert " + Quote(kGoldMaterial) + " --quiet --formats exr --out " + Quote(dir_ / "lut"))
+          .exit_code,
+      0);
   const fs::path cut = dir_ / "cut.exr";
   WriteText(cut, ReadAll(dir_ / "lut" / "gold.exr").substr(0, 1));
   const std::string err =
