@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include "brdf/core/error.h"
+#include "brdf/core/json_error.h"
 #include "brdf/exporter/metadata.h"
 
 namespace brdf::exporter::detail {
@@ -64,21 +65,28 @@ ordered_json PayloadJson(const PackedVolume& payload) {
 }
 
 ordered_json ParseEmbeddedJson(const std::string& text, const std::string& what) {
+  // The text comes from the caller (a fitted model to record), not from a file: a bad one is
+  // a bad argument, described as a file's JSON would be.
   try {
     return ordered_json::parse(text);
-  } catch (const nlohmann::json::exception& e) {
-    throw InvalidArgument(what + " is not valid JSON: " + e.what());
+  } catch (const nlohmann::json::parse_error& e) {
+    throw InvalidArgument(JsonSyntaxError(what, text, e.byte).what());
+  } catch (const nlohmann::json::out_of_range&) {
+    throw InvalidArgument(JsonNumberTooLargeError(what, text).what());
   }
 }
 
 ordered_json ParseJsonDocument(std::string_view text, const std::string& file) {
+  ordered_json j;
   try {
-    ordered_json j = ordered_json::parse(text);
-    if (!j.is_object()) throw FormatError(file, "top level", "a JSON object", j.type_name());
-    return j;
+    j = ordered_json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
-    throw FormatError(file, "byte " + std::to_string(e.byte), "valid JSON", e.what());
+    throw JsonSyntaxError(file, text, e.byte);
+  } catch (const nlohmann::json::out_of_range&) {
+    throw JsonNumberTooLargeError(file, text);
   }
+  if (!j.is_object()) throw FormatError(file, "top level", "a JSON object", j.type_name());
+  return j;
 }
 
 JsonFields::JsonFields(const ordered_json& object, std::string file, std::string prefix)

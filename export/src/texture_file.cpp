@@ -37,17 +37,22 @@ void CheckRecordedPayload(const LoadedTexture& t, const std::string& what, int w
 }  // namespace
 
 void FinishLoadedTexture(LoadedTexture& t) {
+  // Metadata read beside a DDS is named by its own file, embedded metadata by the texture's.
+  const bool beside = !t.metadata_file.empty();
   if (!t.sidecar_json.empty()) {
-    const SidecarInfo info = ParseSidecarJson(t.sidecar_json, t.file + " (embedded sidecar)");
-    CheckRecordedPayload(t, "embedded sidecar", info.width, info.height, info.slices,
-                         info.payload_bytes, info.payload_crc32);
+    const SidecarInfo info =
+        ParseSidecarJson(t.sidecar_json, beside ? t.metadata_file : t.file + " (embedded sidecar)");
+    CheckRecordedPayload(t, beside ? "sidecar " + t.metadata_file : "embedded sidecar", info.width,
+                         info.height, info.slices, info.payload_bytes, info.payload_crc32);
     t.theta_in_deg = info.theta_in_deg;
     t.theta_in_from_metadata = true;
   } else if (!t.atlas_manifest_json.empty()) {
-    const AtlasManifest m =
-        ParseAtlasManifest(t.atlas_manifest_json, t.file + " (embedded manifest)");
-    CheckRecordedPayload(t, "embedded atlas manifest", m.texture_width, m.texture_height,
-                         static_cast<int>(m.theta_in_deg.size()), m.payload_bytes, m.payload_crc32);
+    const AtlasManifest m = ParseAtlasManifest(
+        t.atlas_manifest_json, beside ? t.metadata_file : t.file + " (embedded manifest)");
+    CheckRecordedPayload(t,
+                         beside ? "atlas manifest " + t.metadata_file : "embedded atlas manifest",
+                         m.texture_width, m.texture_height, static_cast<int>(m.theta_in_deg.size()),
+                         m.payload_bytes, m.payload_crc32);
     t.theta_in_deg = m.theta_in_deg;
     t.theta_in_from_metadata = true;
   } else if (t.theta_in_deg.size() != static_cast<std::size_t>(t.volume.depth)) {
@@ -70,9 +75,11 @@ LoadedTexture ReadTextureFile(const std::string& path) {
     std::filesystem::path sidecar(path);
     sidecar.replace_extension(".json");
     std::error_code ec;
-    if (std::filesystem::is_regular_file(sidecar, ec)) {
+    if (std::filesystem::is_regular_file(sidecar, ec) &&
+        !std::filesystem::equivalent(sidecar, path, ec)) {
       // "<prefix>.json" beside an atlas is its manifest, beside a LUT its sidecar.
       std::string text = ReadFileText(sidecar.string(), 16u << 20);
+      t.metadata_file = sidecar.string();
       if (text.find("\"brdf-atlas-manifest\"") != std::string::npos)
         t.atlas_manifest_json = std::move(text);
       else

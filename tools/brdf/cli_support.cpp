@@ -134,4 +134,10 @@ void ReportRemovedTemporaries(const std::vector<std::string>& removed) {
                removed.size(), removed.size() == 1 ? "" : "s", list.c_str());
 }
 
+std::string JoinArguments(const std::vector<std::string>& arguments) {
+  std::string joined;
+  for (const std::string& a : arguments) joined += (joined.empty() ? "" : ", ") + a;
+  return joined;
+}
+
 }  // namespace brdf::cli

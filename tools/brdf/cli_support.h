@@ -28,6 +28,9 @@ std::vector<std::string> MaterialLibraryFiles();
 // material of that name. Throws InvalidArgument listing the library names when neither exists.
 std::string ResolveMaterial(const std::string& name_or_file);
 
+// The command-line arguments joined with ", " (for "nothing found in a, b").
+std::string JoinArguments(const std::vector<std::string>& arguments);
+
 // Lower-case extension including the dot (".bpc"), or "" when there is none.
 std::string LowerExtension(const std::string& path);
 

@@ -40,8 +40,10 @@ int RunAtlas(const AtlasOptions& options) {
     throw InvalidArgument("--jobs: expected at least 1, got " + std::to_string(options.jobs));
 
   DiscoveredInputs found = DiscoverInputs(options.inputs, InputKinds{.exported_luts = true});
-  if (found.inputs.empty() && found.failures.empty())
-    throw InvalidArgument("no captures, material files or exported LUTs found in the inputs");
+  if (found.inputs.empty() && found.failures.empty()) {
+    throw InvalidArgument("no captures, material files or exported LUTs found in " +
+                          JoinArguments(options.inputs));
+  }
 
   std::vector<std::string> outputs = {options.out + ".ktx2", options.out + ".dds",
                                       options.out + ".exr", options.out + ".json"};

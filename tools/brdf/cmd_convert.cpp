@@ -106,9 +106,8 @@ int RunConvert(const ConvertOptions& options) {
 
   DiscoveredInputs found = DiscoverInputs(options.inputs);
   if (found.inputs.empty() && found.failures.empty()) {
-    std::string args;
-    for (const auto& a : options.inputs) args += (args.empty() ? "" : ", ") + a;
-    throw InvalidArgument("no captures (.bpc) or material files (.json) found in " + args);
+    throw InvalidArgument("no captures (.bpc) or material files (.json) found in " +
+                          JoinArguments(options.inputs));
   }
   const fs::path out_dir(options.out);
   std::error_code ec;

@@ -4,12 +4,14 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <vector>
 
-#include "brdf/core/bpc.h"
 #include "brdf/core/csv.h"
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
 #include "brdf/core/measurement.h"
+#include "brdf/sources/capture.h"
+#include "brdf/sources/detect.h"
 #include "cli_support.h"
 #include "commands.h"
 
@@ -42,14 +44,18 @@ void CheckFinite(const Measurement& m, const std::string& file) {
 }  // namespace
 
 int RunExportCsv(const ExportCsvOptions& options) {
-  if (LowerExtension(options.file) != ".bpc")
-    throw InvalidArgument(options.file +
-                          ": export-csv reads .bpc captures (bring other formats in with "
+  // By content, as every command recognises a file (a capture under another name is one).
+  const sources::FileKind kind = sources::DetectFileKind(options.file);
+  if (kind != sources::FileKind::kCapture)
+    throw InvalidArgument(options.file + ": a " + sources::FileKindName(kind) +
+                          "; export-csv reads .bpc captures (bring other formats in with "
                           "`brdf import` first)");
   CheckOutputPath(options.out, options.file, ".csv", options.force);
-  // Strict: a damaged capture is refused with the first problem (offset and slice); an
-  // unfinished but intact one is exported with its incomplete slices marked.
-  const Measurement m = LoadBpc(options.file);
+  // The capture rule of every command (brdf/sources/capture.h), for a copy: damage and
+  // inconsistent structure are refused as convert refuses them; an unfinished capture is
+  // exported with its incomplete slices marked; a cut end chunk or bytes after it are warnings.
+  std::vector<std::string> warnings;
+  const Measurement m = sources::LoadCaptureForCopy(options.file, &warnings);
   CheckFinite(m, options.file);
   const std::string text = FormatCsv(m);
   // What is written must read back: a value outside the CSV's validated ranges (θout > 90°,
@@ -60,6 +66,8 @@ int RunExportCsv(const ExportCsvOptions& options) {
     throw InvalidArgument(options.file + " cannot be written as a CSV point cloud: " + e.what());
   }
   WriteFileAtomically(options.out, text);
+  // Warnings after the work: a refusal stays the one line on stderr.
+  for (const std::string& w : warnings) std::fprintf(stderr, "%s\n", w.c_str());
   std::printf("%s -> %s: %zu slices, %zu samples\n", options.file.c_str(), options.out.c_str(),
               m.slices.size(), m.SampleCount());
   return 0;

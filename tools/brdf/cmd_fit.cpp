@@ -117,8 +117,10 @@ int RunFit(const FitCommandOptions& options) {
       if (!fs::is_directory(f.path, ec)) failures.push_back(f);
     }
   }
-  if (inputs.empty() && failures.empty())
-    throw InvalidArgument("no captures, material files or measured BRDF files found in the inputs");
+  if (inputs.empty() && failures.empty()) {
+    throw InvalidArgument("no captures, material files or measured BRDF files found in " +
+                          JoinArguments(options.inputs));
+  }
 
   // Output names: one input and one model write --out itself.
   const bool single = inputs.size() == 1 && failures.empty() && models.size() == 1;

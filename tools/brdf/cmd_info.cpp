@@ -432,15 +432,22 @@ std::string TripleText(const Json& v) {
   return Fixed(v[0]) + " " + Fixed(v[1]) + " " + Fixed(v[2]);
 }
 
+// Which commands the "usable" verdict speaks for: convert reads captures (and material files),
+// a third-party table is evaluated directly and converted only after 'brdf import'.
+const char* JudgingCommands(const Json& j) {
+  return IsImportedFormat(j) ? "'brdf eval'" : "'brdf convert' and 'brdf eval'";
+}
+
 void PrintRefusalsText(const Json& j) {
   if (j.contains("warnings"))
     for (const auto& w : j["warnings"]) std::printf("%s\n", w.get<std::string>().c_str());
   if (!j.contains("refusals")) return;
+  const char* verb_s = IsImportedFormat(j) ? "s" : "";  // one command, or two
   if (j["refusals"].empty()) {
-    std::printf("usable: yes ('brdf convert' and 'brdf eval' accept it)\n");
+    std::printf("usable: yes (%s accept%s it)\n", JudgingCommands(j), verb_s);
     return;
   }
-  std::printf("usable: no; 'brdf convert' and 'brdf eval' refuse it: %zu reason%s\n",
+  std::printf("usable: no; %s refuse%s it: %zu reason%s\n", JudgingCommands(j), verb_s,
               j["refusals"].size(), j["refusals"].size() == 1 ? "" : "s");
   for (const auto& r : j["refusals"]) std::printf("  %s\n", r.get<std::string>().c_str());
 }
@@ -682,8 +689,8 @@ int RunInfo(const InfoOptions& options) {
   // can check files with `brdf info`.
   if (j.contains("usable") && !j["usable"].get<bool>()) {
     const std::size_t n = j["refusals"].size();
-    std::fprintf(stderr, "brdf: %s: %zu problem%s that 'brdf convert' and 'brdf eval' refuse%s\n",
-                 options.file.c_str(), n, n == 1 ? "" : "s",
+    std::fprintf(stderr, "brdf: %s: %zu problem%s that %s refuse%s%s\n", options.file.c_str(), n,
+                 n == 1 ? "" : "s", JudgingCommands(j), IsImportedFormat(j) ? "s" : "",
                  options.json ? " (listed under \"refusals\")" : " (listed above)");
     return 1;
   }

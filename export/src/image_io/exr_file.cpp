@@ -130,9 +130,14 @@ ExrImage ReadExrImage(const std::string& path) {
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {
-    // OpenEXR's own words ("Cannot read image file ... File is not an image file.") are the
-    // best description of the damage it found.
-    throw FormatError(path, "EXR content", "a readable OpenEXR image", e.what());
+    // OpenEXR's own words ("Cannot read image file "F". Early end of file: read 1 out of 4
+    // requested bytes.") are the best description of the damage it found; the sentence that
+    // repeats the file name is dropped, since the message starts with it already.
+    std::string why = e.what();
+    const std::string named = "\"" + path + "\". ";
+    if (const std::size_t at = why.find(named); at != std::string::npos)
+      why = why.substr(at + named.size());
+    throw FormatError(path, "EXR content", "a readable OpenEXR image", why);
   }
   return out;
 }

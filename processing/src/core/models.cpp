@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "brdf/core/error.h"
+#include "brdf/core/json_error.h"
 
 namespace brdf {
 namespace {
@@ -189,11 +190,10 @@ Material ParseMaterialJson(std::string_view json_text, const std::string& file) 
   try {
     doc = nlohmann::json::parse(json_text.begin(), json_text.end());
   } catch (const nlohmann::json::parse_error& e) {
-    throw FormatError(file, BytePosition(e.byte), "valid JSON", "text that does not parse as JSON");
-  } catch (const nlohmann::json::exception&) {
-    // out_of_range: a number literal beyond double's range (1e400), i.e. an infinity.
-    throw FormatError(file, "JSON text", "finite numbers",
-                      "a number too large for a double (it would be infinite)");
+    throw JsonSyntaxError(file, json_text, e.byte);
+  } catch (const nlohmann::json::out_of_range&) {
+    // A number literal beyond double's range (1e400), i.e. an infinity.
+    throw JsonNumberTooLargeError(file, json_text);
   }
   if (!doc.is_object())
     throw FormatError(file, "top level", "a JSON object with a \"model\" member",

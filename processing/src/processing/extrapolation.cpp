@@ -10,6 +10,7 @@
 
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
+#include "brdf/core/json_error.h"
 
 namespace brdf::processing {
 namespace {
@@ -107,7 +108,9 @@ std::optional<ExtrapolationParams> ExtrapolationFromJson(std::string_view json_t
   try {
     doc = json::parse(json_text.begin(), json_text.end());
   } catch (const json::parse_error& e) {
-    throw FormatError(file, BytePosition(e.byte), "valid JSON", e.what());
+    throw JsonSyntaxError(file, json_text, e.byte);
+  } catch (const json::out_of_range&) {
+    throw JsonNumberTooLargeError(file, json_text);
   }
   if (!doc.is_object()) throw FormatError(file, "top level", "a JSON object", doc.type_name());
   const auto it = doc.find("extrapolate");

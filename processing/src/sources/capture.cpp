@@ -52,31 +52,33 @@ void CheckStructure(CaptureAssessment& a) {
     if (duplicate)
       a.refusals.push_back({where, "a slice index not used before",
                             "slice index " + std::to_string(index) + " a second time",
-                            "two chunks claim to be the same slice", repair});
+                            "two chunks claim to be the same slice", repair,
+                            CaptureRefusal::Cause::kStructure});
     else if (index < 0 || static_cast<std::size_t>(index) >= slice_chunks)
       a.refusals.push_back(
           {where,
            "a slice index below the number of slice chunks (" + std::to_string(slice_chunks) + ")",
-           "slice index " + std::to_string(index), "the file's slices are numbered wrong", repair});
+           "slice index " + std::to_string(index), "the file's slices are numbered wrong", repair,
+           CaptureRefusal::Cause::kStructure});
   }
   if (r.finished && r.problems.empty()) {
     const std::string where = BytePosition(r.end_offset) + " (end chunk)";
     if (r.end_slice_count != static_cast<std::int64_t>(r.measurement.slices.size()))
-      a.refusals.push_back({where,
-                            "slice_count " + std::to_string(r.measurement.slices.size()) +
-                                " (the slices in the file)",
-                            r.end_slice_count < 0
-                                ? std::string("no slice count")
-                                : "slice_count " + std::to_string(r.end_slice_count),
-                            "the end chunk does not describe this file", repair});
+      a.refusals.push_back(
+          {where,
+           "slice_count " + std::to_string(r.measurement.slices.size()) +
+               " (the slices in the file)",
+           r.end_slice_count < 0 ? std::string("no slice count")
+                                 : "slice_count " + std::to_string(r.end_slice_count),
+           "the end chunk does not describe this file", repair, CaptureRefusal::Cause::kStructure});
     if (r.end_sample_count != static_cast<std::int64_t>(r.measurement.SampleCount()))
-      a.refusals.push_back({where,
-                            "sample_count " + std::to_string(r.measurement.SampleCount()) +
-                                " (the samples in the file)",
-                            r.end_sample_count < 0
-                                ? std::string("no sample count")
-                                : "sample_count " + std::to_string(r.end_sample_count),
-                            "the end chunk does not describe this file", repair});
+      a.refusals.push_back(
+          {where,
+           "sample_count " + std::to_string(r.measurement.SampleCount()) +
+               " (the samples in the file)",
+           r.end_sample_count < 0 ? std::string("no sample count")
+                                  : "sample_count " + std::to_string(r.end_sample_count),
+           "the end chunk does not describe this file", repair, CaptureRefusal::Cause::kStructure});
   }
 }
 
@@ -95,7 +97,8 @@ void CheckValues(CaptureAssessment& a) {
                           "values a LUT can be built from",
                           p.message,
                           {},
-                          Remedy{RemedyKind::kRecapture, a.path}});
+                          Remedy{RemedyKind::kRecapture, a.path},
+                          CaptureRefusal::Cause::kValues});
   }
 }
 
@@ -150,7 +153,7 @@ CaptureAssessment AssessCapture(const std::string& path, BpcReadResult read) {
           "corrupt chunk; a LUT needs every slice intact; " + intact +
               (r.intact_data_after_damage ? ", some of them after the damage"
                                           : " end at byte " + std::to_string(r.valid_bytes)),
-          continue_remedy});
+          continue_remedy, CaptureRefusal::Cause::kDamage});
       continue;
     }
     if (p.kind == BpcProblemKind::kTruncated) {
@@ -161,7 +164,7 @@ CaptureAssessment AssessCapture(const std::string& path, BpcReadResult read) {
             "the capture was interrupted inside slice " + std::to_string(p.slice_index) +
                 "; a LUT needs every slice; " + intact + " end at byte " +
                 std::to_string(r.valid_bytes),
-            continue_remedy});
+            continue_remedy, CaptureRefusal::Cause::kDamage});
         continue;
       }
       tail_cut_outside_slices = true;
@@ -177,21 +180,24 @@ CaptureAssessment AssessCapture(const std::string& path, BpcReadResult read) {
           "a slice the instrument stopped before finishing (" + std::to_string(s.samples.size()) +
               " samples)",
           "a LUT needs every slice complete",
-          Remedy{RemedyKind::kRepairCapture, path, r.valid_bytes, a.missing_theta_in_deg}});
+          Remedy{RemedyKind::kRepairCapture, path, r.valid_bytes, a.missing_theta_in_deg},
+          CaptureRefusal::Cause::kIncompleteSlice});
   }
   CheckStructure(a);
   CheckValues(a);
   if (!r.finished && a.refusals.empty()) {
     if (!a.missing_theta_in_deg.empty()) {
-      a.refusals.push_back(CaptureRefusal{
-          BytePosition(r.valid_bytes),
-          "slices for every planned θin (" + DegList(a.planned_theta_in_deg) + "°)",
-          "the end of an unfinished capture with θin " +
-              (a.present_theta_in_deg.empty() ? std::string("none")
-                                              : DegList(a.present_theta_in_deg) + "°") +
-              " only (missing " + DegList(a.missing_theta_in_deg) + "°)",
-          {},
-          continue_remedy});
+      a.refusals.push_back(
+          CaptureRefusal{BytePosition(r.valid_bytes),
+                         "slices for every planned θin (" + DegList(a.planned_theta_in_deg) + "°)",
+                         "the end of an unfinished capture " +
+                             (a.present_theta_in_deg.empty()
+                                  ? std::string("without any slice")
+                                  : "with θin " + DegList(a.present_theta_in_deg) + "° only") +
+                             " (missing " + DegList(a.missing_theta_in_deg) + "°)",
+                         {},
+                         continue_remedy,
+                         CaptureRefusal::Cause::kMissingSlices});
     } else {
       a.warnings.push_back(
           path + ": warning: no intact end chunk (" +
@@ -218,6 +224,24 @@ Measurement LoadCaptureForLut(const std::string& path, std::vector<std::string>*
   return std::move(a.read.measurement);
 }
 
+Measurement LoadCaptureForCopy(const std::string& path, std::vector<std::string>* warnings) {
+  CaptureAssessment a = AssessCapture(path);
+  const bool empty = a.read.measurement.SampleCount() == 0;
+  for (const CaptureRefusal& refusal : a.refusals)
+    if (refusal.cause == CaptureRefusal::Cause::kDamage ||
+        refusal.cause == CaptureRefusal::Cause::kStructure ||
+        (empty && refusal.cause == CaptureRefusal::Cause::kMissingSlices))
+      throw refusal.ToError(path);  // nothing to copy from an unfinished capture: resume it
+  if (warnings) {
+    warnings->insert(warnings->end(), a.warnings.begin(), a.warnings.end());
+    if (!a.read.finished && !a.missing_theta_in_deg.empty())
+      warnings->push_back(path + ": warning: an unfinished capture: planned θin " +
+                          DegList(a.missing_theta_in_deg) +
+                          "° not captured yet; only the slices present are copied");
+  }
+  return std::move(a.read.measurement);
+}
+
 RepairReport RepairCapture(const std::string& input, const std::string& output, bool overwrite) {
   std::error_code ec;
   if (fs::exists(output, ec) && fs::equivalent(input, output, ec))
@@ -227,9 +251,15 @@ RepairReport RepairCapture(const std::string& input, const std::string& output, 
     throw InvalidArgument(output + ": already exists", Remedy{RemedyKind::kForceOverwrite, output});
   CaptureAssessment a = AssessCapture(input);
   const BpcReadResult& r = a.read;
+  // Damage, an incomplete slice, or CRC-valid chunks that contradict each other (slice
+  // indices, the end chunk's counts): what the assessment tells the user to repair.
   const bool damaged =
-      !r.problems.empty() || std::any_of(r.measurement.slices.begin(), r.measurement.slices.end(),
-                                         [](const Slice& s) { return !s.complete; });
+      !r.problems.empty() ||
+      std::any_of(r.measurement.slices.begin(), r.measurement.slices.end(),
+                  [](const Slice& s) { return !s.complete; }) ||
+      std::any_of(a.refusals.begin(), a.refusals.end(), [](const CaptureRefusal& refusal) {
+        return refusal.cause == CaptureRefusal::Cause::kStructure;
+      });
   if (r.finished && !damaged)
     throw InvalidArgument(input + ": an intact, finished capture (" +
                           SlicesText(r.measurement.slices.size()) + "); nothing to repair");
@@ -252,6 +282,14 @@ RepairReport RepairCapture(const std::string& input, const std::string& output, 
   for (const BpcProblem& p : r.problems)
     if (p.kind == BpcProblemKind::kTrailingData)
       report.dropped.push_back({p.offset, p.size, -1, std::nullopt, "bytes after the end chunk"});
+  // An end chunk whose counts contradict the slices is dropped (the output is unfinished and
+  // gets a true one when it is resumed); slices with inconsistent indices are renumbered.
+  for (const CaptureRefusal& refusal : a.refusals)
+    if (refusal.cause == CaptureRefusal::Cause::kStructure && r.finished &&
+        refusal.position.find("end chunk") != std::string::npos)
+      report.dropped.push_back(
+          {r.end_offset, r.valid_bytes > r.end_offset ? r.valid_bytes - r.end_offset : 0, -1,
+           std::nullopt, "end chunk: expected " + refusal.expected + ", got " + refusal.got});
 
   // The header keeps what the capture started with (the settings a resume compares); the end
   // chunk's metadata, if any, is not carried over: the repaired capture is unfinished again.

@@ -10,6 +10,7 @@
 
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
+#include "brdf/core/json_error.h"
 
 namespace brdf::sources {
 namespace {
@@ -40,11 +41,14 @@ FileKind ClassifyJson(const std::string& path) {
   if (EndsWith(Lower(fs::path(path).filename().string()), kExtrapolationSuffix))
     return FileKind::kExtrapolation;
   const std::string text = ReadFileText(path, kMaxJsonBytes);
-  const auto j = nlohmann::json::parse(text, nullptr, /*allow_exceptions=*/false);
-  if (j.is_discarded())
-    throw FormatError(path, "JSON text",
-                      "valid JSON (a material file, an export sidecar or an atlas manifest)",
-                      "text that does not parse as JSON");
+  nlohmann::json j;
+  try {
+    j = nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw JsonSyntaxError(path, text, e.byte);
+  } catch (const nlohmann::json::out_of_range&) {
+    throw JsonNumberTooLargeError(path, text);
+  }
   if (!j.is_object()) return FileKind::kOtherJson;
   if (const auto kind = j.find("kind"); kind != j.end() && kind->is_string()) {
     if (*kind == "brdf-lut-sidecar") return FileKind::kSidecar;

@@ -200,12 +200,16 @@ OpenedTexture OpenExportedTexture(const std::string& path) {
                           std::string(FileKindName(kind)));
   out.texture_path = path;
   out.texture = exporter::ReadTextureFile(path);
+  // Metadata found beside a DDS is named by its own file, embedded metadata by the texture's.
+  const std::string& beside = out.texture.metadata_file;
+  out.sidecar_path = beside;
   if (!out.texture.sidecar_json.empty()) {
-    out.sidecar = exporter::ParseSidecarJson(out.texture.sidecar_json, path + " (sidecar)");
+    out.sidecar = exporter::ParseSidecarJson(out.texture.sidecar_json,
+                                             beside.empty() ? path + " (sidecar)" : beside);
     out.checksum_verified = true;  // FinishLoadedTexture compared it
   } else if (!out.texture.atlas_manifest_json.empty()) {
-    out.manifest =
-        exporter::ParseAtlasManifest(out.texture.atlas_manifest_json, path + " (manifest)");
+    out.manifest = exporter::ParseAtlasManifest(out.texture.atlas_manifest_json,
+                                                beside.empty() ? path + " (manifest)" : beside);
     out.checksum_verified = true;
   } else {
     out.warnings.push_back(path + ": warning: no sidecar recorded or found beside it: θin " +

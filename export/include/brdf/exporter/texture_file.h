@@ -33,6 +33,9 @@ struct LoadedTexture {
   // atlas ("brdf.atlas"); empty when absent (DDS files, third-party KTX2 files).
   std::string sidecar_json;
   std::string atlas_manifest_json;
+  // Where sidecar_json / atlas_manifest_json came from when not embedded: the "<stem>.json"
+  // read beside a DDS file (errors in it name that file); empty for embedded metadata.
+  std::string metadata_file;
   // The θin list (degrees) from the embedded metadata or a sidecar found beside a DDS file;
   // otherwise k·20° (docs/design.md §5's Δin) with theta_in_from_metadata = false.
   std::vector<double> theta_in_deg;
@@ -46,7 +49,8 @@ struct LoadedTexture {
 
 // Reads a .ktx2 or .dds file, recognised by its first bytes (not its extension). For a DDS
 // file, a sidecar "<stem>.json" beside it, if present and of the same size, supplies the θin
-// list and its checksum is verified. Throws IoError / FormatError.
+// list and its checksum is verified (a DDS saved under a .json name is not its own sidecar).
+// Throws IoError / FormatError.
 LoadedTexture ReadTextureFile(const std::string& path);
 
 // Fills theta_in_deg, theta_in_from_metadata and lut from volume and the embedded metadata,

@@ -40,6 +40,18 @@ enum class RemedyKind {
 };
 
 struct Remedy {
+  // Remedy{} is "nothing to suggest"; otherwise the kind, the file it acts on and, for the
+  // capture remedies, the intact prefix and the missing slices. A constructor rather than
+  // aggregate initialisation, so that `Remedy{kind, file}` states every member it leaves at its
+  // default instead of relying on the aggregate rule (-Wmissing-field-initializers).
+  Remedy() = default;
+  Remedy(RemedyKind remedy_kind, std::string remedy_file, std::uint64_t intact_bytes = 0,
+         std::vector<double> missing_theta_in_deg = {})
+      : kind(remedy_kind),
+        file(std::move(remedy_file)),
+        valid_bytes(intact_bytes),
+        theta_in_deg(std::move(missing_theta_in_deg)) {}
+
   RemedyKind kind = RemedyKind::kNone;
   std::string file;                  // the file the remedy acts on
   std::uint64_t valid_bytes = 0;     // kResumeCapture: the intact prefix kept by a resume

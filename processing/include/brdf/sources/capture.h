@@ -27,9 +27,19 @@ namespace brdf::sources {
 
 // Why a capture cannot become a LUT, as the FormatError it throws would say it.
 struct CaptureRefusal {
+  // What kind of reason it is: commands that copy every sample (`brdf export-csv`) refuse
+  // damage and inconsistent structure only; repair rewrites both.
+  enum class Cause {
+    kDamage,           // a corrupt chunk or a cut inside a slice
+    kStructure,        // CRC-valid chunks that disagree (slice indices, end chunk counts)
+    kIncompleteSlice,  // a slice the instrument stopped before finishing
+    kMissingSlices,    // an unfinished capture without every planned slice
+    kValues,           // values a LUT cannot be built from (NaN, angles out of range, ...)
+  };
   std::string position;  // "byte 1840 (slice 2)"
   std::string expected, got, hint;
   Remedy remedy;
+  Cause cause = Cause::kDamage;
   // The error itself: "<file>: <position>: expected ..., got ... (<hint>)" with the remedy.
   FormatError ToError(const std::string& file) const;
 };
@@ -65,6 +75,15 @@ CaptureAssessment AssessCapture(const std::string& path, BpcReadResult read);
 
 // AssessCapture(path).UsableMeasurement(), moved out, warnings appended to `warnings`.
 Measurement LoadCaptureForLut(const std::string& path, std::vector<std::string>* warnings);
+
+// The same assessment for a command that copies every sample instead of building a LUT
+// (`brdf export-csv`): refused for damage and inconsistent structure exactly as AssessCapture
+// refuses (the first such refusal, thrown as its FormatError); an incomplete slice and planned
+// slices not captured yet are kept (with a warning for the latter; an unfinished capture without
+// any sample is refused with the resume remedy), as are values a LUT could
+// not be built from (the caller's format decides whether it can hold them). A cut or missing end
+// chunk and bytes after it give AssessCapture's warnings.
+Measurement LoadCaptureForCopy(const std::string& path, std::vector<std::string>* warnings);
 
 // What RepairCapture dropped from the damaged file.
 struct DroppedPart {
