@@ -424,8 +424,13 @@ std::vector<std::uint8_t> EncodeRowData(const RowData& row) {
 }
 
 RowData DecodeRowData(std::span<const std::uint8_t> payload) {
-  return ParsePayload(MessageType::kRowData, payload, [](ByteReader& r) {
-    RowData row;
+  RowData row;
+  DecodeRowData(payload, row);
+  return row;
+}
+
+void DecodeRowData(std::span<const std::uint8_t> payload, RowData& row) {
+  ParsePayload(MessageType::kRowData, payload, [&row](ByteReader& r) {
     row.row = r.U16("row");
     row.first_column = r.U16("first_column");
     const std::uint16_t n = r.U16("sample count");
@@ -444,8 +449,7 @@ RowData DecodeRowData(std::span<const std::uint8_t> payload) {
       }
       s.clipped_channels = *p++;
     }
-    if (r.remaining() > 0) row.nd_index = r.U8("nd_index");  // protocol 1.1
-    return row;
+    row.nd_index = r.remaining() > 0 ? r.U8("nd_index") : 0;  // protocol 1.1
   });
 }
 

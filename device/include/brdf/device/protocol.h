@@ -254,6 +254,9 @@ SliceBegin DecodeSliceBegin(std::span<const std::uint8_t> payload);
 // Throws InvalidArgument for more than kMaxSamplesPerRowFrame samples.
 std::vector<std::uint8_t> EncodeRowData(const RowData& row);
 RowData DecodeRowData(std::span<const std::uint8_t> payload);
+// The same into `row`, reusing its sample storage (the driver decodes every row of a slice
+// into one RowData). `row` is unspecified after a throw.
+void DecodeRowData(std::span<const std::uint8_t> payload, RowData& row);
 std::vector<std::uint8_t> EncodeSliceEnd(const SliceEnd& end);
 SliceEnd DecodeSliceEnd(std::span<const std::uint8_t> payload);
 std::vector<std::uint8_t> EncodeError(const ErrorReply& error);
