@@ -538,7 +538,7 @@ Metadata Capture(Driver& driver, const CapturePlan& plan, const CaptureCallbacks
                         "capture cancelled before the slice at θin " + AngleText(t) + "°");
     SliceReport report;
     Slice slice = WithRetries(driver, callbacks, [&] { return driver.MeasureSlice(t, &report); });
-    if (callbacks.on_slice) callbacks.on_slice(slice, report);
+    if (callbacks.on_slice) callbacks.on_slice(std::move(slice), report);
   }
   Metadata final_metadata = merge(driver.CalibrationMetadata());
   final_metadata.capture_end = UtcNowIso8601();
