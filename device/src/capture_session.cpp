@@ -311,22 +311,24 @@ CaptureSessionResult RunCaptureSession(const CaptureRequest& request, Transport&
     if (events.on_calibrated) events.on_calibrated(header, !restored);
   };
   callbacks.on_slice = [&](Slice&& slice, const SliceReport& report) {
-    writer.Then([&appender, s = std::move(slice)] { appender->AppendSlice(s); });
     ++slices_handed;
     result.new_samples += report.samples;
     result.saturated += report.saturated;
     result.below_noise_floor += report.below_noise_floor;
     slice_seconds.push_back(report.seconds);
-    if (events.on_slice) {
-      SliceProgress p;
-      p.report = report;
-      p.index = slices_before + slices_handed;
-      p.planned = result.slices_planned;
-      double mean = 0;
-      for (double s : slice_seconds) mean += s / static_cast<double>(slice_seconds.size());
-      p.eta_seconds = mean * static_cast<double>(pending.size() - slice_seconds.size());
-      events.on_slice(p);
-    }
+    SliceProgress p;
+    p.report = report;
+    p.index = slices_before + slices_handed;
+    p.planned = result.slices_planned;
+    double mean = 0;
+    for (double s : slice_seconds) mean += s / static_cast<double>(slice_seconds.size());
+    p.eta_seconds = mean * static_cast<double>(pending.size() - slice_seconds.size());
+    // The progress event comes from the writer, once the slice is on disk: what the user reads
+    // as captured is durable.
+    writer.Then([&appender, &events, s = std::move(slice), p] {
+      appender->AppendSlice(s);
+      if (events.on_slice) events.on_slice(p);
+    });
   };
 
   // What is durable in the file once the writer is idle (every way out of the session).

@@ -101,6 +101,8 @@ struct SessionEvents {
   std::function<void(const InstrumentInfo&)> on_connected;
   // Dark and white references are ready (measured, or taken from the file on resume).
   std::function<void(const Metadata& header, bool measured)> on_calibrated;
+  // A slice is in the file and flushed to disk. Called from the session's writer thread (one
+  // call at a time, in capture order), possibly while on_retry runs on the caller's thread.
   std::function<void(const SliceProgress&)> on_slice;
   // A recoverable fault; the driver is retrying (message says what and which attempt).
   std::function<void(const std::string& message)> on_retry;
