@@ -10,6 +10,7 @@
 
 #include "brdf/core/bpc.h"
 #include "brdf/core/error.h"
+#include "brdf/core/file_util.h"
 
 namespace brdf::device {
 namespace {
@@ -178,25 +179,15 @@ CaptureSessionResult RunCaptureSession(const CaptureRequest& request, Transport&
   std::map<std::string, std::string> settings = request.settings;
   settings["theta_in_deg"] = ThetaList(request.theta_in_deg);
 
-  // What is already on disk.
-  std::error_code ec;
-  const fs::file_status status = fs::status(path, ec);
-  const bool exists = fs::exists(status);
-  if (exists && !fs::is_regular_file(status)) {
-    result.outcome = CaptureOutcome::kRefused;
-    result.message = path + " exists and is not a regular file";
-    return result;
-  }
+  // What is already on disk, by the rule of every writing command: resuming a file is a
+  // deliberate way of writing into it, as --force is.
   SessionStart start;
+  start.removed_temporaries = CheckWritableOutput(path, request.force || request.resume);
+  std::error_code ec;
+  const bool exists = fs::exists(path, ec);
   start.slices_planned = request.theta_in_deg.size();
   std::vector<double> pending = request.theta_in_deg;
   std::optional<BpcReadResult> existing;
-  if (exists && !request.resume && !request.force) {
-    result.outcome = CaptureOutcome::kRefused;
-    result.next = NextStep::kResumeOrOverwrite;
-    result.message = path + " already exists";
-    return result;
-  }
   if (request.resume && exists) {
     try {
       existing = ReadBpc(path);
