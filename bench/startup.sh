@@ -26,6 +26,7 @@ commands=(
   "info|info $samples/captures/gold.bpc"
   "eval|eval $samples/materials/aluminium.json --in 40,0 --out 40,180"
   "capture (θin 0, 30°×15° grid)|capture --device sim --material gold --sample s --theta-in 0 --phi-out-step 30 --theta-out-step 15 --out c.bpc --force"
+  "capture (full reference geometry, 109,440 samples)|capture --device sim --material gold --sample s --out c.bpc --force"
   "convert (writes EXR + PNG)|convert $samples/materials/aluminium.json --out luts --formats exr,png"
 )
 

@@ -423,30 +423,38 @@ std::vector<std::uint8_t> EncodeRowData(const RowData& row) {
   return w.Take();
 }
 
-RowData DecodeRowData(std::span<const std::uint8_t> payload) {
+RowDataView DecodeRowDataView(std::span<const std::uint8_t> payload) {
   return ParsePayload(MessageType::kRowData, payload, [](ByteReader& r) {
-    RowData row;
+    RowDataView row;
     row.row = r.U16("row");
     row.first_column = r.U16("first_column");
     const std::uint16_t n = r.U16("sample count");
     if (n > kMaxSamplesPerRowFrame)
       r.Fail("at most " + std::to_string(kMaxSamplesPerRowFrame) + " samples", std::to_string(n));
     row.exposure_ms = r.F32("exposure_ms");
-    row.samples.resize(n);
-    // One bounds check for all samples (13 bytes each), then plain loads: this loop is most of
-    // the host's decoding work.
-    const std::uint8_t* p = r.Bytes(std::size_t{n} * 13, "samples (13 bytes each)");
-    for (RowSample& s : row.samples) {
-      for (float& c : s.counts) {
-        const std::uint32_t bits = LoadU32(p);
-        std::memcpy(&c, &bits, sizeof c);
-        p += 4;
-      }
-      s.clipped_channels = *p++;
-    }
-    if (r.remaining() > 0) row.nd_index = r.U8("nd_index");  // protocol 1.1
+    // One bounds check for all samples, which stay where they are.
+    const std::size_t bytes = std::size_t{n} * RowDataView::kSampleBytes;
+    row.sample_bytes =
+        std::span<const std::uint8_t>(r.Bytes(bytes, "samples (13 bytes each)"), bytes);
+    row.nd_index = r.remaining() > 0 ? r.U8("nd_index") : 0;  // protocol 1.1
     return row;
   });
+}
+
+RowData DecodeRowData(std::span<const std::uint8_t> payload) {
+  const RowDataView view = DecodeRowDataView(payload);
+  RowData row;
+  row.row = view.row;
+  row.first_column = view.first_column;
+  row.exposure_ms = view.exposure_ms;
+  row.nd_index = view.nd_index;
+  row.samples.resize(view.size());
+  for (std::size_t i = 0; i < row.samples.size(); ++i) {
+    for (int c = 0; c < 3; ++c)
+      row.samples[i].counts[static_cast<std::size_t>(c)] = view.Counts(i, c);
+    row.samples[i].clipped_channels = view.ClippedChannels(i);
+  }
+  return row;
 }
 
 std::vector<std::uint8_t> EncodeSliceEnd(const SliceEnd& end) {

@@ -186,6 +186,13 @@ SimulatedFirmware::SimulatedFirmware(SimulatorConfig config) : config_(std::move
   geometry_.max_exposure_ms = static_cast<float>(m.max_exposure_ms);
   geometry_.nd_transmittance = m.nd_transmittance;
   geometry_.columns = static_cast<std::uint16_t>(columns);
+  column_cos_phi_.resize(geometry_.columns);
+  column_sin_phi_.resize(geometry_.columns);
+  for (std::size_t col = 0; col < geometry_.columns; ++col) {
+    const double phi = DegToRad(geometry_.PhiOutDeg(col));
+    column_cos_phi_[col] = std::cos(phi);
+    column_sin_phi_[col] = std::sin(phi);
+  }
 
   white_ = config_.white_reference;
   if (!white_) white_ = std::make_shared<LambertianPanel>(SpectralonWhiteReference().rho);
@@ -439,11 +446,12 @@ void SimulatedFirmware::StartSlice(float theta_in_deg) {
 std::array<double, 3> SimulatedFirmware::RowRates(std::size_t row,
                                                   std::vector<std::array<double, 3>>* rates) const {
   const InstrumentModel& m = config_.model;
-  const double theta_out = geometry_.ThetaOutDeg(row);
+  const double theta_out = DegToRad(geometry_.ThetaOutDeg(row));
+  const double sin_theta = std::sin(theta_out), cos_theta = std::cos(theta_out);
   std::array<double, 3> brightest{};
   if (rates) rates->resize(geometry_.columns);
   for (std::size_t col = 0; col < geometry_.columns; ++col) {
-    const Vec3 view = SphericalDirectionDeg(theta_out, geometry_.PhiOutDeg(col));
+    const Vec3 view{sin_theta * column_cos_phi_[col], sin_theta * column_sin_phi_[col], cos_theta};
     const Rgb f = config_.sample->Eval(light_, view);
     std::array<double, 3> rate{};
     for (int c = 0; c < 3; ++c) {
@@ -476,6 +484,7 @@ SimulatedFirmware::Reading SimulatedFirmware::Read(const std::array<double, 3>& 
   const InstrumentModel& m = config_.model;
   const double s = config_.noise_level;
   const double full = m.adc_full_scale_counts;
+  const double sqrt_frames = std::sqrt(frames);
   Reading r;
   for (int c = 0; c < 3; ++c) {
     // The light the detector integrates: exposure time × filter transmittance (the same
@@ -493,7 +502,7 @@ SimulatedFirmware::Reading SimulatedFirmware::Read(const std::array<double, 3>& 
     if (mean + 6 * sigma < full && mean - 6 * sigma > 0) {
       // No frame can clip (beyond 6σ the Gaussian model is not meant to be exact), so the mean
       // of the frames is drawn directly.
-      r.counts[c] = static_cast<float>(mean + sigma / std::sqrt(frames) * normal_(rng_));
+      r.counts[c] = static_cast<float>(mean + sigma / sqrt_frames * normal_(rng_));
       continue;
     }
     double sum = 0;

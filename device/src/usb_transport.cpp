@@ -4,8 +4,10 @@
 
 #include <hidapi/hidapi.h>
 #include <libusb-1.0/libusb.h>
+#include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <cwchar>
@@ -72,16 +74,24 @@ AccessProblem ProblemOf(int libusb_error) {
   }
 }
 
-std::string AccessText(AccessProblem p, const std::string& detail) {
+// "/dev/bus/usb/001/002": the node libusb opens for a device (Linux usbfs).
+std::string UsbNode(libusb_device* dev) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "/dev/bus/usb/%03d/%03d", libusb_get_bus_number(dev),
+                libusb_get_device_address(dev));
+  return buf;
+}
+
+// One clause for the log line and the error message: the cause, the node, what to do.
+std::string AccessText(AccessProblem p, const std::string& node, const std::string& detail) {
   switch (p) {
     case AccessProblem::kNone:
       return detail;
     case AccessProblem::kPermission:
-      return "permission denied (" + detail +
-             "): this user may not open the device; install the udev rule "
-             "70-brdf-scatterometer.rules";
+      return "permission denied: this user may not open " +
+             (node.empty() ? "its device node" : node) + "; " + UdevRemedy();
     case AccessProblem::kBusy:
-      return "the device is in use by another program (" + detail + ")";
+      return "in use by another program (" + detail + ")";
     case AccessProblem::kOther:
       return detail;
   }
@@ -300,6 +310,53 @@ std::vector<HidCandidate> EnumerateHid(const DeviceSpec* spec) {
   return out;
 }
 
+struct HidOpenFailure {
+  AccessProblem problem = AccessProblem::kOther;
+  std::string node, detail;
+};
+
+// hidapi says only that hid_open_path failed. Its hidraw backend (the field) opens the path
+// itself, so access(2) tells why; its libusb backend (the tests) names the device by bus and
+// port chain ("1-1:1.0"), whose usbfs node libusb_open tries.
+HidOpenFailure WhyHidOpenFailed(const HidCandidate& c) {
+  HidOpenFailure f;
+  f.detail = "hidapi cannot open " + c.path;
+  if (c.path.rfind("/dev/", 0) == 0) {
+    f.node = c.path;
+    if (::access(c.path.c_str(), R_OK | W_OK) != 0) {
+      f.problem = errno == EACCES ? AccessProblem::kPermission : AccessProblem::kOther;
+      f.detail += std::string(": ") + std::strerror(errno);
+    } else {
+      f.problem = AccessProblem::kBusy;
+    }
+    return f;
+  }
+  const std::string ports = c.path.substr(0, c.path.find(':'));
+  LibusbContext ctx;
+  libusb_device** list = nullptr;
+  const ssize_t n = libusb_get_device_list(ctx.ctx, &list);
+  for (ssize_t i = 0; i < n; ++i) {
+    std::uint8_t chain[8];
+    const int depth = libusb_get_port_numbers(list[i], chain, sizeof chain);
+    std::string name = std::to_string(libusb_get_bus_number(list[i]));
+    for (int k = 0; k < depth; ++k) name += (k == 0 ? "-" : ".") + std::to_string(chain[k]);
+    if (depth <= 0 || name != ports) continue;
+    f.node = UsbNode(list[i]);
+    libusb_device_handle* h = nullptr;
+    const int r = libusb_open(list[i], &h);
+    if (r == 0) {
+      libusb_close(h);
+      f.problem = AccessProblem::kBusy;
+    } else {
+      f.problem = ProblemOf(r);
+      f.detail += std::string(": ") + libusb_strerror(r);
+    }
+    break;
+  }
+  libusb_free_device_list(list, 1);
+  return f;
+}
+
 UsbModel ModelFor(std::uint16_t vid, std::uint16_t pid) {
   const std::optional<UsbModel> m = FindUsbModel(vid, pid);
   if (m) return *m;
@@ -310,6 +367,12 @@ UsbModel ModelFor(std::uint16_t vid, std::uint16_t pid) {
 }
 
 }  // namespace
+
+std::string UdevRemedy() {
+  return "copy the udev rule 70-brdf-scatterometer.rules (installed in " BRDF_UDEV_RULES_DIR
+         ", in the sources device/udev/) to /etc/udev/rules.d/, run 'sudo udevadm control "
+         "--reload && sudo udevadm trigger' and plug the instrument in again";
+}
 
 std::unique_ptr<Transport> OpenUsbTransport(const DeviceSpec& spec) {
   if (spec.kind != DeviceSpec::Kind::kUsb)
@@ -328,7 +391,8 @@ std::unique_ptr<Transport> OpenUsbTransport(const DeviceSpec& spec) {
     libusb_device_handle* h = nullptr;
     int r = libusb_open(list[i], &h);
     if (r != 0) {
-      problems += "; " + where + ": " + AccessText(ProblemOf(r), libusb_strerror(r));
+      problems +=
+          "; " + where + ": " + AccessText(ProblemOf(r), UsbNode(list[i]), libusb_strerror(r));
       continue;
     }
     const std::string serial = SerialOf(h, d);
@@ -340,7 +404,8 @@ std::unique_ptr<Transport> OpenUsbTransport(const DeviceSpec& spec) {
     libusb_set_auto_detach_kernel_driver(h, 1);
     r = libusb_claim_interface(h, model.interface_number);
     if (r != 0) {
-      problems += "; " + where + ": " + AccessText(ProblemOf(r), libusb_strerror(r));
+      problems +=
+          "; " + where + ": " + AccessText(ProblemOf(r), UsbNode(list[i]), libusb_strerror(r));
       libusb_close(h);
       continue;
     }
@@ -350,9 +415,11 @@ std::unique_ptr<Transport> OpenUsbTransport(const DeviceSpec& spec) {
                                                    " (" + where + ")");
   }
   libusb_free_device_list(list, 1);
-  if (!result)
-    throw DeviceError("no " + LookedFor(spec, "USB") + " found" +
-                      (problems.empty() ? "" : problems));
+  if (!result) {
+    // A device that matched but could not be opened is the answer, not "not found".
+    if (!problems.empty()) throw DeviceError(LookedFor(spec, "USB") + " on " + problems.substr(2));
+    throw DeviceError("no " + LookedFor(spec, "USB") + " found");
+  }
   return result;
 }
 
@@ -365,9 +432,8 @@ std::unique_ptr<Transport> OpenHidTransport(const DeviceSpec& spec) {
   for (const HidCandidate& c : found) {
     hid_device* dev = hid_open_path(c.path.c_str());
     if (dev == nullptr) {
-      problems += "; HID " + c.path +
-                  ": cannot open it (permission denied or in use; install "
-                  "the udev rule 70-brdf-scatterometer.rules)";
+      const HidOpenFailure why = WhyHidOpenFailed(c);
+      problems += "; " + c.path + ": " + AccessText(why.problem, why.node, why.detail);
       continue;
     }
     const UsbModel model = ModelFor(c.vid, c.pid);
@@ -376,7 +442,8 @@ std::unique_ptr<Transport> OpenHidTransport(const DeviceSpec& spec) {
                                               (c.serial.empty() ? "(no serial)" : c.serial) + " (" +
                                               c.path + ")");
   }
-  throw DeviceError("no " + LookedFor(spec, "HID") + " found" + problems);
+  if (!problems.empty()) throw DeviceError(LookedFor(spec, "HID") + " on " + problems.substr(2));
+  throw DeviceError("no " + LookedFor(spec, "HID") + " found");
 }
 
 TransportStats StatsOf(const Transport& transport) {
@@ -419,11 +486,14 @@ std::vector<FoundInstrument> ListInstruments(bool identify) {
       std::snprintf(where, sizeof where, "bus %03d device %03d", libusb_get_bus_number(list[i]),
                     libusb_get_device_address(list[i]));
       f.bus_path = where;
+      f.device_node = UsbNode(list[i]);
       libusb_device_handle* h = nullptr;
       const int r = libusb_open(list[i], &h);
       if (r != 0) {
         f.problem = ProblemOf(r);
-        f.problem_detail = libusb_strerror(r);
+        f.problem_detail = f.problem == AccessProblem::kPermission
+                               ? AccessText(f.problem, f.device_node, libusb_strerror(r))
+                               : libusb_strerror(r);
       } else {
         f.serial = SerialOf(h, d);
         libusb_close(h);
@@ -458,8 +528,12 @@ std::vector<FoundInstrument> ListInstruments(bool identify) {
     f.bus_path = c.path;
     hid_device* dev = hid_open_path(c.path.c_str());
     if (dev == nullptr) {
-      f.problem = AccessProblem::kPermission;
-      f.problem_detail = "cannot open " + c.path;
+      const HidOpenFailure why = WhyHidOpenFailed(c);
+      f.problem = why.problem;
+      f.device_node = why.node;
+      f.problem_detail = why.problem == AccessProblem::kPermission
+                             ? AccessText(why.problem, why.node, why.detail)
+                             : why.detail;
     } else if (identify) {
       HidTransport t(std::make_unique<HidLibrary>(), dev, ModelFor(c.vid, c.pid), "HID " + c.path);
       ask_identity(f, t);

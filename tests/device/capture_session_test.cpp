@@ -7,9 +7,11 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "brdf/core/bpc.h"
 #include "brdf/core/error.h"
+#include "brdf/core/file_util.h"
 #include "brdf/device/capture_session.h"
 #include "brdf/device/usb_models.h"
 #include "device_test_support.h"
@@ -43,14 +45,25 @@ class Session : public ::testing::Test {
   std::string dir_;
 };
 
-TEST_F(Session, ExistingFileIsRefusedUnlessForcedAndNonBpcNamesAreRefused) {
+TEST_F(Session, ExistingFileFollowsTheOverwriteRuleAndNonBpcNamesAreRefused) {
   const SimulatorConfig c = Config(LibraryMaterial("gold"), 1, 15, 15);
   EXPECT_THROW(Run(Request("cap.txt"), c), InvalidArgument);
   EXPECT_FALSE(std::filesystem::exists(dir_ + "/cap.txt"));
   ASSERT_EQ(Run(Request("a.bpc"), c).outcome, CaptureOutcome::kFinished);
-  const CaptureSessionResult again = Run(Request("a.bpc"), c);
-  EXPECT_EQ(again.outcome, CaptureOutcome::kRefused);
-  EXPECT_EQ(again.next, NextStep::kResumeOrOverwrite);
+  // The overwrite rule of every writing command (CheckWritableOutput): the existing file is
+  // named, and a folder is refused even with force.
+  try {
+    Run(Request("a.bpc"), c);
+    ADD_FAILURE() << "an existing capture was overwritten without force";
+  } catch (const OutputExistsError& e) {
+    EXPECT_EQ(e.paths(), std::vector<std::string>{dir_ + "/a.bpc"});
+  }
+  std::filesystem::create_directory(dir_ + "/folder.bpc");
+  CaptureRequest into_folder = Request("folder.bpc");
+  into_folder.force = true;
+  EXPECT_THROW(Run(into_folder, c), IoError);
+  into_folder.resume = true;
+  EXPECT_THROW(Run(into_folder, c), IoError);
   CaptureRequest forced = Request("a.bpc");
   forced.force = true;
   EXPECT_EQ(Run(forced, c).outcome, CaptureOutcome::kFinished);

@@ -6,8 +6,11 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -200,6 +203,113 @@ TEST(Capture, SigmaDescribesTheActualScatter) {
     std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
     // For Gaussian errors the median of |error/σ| is 0.6745.
     EXPECT_NEAR(z[z.size() / 2], 0.6745, 0.1) << name;
+  }
+}
+
+// Distance in representable floats (0: the same float, 1: neighbours).
+std::int64_t UlpDistance(float a, float b) {
+  const auto ordered = [](float x) {
+    const auto bits = static_cast<std::int64_t>(std::bit_cast<std::int32_t>(x));
+    return bits < 0 ? std::int64_t{INT32_MIN} - bits : bits;
+  };
+  return std::llabs(ordered(a) - ordered(b));
+}
+
+TEST(Capture, ValuesAndSigmasAreTheFirstOrderFormulaToTheFloat) {
+  // The calibration and its uncertainty recomputed in long double from the raw readings on the
+  // wire, written from the header's formula f = ρ_w/π · t_w T_w/(t_s T_s) · s/w (s = C_s − D,
+  // w = C_w − D) with σf² = Σ (∂f/∂x)² var(x) over x = C_s, C_w, D taken directly:
+  //   ∂f/∂C_s = k/w, ∂f/∂C_w = −k·s/w², ∂f/∂D = k·(s − w)/w²   (k = f·w/s),
+  //   var C_s = (σr² + shot·max(0, s))/N, var C_w = (σr² + shot·w)/N_w, var D = σr²/N_D.
+  // The driver's float values must be the exact values rounded: the same float or its
+  // neighbour. Gold has bright peaks, the diamond rows read through ND filters, and black
+  // plastic at a fixed 1 ms exposure has thousands of samples at and below dark.
+  struct Case {
+    const char* name;
+    ExposureSetting exposure;
+  };
+  for (const Case& test_case : {Case{"gold", {}}, Case{"diamond_on_black", {}},
+                                Case{"plastic_glossy_black", {ExposureMode::kFixed, 1}}}) {
+    const char* name = test_case.name;
+    SimulatedFirmware fw(Config(LibraryMaterial(name), 1));
+    LoopbackTransport loopback(fw);
+    RecordingTransport link(loopback);
+    Driver driver(link);
+    CapturePlan plan;
+    plan.theta_in_deg = {0, 20, 40, 60};
+    plan.exposure = test_case.exposure;
+    std::vector<Slice> slices;
+    CaptureCallbacks callbacks;
+    callbacks.on_slice = [&](const Slice& slice, const SliceReport&) { slices.push_back(slice); };
+    Capture(driver, plan, callbacks);
+    ASSERT_EQ(slices.size(), 4u);
+
+    const IdentityInfo& id = driver.info().identity;
+    const GeometryInfo& g = driver.info().geometry;
+    const DarkCalibration& dark = *driver.dark();
+    const long double pi = std::acos(-1.0L);
+    const std::array<double, 3> rho = DriverOptions{}.white.rho;
+    FrameReader reader;
+    for (const std::vector<std::uint8_t>& chunk : link.received()) reader.Append(chunk);
+    std::size_t slice_index = 0, checked = 0, same_rgb = 0, same_sigma = 0, below = 0, nd = 0;
+    std::int64_t worst_rgb = 0, worst_sigma = 0;
+    const WhiteCalibration* white = nullptr;
+    for (DecodeResult r = reader.Next(); r.status != DecodeStatus::kNeedMore; r = reader.Next()) {
+      ASSERT_EQ(r.status, DecodeStatus::kComplete);
+      if (r.frame.type == static_cast<std::uint8_t>(MessageType::kSliceBegin)) {
+        const float theta_in = DecodeSliceBegin(r.frame.payload).theta_in_deg;
+        white = nullptr;
+        for (const WhiteCalibration& w : driver.whites())
+          if (w.theta_in_deg == theta_in) white = &w;
+        ASSERT_NE(white, nullptr) << theta_in;
+      }
+      if (r.frame.type == static_cast<std::uint8_t>(MessageType::kSliceEnd)) ++slice_index;
+      if (r.frame.type != static_cast<std::uint8_t>(MessageType::kRowData)) continue;
+      const RowData row = DecodeRowData(r.frame.payload);
+      nd += row.nd_index != 0;
+      const long double t_s = static_cast<long double>(row.exposure_ms) *
+                              static_cast<long double>(g.nd_transmittance.at(row.nd_index));
+      for (std::size_t i = 0; i < row.samples.size(); ++i) {
+        const Sample& got =
+            slices.at(slice_index)
+                .samples.at(std::size_t{row.row} * g.columns + row.first_column + i);
+        bool under_floor = false;
+        for (int c = 0; c < 3; ++c) {
+          const long double d = dark.mean_counts[c];
+          const long double read_var = static_cast<long double>(dark.read_noise_counts[c]) *
+                                       static_cast<long double>(dark.read_noise_counts[c]);
+          const long double s = static_cast<long double>(row.samples[i].counts[c]) - d;
+          const long double w = static_cast<long double>(white->counts[c]) - d;
+          const long double k = rho[c] / pi * white->exposure_ms * white->nd_transmittance / t_s;
+          const long double f = k * s / w;
+          const long double df_ds = k / w, df_dw = -k * s / (w * w), df_dd = k * (s - w) / (w * w);
+          const long double shot = id.shot_variance_per_count;
+          const long double var_s = (read_var + shot * std::max(0.0L, s)) / id.frames_per_reading;
+          const long double var_w = (read_var + shot * w) / white->frames;
+          const long double var_d = read_var / dark.frames;
+          const long double sigma =
+              std::sqrt(df_ds * df_ds * var_s + df_dw * df_dw * var_w + df_dd * df_dd * var_d);
+          const std::int64_t du = UlpDistance(got.rgb[c], static_cast<float>(f));
+          const std::int64_t ds = UlpDistance(got.sigma[c], static_cast<float>(sigma));
+          worst_rgb = std::max(worst_rgb, du);
+          worst_sigma = std::max(worst_sigma, ds);
+          same_rgb += du == 0;
+          same_sigma += ds == 0;
+          ++checked;
+          under_floor = under_floor || s < 3 * std::sqrt(read_var / id.frames_per_reading);
+        }
+        EXPECT_EQ((got.flags & kFlagBelowNoiseFloor) != 0, under_floor);
+        below += under_floor;
+      }
+    }
+    EXPECT_EQ(slice_index, 4u);
+    EXPECT_EQ(checked, 3u * 109440u) << name;
+    EXPECT_LE(worst_rgb, 1) << name;
+    EXPECT_LE(worst_sigma, 1) << name;
+    std::printf(
+        "%s: %zu values, rounded exactly: f %zu, sigma %zu; %zu samples under the floor, "
+        "%zu row frames through an ND filter\n",
+        name, checked, same_rgb, same_sigma, below, nd);
   }
 }
 

@@ -8,9 +8,11 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "brdf/core/bpc.h"
 #include "brdf/device/capture_session.h"
@@ -87,9 +89,10 @@ INSTANTIATE_TEST_SUITE_P(Transports, UsbCapture,
 // The emulated device lives in this process; the brdf child process inherits umockdev's
 // environment (preload library and testbed), so it finds the device on "its" USB bus.
 
-std::string RunTool(const std::string& args, int* exit_code) {
+// `prefix` goes before the tool (e.g. a command that drops privileges).
+std::string RunTool(const std::string& args, int* exit_code, const std::string& prefix = "") {
   std::string out;
-  std::FILE* pipe = ::popen((std::string(BRDF_TOOL) + " " + args + " 2>&1").c_str(), "r");
+  std::FILE* pipe = ::popen((prefix + std::string(BRDF_TOOL) + " " + args + " 2>&1").c_str(), "r");
   if (pipe == nullptr) return out;
   char buf[4096];
   for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, pipe)) > 0;) out.append(buf, n);
@@ -132,6 +135,54 @@ TEST_P(UsbCapture, DevicesListsTheInstrumentAndCaptureOpensItByVidPidSerial) {
   const Measurement m = LoadBpc(out);
   EXPECT_EQ(m.metadata.instrument_serial, "SN-4711");
   EXPECT_EQ(m.slices.size(), 4u);
+  std::filesystem::remove_all(tmpl);
+}
+
+TEST_P(UsbCapture, PermissionDeniedIsOneLineNamingTheNodeTheCauseAndTheUdevRule) {
+  // The emulated node with mode 000, as without the udev rule. Root opens any node
+  // (CAP_DAC_OVERRIDE), so as root the tool runs with that capability dropped (setpriv).
+  SimulatorConfig c = Config(LibraryMaterial("gold"), 1, 15, 15);
+  EmulatedUsbInstrument emu(c, GetParam());
+  emu.SetNodeMode(0);
+  const std::string as_user =
+      ::geteuid() == 0 ? "setpriv --bounding-set -dac_override,-dac_read_search " : "";
+  const bool usb = GetParam() == UsbPersonality::kBulk;
+  const std::string spec = std::string(usb ? "usb" : "hid") + ":1209:" + (usb ? "b7d1" : "b7d2");
+  // The device (its IDs and node), the cause, and the remedy: the shipped rule, where it is
+  // installed and where udev reads it, the reload, the replug.
+  const std::vector<std::string> wanted = {spec.substr(4),
+                                           emu.DeviceNode(),
+                                           "permission denied",
+                                           "70-brdf-scatterometer.rules",
+                                           "/lib/udev/rules.d",
+                                           "/etc/udev/rules.d",
+                                           "udevadm",
+                                           "plug the instrument in again"};
+  int code = -1;
+  const std::string listed = RunTool("devices", &code, as_user);
+  EXPECT_EQ(code, 0) << listed;
+  const auto line_with = [](const std::string& text, const std::string& what) {
+    const std::size_t at = text.find(what);
+    if (at == std::string::npos) return std::string();
+    const std::size_t begin = text.rfind('\n', at), end = text.find('\n', at);
+    return text.substr(begin == std::string::npos ? 0 : begin + 1,
+                       end == std::string::npos ? std::string::npos : end - begin - 1);
+  };
+  const std::string device_line = line_with(listed, spec);
+  EXPECT_EQ(std::count(listed.begin(), listed.end(), '\n'), 1) << listed;
+  for (const std::string& w : wanted)
+    EXPECT_NE(device_line.find(w), std::string::npos) << "'" << w << "' in: " << listed;
+
+  char tmpl[] = "/tmp/brdf_usb_denied_XXXXXX";
+  ASSERT_NE(::mkdtemp(tmpl), nullptr);
+  const std::string out = std::string(tmpl) + "/c.bpc";
+  const std::string refused =
+      RunTool("capture --device " + spec + " --sample s --out " + out + " --quiet", &code, as_user);
+  EXPECT_EQ(code, 1) << refused;
+  EXPECT_EQ(std::count(refused.begin(), refused.end(), '\n'), 1) << refused;
+  for (const std::string& w : wanted)
+    EXPECT_NE(refused.find(w), std::string::npos) << "'" << w << "' in: " << refused;
+  EXPECT_FALSE(std::filesystem::exists(out));
   std::filesystem::remove_all(tmpl);
 }
 

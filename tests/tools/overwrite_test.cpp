@@ -75,12 +75,34 @@ TEST_F(Overwrite, ImportRefusesAnExistingFileWithoutForce) {
                           dir_ / "in.bpc");
 }
 
+// A coarse geometry (one θin, 15° × 30° steps) so the simulated capture takes milliseconds.
+const std::string kSmallCapture =
+    "capture --device sim --material gold --sample s --theta-in 0 --theta-out-step 15 "
+    "--phi-out-step 30 --quiet";
+
+TEST_F(Overwrite, CaptureRefusesAnExistingFileWithoutForce) {
+  ExpectRefusedThenForced(kSmallCapture + " --out " + Quote(dir_ / "c.bpc"), dir_ / "c.bpc");
+  // The same line, word for word, as another writing command's (only the path differs).
+  const ToolRun capture = Run(kSmallCapture + " --out " + Quote(dir_ / "c.bpc"));
+  ASSERT_EQ(Run("export-csv " + Quote(kGoldCapture) + " --out " + Quote(dir_ / "c.csv")).exit_code,
+            0);
+  const ToolRun csv = Run("export-csv " + Quote(kGoldCapture) + " --out " + Quote(dir_ / "c.csv"));
+  ASSERT_EQ(capture.ErrLines().size(), 1u) << capture.err;
+  ASSERT_EQ(csv.ErrLines().size(), 1u) << csv.err;
+  std::string expected = csv.ErrLines()[0];
+  expected.replace(expected.find("c.csv"), 5, "c.bpc");
+  EXPECT_EQ(capture.ErrLines()[0], expected);
+}
+
 TEST_F(Overwrite, AnOutputThatIsAFolderIsRefusedEvenWithForce) {
   fs::create_directories(dir_ / "luts" / "gold.ktx2");
   fs::create_directories(dir_ / "lib.json");
+  fs::create_directories(dir_ / "c.bpc");
   for (const std::string& args :
        {"convert " + Quote(kGoldCapture) + " --quiet --force --out " + Quote(dir_ / "luts"),
-        "atlas " + Quote(kGoldCapture) + " --quiet --force --out " + Quote(dir_ / "lib")}) {
+        "atlas " + Quote(kGoldCapture) + " --quiet --force --out " + Quote(dir_ / "lib"),
+        kSmallCapture + " --force --out " + Quote(dir_ / "c.bpc"),
+        kSmallCapture + " --resume --out " + Quote(dir_ / "c.bpc")}) {
     const ToolRun r = Run(args);
     EXPECT_EQ(r.exit_code, 1) << args;
     const std::vector<std::string> lines = r.ErrLines();

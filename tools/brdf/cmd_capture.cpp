@@ -159,8 +159,6 @@ std::string Advice(const device::CaptureSessionResult& r, const std::string& out
              "the rest";
     case NextStep::kRetry:
       return "nothing was saved; check the instrument and run the command again";
-    case NextStep::kResumeOrOverwrite:
-      return "use --resume to continue an interrupted capture or --force to overwrite it";
     case NextStep::kOverwrite:
       return "start over with --force";
     case NextStep::kAcceptInstrument:
@@ -250,6 +248,7 @@ int RunCapture(const CaptureOptions& o) {
 
   device::SessionEvents events;
   events.on_start = [&](const device::SessionStart& s) {
+    ReportRemovedTemporaries(s.removed_temporaries);
     if (o.quiet) return;
     if (o.resume && !s.resuming)
       std::fprintf(stderr, "%s does not exist yet: starting a new capture\n", o.out.c_str());

@@ -46,10 +46,6 @@ const char* ProblemName(device::AccessProblem p) {
   return "";
 }
 
-constexpr const char* kUdevHint =
-    "install the udev rule device/udev/70-brdf-scatterometer.rules (README, \"Instrument "
-    "access\") and plug the instrument in again";
-
 }  // namespace
 
 int RunDevices(const DevicesOptions& o) {
@@ -65,13 +61,13 @@ int RunDevices(const DevicesOptions& o) {
       const device::FoundInstrument& f = found[i];
       std::printf(
           "%s\n    {\"interface\": %s, \"vendor_id\": \"%s\", \"product_id\": \"%s\", "
-          "\"model\": %s, \"serial\": %s, \"firmware\": %s, \"path\": %s, \"problem\": %s, "
-          "\"detail\": %s}",
+          "\"model\": %s, \"serial\": %s, \"firmware\": %s, \"path\": %s, \"node\": %s, "
+          "\"problem\": %s, \"detail\": %s}",
           i == 0 ? "" : ",", f.kind == device::DeviceSpec::Kind::kUsb ? "\"usb\"" : "\"hid\"",
           Hex4(f.vendor_id).c_str(), Hex4(f.product_id).c_str(), JsonString(f.model).c_str(),
           JsonString(f.serial).c_str(), JsonString(f.firmware_version).c_str(),
-          JsonString(f.bus_path).c_str(), JsonString(ProblemName(f.problem)).c_str(),
-          JsonString(f.problem_detail).c_str());
+          JsonString(f.bus_path).c_str(), JsonString(f.device_node).c_str(),
+          JsonString(ProblemName(f.problem)).c_str(), JsonString(f.problem_detail).c_str());
     }
     std::printf("%s]\n}\n", found.empty() ? "" : "\n  ");
     return 0;
@@ -80,7 +76,6 @@ int RunDevices(const DevicesOptions& o) {
     std::printf("no instruments found (looked for %s)\n", looked.c_str());
     return 0;
   }
-  bool permission = false;
   for (const device::FoundInstrument& f : found) {
     const bool usb = f.kind == device::DeviceSpec::Kind::kUsb;
     std::string line = std::string(usb ? "usb" : "hid") + ":" + Hex4(f.vendor_id) + ":" +
@@ -88,14 +83,15 @@ int RunDevices(const DevicesOptions& o) {
                        f.model;
     if (!f.firmware_version.empty()) line += ", firmware " + f.firmware_version;
     line += ", " + f.bus_path;
-    if (f.problem != device::AccessProblem::kNone)
+    if (!f.device_node.empty()) line += " (" + f.device_node + ")";
+    // For a permission problem the library's detail is the whole clause: cause, node, remedy.
+    if (f.problem == device::AccessProblem::kPermission)
+      line += " — " + f.problem_detail;
+    else if (f.problem != device::AccessProblem::kNone)
       line += std::string(" — ") + ProblemName(f.problem) +
               (f.problem_detail.empty() ? "" : " (" + f.problem_detail + ")");
-    permission = permission || f.problem == device::AccessProblem::kPermission;
     std::printf("%s\n", line.c_str());
   }
-  if (permission)
-    std::printf("to open the instruments marked 'permission denied': %s\n", kUdevHint);
   return 0;
 }
 

@@ -3,6 +3,7 @@
 //
 // <sys/ioctl.h> must come before <linux/usbdevice_fs.h> (docs/design.md §3, known snags).
 #include <sys/ioctl.h>
+#include <sys/stat.h>
 // clang-format off
 #include <linux/usbdevice_fs.h>
 // clang-format on
@@ -460,6 +461,16 @@ std::uint64_t EmulatedUsbInstrument::in_transfers() const { return impl_->in_tra
 std::uint64_t EmulatedUsbInstrument::frames_sent() const { return impl_->frames_sent; }
 
 void EmulatedUsbInstrument::Unplug() { impl_->unplugged = true; }
+
+void EmulatedUsbInstrument::SetNodeMode(unsigned mode) {
+  gchar* root = umockdev_testbed_get_root_dir(impl_->testbed);
+  const std::string node = std::string(root) + impl_->devnode;
+  g_free(root);
+  if (::chmod(node.c_str(), static_cast<mode_t>(mode)) != 0)
+    throw DeviceError("umockdev: cannot change the mode of " + node + ": " + std::strerror(errno));
+}
+
+std::string EmulatedUsbInstrument::DeviceNode() const { return impl_->devnode; }
 
 SimLink ParseSimLink(std::string_view text) {
   if (text == "loopback") return SimLink::kLoopback;

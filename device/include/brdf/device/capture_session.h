@@ -67,7 +67,6 @@ enum class NextStep {
   kNone,
   kResume,              // completed slices are saved: run the same capture again, resuming
   kRetry,               // nothing was saved: check the instrument, run the capture again
-  kResumeOrOverwrite,   // the file exists: resume it, or overwrite it deliberately
   kOverwrite,           // the file cannot be resumed: start over, overwriting it deliberately
   kAcceptInstrument,    // a different instrument: connect the original or accept this one
   kUseOriginalSettings  // resume with other settings than the file records
@@ -86,6 +85,8 @@ struct SessionStart {
   std::size_t slices_done = 0;  // already in the file
   std::size_t slices_planned = 0;
   std::vector<double> pending_theta_in_deg;
+  // Temporary files of killed runs removed from the capture's folder (CheckWritableOutput).
+  std::vector<std::string> removed_temporaries;
 };
 
 struct SliceProgress {
@@ -101,6 +102,8 @@ struct SessionEvents {
   std::function<void(const InstrumentInfo&)> on_connected;
   // Dark and white references are ready (measured, or taken from the file on resume).
   std::function<void(const Metadata& header, bool measured)> on_calibrated;
+  // A slice is in the file and flushed to disk. Called from the session's writer thread (one
+  // call at a time, in capture order), possibly while on_retry runs on the caller's thread.
   std::function<void(const SliceProgress&)> on_slice;
   // A recoverable fault; the driver is retrying (message says what and which attempt).
   std::function<void(const std::string& message)> on_retry;
@@ -122,7 +125,10 @@ struct CaptureSessionResult {
 // polled while measuring: once it is true the scan is aborted on the instrument and the result
 // is kInterrupted with the completed slices saved. Throws InvalidArgument for a request no
 // capture can run with (a name not ending in .bpc, no θin, a θin listed twice or not offered
-// by the instrument), IoError when the file cannot be written.
+// by the instrument), IoError when the file cannot be written. An existing file follows the
+// overwrite rule of every writing command (brdf::CheckWritableOutput in brdf/core/file_util.h):
+// OutputExistsError unless `force` or `resume`, IoError for a folder, FIFO or device whatever
+// they say; both before anything is measured.
 CaptureSessionResult RunCaptureSession(const CaptureRequest& request, Transport& link,
                                        const SessionEvents& events = {},
                                        const std::atomic<bool>* cancel = nullptr);

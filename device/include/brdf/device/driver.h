@@ -209,8 +209,9 @@ struct CaptureCallbacks {
   // Once, after the calibration and before the first slice: the metadata a file header carries
   // (capture_end still empty).
   std::function<void(const Metadata&)> on_calibrated;
-  // As each slice completes, in capture order.
-  std::function<void(const Slice&, const SliceReport&)> on_slice;
+  // As each slice completes, in capture order. The slice is handed over: the callback may move
+  // from it (a callback taking `const Slice&` works too).
+  std::function<void(Slice&&, const SliceReport&)> on_slice;
 };
 
 // The whole capture: Connect, SetExposure, MeasureDark, MeasureWhite for every θin of the plan,

@@ -25,6 +25,7 @@
 #pragma once
 
 #include <array>
+#include <bit>
 #include <cstddef>
 #include <cstdint>
 #include <span>
@@ -254,6 +255,28 @@ SliceBegin DecodeSliceBegin(std::span<const std::uint8_t> payload);
 // Throws InvalidArgument for more than kMaxSamplesPerRowFrame samples.
 std::vector<std::uint8_t> EncodeRowData(const RowData& row);
 RowData DecodeRowData(std::span<const std::uint8_t> payload);
+// A ROW_DATA payload checked as DecodeRowData checks it, with the samples left in the payload
+// (13 bytes each: three f32 counts, then the clip bits): the driver calibrates straight from
+// the frame instead of from a copy. Valid while `payload` is.
+struct RowDataView {
+  static constexpr std::size_t kSampleBytes = 13;
+  std::uint16_t row = 0;
+  std::uint16_t first_column = 0;
+  float exposure_ms = 0;
+  std::uint8_t nd_index = 0;
+  std::span<const std::uint8_t> sample_bytes;  // size() × kSampleBytes
+
+  std::size_t size() const { return sample_bytes.size() / kSampleBytes; }
+  float Counts(std::size_t i, int channel) const {
+    std::uint32_t bits = 0;
+    for (int b = 3; b >= 0; --b)
+      bits = (bits << 8) | sample_bytes[i * kSampleBytes + 4 * static_cast<std::size_t>(channel) +
+                                        static_cast<std::size_t>(b)];
+    return std::bit_cast<float>(bits);
+  }
+  std::uint8_t ClippedChannels(std::size_t i) const { return sample_bytes[i * kSampleBytes + 12]; }
+};
+RowDataView DecodeRowDataView(std::span<const std::uint8_t> payload);
 std::vector<std::uint8_t> EncodeSliceEnd(const SliceEnd& end);
 SliceEnd DecodeSliceEnd(std::span<const std::uint8_t> payload);
 std::vector<std::uint8_t> EncodeError(const ErrorReply& error);

@@ -204,6 +204,9 @@ class SimulatedFirmware {
   Exposure slice_exposure_;  // kAutoPerSlice / kFixed
   std::size_t next_row_ = 0, next_column_ = 0;
   std::vector<Reading> row_readings_;
+  // cos φ and sin φ of every detector column, so a row costs two trig calls, not four per
+  // sample (the same products as SphericalDirectionDeg, so the same bits).
+  std::vector<double> column_cos_phi_, column_sin_phi_;
   Exposure row_exposure_;
   std::uint32_t slice_samples_ = 0, slice_clipped_ = 0;
 };

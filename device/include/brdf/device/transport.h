@@ -11,6 +11,7 @@
 #include <cstdint>
 #include <span>
 #include <string>
+#include <vector>
 
 namespace brdf::device {
 
@@ -49,6 +50,30 @@ class LoopbackTransport final : public Transport {
 
  private:
   SimulatedFirmware& firmware_;
+};
+
+// Forwards to another transport and keeps every chunk of bytes the instrument sent, in order
+// and as delivered: a session recorded for a benchmark to replay, or for a test to decode and
+// recompute from the raw readings.
+class RecordingTransport final : public Transport {
+ public:
+  // `link` must outlive the recorder.
+  explicit RecordingTransport(Transport& link) : link_(link) {}
+
+  void Write(std::span<const std::uint8_t> bytes) override { link_.Write(bytes); }
+  std::size_t Read(std::span<std::uint8_t> buffer, int timeout_ms) override {
+    const std::size_t n = link_.Read(buffer, timeout_ms);
+    if (n > 0)
+      received_.emplace_back(buffer.begin(), buffer.begin() + static_cast<std::ptrdiff_t>(n));
+    return n;
+  }
+  std::string Description() const override { return link_.Description(); }
+
+  const std::vector<std::vector<std::uint8_t>>& received() const { return received_; }
+
+ private:
+  Transport& link_;
+  std::vector<std::vector<std::uint8_t>> received_;
 };
 
 }  // namespace brdf::device

@@ -39,8 +39,16 @@ struct FoundInstrument {
   std::string bus_path;          // "bus 001 device 002" (USB) or hidapi's path ("1-1:1.0")
   std::string firmware_version;  // from IDENTIFY when `identify` was asked and it answered
   AccessProblem problem = AccessProblem::kNone;
-  std::string problem_detail;  // the library's own words, for the log line
+  // What went wrong in one line of the user's terms; for kPermission it names the device node
+  // and the remedy (UdevRemedy()).
+  std::string problem_detail;
+  std::string device_node;  // "/dev/bus/usb/001/002" or "/dev/hidraw3"; empty when unknown
 };
+
+// What a user whose account may not open the instrument's device node does, in one clause:
+// copy the shipped udev rule (installed by `cmake --install` into <prefix>/lib/udev/rules.d;
+// udev reads /etc/udev/rules.d), reload udev and plug the instrument in again.
+std::string UdevRemedy();
 
 // Every instrument of the model table on USB (bulk personality) and HID. With `identify`, each
 // accessible one is opened and asked IDENTIFY for its firmware version. Never throws for a

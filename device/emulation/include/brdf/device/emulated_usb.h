@@ -27,6 +27,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <string_view>
 
 #include "brdf/device/simulator.h"
@@ -54,6 +55,12 @@ class EmulatedUsbInstrument {
   std::uint64_t frames_sent() const;    // firmware frames
   // Simulates pulling the cable: the device vanishes from the bus.
   void Unplug();
+  // Sets the permission bits of the emulated device node (/dev/bus/usb/001/002 inside the
+  // testbed): 0 gives what a user without the udev rule meets, EACCES on open. (A process with
+  // CAP_DAC_OVERRIDE, e.g. root, still opens it.) Throws DeviceError when chmod fails.
+  void SetNodeMode(unsigned mode);
+  // The device node as the instrument's user sees it, "/dev/bus/usb/001/002".
+  std::string DeviceNode() const;
 
  private:
   struct Impl;
