@@ -1,12 +1,15 @@
 #include "brdf/engines/engine_export.h"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <functional>
+#include <mutex>
 #include <string>
+#include <unordered_map>
 
 #include <fmt/format.h>
 #include <unistd.h>
@@ -21,6 +24,7 @@
 #include "brdf/exporter/shader_code.h"
 #include "brdf/exporter/sidecar.h"
 #include "engine_files.h"
+#include "staged_files.h"
 
 namespace brdf::engines {
 
@@ -28,6 +32,7 @@ namespace fs = std::filesystem;
 using ordered_json = nlohmann::ordered_json;
 using detail::Handoff;
 using detail::HandoffCell;
+using detail::StagedFiles;
 
 namespace {
 
@@ -148,15 +153,22 @@ ordered_json ProbeJson(const Handoff& h) {
         ij.push_back({360, 180});
         ij.push_back({45, 10});
       }
-      // The brightest texel of the slice (first one on ties): the peak of the lobe.
+      // The brightest texel of the slice (first one on ties): the peak of the lobe. Decoded
+      // inline (c = c_s · 2^(e − 24), the scale built as a float's bits): the same exact values
+      // as exporter::DecodeRgb9e5, without a call per texel of the slice.
       int best_i = 0, best_j = 0;
       float best = -1;
-      for (int j = 0; j < 181; ++j)
+      for (int j = 0; j < 181; ++j) {
+        const std::uint32_t* row = &vol.words[vol.Index(cell.x0, cell.y0 + j, k)];
         for (int i = 0; i < 361; ++i) {
-          const auto c = exporter::DecodeRgb9e5(vol.words[vol.Index(cell.x0 + i, cell.y0 + j, k)]);
-          const float y = 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2];
+          const std::uint32_t w = row[i];
+          const float scale = std::bit_cast<float>(((w >> 27) + 103u) << 23);
+          const float y = 0.2126f * (static_cast<float>(w & 511u) * scale) +
+                          0.7152f * (static_cast<float>((w >> 9) & 511u) * scale) +
+                          0.0722f * (static_cast<float>((w >> 18) & 511u) * scale);
           if (y > best) best = y, best_i = i, best_j = j;
         }
+      }
       ij.push_back({best_i, best_j});
       for (const auto& [i, j] : ij) {
         const int x = cell.x0 + i, y = cell.y0 + j;
@@ -338,31 +350,53 @@ struct Sources {
   std::function<exporter::FloatImage()> composite;
 };
 
-// Places `path` as a hard link to `source` (same bytes, no second copy to write and flush):
-// linked under a temporary name, then renamed over `path`, so the final name appears whole.
-// The source is already durable; the folder is synced by the next atomic write into it.
-// Returns false when linking is impossible (no source, another file system), so the caller
-// writes the bytes instead.
-bool LinkAtomically(const std::string& source, const std::string& path) {
-  if (source.empty()) return false;
-  AtomicOutputPath out(path);
-  if (::link(source.c_str(), out.temp_path().c_str()) != 0) return false;
-  if (std::rename(out.temp_path().c_str(), path.c_str()) != 0) return false;
-  return true;  // the destructor's unlink of the (renamed) temporary name is a no-op
-}
+// Files every material of a layout shares (importer, shaders, viewer): their text is a function
+// of their path alone, so once this process has written one or found it identical, later
+// materials of the batch only check that it is still there with that size (one stat) instead of
+// generating the text and reading the file again.
+class SharedFiles {
+ public:
+  static SharedFiles& Instance() {
+    static SharedFiles instance;
+    return instance;
+  }
+  // Writes `path` with text() when it is missing or different; returns true when written.
+  template <class Text>
+  bool Ensure(const std::string& path, Text&& text) {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      if (const auto it = sizes_.find(path); it != sizes_.end()) {
+        std::error_code ec;
+        if (fs::file_size(path, ec) == it->second && !ec) return false;
+      }
+    }
+    const std::string bytes = text();
+    const bool write = !SameContent(path, bytes);
+    if (write) WriteFileAtomically(path, bytes);
+    const std::lock_guard<std::mutex> lock(mutex_);
+    sizes_[path] = bytes.size();
+    return write;
+  }
 
-// Writes a file every material of a layout shares only when it is missing or different, so a
-// batch writes each once.
-bool SameContent(const std::string& path, std::string_view bytes) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec) || fs::file_size(path, ec) != bytes.size()) return false;
-  return ReadFileText(path, bytes.size()) == bytes;
-}
+ private:
+  static bool SameContent(const std::string& path, std::string_view bytes) {
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec) || fs::file_size(path, ec) != bytes.size()) return false;
+    return ReadFileText(path, bytes.size()) == bytes;
+  }
+  std::mutex mutex_;
+  std::unordered_map<std::string, std::uintmax_t> sizes_;
+};
 
-// Writes one engine folder; returns the paths written or linked (shared files included when
-// they had to be written).
-std::vector<std::string> WriteEngineFolder(Engine e, const fs::path& dir, const Handoff& h,
-                                           const Sources& src, std::string& manifest_path,
+// The RGBA16F volume DDS streamed into `w`: header, then the texels converted chunk by chunk
+// (no copy of the whole payload in memory).
+void WriteRgba16fDds(StagedFiles::Writer& w, const exporter::PackedVolume& volume);
+
+// Stages one engine folder's per-material files in `staged` and writes its shared files;
+// returns the shared files it had to write.
+std::vector<std::string> StageEngineFolder(Engine e, const fs::path& dir, const Handoff& h,
+                                           const Sources& src, StagedFiles& staged,
+                                           std::string& manifest_temp,
                                            const std::string& manifest) {
   std::error_code ec;
   fs::create_directories(dir, ec);
@@ -372,30 +406,19 @@ std::vector<std::string> WriteEngineFolder(Engine e, const fs::path& dir, const 
   const MaterialFiles f = FilesOf(e, h.name);
   const std::string shader = ShaderFile(e, h.layout);
   std::vector<std::string> written;
-  const auto put = [&](const std::string& file, std::string_view bytes) {
-    const std::string path = (dir / file).string();
-    WriteFileAtomically(path, bytes);
-    written.push_back(path);
-  };
-  const auto shared = [&](const std::string& file, const std::string& bytes) {
-    if (!SameContent((dir / file).string(), bytes)) put(file, bytes);
+  const auto path_of = [&](const std::string& file) { return (dir / file).string(); };
+  const auto shared = [&](const std::string& file, auto&& text) {
+    if (SharedFiles::Instance().Ensure(path_of(file), text)) written.push_back(path_of(file));
   };
   const auto linked = [&](const std::string& file, const std::string& source,
                           const std::function<std::string()>& bytes) {
-    const std::string path = (dir / file).string();
-    if (LinkAtomically(source, path))
-      written.push_back(path);
-    else
-      put(file, bytes());
+    if (!staged.Link(source, path_of(file))) staged.Write(path_of(file), bytes());
   };
   // The tiled/sliced EXR: the regular composite EXR when there is one (same layout), else a
   // half-float one written here.
   const auto tiles = [&](const std::string& file) {
-    const std::string path = (dir / file).string();
-    if (LinkAtomically(src.exr_path, path)) {
-      written.push_back(path);
-      return;
-    }
+    const std::string path = path_of(file);
+    if (staged.Link(src.exr_path, path)) return;
     exporter::WriteExr(
         path, src.composite(),
         exporter::ExrOptions(exporter::ExrPixelType::kHalf, exporter::ExrCompression::kNone),
@@ -409,53 +432,64 @@ std::vector<std::string> WriteEngineFolder(Engine e, const fs::path& dir, const 
   switch (e) {
     case Engine::kUnity:
       linked(f.texture, src.ktx2_path, src.ktx2_bytes);
-      fs::create_directories(dir / "Editor", ec);
-      shared("Editor/MeasuredBrdfImporter.cs", detail::UnityImporterCs());
-      shared(shader, detail::UnityHlsl(h.layout));
+      shared("Editor/MeasuredBrdfImporter.cs", [&] {
+        std::error_code dir_ec;
+        fs::create_directories(dir / "Editor", dir_ec);
+        return detail::UnityImporterCs();
+      });
+      shared(shader, [&] { return detail::UnityHlsl(h.layout); });
       break;
     case Engine::kUnreal:
       tiles(f.tiles);
-      put(f.texture, EncodeRgba16fDds(*h.volume));
-      shared(shader, detail::UnrealUsh(h.layout));
-      shared("import_measured_brdf.py", detail::UnrealImportPython());
+      staged.WriteWith(path_of(f.texture),
+                   [&](StagedFiles::Writer& w) { WriteRgba16fDds(w, *h.volume); });
+      shared(shader, [&] { return detail::UnrealUsh(h.layout); });
+      shared("import_measured_brdf.py", [] { return detail::UnrealImportPython(); });
       break;
     case Engine::kGodot:
       linked(f.texture, src.dds_path, [&] { return exporter::EncodeDds(*h.volume); });
       tiles(f.tiles);
-      put(f.tiles_import, detail::GodotSlicesImport(h, f.tiles));
-      shared(shader, detail::GodotShader(h.layout));
+      staged.Write(path_of(f.tiles_import), detail::GodotSlicesImport(h, f.tiles));
+      shared(shader, [&] { return detail::GodotShader(h.layout); });
       break;
     case Engine::kWeb:
       linked(f.texture, src.ktx2_path, src.ktx2_bytes);
-      shared(shader, detail::WebModuleJs(h.layout));
-      shared("index.html", detail::WebViewerHtml(shader, ""));
-      shared("package.json", detail::WebPackageJson());
+      shared(shader, [&] { return detail::WebModuleJs(h.layout); });
+      shared("index.html", [] { return detail::WebViewerHtml(); });
+      shared("package.json", [] { return detail::WebPackageJson(); });
       // The same lookup as plain GLSL files for other WebGL 2 / OpenGL code.
-      shared(detail::ShaderStem(h.layout) + ".es300.glsl",
-             exporter::MeasuredBrdfGlslFile(exporter::GlslVersion::kEs300, h.layout));
-      shared(detail::ShaderStem(h.layout) + ".450.glsl",
-             exporter::MeasuredBrdfGlslFile(exporter::GlslVersion::k450, h.layout));
+      shared(detail::ShaderStem(h.layout) + ".es300.glsl", [&] {
+        return exporter::MeasuredBrdfGlslFile(exporter::GlslVersion::kEs300, h.layout);
+      });
+      shared(detail::ShaderStem(h.layout) + ".450.glsl", [&] {
+        return exporter::MeasuredBrdfGlslFile(exporter::GlslVersion::k450, h.layout);
+      });
       break;
   }
-  // The manifest: written into the first folder, hard-linked into the others.
-  if (!LinkAtomically(manifest_path, (dir / f.manifest).string()))
-    put(f.manifest, manifest);
-  else
-    written.push_back((dir / f.manifest).string());
-  if (manifest_path.empty()) manifest_path = (dir / f.manifest).string();
+  // The manifest: written into the first folder, hard-linked (from its temporary name) into
+  // the others.
+  const std::string manifest_path = path_of(f.manifest);
+  if (!staged.Link(manifest_temp, manifest_path)) {
+    staged.Write(manifest_path, manifest);
+    manifest_temp = staged.temp_path_of_last();
+  }
   return written;
 }
 
 std::vector<std::string> WriteHandoff(const fs::path& base, const Handoff& h, const Sources& src,
                                       const EngineSet& engines) {
-  std::vector<std::string> written;
   const std::vector<Engine> selected = Selected(engines);
   const std::string manifest = ManifestJson(h, selected);
-  std::string manifest_path;
+  StagedFiles staged;
+  std::string manifest_temp;
+  std::vector<std::string> shared;
   for (Engine e : selected) {
-    const auto w = WriteEngineFolder(e, base / FolderOf(e), h, src, manifest_path, manifest);
-    written.insert(written.end(), w.begin(), w.end());
+    const auto w = StageEngineFolder(e, base / FolderOf(e), h, src, staged, manifest_temp, manifest);
+    shared.insert(shared.end(), w.begin(), w.end());
   }
+  staged.Commit();
+  std::vector<std::string> written = staged.paths();
+  written.insert(written.end(), shared.begin(), shared.end());
   return written;
 }
 
@@ -529,28 +563,84 @@ std::uint16_t FloatToHalf(float value) {
   return sign | static_cast<std::uint16_t>(half);
 }
 
-std::string Rgba16fBytes(const exporter::PackedVolume& volume) {
-  std::string out(volume.words.size() * 8, '\0');
-  constexpr std::uint16_t kOne = 0x3c00;
-  for (std::size_t t = 0; t < volume.words.size(); ++t) {
-    const auto c = exporter::DecodeRgb9e5(volume.words[t]);
-    const std::uint16_t h[4] = {FloatToHalf(c[0]), FloatToHalf(c[1]), FloatToHalf(c[2]), kOne};
-    for (int i = 0; i < 4; ++i) {
-      out[t * 8 + 2 * i] = static_cast<char>(h[i] & 0xff);
-      out[t * 8 + 2 * i + 1] = static_cast<char>(h[i] >> 8);
-    }
-  }
-  return out;
+namespace {
+
+// Binary16 bits of one RGB9E5 channel value m · 2^(e − 24) (mantissa m < 512, exponent e < 32).
+// Every such value is exact in half, so there is nothing to round: it has at most 9
+// significant bits and lies in [2^−24, 65408], within half's subnormal step 2^−24 and largest
+// finite 65504. Half stores n · 2^−24 for n < 1024 as the subnormal n (here n = m · 2^e), else
+// exponent field p + e − 9 (p: the position of m's leading bit, so the value is
+// 2^(p + e − 24) · 1.f) and the 10 fraction bits below the leading one.
+constexpr std::uint16_t HalfOfRgb9e5Channel(std::uint32_t m, std::uint32_t e) {
+  if (m == 0) return 0;
+  const int p = std::bit_width(m) - 1;
+  const int field = p + static_cast<int>(e) - 9;
+  if (field <= 0) return static_cast<std::uint16_t>(m << e);
+  return static_cast<std::uint16_t>((static_cast<std::uint32_t>(field) << 10) |
+                                    ((m << (10 - p)) & 0x3ffu));
 }
 
-std::string EncodeRgba16fDds(const exporter::PackedVolume& volume) {
+// All 32 × 512 channel values, indexed by e · 512 + m (32 KiB, built at compile time).
+constexpr auto kHalfOfChannel = [] {
+  std::array<std::uint16_t, 32 * 512> t{};
+  for (std::uint32_t e = 0; e < 32; ++e)
+    for (std::uint32_t m = 0; m < 512; ++m) t[e * 512 + m] = HalfOfRgb9e5Channel(m, e);
+  return t;
+}();
+
+// One texel: R, G, B halves and alpha 1.0 (0x3c00), little-endian, 8 bytes at `out`.
+inline void PutRgba16fTexel(std::uint32_t word, char* out) {
+  const std::uint16_t* row = &kHalfOfChannel[(word >> 27) * 512];
+  const std::uint64_t texel = std::uint64_t{row[word & 511u]} |
+                              (std::uint64_t{row[(word >> 9) & 511u]} << 16) |
+                              (std::uint64_t{row[(word >> 18) & 511u]} << 32) |
+                              (std::uint64_t{0x3c00} << 48);
+  for (int b = 0; b < 8; ++b) out[b] = static_cast<char>((texel >> (8 * b)) & 0xffu);
+}
+
+void CheckVolume(const exporter::PackedVolume& volume) {
   if (volume.width < 1 || volume.height < 1 || volume.depth < 1 ||
       volume.words.size() != static_cast<std::size_t>(volume.width) * volume.height * volume.depth)
     throw InvalidArgument(fmt::format("RGBA16F DDS: inconsistent volume {} × {} × {}", volume.width,
                                       volume.height, volume.depth));
+}
+
+std::string Rgba16fDdsHeader(const exporter::PackedVolume& volume) {
   return exporter::DdsVolumeHeader(volume.width, volume.height, volume.depth,
-                                   kDxgiFormatR16g16b16a16Float, 8) +
-         Rgba16fBytes(volume);
+                                   kDxgiFormatR16g16b16a16Float, 8);
+}
+
+void WriteRgba16fDds(StagedFiles::Writer& w, const exporter::PackedVolume& volume) {
+  CheckVolume(volume);
+  w.Append(Rgba16fDdsHeader(volume));
+  constexpr std::size_t kTexelsPerChunk = StagedFiles::Writer::kChunkBytes / 8;
+  for (std::size_t t = 0; t < volume.words.size(); t += kTexelsPerChunk) {
+    const std::size_t n = std::min(kTexelsPerChunk, volume.words.size() - t);
+    char* out = w.Reserve(n * 8);
+    for (std::size_t i = 0; i < n; ++i) PutRgba16fTexel(volume.words[t + i], out + 8 * i);
+    w.Keep(n * 8);
+  }
+}
+
+}  // namespace
+
+std::uint16_t Rgb9e5ChannelToHalf(std::uint32_t mantissa, std::uint32_t exponent) {
+  if (mantissa > 511 || exponent > 31)
+    throw InvalidArgument(fmt::format("RGB9E5 channel: mantissa {} (0..511), exponent {} (0..31)",
+                                      mantissa, exponent));
+  return kHalfOfChannel[exponent * 512 + mantissa];
+}
+
+std::string Rgba16fBytes(const exporter::PackedVolume& volume) {
+  std::string out(volume.words.size() * 8, '\0');
+  for (std::size_t t = 0; t < volume.words.size(); ++t)
+    PutRgba16fTexel(volume.words[t], out.data() + 8 * t);
+  return out;
+}
+
+std::string EncodeRgba16fDds(const exporter::PackedVolume& volume) {
+  CheckVolume(volume);
+  return Rgba16fDdsHeader(volume) + Rgba16fBytes(volume);
 }
 
 std::vector<std::string> EngineOutputPaths(const std::string& out_dir, const std::string& name,

@@ -71,7 +71,9 @@ struct EngineExportResult {
 
 // The one call `brdf convert` makes per input: exporter::ExportLut into OUT_DIR, then the
 // engine folders OUT_DIR/<engine>/ for the selected engines (created when missing). Every file
-// is written atomically. Throws InvalidArgument / IoError.
+// is written atomically; the per-material engine files of one call are synced together (each
+// file's data before its rename, then each folder once), so no partial file is ever visible
+// under a final name. Throws InvalidArgument / IoError.
 EngineExportResult ExportLutWithEngines(const std::string& out_dir, const Lut& lut,
                                         exporter::TextureMetadata metadata,
                                         const exporter::LutExportOptions& options,
@@ -89,14 +91,19 @@ std::vector<std::string> WriteAtlasWithEngines(
     const std::string& prefix, const std::vector<exporter::AtlasMaterial>& materials,
     const exporter::ExrOptions& exr_options, const EngineSet& engines);
 
-// The RGBA16F payload of the Unreal DDS: every RGB9E5 word decoded and converted to IEEE
-// half (exact: a decoded RGB9E5 value has at most 9 significant bits and is ≤ 65408, both
-// within half's range and precision), alpha = 1.0; 8 bytes per texel, little-endian, texels
-// in PackedVolume order.
+// The RGBA16F payload of the Unreal DDS: every RGB9E5 channel converted to IEEE half
+// directly from its mantissa and exponent (Rgb9e5ChannelToHalf: exact, no rounding), alpha =
+// 1.0; 8 bytes per texel, little-endian, texels in PackedVolume order. The conversion export
+// uses streams the same bytes into the file chunk by chunk instead of building this string.
 std::string Rgba16fBytes(const exporter::PackedVolume& volume);
 // The whole RGBA16F volume DDS (exporter::DdsVolumeHeader with DXGI format 10).
 std::string EncodeRgba16fDds(const exporter::PackedVolume& volume);
-// IEEE 754 binary16 from a float, round to nearest even (overflow → +inf, NaN kept).
+// Binary16 bits of the RGB9E5 channel value mantissa · 2^(exponent − 24) (mantissa 0..511,
+// exponent 0..31; throws InvalidArgument outside). Exact: every such value has at most 9
+// significant bits and lies in [2^−24, 65408], which half represents without rounding
+// (subnormals below 2^−14).
+std::uint16_t Rgb9e5ChannelToHalf(std::uint32_t mantissa, std::uint32_t exponent);
+// IEEE 754 binary16 from any float, round to nearest even (overflow → ±inf, NaN kept quiet).
 std::uint16_t FloatToHalf(float value);
 
 }  // namespace brdf::engines
