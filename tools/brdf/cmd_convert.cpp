@@ -119,10 +119,14 @@ int RunConvert(const ConvertOptions& options) {
   RefuseCollisions(out_dir, export_options.formats, found.inputs, found.failures);
   {
     // The overwrite rule, for every output of the run before any work is done.
-    std::vector<std::string> outputs;
-    for (const BatchInput& in : found.inputs)
+    std::vector<std::string> outputs, names;
+    for (const BatchInput& in : found.inputs) {
       for (std::string& p : OutputPaths(out_dir, in.name, export_options.formats))
         outputs.push_back(std::move(p));
+      names.push_back(in.name);
+    }
+    for (std::string& p : engines::EngineOutputsToCheck(out_dir.string(), names, engine_set))
+      outputs.push_back(std::move(p));
     ReportRemovedTemporaries(CheckWritableOutputs(outputs, options.force));
   }
 
