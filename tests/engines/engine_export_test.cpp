@@ -1,5 +1,6 @@
-// brdf::engines: engine selection, IEEE half conversion against published bit patterns, the
-// files each engine folder receives, and manifests whose probe texels are the texture's own
+// brdf::engines: engine selection, IEEE half conversion against published bit patterns and
+// against numpy's float16 (Debian /usr/bin/python3, run by the test), the files each engine
+// folder receives, and manifests whose probe texels are the texture's own
 // texels (decoded here from EXT_texture_shared_exponent, not with the exporter's decoder).
 #include "brdf/engines/engine_export.h"
 
@@ -7,6 +8,10 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+#include <random>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -15,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include "brdf/core/error.h"
+#include "brdf/exporter/packed_volume.h"
 
 namespace brdf {
 namespace {
@@ -92,6 +98,114 @@ TEST(FloatToHalf, MatchesPublishedBitPatterns) {
   EXPECT_EQ(engines::FloatToHalf(65408.0f), 0x7bfc);  // the largest RGB9E5 value, exact
 }
 
+// numpy's float32 → float16 conversion (round to nearest even, subnormals, overflow to inf) of
+// `values`, run in Debian's python: an implementation independent of the code under test.
+std::vector<std::uint16_t> NumpyHalves(const std::vector<float>& values, const fs::path& dir) {
+  const fs::path in = dir / "floats.bin", out = dir / "halves.bin";
+  std::ofstream(in, std::ios::binary)
+      .write(reinterpret_cast<const char*>(values.data()),
+             static_cast<std::streamsize>(values.size() * sizeof(float)));
+  const std::string cmd = std::string(BRDF_PYTHON3) +
+                          " -c \"import numpy as np, sys; np.fromfile(sys.argv[1], '<f4')"
+                          ".astype('<f2').tofile(sys.argv[2])\" '" +
+                          in.string() + "' '" + out.string() + "'";
+  EXPECT_EQ(std::system(cmd.c_str()), 0) << cmd << ": Debian python3 with numpy is required";
+  const std::string bytes = Read(out);
+  std::vector<std::uint16_t> halves(bytes.size() / 2);
+  for (std::size_t i = 0; i < halves.size(); ++i)
+    halves[i] = static_cast<std::uint16_t>(static_cast<unsigned char>(bytes[2 * i]) |
+                                           (static_cast<unsigned char>(bytes[2 * i + 1]) << 8));
+  EXPECT_EQ(halves.size(), values.size());
+  return halves;
+}
+
+// Every value an RGB9E5 channel can hold (32 exponents × 512 mantissas, subnormal halves
+// included), converted by the table the Unreal DDS uses, equals numpy's float16 of the same
+// value; and Rgba16fBytes puts those halves, with alpha 1.0, where each channel belongs.
+TEST_F(EngineExport, Rgb9e5ChannelHalvesEqualNumpyForEveryChannelValue) {
+  std::vector<float> values;
+  std::vector<std::uint16_t> ours;
+  for (std::uint32_t e = 0; e < 32; ++e)
+    for (std::uint32_t m = 0; m < 512; ++m) {
+      values.push_back(static_cast<float>(std::ldexp(static_cast<double>(m), int(e) - 24)));
+      ours.push_back(engines::Rgb9e5ChannelToHalf(m, e));
+    }
+  const std::vector<std::uint16_t> numpy = NumpyHalves(values, dir_);
+  ASSERT_EQ(numpy.size(), ours.size());
+  int differing = 0;
+  for (std::size_t i = 0; i < ours.size(); ++i)
+    if (ours[i] != numpy[i] && ++differing <= 5)
+      ADD_FAILURE() << "m " << i % 512 << " e " << i / 512 << " (" << values[i] << "): 0x"
+                    << std::hex << ours[i] << ", numpy 0x" << numpy[i];
+  EXPECT_EQ(differing, 0);
+
+  exporter::PackedVolume vol;  // every (e, m) once in each channel, mantissas rotated
+  vol.width = 512;
+  vol.height = 32;
+  vol.depth = 1;
+  for (std::uint32_t e = 0; e < 32; ++e)
+    for (std::uint32_t m = 0; m < 512; ++m)
+      vol.words.push_back((e << 27) | m | (((m + 171) % 512) << 9) | (((m + 342) % 512) << 18));
+  const std::string bytes = engines::Rgba16fBytes(vol);
+  ASSERT_EQ(bytes.size(), vol.words.size() * 8);
+  const auto half_at = [&](std::size_t t, int c) {
+    return static_cast<std::uint16_t>(static_cast<unsigned char>(bytes[8 * t + 2 * c]) |
+                                      (static_cast<unsigned char>(bytes[8 * t + 2 * c + 1]) << 8));
+  };
+  for (std::size_t t = 0; t < vol.words.size(); ++t) {
+    const std::size_t e = t / 512, m = t % 512;
+    ASSERT_EQ(half_at(t, 0), numpy[e * 512 + m]) << t;
+    ASSERT_EQ(half_at(t, 1), numpy[e * 512 + (m + 171) % 512]) << t;
+    ASSERT_EQ(half_at(t, 2), numpy[e * 512 + (m + 342) % 512]) << t;
+    ASSERT_EQ(half_at(t, 3), 0x3c00) << t;
+  }
+}
+
+// FloatToHalf against numpy where rounding matters: every half value, every midpoint between
+// neighbouring halves (the ties, which go to the even neighbour) and the floats one ulp either
+// side of it, the subnormal range, overflow near 65520, and 300 000 random floats of every
+// exponent from 2^-30 to 2^17, both signs. NaNs are compared as NaN.
+TEST_F(EngineExport, FloatToHalfEqualsNumpyIncludingTiesAndSubnormals) {
+  std::vector<float> values;
+  const auto half_value = [](std::uint32_t h) {  // decoded from the bit pattern (IEEE 754)
+    const std::uint32_t exp = (h >> 10) & 31, frac = h & 1023;
+    const double mag = exp == 0 ? std::ldexp(double(frac), -24)
+                                : std::ldexp(1.0 + frac / 1024.0, int(exp) - 15);
+    return (h & 0x8000) ? -mag : mag;
+  };
+  for (std::uint32_t h = 0; h < 0x7c00; ++h) {
+    for (std::uint32_t sign : {0u, 0x8000u}) {
+      const double v = half_value(h | sign);
+      values.push_back(static_cast<float>(v));
+      const double next = h + 1 < 0x7c00 ? half_value((h + 1) | sign) : (sign ? -65536.0 : 65536.0);
+      const float tie = static_cast<float>((v + next) / 2);  // exact in float
+      values.push_back(tie);
+      values.push_back(std::nextafter(tie, 0.0f));
+      values.push_back(std::nextafter(tie, tie * 2));
+    }
+  }
+  for (float v : {65504.0f, 65519.0f, 65520.0f, 1e6f, std::ldexp(1.0f, -25), std::ldexp(1.0f, -26),
+                  std::ldexp(1.5f, -25), std::ldexp(1.0f, -40), 0.0f, -0.0f,
+                  std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
+                  std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::denorm_min()})
+    values.push_back(v);
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> exponent(-30, 17);
+  std::uniform_real_distribution<float> mantissa(1.0f, 2.0f);
+  for (int i = 0; i < 300000; ++i)
+    values.push_back((i % 2 ? -1.0f : 1.0f) * std::ldexp(mantissa(rng), exponent(rng)));
+  const std::vector<std::uint16_t> numpy = NumpyHalves(values, dir_);
+  ASSERT_EQ(numpy.size(), values.size());
+  int differing = 0;
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const std::uint16_t ours = engines::FloatToHalf(values[i]);
+    const bool both_nan = (ours & 0x7fff) > 0x7c00 && (numpy[i] & 0x7fff) > 0x7c00;
+    if (ours != numpy[i] && !both_nan && ++differing <= 5)
+      ADD_FAILURE() << values[i] << ": 0x" << std::hex << ours << ", numpy 0x" << numpy[i];
+  }
+  EXPECT_EQ(differing, 0) << "of " << values.size();
+}
+
 TEST_F(EngineExport, WritesEveryEngineFolderWithTheContainersAsBytes) {
   const Lut lut = Pattern({0, 20, 40, 60});
   exporter::TextureMetadata meta;
@@ -125,6 +239,8 @@ TEST_F(EngineExport, WritesEveryEngineFolderWithTheContainersAsBytes) {
   EXPECT_EQ(Read(dir_ / "unity/felt.brdf3d"), ktx2);
   EXPECT_EQ(Read(dir_ / "web/felt.ktx2"), ktx2);
   EXPECT_EQ(Read(dir_ / "godot/felt.dds"), Read(dir_ / "felt.dds"));
+  // The DDS streamed in 64 KiB chunks (the last one partial) holds the whole-volume encoding.
+  EXPECT_EQ(Read(dir_ / "unreal/felt.dds"), engines::EncodeRgba16fDds(exporter::PackLut(lut)));
   // The paths a failed conversion must remove are the per-material ones.
   const auto paths = engines::EngineOutputPaths(dir_.string(), "felt", ParseEngines("all"));
   EXPECT_EQ(paths.size(), 11u);
