@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -285,6 +286,64 @@ TEST_F(EngineExport, FittedModelsBecomeTheFallbackMaterial) {
   const auto j = nlohmann::json::parse(Read(dir_ / "web/f.manifest.json"));
   EXPECT_EQ(j["fallback_material"]["models"][0]["model"], "ggx");
   EXPECT_EQ(j["fallback_material"]["models"][0]["fit"]["rmse"], 0.01);
+}
+
+// `brdf fit` results (written here in its output form: NAME.MODEL.json with "model" and "fit")
+// become the fallback material; other materials' fits and other files are not picked up.
+TEST_F(EngineExport, FitResultsOfTheMaterialBecomeTheFallbackWithGltfValues) {
+  const fs::path fits = dir_ / "fits";
+  fs::create_directories(fits);
+  std::ofstream(fits / "f.unreal-defaultlit.json")
+      << R"({"name": "f", "model": "unreal-defaultlit", "base_color": [0.8, 0.5, 0.2],
+             "metallic": 0.25, "specular": 0.6, "roughness": 0.4, "fit": {"rmse": 0.03}})";
+  std::ofstream(fits / "f.unity-urp-lit.json")
+      << R"({"model": "unity-urp-lit", "base_map": [0.7, 0.4, 0.2], "metallic": 0.2,
+             "smoothness": 0.6, "fit": {"rmse": 0.05}})";
+  std::ofstream(fits / "g.ggx.json") << R"({"model": "ggx", "fit": {"rmse": 1}})";
+  std::ofstream(fits / "f.json") << R"({"model": "ggx"})";
+  std::ofstream(fits / "f.ggx.extra.json") << R"({"model": "ggx"})";
+  const std::vector<std::string> read = engines::ReadFitResults(fits.string(), "f");
+  ASSERT_EQ(read.size(), 2u);
+  exporter::TextureMetadata meta;
+  meta.name = "f";
+  fs::create_directories(dir_ / "out");
+  engines::ExportLutWithEngines((dir_ / "out").string(), Pattern({0, 20, 40, 60}), meta,
+                                {}, ParseEngines("unreal,web"), read);
+  const auto j = nlohmann::json::parse(Read(dir_ / "out/unreal/f.manifest.json"));
+  const auto& fallback = j["fallback_material"];
+  ASSERT_EQ(fallback["models"].size(), 2u);
+  EXPECT_EQ(fallback["models"][0]["model"], "unity-urp-lit");  // file-name order
+  EXPECT_EQ(fallback["models"][1]["fit"]["rmse"], 0.03);
+  // glTF 2.0 + KHR_materials_specular, checked by the extensions' own formulas: dielectric
+  // F0 = min(0.04 · specularColorFactor, 1) · specularFactor, F0 = mix(dielectric, baseColor,
+  // metallic); Unreal: F0 = lerp(0.08 · Specular, BaseColor, Metallic) (ShadingModels.ush).
+  const auto& g = fallback["gltf"]["material"];
+  const auto& pbr = g["pbrMetallicRoughness"];
+  const auto& spec = g["extensions"]["KHR_materials_specular"];
+  const double metallic = pbr["metallicFactor"];
+  EXPECT_DOUBLE_EQ(metallic, 0.25);
+  EXPECT_DOUBLE_EQ(pbr["roughnessFactor"].get<double>(), 0.4);
+  EXPECT_EQ(pbr["baseColorFactor"][3], 1.0);
+  const double base[3] = {0.8, 0.5, 0.2};
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_DOUBLE_EQ(pbr["baseColorFactor"][c].get<double>(), base[c]);
+    const double dielectric = std::min(0.04 * spec["specularColorFactor"][c].get<double>(), 1.0) *
+                              spec["specularFactor"].get<double>();
+    const double gltf_f0 = dielectric * (1 - metallic) + base[c] * metallic;
+    const double unreal_f0 = 0.08 * 0.6 * (1 - metallic) + base[c] * metallic;
+    EXPECT_NEAR(gltf_f0, unreal_f0, 1e-15) << c;
+  }
+  EXPECT_EQ(fallback["gltf"]["rmse"], 0.03);
+  EXPECT_EQ(Read(dir_ / "out/web/f.manifest.json"), Read(dir_ / "out/unreal/f.manifest.json"));
+
+  std::ofstream(fits / "f.ward.json") << R"({"model": "ward", "fit": 3})";
+  try {
+    engines::ReadFitResults(fits.string(), "f");
+    FAIL() << "accepted a fit without a fit report";
+  } catch (const FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find("f.ward.json"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("a number"), std::string::npos) << e.what();
+  }
 }
 
 TEST_F(EngineExport, LayoutsOtherThanTheReferenceGetTheirOwnShaderFiles) {

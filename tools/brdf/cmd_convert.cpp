@@ -97,6 +97,14 @@ int RunConvert(const ConvertOptions& options) {
   export_options.formats = exporter::ParseExportFormats(options.formats);
   export_options.exr = ParseExrOptions(options.exr_type, options.exr_compression);
   const engines::EngineSet engine_set = engines::ParseEngines(options.engines);
+  if (!options.engine_fits.empty()) {
+    if (!engine_set.Any())
+      throw InvalidArgument("--engine-fits: goes with --engine (the fits go into its manifests)");
+    std::error_code fits_ec;
+    if (!fs::is_directory(options.engine_fits, fits_ec))
+      throw IoError(options.engine_fits + ": not a folder (--engine-fits: the folder `brdf fit "
+                    "--out` wrote)");
+  }
   std::optional<processing::ExtrapolationParams> extrapolate;
   const bool auto_extrapolate = options.extrapolate == "auto";  // fitted per input (brdf fit)
   if (!options.extrapolate.empty() && !auto_extrapolate)
@@ -172,8 +180,11 @@ int RunConvert(const ConvertOptions& options) {
           outputs.push_back(std::move(p));
         const OutputGuard guard(std::move(outputs));
         try {
-          engines::ExportLutWithEngines(out_dir.string(), built.lut, metadata, export_options,
-                                        engine_set);
+          engines::ExportLutWithEngines(
+              out_dir.string(), built.lut, metadata, export_options, engine_set,
+              options.engine_fits.empty()
+                  ? std::vector<std::string>{}
+                  : engines::ReadFitResults(options.engine_fits, in.name));
         } catch (...) {
           // No partial set: remove what this conversion already renamed into place (the
           // writer that failed removed its own temporary file).

@@ -196,11 +196,18 @@ ordered_json ProbeJson(const Handoff& h) {
 ordered_json FallbackMaterialJson(const std::vector<std::string>& fitted_models_json) {
   if (fitted_models_json.empty()) return nullptr;
   ordered_json models = ordered_json::array();
-  for (const std::string& m : fitted_models_json) models.push_back(ordered_json::parse(m));
+  ordered_json gltf = nullptr;
+  for (const std::string& m : fitted_models_json) {
+    ordered_json model = ordered_json::parse(m);
+    if (gltf.is_null() && model.is_object() && model.value("model", "") == "unreal-defaultlit")
+      gltf = ordered_json::parse(GltfFromUnrealDefaultLit(m));
+    models.push_back(std::move(model));
+  }
   return ordered_json{{"note",
                        "analytic fits of the same data, for engines or LODs that cannot "
                        "sample the 3D LUT; see each model's \"fit\" member for its error"},
-                      {"models", std::move(models)}};
+                      {"models", std::move(models)},
+                      {"gltf", std::move(gltf)}};
 }
 
 // What one engine's folder holds and how it imports (a member of "engines" in the manifest).
@@ -729,10 +736,75 @@ std::vector<std::string> EngineOutputsToCheck(const std::string& out_dir,
   return paths;
 }
 
+std::vector<std::string> ReadFitResults(const std::string& fits_dir, const std::string& name) {
+  std::error_code ec;
+  if (!fs::is_directory(fits_dir, ec))
+    throw IoError(fits_dir + ": not a folder (expected the folder `brdf fit --out` wrote)");
+  std::vector<std::string> files;
+  const std::string prefix = name + ".";
+  for (fs::directory_iterator it(fits_dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string f = it->path().filename().string();
+    if (f.size() > prefix.size() + 5 && f.starts_with(prefix) && f.ends_with(".json") &&
+        f.find('.', prefix.size()) == f.size() - 5)
+      files.push_back(it->path().string());
+  }
+  std::sort(files.begin(), files.end());
+  std::vector<std::string> fits;
+  for (const std::string& path : files) {
+    const std::string text = ReadFileText(path, 16u << 20);
+    const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
+    if (j.is_discarded() || !j.is_object())
+      throw FormatError(path, "the whole file", "a `brdf fit` result (a JSON object)", "not valid JSON");
+    const auto kind = [&](const char* key) {
+      return j.contains(key) ? std::string("a ") + j[key].type_name() : std::string("none");
+    };
+    if (!j.contains("model") || !j["model"].is_string())
+      throw FormatError(path, "member \"model\"", "the fitted model's name", kind("model"));
+    if (!j.contains("fit") || !j["fit"].is_object())
+      throw FormatError(path, "member \"fit\"", "the fit report of `brdf fit`", kind("fit"));
+    fits.push_back(j.dump());
+  }
+  return fits;
+}
+
+std::string GltfFromUnrealDefaultLit(const std::string& fit_json) {
+  const nlohmann::json j = nlohmann::json::parse(fit_json, nullptr, false);
+  if (j.is_discarded() || !j.is_object() || j.value("model", "") != "unreal-defaultlit")
+    throw InvalidArgument("glTF values: expected an unreal-defaultlit fit");
+  const auto number = [&](const char* key) {
+    if (!j.contains(key) || !j[key].is_number())
+      throw InvalidArgument(std::string("glTF values: the unreal-defaultlit fit has no ") + key);
+    return j[key].get<double>();
+  };
+  if (!j.contains("base_color") || !j["base_color"].is_array() || j["base_color"].size() != 3)
+    throw InvalidArgument("glTF values: the unreal-defaultlit fit has no base_color");
+  const std::vector<double> base = j["base_color"].get<std::vector<double>>();
+  const double metallic = number("metallic"), specular = number("specular"),
+               roughness = number("roughness");
+  const double grey = 2.0 * specular;
+  ordered_json out = {
+      {"note",
+       "glTF 2.0 values from the unreal-defaultlit fit: same base colour, metallic, roughness "
+       "(alpha = roughness^2) and dielectric F0 = 0.08 * Specular = 0.04 * specularColorFactor; "
+       "glTF's BRDF differs in its Fresnel-weighted diffuse and Smith term"},
+      {"from", "unreal-defaultlit"},
+      {"rmse", j.contains("fit") && j["fit"].is_object() ? j["fit"].value("rmse", -1.0) : -1.0},
+      {"material",
+       {{"pbrMetallicRoughness",
+         {{"baseColorFactor", {base[0], base[1], base[2], 1.0}},
+          {"metallicFactor", metallic},
+          {"roughnessFactor", roughness}}},
+        {"extensions",
+         {{"KHR_materials_specular",
+           {{"specularFactor", 1.0}, {"specularColorFactor", {grey, grey, grey}}}}}}}}};
+  return out.dump();
+}
+
 EngineExportResult ExportLutWithEngines(const std::string& out_dir, const Lut& lut,
                                         exporter::TextureMetadata metadata,
                                         const exporter::LutExportOptions& options,
-                                        const EngineSet& engines) {
+                                        const EngineSet& engines,
+                                        const std::vector<std::string>& fits_json) {
   EngineExportResult result;
   const exporter::PackedVolume packed = exporter::PackLut(lut);
   result.lut = exporter::ExportLut(out_dir, lut, packed, metadata, options);
@@ -746,6 +818,7 @@ EngineExportResult ExportLutWithEngines(const std::string& out_dir, const Lut& l
   h.cells = {{metadata.name, 0, 0}};
   h.composite = exporter::SquareishGrid(lut.slices());
   h.fitted_models_json = metadata.fitted_models_json;
+  h.fitted_models_json.insert(h.fitted_models_json.end(), fits_json.begin(), fits_json.end());
   const fs::path dir(out_dir);
   const auto main_file = [&](bool written, const char* ext) {
     return written ? (dir / (metadata.name + ext)).string() : std::string();
