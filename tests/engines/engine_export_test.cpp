@@ -273,6 +273,19 @@ TEST_F(EngineExport, ManifestProbesAreTheTexturesOwnTexels) {
       EXPECT_DOUBLE_EQ(p["uvw"][0].get<double>(), (x + 0.5) / 361);
       EXPECT_DOUBLE_EQ(p["theta_in_deg"].get<double>(), 20.0 * z);
     }
+    // Each slice's probes include its peak: the texel of largest Rec.709 luminance.
+    const auto luminance = [](const std::array<double, 3>& c) {
+      return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2];
+    };
+    for (int z = 0; z < 4; ++z) {
+      double peak = 0, probed = 0;
+      for (std::size_t t = 0; t < 361u * 181u; ++t)
+        peak = std::max(peak, luminance(Decode(U32(ktx2, level + 4 * (z * 361u * 181u + t)))));
+      for (const auto& p : j["probe_texels"])
+        if (p["index"][2] == z)
+          probed = std::max(probed, luminance({p["rgb"][0], p["rgb"][1], p["rgb"][2]}));
+      EXPECT_NEAR(probed, peak, 1e-12 * peak) << "slice " << z;
+    }
   }
 }
 

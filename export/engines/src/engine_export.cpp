@@ -154,20 +154,22 @@ ordered_json ProbeJson(const Handoff& h) {
         ij.push_back({360, 180});
         ij.push_back({45, 10});
       }
-      // The brightest texel of the slice (first one on ties): the peak of the lobe. Decoded
-      // inline (c = c_s · 2^(e − 24), the scale built as a float's bits): the same exact values
-      // as exporter::DecodeRgb9e5, without a call per texel of the slice.
+      // The brightest texel of the slice (first one on ties): the peak of the lobe. Luminance
+      // (Rec.709 weights 0.2126, 0.7152, 0.0722) compared exactly in integers: a texel's is
+      // (2126 r_s + 7152 g_s + 722 b_s) · 2^e / 10^4 · 2^−24 with 9-bit mantissas, so the key
+      // (2126 r_s + 7152 g_s + 722 b_s) << e (< 2^54) orders texels as their luminance does,
+      // without decoding each texel of the slice.
       int best_i = 0, best_j = 0;
-      float best = -1;
+      std::uint64_t best = 0;
+      bool any = false;
       for (int j = 0; j < 181; ++j) {
         const std::uint32_t* row = &vol.words[vol.Index(cell.x0, cell.y0 + j, k)];
         for (int i = 0; i < 361; ++i) {
           const std::uint32_t w = row[i];
-          const float scale = std::bit_cast<float>(((w >> 27) + 103u) << 23);
-          const float y = 0.2126f * (static_cast<float>(w & 511u) * scale) +
-                          0.7152f * (static_cast<float>((w >> 9) & 511u) * scale) +
-                          0.0722f * (static_cast<float>((w >> 18) & 511u) * scale);
-          if (y > best) best = y, best_i = i, best_j = j;
+          const std::uint64_t key = std::uint64_t{2126u * (w & 511u) + 7152u * ((w >> 9) & 511u) +
+                                                  722u * ((w >> 18) & 511u)}
+                                    << (w >> 27);
+          if (key > best || !any) best = key, best_i = i, best_j = j, any = true;
         }
       }
       ij.push_back({best_i, best_j});
