@@ -7,6 +7,10 @@
 #
 #   bench/e2e/engines_overhead.sh [BUILD_DIR [REPETITIONS [JOBS [OTHER_BRDF]]]]
 #
+# BRDF_BENCH_OUT (optional) is the folder the outputs go to (default BUILD_DIR/bench-e2e), e.g.
+# a tmpfs (/dev/shm/...) to time the work without the disk, whose contention on a shared
+# machine dominates the wall times.
+#
 # OTHER_BRDF (optional): another build of the brdf tool (e.g. before a change) whose
 # `--engine all` runs are interleaved with the others as a third configuration, "other".
 #
@@ -36,7 +40,7 @@ declare -A walls cpus
 load_start=$(cut -d' ' -f1-3 /proc/loadavg)
 for ((r = 1; r <= reps; ++r)); do
   for config in "${configs[@]}"; do
-    out=$work/eng_$config
+    out=${BRDF_BENCH_OUT:-$work}/eng_$config
     rm -rf "$out"
     sync
     extra=()
