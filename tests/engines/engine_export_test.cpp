@@ -11,11 +11,11 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <limits>
-#include <random>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <random>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -170,8 +170,8 @@ TEST_F(EngineExport, FloatToHalfEqualsNumpyIncludingTiesAndSubnormals) {
   std::vector<float> values;
   const auto half_value = [](std::uint32_t h) {  // decoded from the bit pattern (IEEE 754)
     const std::uint32_t exp = (h >> 10) & 31, frac = h & 1023;
-    const double mag = exp == 0 ? std::ldexp(double(frac), -24)
-                                : std::ldexp(1.0 + frac / 1024.0, int(exp) - 15);
+    const double mag =
+        exp == 0 ? std::ldexp(double(frac), -24) : std::ldexp(1.0 + frac / 1024.0, int(exp) - 15);
     return (h & 0x8000) ? -mag : mag;
   };
   for (std::uint32_t h = 0; h < 0x7c00; ++h) {
@@ -185,10 +185,11 @@ TEST_F(EngineExport, FloatToHalfEqualsNumpyIncludingTiesAndSubnormals) {
       values.push_back(std::nextafter(tie, tie * 2));
     }
   }
-  for (float v : {65504.0f, 65519.0f, 65520.0f, 1e6f, std::ldexp(1.0f, -25), std::ldexp(1.0f, -26),
-                  std::ldexp(1.5f, -25), std::ldexp(1.0f, -40), 0.0f, -0.0f,
-                  std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
-                  std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::denorm_min()})
+  for (float v :
+       {65504.0f, 65519.0f, 65520.0f, 1e6f, std::ldexp(1.0f, -25), std::ldexp(1.0f, -26),
+        std::ldexp(1.5f, -25), std::ldexp(1.0f, -40), 0.0f, -0.0f,
+        std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
+        std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::denorm_min()})
     values.push_back(v);
   std::mt19937 rng(11);
   std::uniform_int_distribution<int> exponent(-30, 17);
@@ -320,8 +321,8 @@ TEST_F(EngineExport, FitResultsOfTheMaterialBecomeTheFallbackWithGltfValues) {
   exporter::TextureMetadata meta;
   meta.name = "f";
   fs::create_directories(dir_ / "out");
-  engines::ExportLutWithEngines((dir_ / "out").string(), Pattern({0, 20, 40, 60}), meta,
-                                {}, ParseEngines("unreal,web"), read);
+  engines::ExportLutWithEngines((dir_ / "out").string(), Pattern({0, 20, 40, 60}), meta, {},
+                                ParseEngines("unreal,web"), read);
   const auto j = nlohmann::json::parse(Read(dir_ / "out/unreal/f.manifest.json"));
   const auto& fallback = j["fallback_material"];
   ASSERT_EQ(fallback["models"].size(), 2u);
@@ -373,6 +374,26 @@ TEST_F(EngineExport, LayoutsOtherThanTheReferenceGetTheirOwnShaderFiles) {
   EXPECT_NE(other.find("MEASURED_BRDF_THETA_IN0_DEG = 10.0;"), std::string::npos);
   const auto j = nlohmann::json::parse(Read(dir_ / "unity/b.manifest.json"));
   EXPECT_EQ(j["engines"]["unity"]["files"]["shader"], "MeasuredBrdf_3x15from10.hlsl");
+}
+
+// One web folder, two layouts: the viewer imports the module each material's manifest names
+// (web_browser renders through it), so the second layout leaves index.html as it was.
+TEST_F(EngineExport, OneViewerServesEveryLayoutOfTheWebFolder) {
+  exporter::TextureMetadata a, b;
+  a.name = "a";
+  b.name = "b";
+  engines::ExportLutWithEngines(dir_.string(), Pattern({0, 20, 40, 60}), a, {},
+                                ParseEngines("web"));
+  const std::string viewer = Read(dir_ / "web/index.html");
+  engines::ExportLutWithEngines(dir_.string(), Pattern({10, 25, 40}), b, {}, ParseEngines("web"));
+  EXPECT_EQ(Read(dir_ / "web/index.html"), viewer);
+  EXPECT_EQ(viewer.find("measured_brdf"), std::string::npos) << "the viewer names a module";
+  EXPECT_NE(viewer.find("manifest.engines.web.files.shader"), std::string::npos);
+  for (const char* m : {"a", "b"}) {
+    const auto j = nlohmann::json::parse(Read(dir_ / "web" / (std::string(m) + ".manifest.json")));
+    const std::string module = j["engines"]["web"]["files"]["shader"];
+    EXPECT_TRUE(fs::is_regular_file(dir_ / "web" / module)) << module;
+  }
 }
 
 TEST_F(EngineExport, AtlasFoldersAddressEachMaterialsCell) {

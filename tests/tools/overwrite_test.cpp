@@ -132,8 +132,8 @@ TEST_F(Overwrite, EngineSharedFilesAreReplacedOnlyWhenTheToolWroteThem) {
   const fs::path out = dir_ / "luts";
   const std::string wood =
       Quote(std::string(BRDF_SOURCE_DIR) + "/data-samples/materials/wood_oak.json");
-  const ToolRun gold = Run("convert " + Quote(kGoldCapture) + " --quiet --engine all --out " +
-                           Quote(out));
+  const ToolRun gold =
+      Run("convert " + Quote(kGoldCapture) + " --quiet --engine all --out " + Quote(out));
   ASSERT_EQ(gold.exit_code, 0) << gold.err;
   const ToolRun oak = Run("convert " + wood + " --quiet --engine all --out " + Quote(out));
   EXPECT_EQ(oak.exit_code, 0) << "a managed shared file was refused: " << oak.err;

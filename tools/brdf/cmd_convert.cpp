@@ -102,7 +102,8 @@ int RunConvert(const ConvertOptions& options) {
       throw InvalidArgument("--engine-fits: goes with --engine (the fits go into its manifests)");
     std::error_code fits_ec;
     if (!fs::is_directory(options.engine_fits, fits_ec))
-      throw IoError(options.engine_fits + ": not a folder (--engine-fits: the folder `brdf fit "
+      throw IoError(options.engine_fits +
+                    ": not a folder (--engine-fits: the folder `brdf fit "
                     "--out` wrote)");
   }
   std::optional<processing::ExtrapolationParams> extrapolate;
@@ -182,9 +183,8 @@ int RunConvert(const ConvertOptions& options) {
         try {
           engines::ExportLutWithEngines(
               out_dir.string(), built.lut, metadata, export_options, engine_set,
-              options.engine_fits.empty()
-                  ? std::vector<std::string>{}
-                  : engines::ReadFitResults(options.engine_fits, in.name));
+              options.engine_fits.empty() ? std::vector<std::string>{}
+                                          : engines::ReadFitResults(options.engine_fits, in.name));
         } catch (...) {
           // No partial set: remove what this conversion already renamed into place (the
           // writer that failed removed its own temporary file).

@@ -452,7 +452,7 @@ std::vector<std::string> StageEngineFolder(Engine e, const fs::path& dir, const 
     case Engine::kUnreal:
       tiles(f.tiles);
       staged.WriteWith(path_of(f.texture),
-                   [&](StagedFiles::Writer& w) { WriteRgba16fDds(w, *h.volume); });
+                       [&](StagedFiles::Writer& w) { WriteRgba16fDds(w, *h.volume); });
       shared(shader, [&] { return detail::UnrealUsh(h.layout); });
       shared("import_measured_brdf.py", [] { return detail::UnrealImportPython(); });
       break;
@@ -471,9 +471,8 @@ std::vector<std::string> StageEngineFolder(Engine e, const fs::path& dir, const 
       shared(detail::ShaderStem(h.layout) + ".es300.glsl", [&] {
         return exporter::MeasuredBrdfGlslFile(exporter::GlslVersion::kEs300, h.layout);
       });
-      shared(detail::ShaderStem(h.layout) + ".450.glsl", [&] {
-        return exporter::MeasuredBrdfGlslFile(exporter::GlslVersion::k450, h.layout);
-      });
+      shared(detail::ShaderStem(h.layout) + ".450.glsl",
+             [&] { return exporter::MeasuredBrdfGlslFile(exporter::GlslVersion::k450, h.layout); });
       break;
   }
   // The manifest: written into the first folder, hard-linked (from its temporary name) into
@@ -494,7 +493,8 @@ std::vector<std::string> WriteHandoff(const fs::path& base, const Handoff& h, co
   std::string manifest_temp;
   std::vector<std::string> shared;
   for (Engine e : selected) {
-    const auto w = StageEngineFolder(e, base / FolderOf(e), h, src, staged, manifest_temp, manifest);
+    const auto w =
+        StageEngineFolder(e, base / FolderOf(e), h, src, staged, manifest_temp, manifest);
     shared.insert(shared.end(), w.begin(), w.end());
   }
   staged.Commit();
@@ -601,10 +601,9 @@ constexpr auto kHalfOfChannel = [] {
 // One texel: R, G, B halves and alpha 1.0 (0x3c00), little-endian, 8 bytes at `out`.
 inline void PutRgba16fTexel(std::uint32_t word, char* out) {
   const std::uint16_t* row = &kHalfOfChannel[(word >> 27) * 512];
-  const std::uint64_t texel = std::uint64_t{row[word & 511u]} |
-                              (std::uint64_t{row[(word >> 9) & 511u]} << 16) |
-                              (std::uint64_t{row[(word >> 18) & 511u]} << 32) |
-                              (std::uint64_t{0x3c00} << 48);
+  const std::uint64_t texel =
+      std::uint64_t{row[word & 511u]} | (std::uint64_t{row[(word >> 9) & 511u]} << 16) |
+      (std::uint64_t{row[(word >> 18) & 511u]} << 32) | (std::uint64_t{0x3c00} << 48);
   if constexpr (std::endian::native == std::endian::little) {
     std::memcpy(out, &texel, 8);
   } else {
@@ -693,8 +692,8 @@ std::vector<std::string> SharedFileCandidates(Engine e, const fs::path& dir) {
       break;
     case Engine::kWeb:
       fixed = {"index.html", "package.json"};
-      shaders = {{"measured_brdf", ".js"}, {"MeasuredBrdf", ".es300.glsl"},
-                 {"MeasuredBrdf", ".450.glsl"}};
+      shaders = {
+          {"measured_brdf", ".js"}, {"MeasuredBrdf", ".es300.glsl"}, {"MeasuredBrdf", ".450.glsl"}};
       break;
   }
   std::vector<std::string> out;
@@ -756,7 +755,8 @@ std::vector<std::string> ReadFitResults(const std::string& fits_dir, const std::
     const std::string text = ReadFileText(path, 16u << 20);
     const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
     if (j.is_discarded() || !j.is_object())
-      throw FormatError(path, "the whole file", "a `brdf fit` result (a JSON object)", "not valid JSON");
+      throw FormatError(path, "the whole file", "a `brdf fit` result (a JSON object)",
+                        "text that is not a JSON object");
     const auto kind = [&](const char* key) {
       return j.contains(key) ? std::string("a ") + j[key].type_name() : std::string("none");
     };

@@ -91,8 +91,8 @@ void StagedFiles::Commit() {
   std::vector<std::string> folders;
   for (Entry& e : entries_) {
     if (std::rename(e.temp->temp_path().c_str(), e.temp->final_path().c_str()) != 0)
-      throw IoError(e.temp->final_path() + ": cannot rename temporary file " +
-                    e.temp->temp_path() + " into place: " + ErrnoText());
+      throw IoError(e.temp->final_path() + ": cannot rename temporary file " + e.temp->temp_path() +
+                    " into place: " + ErrnoText());
     const std::string folder = FolderOf(e.temp->final_path());
     if (std::find(folders.begin(), folders.end(), folder) == folders.end())
       folders.push_back(folder);
