@@ -5,7 +5,14 @@
 # (user + system) time from /usr/bin/time -v. Alternating keeps both configurations under the
 # same machine load.
 #
-#   bench/e2e/engines_overhead.sh [BUILD_DIR [REPETITIONS [JOBS]]]
+#   bench/e2e/engines_overhead.sh [BUILD_DIR [REPETITIONS [JOBS [OTHER_BRDF]]]]
+#
+# BRDF_BENCH_OUT (optional) is the folder the outputs go to (default BUILD_DIR/bench-e2e), e.g.
+# a tmpfs (/dev/shm/...) to time the work without the disk, whose contention on a shared
+# machine dominates the wall times.
+#
+# OTHER_BRDF (optional): another build of the brdf tool (e.g. before a change) whose
+# `--engine all` runs are interleaved with the others as a third configuration, "other".
 #
 # Uses the captures bench/e2e/convert_batch.sh makes and caches in BUILD_DIR/bench-e2e/captures
 # (run it once first).
@@ -13,7 +20,10 @@ set -euo pipefail
 build=${1:-build}
 reps=${2:-3}
 jobs=${3:-2}
+other=${4:-}
 brdf=$build/tools/brdf
+configs=(base engines)
+[[ -n $other ]] && configs+=(other)
 work=$build/bench-e2e
 caps=$work/captures
 [[ -x $brdf ]] || { echo "missing $brdf: build the target brdf" >&2; exit 2; }
@@ -29,13 +39,15 @@ cpu_seconds() { awk -F': ' '/User time|System time/ {s += $2} END {print s}' "$1
 declare -A walls cpus
 load_start=$(cut -d' ' -f1-3 /proc/loadavg)
 for ((r = 1; r <= reps; ++r)); do
-  for config in base engines; do
-    out=$work/eng_$config
+  for config in "${configs[@]}"; do
+    out=${BRDF_BENCH_OUT:-$work}/eng_$config
     rm -rf "$out"
     sync
     extra=()
-    [[ $config == engines ]] && extra=(--engine all)
-    /usr/bin/time -v -o "$work/eng_time.txt" "$brdf" convert "$caps" --out "$out" --jobs "$jobs" \
+    exe=$brdf
+    [[ $config != base ]] && extra=(--engine all)
+    [[ $config == other ]] && exe=$other
+    /usr/bin/time -v -o "$work/eng_time.txt" "$exe" convert "$caps" --out "$out" --jobs "$jobs" \
       --quiet "${extra[@]}" > "$work/eng_convert.log"
     walls[$config]+="$(wall_seconds "$work/eng_time.txt") "
     cpus[$config]+="$(cpu_seconds "$work/eng_time.txt") "
@@ -46,7 +58,7 @@ for ((r = 1; r <= reps; ++r)); do
   done
 done
 load_end=$(cut -d' ' -f1-3 /proc/loadavg)
-for config in base engines; do
+for config in "${configs[@]}"; do
   w=$(tr ' ' '\n' <<< "${walls[$config]}" | grep . | median)
   wmin=$(tr ' ' '\n' <<< "${walls[$config]}" | grep . | sort -g | head -1)
   c=$(tr ' ' '\n' <<< "${cpus[$config]}" | grep . | median)
@@ -56,4 +68,8 @@ done
 # On a shared machine the minimum wall time is the least disturbed run; CPU time is load-proof.
 awk -v wb="$w_base" -v we="$w_engines" -v mb="$m_base" -v me="$m_engines" -v cb="$c_base" -v ce="$c_engines" \
   'BEGIN {printf "--engine all adds %.1f %% wall (median), %.1f %% wall (minimum), %.1f %% cpu (median)\n", (we / wb - 1) * 100, (me / mb - 1) * 100, (ce / cb - 1) * 100}'
+if [[ -n $other ]]; then
+  awk -v wb="$w_base" -v we="$w_other" -v mb="$m_base" -v me="$m_other" -v cb="$c_base" -v ce="$c_other" \
+    'BEGIN {printf "other --engine all adds %.1f %% wall (median), %.1f %% wall (minimum), %.1f %% cpu (median)\n", (we / wb - 1) * 100, (me / mb - 1) * 100, (ce / cb - 1) * 100}'
+fi
 echo "load average: start $load_start, end $load_end"

@@ -10,6 +10,7 @@
   - The Unreal editor script byte-compiled (py_compile) and run against a stub `unreal`
     module: both import routes ask for sRGB off, TC_HDR, no mips, clamp, tiles 361 × 181.
   - The Godot .import file: importer 3d_texture, 2 × 2 slices, no mipmaps.
+  - `brdf fit` output passed with --engine-fits is the manifest's fallback material, as written.
 Usage: engine_handoff_checks.py BRDF_TOOL SOURCE_DIR MCS MONO   (Debian /usr/bin/python3)
 """
 import configparser
@@ -185,6 +186,23 @@ def check_godot(out, name):
     print("godot: .import = 3d_texture, 2 x 2 slices, no mipmaps; sliced EXR 722 x 362 (OpenImageIO)")
 
 
+def check_fits(tool, mat, work):
+    """`brdf fit` results given with --engine-fits land in the manifest as written by brdf fit."""
+    fits = os.path.join(work, "fits")
+    os.makedirs(fits)
+    fit_file = os.path.join(fits, "gold_like.lambert.json")  # the name `--out FITS` would give
+    run([tool, "fit", mat, "--model", "lambert", "--out", fit_file, "--quiet"])
+    fit = json.load(open(fit_file))
+    out = os.path.join(work, "out_fits")
+    run([tool, "convert", mat, "--out", out, "--engine", "web", "--engine-fits", fits, "--quiet",
+         "--formats", "ktx2"])
+    fallback = json.load(open(os.path.join(out, "web", "gold_like.manifest.json")))["fallback_material"]
+    models = fallback["models"] if fallback else []
+    expect(len(models) == 1 and models[0] == fit, f"--engine-fits: fallback models {models!r:.300}")
+    expect(fallback is not None and fallback["gltf"] is None, "--engine-fits: glTF values without an unreal-defaultlit fit")
+    print(f"--engine-fits: the brdf fit result (lambert, rmse {fit['fit']['rmse']:.4g}) is the manifest's fallback material as written")
+
+
 def main():
     tool, source, mcs, mono = sys.argv[1:5]
     work = tempfile.mkdtemp(prefix="brdf_engine_checks_")
@@ -199,6 +217,7 @@ def main():
            "brdf: error: unknown engine 'unrael' (known: unity, unreal, godot, web, all)"
            and not os.path.exists(os.path.join(work, "bad")),
            f"--engine unrael: exit {bad.returncode}, stderr {bad.stderr!r}")
+    check_fits(tool, mat, work)
     words, want = check_dds(out, "gold_like")
     check_unity(out, "gold_like", mcs, mono, work, words, want)
     check_unreal(out, work)

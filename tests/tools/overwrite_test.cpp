@@ -113,6 +113,100 @@ TEST_F(Overwrite, AnOutputThatIsAFolderIsRefusedEvenWithForce) {
   EXPECT_FALSE(fs::exists(dir_ / "luts" / "gold.dds")) << "nothing may be written";
 }
 
+// `--engine` outputs follow the same rule (issue 7): a run whose regular outputs are all new but
+// whose engine files exist is refused before it writes anything, with one line naming the engine
+// file and --force; --force rewrites it. The expected state is the first run's files.
+TEST_F(Overwrite, ConvertRefusesExistingEngineOutputsWithoutForce) {
+  const fs::path out = dir_ / "luts";
+  const ToolRun first = Run("convert " + Quote(kGoldCapture) +
+                            " --quiet --formats ktx2 --engine unreal --out " + Quote(out));
+  ASSERT_EQ(first.exit_code, 0) << first.err;
+  const fs::path dds = out / "unreal" / "gold.dds";
+  const std::string before = ReadAll(dds);
+  fs::last_write_time(dds, fs::file_time_type::clock::now() - std::chrono::hours(1));
+  const auto stamp = fs::last_write_time(dds);
+
+  // gold.json does not exist yet: only the engine files stand in the way.
+  const std::string second_args = "convert " + Quote(kGoldCapture) +
+                                  " --quiet --formats json --engine unreal --out " + Quote(out);
+  const ToolRun second = Run(second_args);
+  EXPECT_EQ(second.exit_code, 1) << second.err;
+  const std::vector<std::string> lines = second.ErrLines();
+  ASSERT_EQ(lines.size(), 1u) << second.err;
+  EXPECT_NE(lines[0].find((fs::path("unreal") / "gold.dds").string() + ": already exists"),
+            std::string::npos)
+      << lines[0];
+  EXPECT_NE(lines[0].find("--force"), std::string::npos) << lines[0];
+  EXPECT_FALSE(fs::exists(out / "gold.json")) << "the refused run wrote a regular output";
+  EXPECT_EQ(ReadAll(dds), before);
+  EXPECT_EQ(fs::last_write_time(dds), stamp) << "the refused run touched " << dds;
+
+  const ToolRun forced = Run(second_args + " --force");
+  EXPECT_EQ(forced.exit_code, 0) << forced.err;
+  EXPECT_NE(fs::last_write_time(dds), stamp) << "--force did not rewrite " << dds;
+  EXPECT_TRUE(fs::exists(out / "gold.json"));
+}
+
+// The files every material of a folder shares (viewer, shaders, importer) are the tool's own
+// when it wrote them: a second material converted into the same folder later needs no --force.
+// A file of that name the tool did not write is the user's and is refused like any output.
+TEST_F(Overwrite, EngineSharedFilesAreReplacedOnlyWhenTheToolWroteThem) {
+  const fs::path out = dir_ / "luts";
+  const std::string wood =
+      Quote(std::string(BRDF_SOURCE_DIR) + "/data-samples/materials/wood_oak.json");
+  const ToolRun gold =
+      Run("convert " + Quote(kGoldCapture) + " --quiet --engine all --out " + Quote(out));
+  ASSERT_EQ(gold.exit_code, 0) << gold.err;
+  const ToolRun oak = Run("convert " + wood + " --quiet --engine all --out " + Quote(out));
+  EXPECT_EQ(oak.exit_code, 0) << "a managed shared file was refused: " << oak.err;
+  EXPECT_TRUE(fs::exists(out / "web" / "wood_oak.manifest.json"));
+
+  const fs::path mine = dir_ / "mine";
+  fs::create_directories(mine / "web");
+  WriteText(mine / "web" / "index.html", "<p>my own page</p>\n");
+  const std::string args =
+      "convert " + Quote(kGoldCapture) + " --quiet --engine web --out " + Quote(mine);
+  const ToolRun refused = Run(args);
+  EXPECT_EQ(refused.exit_code, 1) << refused.err;
+  const std::vector<std::string> lines = refused.ErrLines();
+  ASSERT_EQ(lines.size(), 1u) << refused.err;
+  EXPECT_NE(lines[0].find((fs::path("web") / "index.html").string() + ": already exists"),
+            std::string::npos)
+      << lines[0];
+  EXPECT_NE(lines[0].find("--force"), std::string::npos) << lines[0];
+  EXPECT_EQ(ReadAll(mine / "web" / "index.html"), "<p>my own page</p>\n");
+  EXPECT_FALSE(fs::exists(mine / "gold.ktx2")) << "the refused run wrote a regular output";
+  EXPECT_FALSE(fs::exists(mine / "web" / "gold.ktx2")) << "the refused run wrote an engine file";
+
+  const ToolRun forced = Run(args + " --force");
+  EXPECT_EQ(forced.exit_code, 0) << forced.err;
+  EXPECT_NE(ReadAll(mine / "web" / "index.html").find("<!DOCTYPE html>"), std::string::npos);
+}
+
+TEST_F(Overwrite, AtlasRefusesExistingEngineOutputsWithoutForce) {
+  const std::string args =
+      "atlas " + Quote(kGoldCapture) + " --quiet --engine godot --out " + Quote(dir_ / "lib");
+  const ToolRun first = Run(args);
+  ASSERT_EQ(first.exit_code, 0) << first.err;
+  for (const char* ext : {".ktx2", ".dds", ".exr", ".json"})
+    fs::remove(dir_ / (std::string("lib") + ext));  // only the engine files remain
+  const fs::path dds = dir_ / "godot" / "lib.dds";
+  fs::last_write_time(dds, fs::file_time_type::clock::now() - std::chrono::hours(1));
+  const auto stamp = fs::last_write_time(dds);
+  const ToolRun second = Run(args);
+  EXPECT_EQ(second.exit_code, 1) << second.err;
+  const std::vector<std::string> lines = second.ErrLines();
+  ASSERT_EQ(lines.size(), 1u) << second.err;
+  EXPECT_NE(lines[0].find((fs::path("godot") / "lib.dds").string() + ": already exists"),
+            std::string::npos)
+      << lines[0];
+  EXPECT_FALSE(fs::exists(dir_ / "lib.ktx2")) << "the refused atlas wrote its texture";
+  EXPECT_EQ(fs::last_write_time(dds), stamp);
+  const ToolRun forced = Run(args + " --force");
+  EXPECT_EQ(forced.exit_code, 0) << forced.err;
+  EXPECT_NE(fs::last_write_time(dds), stamp);
+}
+
 // A run killed before renaming its outputs leaves ".brdf-<pid>-<n>.tmp" files; the next run into
 // that folder removes them and says so in one note.
 TEST_F(Overwrite, ConvertRemovesAndReportsTemporariesOfAKilledRun) {

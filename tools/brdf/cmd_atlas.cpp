@@ -47,13 +47,12 @@ int RunAtlas(const AtlasOptions& options) {
 
   std::vector<std::string> outputs = {options.out + ".ktx2", options.out + ".dds",
                                       options.out + ".exr", options.out + ".json"};
-  {
-    const fs::path prefix(options.out);
-    for (std::string& p : engines::EngineOutputPaths(
-             prefix.has_parent_path() ? prefix.parent_path().string() : std::string("."),
-             prefix.filename().string(), engine_set))
-      outputs.push_back(std::move(p));
-  }
+  const fs::path prefix(options.out);
+  const std::string engine_dir =
+      prefix.has_parent_path() ? prefix.parent_path().string() : std::string(".");
+  for (std::string& p :
+       engines::EngineOutputPaths(engine_dir, prefix.filename().string(), engine_set))
+    outputs.push_back(std::move(p));
   {
     std::set<std::string> inputs;
     std::error_code ec;
@@ -64,7 +63,14 @@ int RunAtlas(const AtlasOptions& options) {
         throw InvalidArgument("--out " + options.out + ": the atlas file " + out +
                               " would overwrite an input; choose another prefix");
   }
-  ReportRemovedTemporaries(CheckWritableOutputs(outputs, options.force));
+  {
+    // The overwrite rule covers the engine folders' shared files too (not the guard's list:
+    // a failed atlas removes only what it created).
+    std::vector<std::string> checked = outputs;
+    for (std::string& p : engines::EngineOutputsToCheck(engine_dir, {}, engine_set))
+      checked.push_back(std::move(p));
+    ReportRemovedTemporaries(CheckWritableOutputs(checked, options.force));
+  }
   std::vector<BatchFailure> failures = found.failures;
   for (const BatchFailure& f : failures)
     std::fprintf(stderr, "%s: FAILED: %s\n", f.path.c_str(), f.reason.c_str());

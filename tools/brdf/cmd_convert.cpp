@@ -97,6 +97,15 @@ int RunConvert(const ConvertOptions& options) {
   export_options.formats = exporter::ParseExportFormats(options.formats);
   export_options.exr = ParseExrOptions(options.exr_type, options.exr_compression);
   const engines::EngineSet engine_set = engines::ParseEngines(options.engines);
+  if (!options.engine_fits.empty()) {
+    if (!engine_set.Any())
+      throw InvalidArgument("--engine-fits: goes with --engine (the fits go into its manifests)");
+    std::error_code fits_ec;
+    if (!fs::is_directory(options.engine_fits, fits_ec))
+      throw IoError(options.engine_fits +
+                    ": not a folder (--engine-fits: the folder `brdf fit "
+                    "--out` wrote)");
+  }
   std::optional<processing::ExtrapolationParams> extrapolate;
   const bool auto_extrapolate = options.extrapolate == "auto";  // fitted per input (brdf fit)
   if (!options.extrapolate.empty() && !auto_extrapolate)
@@ -118,10 +127,14 @@ int RunConvert(const ConvertOptions& options) {
   RefuseCollisions(out_dir, export_options.formats, found.inputs, found.failures);
   {
     // The overwrite rule, for every output of the run before any work is done.
-    std::vector<std::string> outputs;
-    for (const BatchInput& in : found.inputs)
+    std::vector<std::string> outputs, names;
+    for (const BatchInput& in : found.inputs) {
       for (std::string& p : OutputPaths(out_dir, in.name, export_options.formats))
         outputs.push_back(std::move(p));
+      names.push_back(in.name);
+    }
+    for (std::string& p : engines::EngineOutputsToCheck(out_dir.string(), names, engine_set))
+      outputs.push_back(std::move(p));
     ReportRemovedTemporaries(CheckWritableOutputs(outputs, options.force));
   }
 
@@ -167,8 +180,10 @@ int RunConvert(const ConvertOptions& options) {
           outputs.push_back(std::move(p));
         const OutputGuard guard(std::move(outputs));
         try {
-          engines::ExportLutWithEngines(out_dir.string(), built.lut, metadata, export_options,
-                                        engine_set);
+          engines::ExportLutWithEngines(
+              out_dir.string(), built.lut, metadata, export_options, engine_set,
+              options.engine_fits.empty() ? std::vector<std::string>{}
+                                          : engines::ReadFitResults(options.engine_fits, in.name));
         } catch (...) {
           // No partial set: remove what this conversion already renamed into place (the
           // writer that failed removed its own temporary file).

@@ -52,6 +52,8 @@ struct ConvertOptions {
   // Engine hand-off folders OUT/<engine>/: "unity,unreal,godot,web" (any subset) or "all";
   // empty: none (brdf/engines/engine_export.h).
   std::string engines;
+  // Folder of `brdf fit` results (NAME.MODEL.json) for the engine manifests' fallback material.
+  std::string engine_fits;
 };
 int RunConvert(const ConvertOptions& options);
 

@@ -285,6 +285,9 @@ int main(int argc, char** argv) {
       "--engine", convert.engines,
       "Also write engine hand-off folders DIR/<engine>/ (importer, shader code, manifest, "
       "texture in the engine's format): unity, unreal, godot, web (comma separated) or all");
+  convert_cmd->add_option("--engine-fits", convert.engine_fits,
+                          "With --engine: folder of `brdf fit` results (NAME.MODEL.json); each "
+                          "manifest carries NAME's fits, with their errors, as fallback material");
   convert_cmd->footer(
       "Material files are first captured noise-free on the reference geometry (theta_in 0, 20, "
       "40, 60; theta_out 0-75; phi_out 0-359; 1 degree steps), then resampled like a capture.\n"

@@ -1,12 +1,16 @@
 #include "brdf/engines/engine_export.h"
 
 #include <algorithm>
+#include <array>
 #include <bit>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <functional>
+#include <mutex>
 #include <string>
+#include <unordered_map>
 
 #include <fmt/format.h>
 #include <unistd.h>
@@ -21,6 +25,7 @@
 #include "brdf/exporter/shader_code.h"
 #include "brdf/exporter/sidecar.h"
 #include "engine_files.h"
+#include "staged_files.h"
 
 namespace brdf::engines {
 
@@ -28,6 +33,7 @@ namespace fs = std::filesystem;
 using ordered_json = nlohmann::ordered_json;
 using detail::Handoff;
 using detail::HandoffCell;
+using detail::StagedFiles;
 
 namespace {
 
@@ -148,15 +154,24 @@ ordered_json ProbeJson(const Handoff& h) {
         ij.push_back({360, 180});
         ij.push_back({45, 10});
       }
-      // The brightest texel of the slice (first one on ties): the peak of the lobe.
+      // The brightest texel of the slice (first one on ties): the peak of the lobe. Luminance
+      // (Rec.709 weights 0.2126, 0.7152, 0.0722) compared exactly in integers: a texel's is
+      // (2126 r_s + 7152 g_s + 722 b_s) · 2^e / 10^4 · 2^−24 with 9-bit mantissas, so the key
+      // (2126 r_s + 7152 g_s + 722 b_s) << e (< 2^54) orders texels as their luminance does,
+      // without decoding each texel of the slice.
       int best_i = 0, best_j = 0;
-      float best = -1;
-      for (int j = 0; j < 181; ++j)
+      std::uint64_t best = 0;
+      bool any = false;
+      for (int j = 0; j < 181; ++j) {
+        const std::uint32_t* row = &vol.words[vol.Index(cell.x0, cell.y0 + j, k)];
         for (int i = 0; i < 361; ++i) {
-          const auto c = exporter::DecodeRgb9e5(vol.words[vol.Index(cell.x0 + i, cell.y0 + j, k)]);
-          const float y = 0.2126f * c[0] + 0.7152f * c[1] + 0.0722f * c[2];
-          if (y > best) best = y, best_i = i, best_j = j;
+          const std::uint32_t w = row[i];
+          const std::uint64_t key = std::uint64_t{2126u * (w & 511u) + 7152u * ((w >> 9) & 511u) +
+                                                  722u * ((w >> 18) & 511u)}
+                                    << (w >> 27);
+          if (key > best || !any) best = key, best_i = i, best_j = j, any = true;
         }
+      }
       ij.push_back({best_i, best_j});
       for (const auto& [i, j] : ij) {
         const int x = cell.x0 + i, y = cell.y0 + j;
@@ -183,11 +198,18 @@ ordered_json ProbeJson(const Handoff& h) {
 ordered_json FallbackMaterialJson(const std::vector<std::string>& fitted_models_json) {
   if (fitted_models_json.empty()) return nullptr;
   ordered_json models = ordered_json::array();
-  for (const std::string& m : fitted_models_json) models.push_back(ordered_json::parse(m));
+  ordered_json gltf = nullptr;
+  for (const std::string& m : fitted_models_json) {
+    ordered_json model = ordered_json::parse(m);
+    if (gltf.is_null() && model.is_object() && model.value("model", "") == "unreal-defaultlit")
+      gltf = ordered_json::parse(GltfFromUnrealDefaultLit(m));
+    models.push_back(std::move(model));
+  }
   return ordered_json{{"note",
                        "analytic fits of the same data, for engines or LODs that cannot "
                        "sample the 3D LUT; see each model's \"fit\" member for its error"},
-                      {"models", std::move(models)}};
+                      {"models", std::move(models)},
+                      {"gltf", std::move(gltf)}};
 }
 
 // What one engine's folder holds and how it imports (a member of "engines" in the manifest).
@@ -338,31 +360,53 @@ struct Sources {
   std::function<exporter::FloatImage()> composite;
 };
 
-// Places `path` as a hard link to `source` (same bytes, no second copy to write and flush):
-// linked under a temporary name, then renamed over `path`, so the final name appears whole.
-// The source is already durable; the folder is synced by the next atomic write into it.
-// Returns false when linking is impossible (no source, another file system), so the caller
-// writes the bytes instead.
-bool LinkAtomically(const std::string& source, const std::string& path) {
-  if (source.empty()) return false;
-  AtomicOutputPath out(path);
-  if (::link(source.c_str(), out.temp_path().c_str()) != 0) return false;
-  if (std::rename(out.temp_path().c_str(), path.c_str()) != 0) return false;
-  return true;  // the destructor's unlink of the (renamed) temporary name is a no-op
-}
+// Files every material of a layout shares (importer, shaders, viewer): their text is a function
+// of their path alone, so once this process has written one or found it identical, later
+// materials of the batch only check that it is still there with that size (one stat) instead of
+// generating the text and reading the file again.
+class SharedFiles {
+ public:
+  static SharedFiles& Instance() {
+    static SharedFiles instance;
+    return instance;
+  }
+  // Writes `path` with text() when it is missing or different; returns true when written.
+  template <class Text>
+  bool Ensure(const std::string& path, Text&& text) {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      if (const auto it = sizes_.find(path); it != sizes_.end()) {
+        std::error_code ec;
+        if (fs::file_size(path, ec) == it->second && !ec) return false;
+      }
+    }
+    const std::string bytes = text();
+    const bool write = !SameContent(path, bytes);
+    if (write) WriteFileAtomically(path, bytes);
+    const std::lock_guard<std::mutex> lock(mutex_);
+    sizes_[path] = bytes.size();
+    return write;
+  }
 
-// Writes a file every material of a layout shares only when it is missing or different, so a
-// batch writes each once.
-bool SameContent(const std::string& path, std::string_view bytes) {
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec) || fs::file_size(path, ec) != bytes.size()) return false;
-  return ReadFileText(path, bytes.size()) == bytes;
-}
+ private:
+  static bool SameContent(const std::string& path, std::string_view bytes) {
+    std::error_code ec;
+    if (!fs::is_regular_file(path, ec) || fs::file_size(path, ec) != bytes.size()) return false;
+    return ReadFileText(path, bytes.size()) == bytes;
+  }
+  std::mutex mutex_;
+  std::unordered_map<std::string, std::uintmax_t> sizes_;
+};
 
-// Writes one engine folder; returns the paths written or linked (shared files included when
-// they had to be written).
-std::vector<std::string> WriteEngineFolder(Engine e, const fs::path& dir, const Handoff& h,
-                                           const Sources& src, std::string& manifest_path,
+// The RGBA16F volume DDS streamed into `w`: header, then the texels converted chunk by chunk
+// (no copy of the whole payload in memory).
+void WriteRgba16fDds(StagedFiles::Writer& w, const exporter::PackedVolume& volume);
+
+// Stages one engine folder's per-material files in `staged` and writes its shared files;
+// returns the shared files it had to write.
+std::vector<std::string> StageEngineFolder(Engine e, const fs::path& dir, const Handoff& h,
+                                           const Sources& src, StagedFiles& staged,
+                                           std::string& manifest_temp,
                                            const std::string& manifest) {
   std::error_code ec;
   fs::create_directories(dir, ec);
@@ -372,30 +416,19 @@ std::vector<std::string> WriteEngineFolder(Engine e, const fs::path& dir, const 
   const MaterialFiles f = FilesOf(e, h.name);
   const std::string shader = ShaderFile(e, h.layout);
   std::vector<std::string> written;
-  const auto put = [&](const std::string& file, std::string_view bytes) {
-    const std::string path = (dir / file).string();
-    WriteFileAtomically(path, bytes);
-    written.push_back(path);
-  };
-  const auto shared = [&](const std::string& file, const std::string& bytes) {
-    if (!SameContent((dir / file).string(), bytes)) put(file, bytes);
+  const auto path_of = [&](const std::string& file) { return (dir / file).string(); };
+  const auto shared = [&](const std::string& file, auto&& text) {
+    if (SharedFiles::Instance().Ensure(path_of(file), text)) written.push_back(path_of(file));
   };
   const auto linked = [&](const std::string& file, const std::string& source,
                           const std::function<std::string()>& bytes) {
-    const std::string path = (dir / file).string();
-    if (LinkAtomically(source, path))
-      written.push_back(path);
-    else
-      put(file, bytes());
+    if (!staged.Link(source, path_of(file))) staged.Write(path_of(file), bytes());
   };
   // The tiled/sliced EXR: the regular composite EXR when there is one (same layout), else a
   // half-float one written here.
   const auto tiles = [&](const std::string& file) {
-    const std::string path = (dir / file).string();
-    if (LinkAtomically(src.exr_path, path)) {
-      written.push_back(path);
-      return;
-    }
+    const std::string path = path_of(file);
+    if (staged.Link(src.exr_path, path)) return;
     exporter::WriteExr(
         path, src.composite(),
         exporter::ExrOptions(exporter::ExrPixelType::kHalf, exporter::ExrCompression::kNone),
@@ -409,53 +442,64 @@ std::vector<std::string> WriteEngineFolder(Engine e, const fs::path& dir, const 
   switch (e) {
     case Engine::kUnity:
       linked(f.texture, src.ktx2_path, src.ktx2_bytes);
-      fs::create_directories(dir / "Editor", ec);
-      shared("Editor/MeasuredBrdfImporter.cs", detail::UnityImporterCs());
-      shared(shader, detail::UnityHlsl(h.layout));
+      shared("Editor/MeasuredBrdfImporter.cs", [&] {
+        std::error_code dir_ec;
+        fs::create_directories(dir / "Editor", dir_ec);
+        return detail::UnityImporterCs();
+      });
+      shared(shader, [&] { return detail::UnityHlsl(h.layout); });
       break;
     case Engine::kUnreal:
       tiles(f.tiles);
-      put(f.texture, EncodeRgba16fDds(*h.volume));
-      shared(shader, detail::UnrealUsh(h.layout));
-      shared("import_measured_brdf.py", detail::UnrealImportPython());
+      staged.WriteWith(path_of(f.texture),
+                       [&](StagedFiles::Writer& w) { WriteRgba16fDds(w, *h.volume); });
+      shared(shader, [&] { return detail::UnrealUsh(h.layout); });
+      shared("import_measured_brdf.py", [] { return detail::UnrealImportPython(); });
       break;
     case Engine::kGodot:
       linked(f.texture, src.dds_path, [&] { return exporter::EncodeDds(*h.volume); });
       tiles(f.tiles);
-      put(f.tiles_import, detail::GodotSlicesImport(h, f.tiles));
-      shared(shader, detail::GodotShader(h.layout));
+      staged.Write(path_of(f.tiles_import), detail::GodotSlicesImport(h, f.tiles));
+      shared(shader, [&] { return detail::GodotShader(h.layout); });
       break;
     case Engine::kWeb:
       linked(f.texture, src.ktx2_path, src.ktx2_bytes);
-      shared(shader, detail::WebModuleJs(h.layout));
-      shared("index.html", detail::WebViewerHtml(shader, ""));
-      shared("package.json", detail::WebPackageJson());
+      shared(shader, [&] { return detail::WebModuleJs(h.layout); });
+      shared("index.html", [] { return detail::WebViewerHtml(); });
+      shared("package.json", [] { return detail::WebPackageJson(); });
       // The same lookup as plain GLSL files for other WebGL 2 / OpenGL code.
-      shared(detail::ShaderStem(h.layout) + ".es300.glsl",
-             exporter::MeasuredBrdfGlslFile(exporter::GlslVersion::kEs300, h.layout));
+      shared(detail::ShaderStem(h.layout) + ".es300.glsl", [&] {
+        return exporter::MeasuredBrdfGlslFile(exporter::GlslVersion::kEs300, h.layout);
+      });
       shared(detail::ShaderStem(h.layout) + ".450.glsl",
-             exporter::MeasuredBrdfGlslFile(exporter::GlslVersion::k450, h.layout));
+             [&] { return exporter::MeasuredBrdfGlslFile(exporter::GlslVersion::k450, h.layout); });
       break;
   }
-  // The manifest: written into the first folder, hard-linked into the others.
-  if (!LinkAtomically(manifest_path, (dir / f.manifest).string()))
-    put(f.manifest, manifest);
-  else
-    written.push_back((dir / f.manifest).string());
-  if (manifest_path.empty()) manifest_path = (dir / f.manifest).string();
+  // The manifest: written into the first folder, hard-linked (from its temporary name) into
+  // the others.
+  const std::string manifest_path = path_of(f.manifest);
+  if (!staged.Link(manifest_temp, manifest_path)) {
+    staged.Write(manifest_path, manifest);
+    manifest_temp = staged.temp_path_of_last();
+  }
   return written;
 }
 
 std::vector<std::string> WriteHandoff(const fs::path& base, const Handoff& h, const Sources& src,
                                       const EngineSet& engines) {
-  std::vector<std::string> written;
   const std::vector<Engine> selected = Selected(engines);
   const std::string manifest = ManifestJson(h, selected);
-  std::string manifest_path;
+  StagedFiles staged;
+  std::string manifest_temp;
+  std::vector<std::string> shared;
   for (Engine e : selected) {
-    const auto w = WriteEngineFolder(e, base / FolderOf(e), h, src, manifest_path, manifest);
-    written.insert(written.end(), w.begin(), w.end());
+    const auto w =
+        StageEngineFolder(e, base / FolderOf(e), h, src, staged, manifest_temp, manifest);
+    shared.insert(shared.end(), w.begin(), w.end());
   }
+  staged.Commit();
+  std::vector<std::string> written = staged.paths();
+  written.insert(written.end(), shared.begin(), shared.end());
   return written;
 }
 
@@ -529,28 +573,87 @@ std::uint16_t FloatToHalf(float value) {
   return sign | static_cast<std::uint16_t>(half);
 }
 
-std::string Rgba16fBytes(const exporter::PackedVolume& volume) {
-  std::string out(volume.words.size() * 8, '\0');
-  constexpr std::uint16_t kOne = 0x3c00;
-  for (std::size_t t = 0; t < volume.words.size(); ++t) {
-    const auto c = exporter::DecodeRgb9e5(volume.words[t]);
-    const std::uint16_t h[4] = {FloatToHalf(c[0]), FloatToHalf(c[1]), FloatToHalf(c[2]), kOne};
-    for (int i = 0; i < 4; ++i) {
-      out[t * 8 + 2 * i] = static_cast<char>(h[i] & 0xff);
-      out[t * 8 + 2 * i + 1] = static_cast<char>(h[i] >> 8);
-    }
-  }
-  return out;
+namespace {
+
+// Binary16 bits of one RGB9E5 channel value m · 2^(e − 24) (mantissa m < 512, exponent e < 32).
+// Every such value is exact in half, so there is nothing to round: it has at most 9
+// significant bits and lies in [2^−24, 65408], within half's subnormal step 2^−24 and largest
+// finite 65504. Half stores n · 2^−24 for n < 1024 as the subnormal n (here n = m · 2^e), else
+// exponent field p + e − 9 (p: the position of m's leading bit, so the value is
+// 2^(p + e − 24) · 1.f) and the 10 fraction bits below the leading one.
+constexpr std::uint16_t HalfOfRgb9e5Channel(std::uint32_t m, std::uint32_t e) {
+  if (m == 0) return 0;
+  const int p = std::bit_width(m) - 1;
+  const int field = p + static_cast<int>(e) - 9;
+  if (field <= 0) return static_cast<std::uint16_t>(m << e);
+  return static_cast<std::uint16_t>((static_cast<std::uint32_t>(field) << 10) |
+                                    ((m << (10 - p)) & 0x3ffu));
 }
 
-std::string EncodeRgba16fDds(const exporter::PackedVolume& volume) {
+// All 32 × 512 channel values, indexed by e · 512 + m (32 KiB, built at compile time).
+constexpr auto kHalfOfChannel = [] {
+  std::array<std::uint16_t, 32 * 512> t{};
+  for (std::uint32_t e = 0; e < 32; ++e)
+    for (std::uint32_t m = 0; m < 512; ++m) t[e * 512 + m] = HalfOfRgb9e5Channel(m, e);
+  return t;
+}();
+
+// One texel: R, G, B halves and alpha 1.0 (0x3c00), little-endian, 8 bytes at `out`.
+inline void PutRgba16fTexel(std::uint32_t word, char* out) {
+  const std::uint16_t* row = &kHalfOfChannel[(word >> 27) * 512];
+  const std::uint64_t texel =
+      std::uint64_t{row[word & 511u]} | (std::uint64_t{row[(word >> 9) & 511u]} << 16) |
+      (std::uint64_t{row[(word >> 18) & 511u]} << 32) | (std::uint64_t{0x3c00} << 48);
+  if constexpr (std::endian::native == std::endian::little) {
+    std::memcpy(out, &texel, 8);
+  } else {
+    for (int b = 0; b < 8; ++b) out[b] = static_cast<char>((texel >> (8 * b)) & 0xffu);
+  }
+}
+
+void CheckVolume(const exporter::PackedVolume& volume) {
   if (volume.width < 1 || volume.height < 1 || volume.depth < 1 ||
       volume.words.size() != static_cast<std::size_t>(volume.width) * volume.height * volume.depth)
     throw InvalidArgument(fmt::format("RGBA16F DDS: inconsistent volume {} × {} × {}", volume.width,
                                       volume.height, volume.depth));
+}
+
+std::string Rgba16fDdsHeader(const exporter::PackedVolume& volume) {
   return exporter::DdsVolumeHeader(volume.width, volume.height, volume.depth,
-                                   kDxgiFormatR16g16b16a16Float, 8) +
-         Rgba16fBytes(volume);
+                                   kDxgiFormatR16g16b16a16Float, 8);
+}
+
+void WriteRgba16fDds(StagedFiles::Writer& w, const exporter::PackedVolume& volume) {
+  CheckVolume(volume);
+  w.Append(Rgba16fDdsHeader(volume));
+  constexpr std::size_t kTexelsPerChunk = StagedFiles::Writer::kChunkBytes / 8;
+  for (std::size_t t = 0; t < volume.words.size(); t += kTexelsPerChunk) {
+    const std::size_t n = std::min(kTexelsPerChunk, volume.words.size() - t);
+    char* out = w.Reserve(n * 8);
+    for (std::size_t i = 0; i < n; ++i) PutRgba16fTexel(volume.words[t + i], out + 8 * i);
+    w.Keep(n * 8);
+  }
+}
+
+}  // namespace
+
+std::uint16_t Rgb9e5ChannelToHalf(std::uint32_t mantissa, std::uint32_t exponent) {
+  if (mantissa > 511 || exponent > 31)
+    throw InvalidArgument(fmt::format("RGB9E5 channel: mantissa {} (0..511), exponent {} (0..31)",
+                                      mantissa, exponent));
+  return kHalfOfChannel[exponent * 512 + mantissa];
+}
+
+std::string Rgba16fBytes(const exporter::PackedVolume& volume) {
+  std::string out(volume.words.size() * 8, '\0');
+  for (std::size_t t = 0; t < volume.words.size(); ++t)
+    PutRgba16fTexel(volume.words[t], out.data() + 8 * t);
+  return out;
+}
+
+std::string EncodeRgba16fDds(const exporter::PackedVolume& volume) {
+  CheckVolume(volume);
+  return Rgba16fDdsHeader(volume) + Rgba16fBytes(volume);
 }
 
 std::vector<std::string> EngineOutputPaths(const std::string& out_dir, const std::string& name,
@@ -565,10 +668,145 @@ std::vector<std::string> EngineOutputPaths(const std::string& out_dir, const std
   return paths;
 }
 
+namespace {
+
+// The marker every shared file carries in its first lines (importer, shaders, viewer, package).
+constexpr std::string_view kManagedMarker = "generated by brdf-toolchain";
+
+// Shared files `e` may write into `dir`: the fixed names, and the existing files named like a
+// layout's shader file (prefix + suffix).
+std::vector<std::string> SharedFileCandidates(Engine e, const fs::path& dir) {
+  std::vector<std::string> fixed;
+  std::vector<std::pair<std::string, std::string>> shaders;  // prefix, suffix
+  switch (e) {
+    case Engine::kUnity:
+      fixed = {"Editor/MeasuredBrdfImporter.cs"};
+      shaders = {{"MeasuredBrdf", ".hlsl"}};
+      break;
+    case Engine::kUnreal:
+      fixed = {"import_measured_brdf.py"};
+      shaders = {{"MeasuredBrdf", ".ush"}};
+      break;
+    case Engine::kGodot:
+      shaders = {{"measured_brdf", ".gdshader"}};
+      break;
+    case Engine::kWeb:
+      fixed = {"index.html", "package.json"};
+      shaders = {
+          {"measured_brdf", ".js"}, {"MeasuredBrdf", ".es300.glsl"}, {"MeasuredBrdf", ".450.glsl"}};
+      break;
+  }
+  std::vector<std::string> out;
+  for (const std::string& f : fixed) out.push_back((dir / f).string());
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    for (const auto& [prefix, suffix] : shaders)
+      if (name.size() > prefix.size() + suffix.size() && name.starts_with(prefix) &&
+          name.ends_with(suffix))
+        out.push_back(it->path().string());
+  }
+  return out;
+}
+
+// True when `path` is a regular file this tool wrote (kManagedMarker near its start).
+bool IsManagedSharedFile(const std::string& path) {
+  try {
+    return ReadFileHead(path, 512).find(kManagedMarker) != std::string::npos;
+  } catch (const Error&) {
+    return false;
+  }
+}
+
+}  // namespace
+
+std::vector<std::string> EngineOutputsToCheck(const std::string& out_dir,
+                                              const std::vector<std::string>& names,
+                                              const EngineSet& engines) {
+  std::vector<std::string> paths;
+  for (const std::string& name : names)
+    for (std::string& p : EngineOutputPaths(out_dir, name, engines)) paths.push_back(std::move(p));
+  for (Engine e : Selected(engines))
+    for (std::string& p : SharedFileCandidates(e, fs::path(out_dir) / FolderOf(e))) {
+      std::error_code ec;
+      const fs::file_status st = fs::status(p, ec);
+      if (ec || !fs::exists(st)) continue;
+      if (fs::is_regular_file(st) && IsManagedSharedFile(p)) continue;
+      paths.push_back(std::move(p));
+    }
+  return paths;
+}
+
+std::vector<std::string> ReadFitResults(const std::string& fits_dir, const std::string& name) {
+  std::error_code ec;
+  if (!fs::is_directory(fits_dir, ec))
+    throw IoError(fits_dir + ": not a folder (expected the folder `brdf fit --out` wrote)");
+  std::vector<std::string> files;
+  const std::string prefix = name + ".";
+  for (fs::directory_iterator it(fits_dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string f = it->path().filename().string();
+    if (f.size() > prefix.size() + 5 && f.starts_with(prefix) && f.ends_with(".json") &&
+        f.find('.', prefix.size()) == f.size() - 5)
+      files.push_back(it->path().string());
+  }
+  std::sort(files.begin(), files.end());
+  std::vector<std::string> fits;
+  for (const std::string& path : files) {
+    const std::string text = ReadFileText(path, 16u << 20);
+    const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
+    if (j.is_discarded() || !j.is_object())
+      throw FormatError(path, "the whole file", "a `brdf fit` result (a JSON object)",
+                        "text that is not a JSON object");
+    const auto kind = [&](const char* key) {
+      return j.contains(key) ? std::string("a ") + j[key].type_name() : std::string("none");
+    };
+    if (!j.contains("model") || !j["model"].is_string())
+      throw FormatError(path, "member \"model\"", "the fitted model's name", kind("model"));
+    if (!j.contains("fit") || !j["fit"].is_object())
+      throw FormatError(path, "member \"fit\"", "the fit report of `brdf fit`", kind("fit"));
+    fits.push_back(j.dump());
+  }
+  return fits;
+}
+
+std::string GltfFromUnrealDefaultLit(const std::string& fit_json) {
+  const nlohmann::json j = nlohmann::json::parse(fit_json, nullptr, false);
+  if (j.is_discarded() || !j.is_object() || j.value("model", "") != "unreal-defaultlit")
+    throw InvalidArgument("glTF values: expected an unreal-defaultlit fit");
+  const auto number = [&](const char* key) {
+    if (!j.contains(key) || !j[key].is_number())
+      throw InvalidArgument(std::string("glTF values: the unreal-defaultlit fit has no ") + key);
+    return j[key].get<double>();
+  };
+  if (!j.contains("base_color") || !j["base_color"].is_array() || j["base_color"].size() != 3)
+    throw InvalidArgument("glTF values: the unreal-defaultlit fit has no base_color");
+  const std::vector<double> base = j["base_color"].get<std::vector<double>>();
+  const double metallic = number("metallic"), specular = number("specular"),
+               roughness = number("roughness");
+  const double grey = 2.0 * specular;
+  ordered_json out = {
+      {"note",
+       "glTF 2.0 values from the unreal-defaultlit fit: same base colour, metallic, roughness "
+       "(alpha = roughness^2) and dielectric F0 = 0.08 * Specular = 0.04 * specularColorFactor; "
+       "glTF's BRDF differs in its Fresnel-weighted diffuse and Smith term"},
+      {"from", "unreal-defaultlit"},
+      {"rmse", j.contains("fit") && j["fit"].is_object() ? j["fit"].value("rmse", -1.0) : -1.0},
+      {"material",
+       {{"pbrMetallicRoughness",
+         {{"baseColorFactor", {base[0], base[1], base[2], 1.0}},
+          {"metallicFactor", metallic},
+          {"roughnessFactor", roughness}}},
+        {"extensions",
+         {{"KHR_materials_specular",
+           {{"specularFactor", 1.0}, {"specularColorFactor", {grey, grey, grey}}}}}}}}};
+  return out.dump();
+}
+
 EngineExportResult ExportLutWithEngines(const std::string& out_dir, const Lut& lut,
                                         exporter::TextureMetadata metadata,
                                         const exporter::LutExportOptions& options,
-                                        const EngineSet& engines) {
+                                        const EngineSet& engines,
+                                        const std::vector<std::string>& fits_json) {
   EngineExportResult result;
   const exporter::PackedVolume packed = exporter::PackLut(lut);
   result.lut = exporter::ExportLut(out_dir, lut, packed, metadata, options);
@@ -582,6 +820,7 @@ EngineExportResult ExportLutWithEngines(const std::string& out_dir, const Lut& l
   h.cells = {{metadata.name, 0, 0}};
   h.composite = exporter::SquareishGrid(lut.slices());
   h.fitted_models_json = metadata.fitted_models_json;
+  h.fitted_models_json.insert(h.fitted_models_json.end(), fits_json.begin(), fits_json.end());
   const fs::path dir(out_dir);
   const auto main_file = [&](bool written, const char* ext) {
     return written ? (dir / (metadata.name + ext)).string() : std::string();

@@ -45,7 +45,9 @@ std::string GodotShader(const exporter::ShaderLutLayout& layout);
 std::string GodotSlicesImport(const Handoff& handoff, const std::string& exr_file);
 // three.js (r180 or later).
 std::string WebModuleJs(const exporter::ShaderLutLayout& layout);
-std::string WebViewerHtml(const std::string& module_file, const std::string& default_material);
+// The viewer reads NAME.manifest.json first and imports the module it names, so one index.html
+// serves every layout of the folder.
+std::string WebViewerHtml();
 std::string WebPackageJson();
 
 inline constexpr int kMinimumThreeRevision = 180;
