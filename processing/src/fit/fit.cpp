@@ -12,6 +12,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <map>
 #include <memory>
@@ -143,7 +144,8 @@ class CompressedCost final : public ceres::CostFunction {
 
   CompressedCost(const std::vector<typename K::Geom>* geom, const std::vector<LossSample>* loss,
                  std::size_t begin, std::size_t end, int channel, FitLoss loss_kind,
-                 double robust_scale, const std::array<bool, kN>& log_scale)
+                 double robust_scale, const std::array<bool, kN>& log_scale,
+                 const std::array<bool, kN>* fixed = nullptr)
       : geom_(geom),
         loss_(loss),
         begin_(begin),
@@ -151,7 +153,8 @@ class CompressedCost final : public ceres::CostFunction {
         channel_(channel),
         loss_kind_(loss_kind),
         b2_(robust_scale * robust_scale),
-        log_scale_(log_scale) {
+        log_scale_(log_scale),
+        fixed_(fixed) {
     set_num_residuals(kN + 1);
     mutable_parameter_block_sizes()->push_back(kN);
   }
@@ -163,7 +166,10 @@ class CompressedCost final : public ceres::CostFunction {
     for (int i = 0; i < kN; ++i) {
       const bool log = log_scale_[static_cast<std::size_t>(i)];
       v[i] = log ? std::exp(x[i]) : x[i];
-      dvdx[i] = log ? v[i] : 1.0;
+      // A value held at its bound (SolveBlock) has no slope: Levenberg-Marquardt leaves it.
+      dvdx[i] = fixed_ != nullptr && (*fixed_)[static_cast<std::size_t>(i)] ? 0.0
+                : log                                                     ? v[i]
+                                                                          : 1.0;
     }
     const bool jac = jacobians != nullptr && jacobians[0] != nullptr;
     // Samples in chunks: the first pass evaluates the chunk's residuals and their slopes (times
@@ -258,6 +264,46 @@ class CompressedCost final : public ceres::CostFunction {
   FitLoss loss_kind_;
   double b2_;
   std::array<bool, kN> log_scale_;
+  const std::array<bool, kN>* fixed_;
+};
+
+// Stops Ceres when a free value sits on one of its bounds with the gradient pointing out of
+// the range (SolveBlock then holds it there). `released` values are ones found at their bound
+// with the gradient pointing inwards; the gradient is only evaluated for them.
+template <int kN>
+class BoundWatch final : public ceres::IterationCallback {
+ public:
+  using Gradient = std::function<std::array<double, kN>()>;
+  BoundWatch(const double* x, const std::array<double, kN>& lo, const std::array<double, kN>& hi,
+             const std::array<bool, kN>& fixed, const std::array<bool, kN>& released,
+             Gradient gradient)
+      : x_(x), lo_(lo), hi_(hi), fixed_(fixed), released_(released), gradient_(std::move(gradient)) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary&) override {
+    bool check = false;
+    for (std::size_t i = 0; i < kN; ++i) {
+      if (fixed_[i] || !AtBound(i)) continue;
+      if (!released_[i]) return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
+      check = true;
+    }
+    if (!check) return ceres::SOLVER_CONTINUE;
+    const std::array<double, kN> g = gradient_();
+    for (std::size_t i = 0; i < kN; ++i)
+      if (!fixed_[i] && Outward(i, g)) return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
+    return ceres::SOLVER_CONTINUE;
+  }
+  bool AtBound(std::size_t i) const { return AtLower(i) || AtUpper(i); }
+  bool AtLower(std::size_t i) const { return x_[i] <= lo_[i] + 1e-12 * (1 + std::fabs(lo_[i])); }
+  bool AtUpper(std::size_t i) const { return x_[i] >= hi_[i] - 1e-12 * (1 + std::fabs(hi_[i])); }
+  // The cost decreases by leaving the range at value i (d cost/dx > 0 at the lower bound).
+  bool Outward(std::size_t i, const std::array<double, kN>& g) const {
+    return (AtLower(i) && g[i] > 0) || (AtUpper(i) && g[i] < 0);
+  }
+
+ private:
+  const double* x_;
+  const std::array<double, kN>&lo_, &hi_;
+  const std::array<bool, kN>&fixed_, &released_;
+  Gradient gradient_;
 };
 // ----------------------------------------------------------------------------------------------
 // Costs in doubles.
@@ -372,7 +418,10 @@ struct Refinement {
 // legacy models' channels are independent; an engine model is a single block).
 struct BlockOutcome {
   std::vector<double> x;
-  ceres::Solver::Summary summary;
+  double initial_cost = 0, final_cost = 0;
+  int iterations = 0;
+  ceres::TerminationType termination = ceres::FAILURE;
+  std::string message;
 };
 
 int Rank(ceres::TerminationType t) {  // worse outcomes rank higher
@@ -470,7 +519,7 @@ class KernelFit {
     out.material = start;
     out.termination = ceres::CONVERGENCE;
     for (std::size_t b = 0; b < blocks.size(); ++b) {
-      const ceres::Solver::Summary& summary = outcomes[b].summary;
+      const BlockOutcome& summary = outcomes[b];
       for (std::size_t i = 0; i < blocks[b].value_index.size(); ++i) {
         const ParameterInfo& p = ParameterOfValue(info_, blocks[b].value_index[i]);
         out.material.values[static_cast<std::size_t>(blocks[b].value_index[i])] =
@@ -478,9 +527,9 @@ class KernelFit {
       }
       out.initial_cost += summary.initial_cost;
       out.final_cost += summary.final_cost;
-      out.iterations += static_cast<int>(summary.iterations.size());
-      if (Rank(summary.termination_type) >= Rank(out.termination)) {
-        out.termination = summary.termination_type;
+      out.iterations += summary.iterations;
+      if (Rank(summary.termination) >= Rank(out.termination)) {
+        out.termination = summary.termination;
         out.message = (blocks.size() > 1 ? "channel " + std::to_string(b) + ": " : std::string()) +
                       summary.message;
       }
@@ -576,16 +625,28 @@ class KernelFit {
     }
   }
 
+  // One block's refinement. Ceres handles bounds by projecting each step onto them; when the
+  // optimum lies on a bound (metallic 0, ks 0) with the gradient pointing out of the range, the
+  // projected steps' predicted decrease is mostly the part cut off, the trust region shrinks
+  // and Ceres crawls along the bound until the function tolerance stops it (57 iterations for
+  // URP's metallic). So a value that reaches a bound with the gradient pointing outwards is held
+  // there (an active set) and Ceres resumes on the others; a held value whose gradient turns
+  // inwards at the end is released and Ceres resumes again. The result satisfies the same
+  // optimality conditions (zero gradient in the free values, outward at the held ones).
   BlockOutcome SolveBlock(const Material& start, const Block& block, double robust_scale,
                           int threads) const {
     BlockOutcome out;
     out.x.resize(block.value_index.size());
-    std::array<bool, kN> log_scale{};
+    std::array<bool, kN> log_scale{}, fixed{}, released{};
+    std::array<double, kN> lo{}, hi{};
     for (std::size_t i = 0; i < block.value_index.size(); ++i) {
       const ParameterInfo& p = ParameterOfValue(info_, block.value_index[i]);
       const double v = start.values[static_cast<std::size_t>(block.value_index[i])];
       out.x[i] = p.log_scale ? std::log(v) : v;
       log_scale[i] = p.log_scale;
+      lo[i] = p.log_scale ? std::log(p.min) : p.min;
+      hi[i] = p.log_scale ? std::log(p.max) : p.max;
+      out.x[i] = std::clamp(out.x[i], lo[i], hi[i]);
     }
     ceres::Problem problem;
     // One residual block per thread (CompressedCost explains why not one per sample).
@@ -595,26 +656,72 @@ class KernelFit {
       const std::size_t begin = n * t / parts, end = n * (t + 1) / parts;
       if (begin == end) continue;
       problem.AddResidualBlock(new CompressedCost<K>(&geom_, &loss_, begin, end, block.channel,
-                                                     options_.loss, robust_scale, log_scale),
+                                                     options_.loss, robust_scale, log_scale,
+                                                     &fixed),
                                nullptr, out.x.data());
     }
     for (std::size_t i = 0; i < block.value_index.size(); ++i) {
-      const ParameterInfo& p = ParameterOfValue(info_, block.value_index[i]);
-      problem.SetParameterLowerBound(out.x.data(), static_cast<int>(i),
-                                     p.log_scale ? std::log(p.min) : p.min);
-      problem.SetParameterUpperBound(out.x.data(), static_cast<int>(i),
-                                     p.log_scale ? std::log(p.max) : p.max);
+      problem.SetParameterLowerBound(out.x.data(), static_cast<int>(i), lo[i]);
+      problem.SetParameterUpperBound(out.x.data(), static_cast<int>(i), hi[i]);
     }
     ceres::Solver::Options so;
     so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
-    so.max_num_iterations = options_.max_iterations;
     so.num_threads = threads;
     so.function_tolerance = 1e-10;
     so.parameter_tolerance = 1e-10;
     so.gradient_tolerance = 1e-12;
     so.logging_type = ceres::SILENT;
     so.minimizer_progress_to_stdout = false;
-    ceres::Solve(so, &problem, &out.summary);
+    so.update_state_every_iteration = true;
+    // The whole gradient (held values included) for the decisions between rounds.
+    const CompressedCost<K> whole(&geom_, &loss_, 0, n, block.channel, options_.loss,
+                                  robust_scale, log_scale);
+    auto gradient = [&] {
+      double residuals[kN + 1], jacobian[(kN + 1) * kN];
+      const double* parameters[] = {out.x.data()};
+      double* jacobians[] = {jacobian};
+      std::array<double, kN> g{};
+      if (!whole.Evaluate(parameters, residuals, jacobians)) return g;
+      for (std::size_t i = 0; i < kN; ++i)
+        for (std::size_t r = 0; r <= kN; ++r) g[i] += jacobian[r * kN + i] * residuals[r];
+      return g;
+    };
+    BoundWatch<kN> watch(out.x.data(), lo, hi, fixed, released, gradient);
+    so.callbacks.push_back(&watch);
+    auto outward = [&](std::size_t i, const std::array<double, kN>& g) { return watch.Outward(i, g); };
+    int remaining = options_.max_iterations;
+    for (int round = 0; round < 2 * kN + 2 && remaining > 0; ++round) {
+      so.max_num_iterations = remaining;
+      ceres::Solver::Summary summary;
+      ceres::Solve(so, &problem, &summary);
+      if (round == 0) out.initial_cost = summary.initial_cost;
+      out.final_cost = summary.final_cost;
+      const int steps = std::max(1, static_cast<int>(summary.iterations.size()) - 1);
+      out.iterations += steps;
+      remaining -= steps;
+      out.termination = summary.termination_type;
+      out.message = summary.message;
+      if (summary.termination_type != ceres::USER_SUCCESS) {
+        if (summary.termination_type != ceres::CONVERGENCE) break;
+        // Converged on the free values: release held ones the gradient now pulls inwards.
+        const std::array<double, kN> g = gradient();
+        bool again = false;
+        for (std::size_t i = 0; i < kN; ++i)
+          if (fixed[i] && !outward(i, g)) fixed[i] = false, released[i] = true, again = true;
+        if (!again) break;
+        continue;
+      }
+      // A free value reached a bound: hold it if the gradient points out, else let Ceres go on.
+      const std::array<double, kN> g = gradient();
+      for (std::size_t i = 0; i < kN; ++i)
+        if (!fixed[i] && watch.AtBound(i)) {
+          if (outward(i, g))
+            fixed[i] = true, released[i] = false;
+          else
+            released[i] = true;
+        }
+    }
+    if (out.termination == ceres::USER_SUCCESS) out.termination = ceres::NO_CONVERGENCE;
     return out;
   }
 
