@@ -3,6 +3,8 @@
 # reference geometry (4 x 76 x 360 = 109,440 samples): plastic_glossy_red at noise level 1.
 # Interleaved per model: bench_fit's runs of a model, then SciPy's of the same model.
 #   bench/fit/compare_scipy.sh BUILD_DIR [REPEATS [MODEL...]]
+# BASELINE_BENCH_FIT=/path/to/an/older/bench_fit adds that build's runs of each model too (its
+# lines are tagged "baseline").
 set -eu
 build=${1:?usage: compare_scipy.sh BUILD_DIR [REPEATS [MODEL...]]}
 repeats=${2:-5}
@@ -15,6 +17,9 @@ trap 'rm -rf "$work"' EXIT
   --out "$work/capture.bpc" --quiet > /dev/null
 uptime >&2
 for model in $models; do
+  if [ -n "${BASELINE_BENCH_FIT:-}" ]; then
+    "$BASELINE_BENCH_FIT" "$work/capture.bpc" "$work" "$repeats" "$model" | sed 's/^{/{"build": "baseline", /'
+  fi
   "$build/bench/bench_fit" "$work/capture.bpc" "$work" "$repeats" "$model"
   OPENBLAS_NUM_THREADS=1 OMP_NUM_THREADS=1 /usr/bin/python3 "$here/scipy_baseline.py" "$work" "$model" "$repeats"
 done

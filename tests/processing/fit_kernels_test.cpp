@@ -39,8 +39,7 @@ void CheckLegacy(Model model, double shape_lo, double shape_hi) {
   using J = ceres::Jet<double, 3>;
   for (int trial = 0; trial < 400; ++trial) {
     const ShadingGeometry g = RandomGeometry(rng);
-    const double v[3] = {unit(rng), unit(rng),
-                         shape_lo * std::pow(shape_hi / shape_lo, unit(rng))};
+    const double v[3] = {unit(rng), unit(rng), shape_lo * std::pow(shape_hi / shape_lo, unit(rng))};
     double grad[3];
     const double f = K::Eval(K::Prepare(g), v, grad);
     const std::string where = std::string(ModelName(model)) + " trial " + std::to_string(trial);
@@ -86,8 +85,8 @@ void CheckEngine(Model model, double shape_lo, double shape_hi) {
     for (int i = 0; i < kN; ++i) x[i] = J(v[i], i);
     const std::array<J, 3> jet = models::EvaluateRgb(model, g, x);
     for (int c = 0; c < 3; ++c) {
-      const std::string where = std::string(ModelName(model)) + " trial " +
-                                std::to_string(trial) + " channel " + std::to_string(c);
+      const std::string where = std::string(ModelName(model)) + " trial " + std::to_string(trial) +
+                                " channel " + std::to_string(c);
       ExpectClose(f[c], want[static_cast<std::size_t>(c)], 1e-11, where + " value");
       EXPECT_EQ(f_only[c], f[c]) << where;
       for (int i = 0; i < kN; ++i)

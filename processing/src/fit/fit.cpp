@@ -168,8 +168,8 @@ class CompressedCost final : public ceres::CostFunction {
       v[i] = log ? std::exp(x[i]) : x[i];
       // A value held at its bound (SolveBlock) has no slope: Levenberg-Marquardt leaves it.
       dvdx[i] = fixed_ != nullptr && (*fixed_)[static_cast<std::size_t>(i)] ? 0.0
-                : log                                                     ? v[i]
-                                                                          : 1.0;
+                : log                                                       ? v[i]
+                                                                            : 1.0;
     }
     const bool jac = jacobians != nullptr && jacobians[0] != nullptr;
     // Samples in chunks: the first pass evaluates the chunk's residuals and their slopes (times
@@ -238,6 +238,12 @@ class CompressedCost final : public ceres::CostFunction {
       for (int k = i; k < kN; ++k) hx(i, k) = hx(k, i) = h(i, k) * dvdx[i] * dvdx[k];
     }
     if (!hx.allFinite() || !gx.allFinite()) return false;
+    // The whole gradient at this point, held values included, for BoundWatch: Ceres evaluates
+    // the Jacobian at every accepted point before its callbacks run.
+    for (int i = 0; i < kN; ++i) {
+      const bool log = log_scale_[static_cast<std::size_t>(i)];
+      last_gradient_[static_cast<std::size_t>(i)] = g(i) * (log ? v[i] : 1.0);
+    }
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, kN, kN>> eig(hx);
     const auto& lambda = eig.eigenvalues();
     const auto& q = eig.eigenvectors();
@@ -265,6 +271,9 @@ class CompressedCost final : public ceres::CostFunction {
   double b2_;
   std::array<bool, kN> log_scale_;
   const std::array<bool, kN>* fixed_;
+
+ public:
+  mutable std::array<double, kN> last_gradient_{};
 };
 
 // Stops Ceres when a free value sits on one of its bounds with the gradient pointing out of
@@ -277,7 +286,12 @@ class BoundWatch final : public ceres::IterationCallback {
   BoundWatch(const double* x, const std::array<double, kN>& lo, const std::array<double, kN>& hi,
              const std::array<bool, kN>& fixed, const std::array<bool, kN>& released,
              Gradient gradient)
-      : x_(x), lo_(lo), hi_(hi), fixed_(fixed), released_(released), gradient_(std::move(gradient)) {}
+      : x_(x),
+        lo_(lo),
+        hi_(hi),
+        fixed_(fixed),
+        released_(released),
+        gradient_(std::move(gradient)) {}
   ceres::CallbackReturnType operator()(const ceres::IterationSummary&) override {
     bool check = false;
     for (std::size_t i = 0; i < kN; ++i) {
@@ -655,10 +669,10 @@ class KernelFit {
     for (std::size_t t = 0; t < parts; ++t) {
       const std::size_t begin = n * t / parts, end = n * (t + 1) / parts;
       if (begin == end) continue;
-      problem.AddResidualBlock(new CompressedCost<K>(&geom_, &loss_, begin, end, block.channel,
-                                                     options_.loss, robust_scale, log_scale,
-                                                     &fixed),
-                               nullptr, out.x.data());
+      problem.AddResidualBlock(
+          new CompressedCost<K>(&geom_, &loss_, begin, end, block.channel, options_.loss,
+                                robust_scale, log_scale, &fixed),
+          nullptr, out.x.data());
     }
     for (std::size_t i = 0; i < block.value_index.size(); ++i) {
       problem.SetParameterLowerBound(out.x.data(), static_cast<int>(i), lo[i]);
@@ -674,8 +688,8 @@ class KernelFit {
     so.minimizer_progress_to_stdout = false;
     so.update_state_every_iteration = true;
     // The whole gradient (held values included) for the decisions between rounds.
-    const CompressedCost<K> whole(&geom_, &loss_, 0, n, block.channel, options_.loss,
-                                  robust_scale, log_scale);
+    const CompressedCost<K> whole(&geom_, &loss_, 0, n, block.channel, options_.loss, robust_scale,
+                                  log_scale);
     auto gradient = [&] {
       double residuals[kN + 1], jacobian[(kN + 1) * kN];
       const double* parameters[] = {out.x.data()};
@@ -686,9 +700,25 @@ class KernelFit {
         for (std::size_t r = 0; r <= kN; ++r) g[i] += jacobian[r * kN + i] * residuals[r];
       return g;
     };
-    BoundWatch<kN> watch(out.x.data(), lo, hi, fixed, released, gradient);
+    std::vector<const CompressedCost<K>*> costs;
+    {
+      std::vector<ceres::ResidualBlockId> ids;
+      problem.GetResidualBlocks(&ids);
+      for (ceres::ResidualBlockId id : ids)
+        costs.push_back(
+            static_cast<const CompressedCost<K>*>(problem.GetCostFunctionForResidualBlock(id)));
+    }
+    auto last_gradient = [&costs] {
+      std::array<double, kN> g{};
+      for (const CompressedCost<K>* c : costs)
+        for (std::size_t i = 0; i < kN; ++i) g[i] += c->last_gradient_[i];
+      return g;
+    };
+    BoundWatch<kN> watch(out.x.data(), lo, hi, fixed, released, last_gradient);
     so.callbacks.push_back(&watch);
-    auto outward = [&](std::size_t i, const std::array<double, kN>& g) { return watch.Outward(i, g); };
+    auto outward = [&](std::size_t i, const std::array<double, kN>& g) {
+      return watch.Outward(i, g);
+    };
     int remaining = options_.max_iterations;
     for (int round = 0; round < 2 * kN + 2 && remaining > 0; ++round) {
       so.max_num_iterations = remaining;

@@ -37,7 +37,7 @@ struct LambertKernel {
   static constexpr int kN = 1;
   struct Geom {};
   static Geom Prepare(const ShadingGeometry&) { return {}; }
-  static double Eval(const Geom&, const double* v, double* grad) {
+  [[gnu::always_inline]] static double Eval(const Geom&, const double* v, double* grad) {
     if (grad) grad[0] = kInvPi;
     return v[0] * kInvPi;
   }
@@ -53,7 +53,7 @@ struct PhongLobeKernel {
     double ln_x;  // ln x; −1e300 when x ≤ 0 (no lobe: exp(n·ln x) = 0 and its slope 0 too)
   };
   static Geom Prepare(double x) { return {x > 0 ? std::log(x) : -1e300}; }
-  static double Eval(const Geom& g, const double* v, double* grad) {
+  [[gnu::always_inline]] static double Eval(const Geom& g, const double* v, double* grad) {
     constexpr double kNorm = 1.0 / (kC * kPi);
     // Below e^−745 exp underflows to 0 anyway, through libm's slow path.
     const double y = v[2] * g.ln_x;
@@ -86,18 +86,20 @@ struct GgxKernel {
     return {g.n_dot_h * g.n_dot_h, tan2(g.n_dot_l), tan2(g.n_dot_v), models::Pow5(1.0 - g.v_dot_h),
             1.0 / (4.0 * g.n_dot_l * g.n_dot_v)};
   }
-  static double Eval(const Geom& g, const double* v, double* grad) {
+  [[gnu::always_inline]] static double Eval(const Geom& g, const double* v, double* grad) {
     const double a2 = v[2] * v[2];
-    const double denom = g.cos_h2 * (a2 - 1.0) + 1.0;
-    const double dist = a2 / (kPi * denom * denom);
+    const double inv_denom = 1.0 / (g.cos_h2 * (a2 - 1.0) + 1.0);
+    const double dist = a2 * kInvPi * inv_denom * inv_denom;
     const double ql = std::sqrt(1.0 + a2 * g.tan2_l), qv = std::sqrt(1.0 + a2 * g.tan2_v);
-    const double g1l = 2.0 / (1.0 + ql), g1v = 2.0 / (1.0 + qv);
-    const double spec = g1l * g1v * dist * g.inv_4lv;
+    // One division for G1(θl)·G1(θv) = 4/((1 + ql)(1 + qv)) and the slopes' 1/(q(1 + q)).
+    const double pl = 1.0 + ql, pv = 1.0 + qv;
+    const double inv = 1.0 / (pl * pv * ql * qv);
+    const double spec = 4.0 * ql * qv * inv * dist * g.inv_4lv;
     const double fresnel = v[1] + (1.0 - v[1]) * g.fc;
     if (grad) {
-      // d/dα² of ln D, ln G1(θl), ln G1(θv): (denom − 2α²cos²θh)/(α²·denom), −tan²/(2q(1 + q)).
-      const double dln = (denom - 2.0 * a2 * g.cos_h2) / (a2 * denom) -
-                         g.tan2_l / (2.0 * ql * (1.0 + ql)) - g.tan2_v / (2.0 * qv * (1.0 + qv));
+      // d/dα² of ln D, ln G1(θl), ln G1(θv): 1/α² − 2cos²θh/denom, −tan²/(2q(1 + q)).
+      const double dln = 1.0 / a2 - 2.0 * g.cos_h2 * inv_denom -
+                         0.5 * inv * (g.tan2_l * pv * qv + g.tan2_v * pl * ql);
       grad[0] = kInvPi;
       grad[1] = (1.0 - g.fc) * spec;
       grad[2] = fresnel * spec * dln * 2.0 * v[2];
@@ -117,13 +119,16 @@ struct WardKernel {
     const double cos2 = g.n_dot_h * g.n_dot_h;
     return {(1.0 - cos2) / cos2, 1.0 / (4 * kPi * std::sqrt(g.n_dot_l * g.n_dot_v))};
   }
-  static double Eval(const Geom& g, const double* v, double* grad) {
-    const double a2 = v[2] * v[2];
-    const double spec = std::exp(-g.tan2_h / a2) * g.k / a2;
+  [[gnu::always_inline]] static double Eval(const Geom& g, const double* v, double* grad) {
+    const double a2 = v[2] * v[2], inv_a2 = 1.0 / a2;
+    // Below e^−745 exp underflows to 0 anyway, through libm's slow path.
+    const double y = -g.tan2_h * inv_a2;
+    const double spec = y > -745.0 ? std::exp(y) * g.k * inv_a2 : 0.0;
     if (grad) {
       grad[0] = kInvPi;
       grad[1] = spec;
-      grad[2] = v[1] * spec * (g.tan2_h - a2) / (a2 * a2) * 2.0 * v[2];  // d spec/dα² = spec(t − α²)/α⁴
+      // d spec/dα² = spec·(tan²θh − α²)/α⁴
+      grad[2] = v[1] * spec * (g.tan2_h - a2) * inv_a2 * inv_a2 * 2.0 * v[2];
     }
     return v[0] * kInvPi + v[1] * spec;
   }
@@ -143,7 +148,8 @@ struct UnrealKernel {
     return {g.n_dot_h, g.n_dot_l, std::min(1.0, std::fabs(g.n_dot_v) + 1e-5),
             models::Pow5(1.0 - g.v_dot_h)};
   }
-  static void Eval(const Geom& g, const double* v, double* f, double (*grad)[kN]) {
+  [[gnu::always_inline]] static void Eval(const Geom& g, const double* v, double* f,
+                                          double (*grad)[kN]) {
     const double metallic = v[3], specular = v[4], roughness = v[5];
     const double r2 = roughness * roughness;
     // a2 = roughness⁴ (floored), a = √a2, and their slopes in roughness.
@@ -165,7 +171,8 @@ struct UnrealKernel {
       f[c] = v[c] * (1.0 - metallic) * kInvPi + dv * (f90 * g.fc + (1.0 - g.fc) * f0[c]);
     if (!grad) return;
     // d(D·Vis)/d roughness = D·Vis·(d ln D/d a2 · da2 − k/den · da).
-    const double ddv = dv * ((d - 2.0 * a2 * g.n_dot_h * g.n_dot_h) / (a2 * d) * da2 - k / den * da);
+    const double ddv =
+        dv * ((d - 2.0 * a2 * g.n_dot_h * g.n_dot_h) / (a2 * d) * da2 - k / den * da);
     const double df90_dg = f90_free ? 50.0 * metallic : 0.0;
     const double df90_dm = f90_free ? 50.0 * (v[1] - 0.08 * specular) : 0.0;
     const double df90_ds = f90_free ? 4.0 * (1.0 - metallic) : 0.0;
@@ -198,7 +205,8 @@ struct HdrpKernel {
             models::Pow5(1.0 - n_dot_v),
             models::Pow5(1.0 - g.v_dot_h)};
   }
-  static void Eval(const Geom& g, const double* v, double* f, double (*grad)[kN]) {
+  [[gnu::always_inline]] static void Eval(const Geom& g, const double* v, double* f,
+                                          double (*grad)[kN]) {
     const double metallic = v[3];
     const double perceptual = 1.0 - v[4];
     double alpha = perceptual * perceptual, dalpha = 2.0 * perceptual;  // d α / d perceptual
@@ -225,7 +233,8 @@ struct HdrpKernel {
     // d λ/d a2, from d√(x² + a2(1 − x²))/d a2 = (1 − x²)/(2√…).
     const double dlambda = 0.5 * (g.n_dot_l * (1.0 - g.n_dot_v * g.n_dot_v) / qv +
                                   g.n_dot_v * (1.0 - g.n_dot_l * g.n_dot_l) / ql);
-    const double ddv_da2 = dv * ((s - 2.0 * a2 * g.n_dot_h * g.n_dot_h) / (a2 * s) - dlambda / lambda);
+    const double ddv_da2 =
+        dv * ((s - 2.0 * a2 * g.n_dot_h * g.n_dot_h) / (a2 * s) - dlambda / lambda);
     const double ddisney = kDisney * (1.0 + g.l_dot_v) * (g.p5l * view + light * g.p5v);
     for (int c = 0; c < 3; ++c) {
       double* gr = grad[c];
@@ -248,7 +257,8 @@ struct UrpKernel {
   static Geom Prepare(const ShadingGeometry& g) {
     return {g.n_dot_h * g.n_dot_h, std::max(0.1, g.v_dot_h * g.v_dot_h)};
   }
-  static void Eval(const Geom& g, const double* v, double* f, double (*grad)[kN]) {
+  [[gnu::always_inline]] static void Eval(const Geom& g, const double* v, double* f,
+                                          double (*grad)[kN]) {
     const double metallic = v[3];
     const double perceptual = 1.0 - v[4];
     double roughness = perceptual * perceptual, drough = 2.0 * perceptual;
@@ -262,10 +272,9 @@ struct UrpKernel {
     }
     if (!grad) return;
     // d term/d roughness = term·(2/ρ − 4ρcos²θh/d − 4/(4ρ + 2)); d/d smoothness = −d/d perceptual.
-    const double dterm = term *
-                         (2.0 / roughness - 4.0 * roughness * g.cos_h2 / d -
-                          4.0 / (4.0 * roughness + 2.0)) *
-                         drough;
+    const double dterm =
+        term * (2.0 / roughness - 4.0 * roughness * g.cos_h2 / d - 4.0 / (4.0 * roughness + 2.0)) *
+        drough;
     for (int c = 0; c < 3; ++c) {
       double* gr = grad[c];
       const double specular = 0.04 * (1.0 - metallic) + v[c] * metallic;
@@ -285,7 +294,8 @@ struct JetEngineKernel {
   static constexpr int kN = kValues;
   using Geom = ShadingGeometry;
   static Geom Prepare(const ShadingGeometry& g) { return g; }
-  static void Eval(const Geom& g, const double* v, double* f, double (*grad)[kN]) {
+  [[gnu::always_inline]] static void Eval(const Geom& g, const double* v, double* f,
+                                          double (*grad)[kN]) {
     if (!grad) {
       const std::array<double, 3> out = models::EvaluateRgb(kModel, g, v);
       for (int c = 0; c < 3; ++c) f[c] = out[c];
