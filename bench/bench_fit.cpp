@@ -1,7 +1,7 @@
 // Fit time per model on one full capture (bench/fit/compare_scipy.sh drives it): the whole
 // FitMaterial (sweep + multi-start refinement) on 1 and 2 threads, and one Ceres refinement
 // from a fixed generic start, whose data and start are written out so SciPy's least_squares
-// can fit the same model, loss and data from the same start side by side.
+// can fit the same model, loss and data from the same start side by side (every model).
 //
 //   bench_fit CAPTURE.bpc OUT_DIR [REPEATS [MODEL]]
 // prints one JSON object per line: {"model", "mode", "threads", "seconds" (median), "cost"}.
@@ -42,7 +42,7 @@ void WriteData(const std::string& path, const processing::FitData& data) {
 
 int main(int argc, char** argv) {
   if (argc < 3) {
-    std::fprintf(stderr, "usage: bench_fit CAPTURE.bpc OUT_DIR [REPEATS]\n");
+    std::fprintf(stderr, "usage: bench_fit CAPTURE.bpc OUT_DIR [REPEATS [MODEL]]\n");
     return 2;
   }
   const Measurement meas = ReadBpc(argv[1]).measurement;
@@ -80,7 +80,7 @@ int main(int argc, char** argv) {
           name.c_str(), threads, Median(seconds), Median(cpu), iterations, cost);
       std::fflush(stdout);
     }
-    if (model == Model::kGgx || model == Model::kLafortune) {
+    {
       // One refinement from the models' generic start (ParameterInfo::start), on one thread.
       Material start;
       start.model = model;

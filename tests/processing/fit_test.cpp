@@ -312,6 +312,28 @@ TEST(FitLosses, EveryLossAndTheRobustOptionRecoverNoiseFreeParameters) {
     }
 }
 
+// The cost Ceres reports (summed per block from the fitter's own kernels and derivatives) is
+// the cost of the fitted material evaluated sample by sample through models::EvaluateRgb.
+TEST(FitLosses, ReportedCostIsTheCostOfTheFittedMaterial) {
+  const Material truth =
+      Material::Make(Model::kGgx, {{0.3, 0.2, 0.1}, {0.05, 0.05, 0.05}, {0.2, 0.2, 0.2}});
+  Measurement meas = NoiseFreeCapture(truth, 6.0);
+  for (Slice& s : meas.slices)  // a misfit for every model, so the costs are far from 0
+    for (std::size_t i = 0; i < s.samples.size(); ++i) s.samples[i].rgb[i % 3] *= 1.2f;
+  for (Model model : {Model::kGgx, Model::kLafortune, Model::kWard, Model::kUnrealDefaultLit,
+                      Model::kUnityHdrpLit, Model::kUnityUrpLit, Model::kUnityUrpLitSpecular})
+    for (FitLoss loss : {FitLoss::kNgan, FitLoss::kLog, FitLoss::kCbrt}) {
+      FitOptions o;
+      o.model = model;
+      o.loss = loss;
+      const FitResult r = FitMaterial(meas, o);
+      const double again = EvaluateFit(meas, r.material, o).final_cost;
+      EXPECT_GT(again, 0) << ModelName(model);
+      EXPECT_NEAR(r.report.final_cost, again, 1e-9 * again)
+          << ModelName(model) << " " << FitLossName(loss);
+    }
+}
+
 // --extrapolate auto on a noise-free GGX capture: between 75° and 90° the §6 band with the
 // chosen p, l is closer to the true GGX values than clamping (p = 1).
 TEST(AutoExtrapolation, BeatsClampingOnANoiseFreeGgxCapture) {

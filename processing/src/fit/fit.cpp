@@ -4,12 +4,15 @@
 
 #include <ceres/ceres.h>
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <map>
 #include <memory>
@@ -19,6 +22,7 @@
 
 #include "brdf/core/error.h"
 #include "fit_data.h"
+#include "fit_kernels.h"
 
 namespace brdf::processing {
 
@@ -45,48 +49,6 @@ T Residual(FitLoss loss, const T& f, double m, double cos_in, double sqrt_w) {
   }
   return T(0);
 }
-
-// One Ceres residual block: a chunk of samples, N fitted values (internal coordinates: the
-// logarithm for log-scale parameters). channel ≥ 0: a legacy model's channel, the N values
-// being that channel's (a, b, shape); channel < 0: all channels, the N values being the whole
-// material layout.
-template <int N>
-struct ChunkCost {
-  const std::vector<FitSample>* samples;
-  std::size_t begin, end;
-  Model model;
-  int channel;
-  FitLoss loss;
-  std::array<bool, N> log_scale;
-
-  template <class T>
-  bool operator()(const T* x, T* r) const {
-    using std::exp;
-    T v[N];
-    for (int i = 0; i < N; ++i) v[i] = log_scale[i] ? exp(x[i]) : x[i];
-    if (channel >= 0) {
-      const T zero(0);
-      for (std::size_t k = begin; k < end; ++k) {
-        const FitSample& s = (*samples)[k];
-        T f;
-        if constexpr (N == 1)
-          f = models::EvaluateChannel(model, s.g, v[0], zero, zero);
-        else
-          f = models::EvaluateChannel(model, s.g, v[0], v[1], v[2]);
-        *r++ = Residual(loss, f, s.m[channel], s.cos_in, s.sqrt_w);
-      }
-    } else {
-      for (std::size_t k = begin; k < end; ++k) {
-        const FitSample& s = (*samples)[k];
-        const std::array<T, 3> f = models::EvaluateRgb(model, s.g, v);
-        for (int c = 0; c < 3; ++c) *r++ = Residual(loss, f[c], s.m[c], s.cos_in, s.sqrt_w);
-      }
-    }
-    return true;
-  }
-};
-
-constexpr std::size_t kChunk = 512;
 
 // The fitted unknowns: one block per independent problem.
 struct Block {
@@ -118,45 +80,245 @@ const ParameterInfo& ParameterOfValue(const ModelInfo& info, int value_index) {
   return info.parameters.front();
 }
 
-template <int N>
-void AddBlockResiduals(ceres::Problem& problem, const std::vector<FitSample>& samples, Model model,
-                       const Block& block, FitLoss loss, ceres::LossFunction* robust, double* x) {
-  ChunkCost<N> proto{&samples, 0, 0, model, block.channel, loss, {}};
-  const ModelInfo& info = DescribeModel(model);
-  for (int i = 0; i < N; ++i)
-    proto.log_scale[static_cast<std::size_t>(i)] =
-        ParameterOfValue(info, block.value_index[static_cast<std::size_t>(i)]).log_scale;
-  const int per_sample = block.channel >= 0 ? 1 : 3;
-  for (std::size_t begin = 0; begin < samples.size(); begin += kChunk) {
-    auto* functor = new ChunkCost<N>(proto);
-    functor->begin = begin;
-    functor->end = std::min(samples.size(), begin + kChunk);
-    const int residuals = static_cast<int>(functor->end - functor->begin) * per_sample;
-    problem.AddResidualBlock(
-        new ceres::AutoDiffCostFunction<ChunkCost<N>, ceres::DYNAMIC, N>(functor, residuals),
-        robust, x);
+// The residual of one sample and channel given the model value f, and its slope dr/df, as
+// Residual above; `target` is the measurement in the loss' own terms (LossTarget, once per fit).
+inline double LossResidual(FitLoss loss, double f, double target, double cos_in, double sqrt_w,
+                           double* slope) {
+  switch (loss) {
+    case FitLoss::kNgan:
+      *slope = sqrt_w * cos_in;
+      return sqrt_w * cos_in * (f - target);
+    case FitLoss::kLog: {
+      const double u = 1.0 + cos_in * f;
+      *slope = sqrt_w * cos_in / u;
+      return sqrt_w * (std::log(u) - target);
+    }
+    case FitLoss::kCbrt: {
+      const double q = std::cbrt(cos_in * f + kCbrtEpsilon);
+      *slope = sqrt_w * cos_in / (3.0 * q * q);
+      return sqrt_w * (q - target);
+    }
   }
+  *slope = 0;
+  return 0;
 }
 
-void AddResiduals(ceres::Problem& problem, const std::vector<FitSample>& samples, Model model,
-                  const Block& block, FitLoss loss, ceres::LossFunction* robust, double* x) {
-  switch (block.value_index.size()) {
-    case 1:
-      return AddBlockResiduals<1>(problem, samples, model, block, loss, robust, x);
-    case 3:
-      return AddBlockResiduals<3>(problem, samples, model, block, loss, robust, x);
-    case 5:
-      return AddBlockResiduals<5>(problem, samples, model, block, loss, robust, x);
-    case 6:
-      return AddBlockResiduals<6>(problem, samples, model, block, loss, robust, x);
-    case 7:
-      return AddBlockResiduals<7>(problem, samples, model, block, loss, robust, x);
-    default:
-      throw InvalidArgument("fit: model " + std::string(ModelName(model)) +
-                            " has an unsupported number of values");
+double LossTarget(FitLoss loss, double m, double cos_in) {
+  switch (loss) {
+    case FitLoss::kNgan:
+      return m;
+    case FitLoss::kLog:
+      return std::log1p(cos_in * m);
+    case FitLoss::kCbrt:
+      return std::cbrt(cos_in * m + kCbrtEpsilon);
   }
+  return m;
 }
 
+// What the residuals need of a sample besides the model's geometry.
+struct LossSample {
+  double sqrt_w, cos_in;
+  std::array<double, 3> target;
+};
+
+// One Ceres residual block standing for the samples [begin, end) of a block's problem.
+//
+// Why not a residual per sample: Levenberg-Marquardt uses the residuals r and Jacobian J of a
+// block only through ½‖r‖² (the cost), JᵀJ and Jᵀr (the step, the gradient, the Jacobi
+// scaling from diag JᵀJ and the predicted decrease ‖r‖² − ‖r + Jδ‖² = −2δᵀJᵀr − δᵀJᵀJδ). Any
+// (r', J') with ‖r'‖ = ‖r‖, J'ᵀJ' = JᵀJ and J'ᵀr' = Jᵀr therefore gives Ceres the same
+// iterations. This block sums JᵀJ and Jᵀr over its samples (the kernels' hand-written
+// derivatives, fit_kernels.h) and hands Ceres N + 1 residuals: with JᵀJ = QΛQᵀ, J' = Λ^½Qᵀ and
+// r'ᵢ = qᵢᵀJᵀr/√λᵢ (rows 0…N−1; Jᵀr lies in the range of JᵀJ), and a last row of zero slope
+// carrying the rest of ‖r‖² (‖r'₀…N−1‖² = ‖P r‖² ≤ ‖r‖², P the projection on J's range).
+// Ceres' cost, gradient, steps and summary are those of the per-sample problem, without a
+// samples × N Jacobian to store and multiply.
+//
+// A robust loss is applied here per sample and channel, as Ceres applies one per residual
+// block (Cauchy's ρ'' < 0, so Ceres' corrector scales r and J by √ρ'): the cost sums ρ(r²),
+// JᵀJ and Jᵀr carry ρ'.
+template <class K>
+class CompressedCost final : public ceres::CostFunction {
+ public:
+  static constexpr int kN = K::kN;
+
+  CompressedCost(const std::vector<typename K::Geom>* geom, const std::vector<LossSample>* loss,
+                 std::size_t begin, std::size_t end, int channel, FitLoss loss_kind,
+                 double robust_scale, const std::array<bool, kN>& log_scale,
+                 const std::array<bool, kN>* fixed = nullptr)
+      : geom_(geom),
+        loss_(loss),
+        begin_(begin),
+        end_(end),
+        channel_(channel),
+        loss_kind_(loss_kind),
+        b2_(robust_scale * robust_scale),
+        log_scale_(log_scale),
+        fixed_(fixed) {
+    set_num_residuals(kN + 1);
+    mutable_parameter_block_sizes()->push_back(kN);
+  }
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    const double* x = parameters[0];
+    double v[kN], dvdx[kN];
+    for (int i = 0; i < kN; ++i) {
+      const bool log = log_scale_[static_cast<std::size_t>(i)];
+      v[i] = log ? std::exp(x[i]) : x[i];
+      // A value held at its bound (SolveBlock) has no slope: Levenberg-Marquardt leaves it.
+      dvdx[i] = fixed_ != nullptr && (*fixed_)[static_cast<std::size_t>(i)] ? 0.0
+                : log                                                       ? v[i]
+                                                                            : 1.0;
+    }
+    const bool jac = jacobians != nullptr && jacobians[0] != nullptr;
+    // Samples in chunks: the first pass evaluates the chunk's residuals and their slopes (times
+    // √ρ' under a robust loss) into columns, the second sums JᵀJ and Jᵀr over the chunk as dot
+    // products of those columns, so no sum is carried from sample to sample through memory.
+    constexpr int kRows = 240;  // a multiple of 3: whole samples of an engine model
+    alignas(16) double rows_r[kRows];
+    alignas(16) double rows_j[kN][kRows];
+    double cost = 0;  // Σ r², or Σ ρ(r²)
+    Eigen::Matrix<double, kN, kN> h = Eigen::Matrix<double, kN, kN>::Zero();
+    Eigen::Matrix<double, kN, 1> g = Eigen::Matrix<double, kN, 1>::Zero();
+    int row = 0;
+    auto flush = [&] {
+      using Column = Eigen::Map<const Eigen::VectorXd, Eigen::Aligned16>;
+      const Column r(rows_r, row);
+      for (int i = 0; i < kN; ++i) {
+        const Column ji(rows_j[i], row);
+        g(i) += ji.dot(r);
+        for (int k = i; k < kN; ++k) h(i, k) += ji.dot(Column(rows_j[k], row));
+      }
+      row = 0;
+    };
+    auto add = [&](const LossSample& ls, int c, double f, const double* df) {
+      double slope;
+      const double r = LossResidual(loss_kind_, f, ls.target[static_cast<std::size_t>(c)],
+                                    ls.cos_in, ls.sqrt_w, &slope);
+      const double sq = r * r;
+      double root_weight = 1;
+      if (b2_ > 0) {
+        cost += b2_ * std::log1p(sq / b2_);
+        root_weight = std::sqrt(1.0 / (1.0 + sq / b2_));
+      } else {
+        cost += sq;
+      }
+      if (!jac) return;
+      rows_r[row] = root_weight * r;
+      const double s = root_weight * slope;
+      for (int i = 0; i < kN; ++i) rows_j[i][row] = s * df[i];
+      ++row;
+    };
+    const std::vector<typename K::Geom>& geom = *geom_;
+    const std::vector<LossSample>& loss = *loss_;
+    for (std::size_t k = begin_; k < end_; ++k) {
+      if constexpr (K::kLegacy) {
+        double df[kN];
+        const double f = K::Eval(geom[k], v, jac ? df : nullptr);
+        add(loss[k], channel_, f, df);
+      } else {
+        double f[3], df[3][kN];
+        K::Eval(geom[k], v, f, jac ? df : nullptr);
+        for (int c = 0; c < 3; ++c) add(loss[k], c, f[c], df[c]);
+      }
+      if (row == kRows) flush();
+    }
+    if (row > 0) flush();
+    if (!std::isfinite(cost)) return false;
+    if (!jac) {
+      for (int i = 0; i < kN; ++i) residuals[i] = 0;
+      residuals[kN] = std::sqrt(cost);
+      return true;
+    }
+    Eigen::Matrix<double, kN, kN> hx;
+    Eigen::Matrix<double, kN, 1> gx;
+    for (int i = 0; i < kN; ++i) {
+      gx(i) = g(i) * dvdx[i];
+      for (int k = i; k < kN; ++k) hx(i, k) = hx(k, i) = h(i, k) * dvdx[i] * dvdx[k];
+    }
+    if (!hx.allFinite() || !gx.allFinite()) return false;
+    // The whole gradient at this point, held values included, for BoundWatch: Ceres evaluates
+    // the Jacobian at every accepted point before its callbacks run.
+    for (int i = 0; i < kN; ++i) {
+      const bool log = log_scale_[static_cast<std::size_t>(i)];
+      last_gradient_[static_cast<std::size_t>(i)] = g(i) * (log ? v[i] : 1.0);
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, kN, kN>> eig(hx);
+    const auto& lambda = eig.eigenvalues();
+    const auto& q = eig.eigenvectors();
+    const double floor = std::max(0.0, lambda.maxCoeff()) * 1e-14;
+    double projected = 0;
+    double* jo = jacobians[0];  // row-major, (kN + 1) × kN
+    for (int i = 0; i < kN; ++i) {
+      const double l = std::max(0.0, lambda(i));
+      const double root = std::sqrt(l);
+      for (int k = 0; k < kN; ++k) jo[i * kN + k] = root * q(k, i);
+      residuals[i] = l > floor ? q.col(i).dot(gx) / root : 0.0;
+      projected += residuals[i] * residuals[i];
+    }
+    for (int k = 0; k < kN; ++k) jo[kN * kN + k] = 0;
+    residuals[kN] = std::sqrt(std::max(0.0, cost - projected));
+    return true;
+  }
+
+ private:
+  const std::vector<typename K::Geom>* geom_;
+  const std::vector<LossSample>* loss_;
+  std::size_t begin_, end_;
+  int channel_;
+  FitLoss loss_kind_;
+  double b2_;
+  std::array<bool, kN> log_scale_;
+  const std::array<bool, kN>* fixed_;
+
+ public:
+  mutable std::array<double, kN> last_gradient_{};
+};
+
+// Stops Ceres when a free value sits on one of its bounds with the gradient pointing out of
+// the range (SolveBlock then holds it there). `released` values are ones found at their bound
+// with the gradient pointing inwards; the gradient is only evaluated for them.
+template <int kN>
+class BoundWatch final : public ceres::IterationCallback {
+ public:
+  using Gradient = std::function<std::array<double, kN>()>;
+  BoundWatch(const double* x, const std::array<double, kN>& lo, const std::array<double, kN>& hi,
+             const std::array<bool, kN>& fixed, const std::array<bool, kN>& released,
+             Gradient gradient)
+      : x_(x),
+        lo_(lo),
+        hi_(hi),
+        fixed_(fixed),
+        released_(released),
+        gradient_(std::move(gradient)) {}
+  ceres::CallbackReturnType operator()(const ceres::IterationSummary&) override {
+    bool check = false;
+    for (std::size_t i = 0; i < kN; ++i) {
+      if (fixed_[i] || !AtBound(i)) continue;
+      if (!released_[i]) return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
+      check = true;
+    }
+    if (!check) return ceres::SOLVER_CONTINUE;
+    const std::array<double, kN> g = gradient_();
+    for (std::size_t i = 0; i < kN; ++i)
+      if (!fixed_[i] && Outward(i, g)) return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
+    return ceres::SOLVER_CONTINUE;
+  }
+  bool AtBound(std::size_t i) const { return AtLower(i) || AtUpper(i); }
+  bool AtLower(std::size_t i) const { return x_[i] <= lo_[i] + 1e-12 * (1 + std::fabs(lo_[i])); }
+  bool AtUpper(std::size_t i) const { return x_[i] >= hi_[i] - 1e-12 * (1 + std::fabs(hi_[i])); }
+  // The cost decreases by leaving the range at value i (d cost/dx > 0 at the lower bound).
+  bool Outward(std::size_t i, const std::array<double, kN>& g) const {
+    return (AtLower(i) && g[i] > 0) || (AtUpper(i) && g[i] < 0);
+  }
+
+ private:
+  const double* x_;
+  const std::array<double, kN>&lo_, &hi_;
+  const std::array<bool, kN>&fixed_, &released_;
+  Gradient gradient_;
+};
 // ----------------------------------------------------------------------------------------------
 // Costs in doubles.
 
@@ -206,6 +368,10 @@ std::vector<double> ShapeGrid(const ParameterInfo& p) {
 struct Sums {
   double aa = 0, ab = 0, bb = 0, am = 0, bm = 0, mm = 0;
 };
+// ½ Σ (w·(m − a·A − b·B))² from the sums.
+double SumsCost(const Sums& s, double a, double b) {
+  return 0.5 * (s.mm - 2 * (a * s.am + b * s.bm) + a * a * s.aa + 2 * a * b * s.ab + b * b * s.bb);
+}
 std::pair<double, double> SolveBox(const Sums& s, bool two) {
   auto cost = [&](double a, double b) {
     return s.mm - 2 * (a * s.am + b * s.bm) + a * a * s.aa + 2 * a * b * s.ab + b * b * s.bb;
@@ -233,82 +399,6 @@ struct Candidate {
   Material material;
   double cost = 0;
 };
-
-// Legacy models: for each shape, kd and ks (or f0, ρs) per channel in closed form (the model
-// is affine in them: f = a·A + b·B + C, the basis from three evaluations).
-void SweepLegacy(const std::vector<FitSample>& sub, Model model, FitLoss loss,
-                 std::vector<Candidate>* out) {
-  const ModelInfo& info = DescribeModel(model);
-  const bool two = info.parameters.size() > 1;
-  const std::vector<double> grid =
-      info.shape_parameter >= 0
-          ? ShapeGrid(info.parameters[static_cast<std::size_t>(info.shape_parameter)])
-          : std::vector<double>{0.0};
-  for (const double shape : grid) {
-    Material m;
-    m.model = model;
-    for (int c = 0; c < 3; ++c) {
-      Sums s;
-      for (const FitSample& x : sub) {
-        const double base = models::EvaluateChannel(model, x.g, 0.0, 0.0, shape);
-        const double a = models::EvaluateChannel(model, x.g, 1.0, 0.0, shape) - base;
-        const double b = two ? models::EvaluateChannel(model, x.g, 0.0, 1.0, shape) - base : 0.0;
-        const double w = x.sqrt_w * x.cos_in;
-        const double wa = w * a, wb = w * b, wm = w * (x.m[c] - base);
-        s.aa += wa * wa, s.ab += wa * wb, s.bb += wb * wb;
-        s.am += wa * wm, s.bm += wb * wm, s.mm += wm * wm;
-      }
-      const auto [a, b] = SolveBox(s, two);
-      m.values[static_cast<std::size_t>(info.parameters[0].offset + c)] = a;
-      if (two) {
-        m.values[static_cast<std::size_t>(info.parameters[1].offset + c)] = b;
-        m.values[static_cast<std::size_t>(info.parameters[2].offset + c)] = shape;
-      }
-    }
-    out->push_back({m, Cost(sub, m, loss)});
-  }
-}
-
-// Engine models: a grid over the shape slider and metallic (or a grey specular colour); the
-// base colour per channel in closed form (affine in it once the others are fixed).
-void SweepEngine(const std::vector<FitSample>& sub, Model model, FitLoss loss,
-                 std::vector<Candidate>* out) {
-  const ModelInfo& info = DescribeModel(model);
-  const ParameterInfo& shape_p = info.parameters[static_cast<std::size_t>(info.shape_parameter)];
-  const ParameterInfo& second = info.parameters[1];  // metallic or specular_color
-  const std::vector<double> second_grid = second.rgb
-                                              ? std::vector<double>{0.02, 0.04, 0.08, 0.2, 0.5, 0.9}
-                                              : std::vector<double>{0.0, 0.5, 1.0};
-  for (const double shape : ShapeGrid(shape_p)) {
-    for (const double level : second_grid) {
-      Material m;
-      m.model = model;
-      for (const ParameterInfo& p : info.parameters)
-        for (int c = 0; c < p.Count(); ++c)
-          m.values[static_cast<std::size_t>(p.offset + c)] = p.start;
-      for (int c = 0; c < second.Count(); ++c)
-        m.values[static_cast<std::size_t>(second.offset + c)] = level;
-      for (int c = 0; c < shape_p.Count(); ++c)
-        m.values[static_cast<std::size_t>(shape_p.offset + c)] = shape;
-      Material zero = m, one = m;
-      for (int c = 0; c < 3; ++c)
-        zero.values[static_cast<std::size_t>(c)] = 0, one.values[static_cast<std::size_t>(c)] = 1;
-      std::array<Sums, 3> s{};
-      for (const FitSample& x : sub) {
-        const auto f0 = models::EvaluateRgb(model, x.g, zero.values.data());
-        const auto f1 = models::EvaluateRgb(model, x.g, one.values.data());
-        const double w = x.sqrt_w * x.cos_in;
-        for (int c = 0; c < 3; ++c) {
-          const double wa = w * (f1[c] - f0[c]), wm = w * (x.m[c] - f0[c]);
-          s[c].aa += wa * wa, s[c].am += wa * wm, s[c].mm += wm * wm;
-        }
-      }
-      for (int c = 0; c < 3; ++c)
-        m.values[static_cast<std::size_t>(c)] = SolveBox(s[c], false).first;
-      out->push_back({m, Cost(sub, m, loss)});
-    }
-  }
-}
 
 Material ClampIntoRange(Material m) {
   const ModelInfo& info = DescribeModel(m.model);
@@ -338,47 +428,15 @@ struct Refinement {
   std::string message;
 };
 
-// One block's problem: its own Ceres problem, since the blocks share no residual (the legacy
-// models' channels are independent; an engine model is a single block). Separate problems keep
-// each Jacobian dense and three times smaller than one joint problem would make it.
+// One block's outcome. Each block is its own Ceres problem: the blocks share no residual (the
+// legacy models' channels are independent; an engine model is a single block).
 struct BlockOutcome {
   std::vector<double> x;
-  ceres::Solver::Summary summary;
+  double initial_cost = 0, final_cost = 0;
+  int iterations = 0;
+  ceres::TerminationType termination = ceres::FAILURE;
+  std::string message;
 };
-
-BlockOutcome SolveBlock(const std::vector<FitSample>& samples, const Material& start,
-                        const Block& block, const FitOptions& options, double robust_scale,
-                        int threads) {
-  const ModelInfo& info = DescribeModel(start.model);
-  BlockOutcome out;
-  out.x.resize(block.value_index.size());
-  for (std::size_t i = 0; i < block.value_index.size(); ++i) {
-    const ParameterInfo& p = ParameterOfValue(info, block.value_index[i]);
-    const double v = start.values[static_cast<std::size_t>(block.value_index[i])];
-    out.x[i] = p.log_scale ? std::log(v) : v;
-  }
-  ceres::Problem problem;
-  ceres::LossFunction* robust = robust_scale > 0 ? new ceres::CauchyLoss(robust_scale) : nullptr;
-  AddResiduals(problem, samples, start.model, block, options.loss, robust, out.x.data());
-  for (std::size_t i = 0; i < block.value_index.size(); ++i) {
-    const ParameterInfo& p = ParameterOfValue(info, block.value_index[i]);
-    problem.SetParameterLowerBound(out.x.data(), static_cast<int>(i),
-                                   p.log_scale ? std::log(p.min) : p.min);
-    problem.SetParameterUpperBound(out.x.data(), static_cast<int>(i),
-                                   p.log_scale ? std::log(p.max) : p.max);
-  }
-  ceres::Solver::Options so;
-  so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
-  so.max_num_iterations = options.max_iterations;
-  so.num_threads = threads;
-  so.function_tolerance = 1e-10;
-  so.parameter_tolerance = 1e-10;
-  so.gradient_tolerance = 1e-12;
-  so.logging_type = ceres::SILENT;
-  so.minimizer_progress_to_stdout = false;
-  ceres::Solve(so, &problem, &out.summary);
-  return out;
-}
 
 int Rank(ceres::TerminationType t) {  // worse outcomes rank higher
   switch (t) {
@@ -391,59 +449,403 @@ int Rank(ceres::TerminationType t) {  // worse outcomes rank higher
   }
 }
 
-Refinement Refine(const std::vector<FitSample>& samples, const Material& start,
-                  const FitOptions& options, double robust_scale) {
-  const ModelInfo& info = DescribeModel(start.model);
-  const std::vector<Block> blocks = BlocksOf(start.model);
-  std::vector<BlockOutcome> outcomes(blocks.size());
-  // Independent blocks run on their own threads when there are threads to spare.
-  const int parallel = std::min<int>(options.threads, static_cast<int>(blocks.size()));
-  if (parallel > 1) {
-    std::vector<std::thread> workers;
-    std::atomic<std::size_t> next{0};
-    std::exception_ptr error;
-    std::mutex error_mutex;
-    for (int t = 0; t < parallel; ++t)
-      workers.emplace_back([&] {
-        for (std::size_t b; (b = next++) < blocks.size();) {
-          try {
-            outcomes[b] = SolveBlock(samples, start, blocks[b], options, robust_scale, 1);
-          } catch (...) {
-            const std::lock_guard<std::mutex> lock(error_mutex);
-            error = std::current_exception();
+// Everything of a fit that runs over the samples, for one model's kernel K (fit_kernels.h):
+// the geometry prepared once, the sweep and the Ceres refinements.
+template <class K>
+class KernelFit {
+ public:
+  static constexpr int kN = K::kN;
+
+  KernelFit(const FitData& data, const FitOptions& options)
+      : data_(data), options_(options), info_(DescribeModel(options.model)) {
+    geom_.reserve(data.samples.size());
+    loss_.reserve(data.samples.size());
+    for (const FitSample& s : data.samples) {
+      geom_.push_back(K::Prepare(s.g));
+      LossSample l{s.sqrt_w, s.cos_in, {}};
+      for (std::size_t c = 0; c < 3; ++c) l.target[c] = LossTarget(options.loss, s.m[c], s.cos_in);
+      loss_.push_back(l);
+    }
+  }
+
+  // ½ Σ r² of `m` over every `stride`-th sample, without a robust loss.
+  double Cost(const Material& m, std::size_t stride = 1) const {
+    double sum = 0, slope;
+    for (std::size_t k = 0; k < geom_.size(); k += stride) {
+      const LossSample& l = loss_[k];
+      double f[3];
+      if constexpr (K::kLegacy) {
+        for (std::size_t c = 0; c < 3; ++c) {
+          double v[kN];
+          for (int i = 0; i < kN; ++i) v[i] = m.values[c + 3 * static_cast<std::size_t>(i)];
+          f[c] = K::Eval(geom_[k], v, nullptr);
+        }
+      } else {
+        K::Eval(geom_[k], m.values.data(), f, nullptr);
+      }
+      for (std::size_t c = 0; c < 3; ++c) {
+        const double r = LossResidual(options_.loss, f[c], l.target[c], l.cos_in, l.sqrt_w, &slope);
+        sum += r * r;
+      }
+    }
+    return 0.5 * sum;
+  }
+
+  // The sweep on every `stride`-th sample: candidates with their cost on those samples.
+  std::vector<Candidate> Sweep(std::size_t stride) const {
+    std::vector<Candidate> out;
+    if constexpr (K::kLegacy)
+      SweepLegacy(stride, &out);
+    else
+      SweepEngine(stride, &out);
+    return out;
+  }
+
+  Refinement Refine(const Material& start, double robust_scale) const {
+    const std::vector<Block> blocks = BlocksOf(start.model);
+    std::vector<BlockOutcome> outcomes(blocks.size());
+    // Independent blocks run on their own threads when there are threads to spare.
+    const int parallel = std::min<int>(options_.threads, static_cast<int>(blocks.size()));
+    if (parallel > 1) {
+      std::vector<std::thread> workers;
+      std::atomic<std::size_t> next{0};
+      std::exception_ptr error;
+      std::mutex error_mutex;
+      for (int t = 0; t < parallel; ++t)
+        workers.emplace_back([&] {
+          for (std::size_t b; (b = next++) < blocks.size();) {
+            try {
+              outcomes[b] = SolveBlock(start, blocks[b], robust_scale, 1);
+            } catch (...) {
+              const std::lock_guard<std::mutex> lock(error_mutex);
+              error = std::current_exception();
+            }
+          }
+        });
+      for (std::thread& w : workers) w.join();
+      if (error) std::rethrow_exception(error);
+    } else {
+      for (std::size_t b = 0; b < blocks.size(); ++b)
+        outcomes[b] = SolveBlock(start, blocks[b], robust_scale, options_.threads);
+    }
+
+    Refinement out;
+    out.material = start;
+    out.termination = ceres::CONVERGENCE;
+    for (std::size_t b = 0; b < blocks.size(); ++b) {
+      const BlockOutcome& summary = outcomes[b];
+      for (std::size_t i = 0; i < blocks[b].value_index.size(); ++i) {
+        const ParameterInfo& p = ParameterOfValue(info_, blocks[b].value_index[i]);
+        out.material.values[static_cast<std::size_t>(blocks[b].value_index[i])] =
+            p.log_scale ? std::exp(outcomes[b].x[i]) : outcomes[b].x[i];
+      }
+      out.initial_cost += summary.initial_cost;
+      out.final_cost += summary.final_cost;
+      out.iterations += summary.iterations;
+      if (Rank(summary.termination) >= Rank(out.termination)) {
+        out.termination = summary.termination;
+        out.message = (blocks.size() > 1 ? "channel " + std::to_string(b) + ": " : std::string()) +
+                      summary.message;
+      }
+    }
+    out.material = ClampIntoRange(out.material);
+    return out;
+  }
+
+ private:
+  // Legacy models: for each shape, kd and ks (or f0, ρs) per channel in closed form. The model
+  // is affine in them, f = a·A + b·B + C, and the kernel's slopes at a = b = 0 are A and B.
+  void SweepLegacy(std::size_t stride, std::vector<Candidate>* out) const {
+    const bool two = kN == 3;
+    const std::vector<double> grid =
+        info_.shape_parameter >= 0
+            ? ShapeGrid(info_.parameters[static_cast<std::size_t>(info_.shape_parameter)])
+            : std::vector<double>{0.0};
+    for (const double shape : grid) {
+      std::array<Sums, 3> s{};
+      for (std::size_t k = 0; k < geom_.size(); k += stride) {
+        double v[kN] = {}, d[kN];
+        v[kN - 1] = kN == 3 ? shape : 0.0;
+        const double base = K::Eval(geom_[k], v, d);
+        const double a = d[0], b = two ? d[1] : 0.0;
+        const FitSample& x = data_.samples[k];
+        const double w = x.sqrt_w * x.cos_in;
+        const double wa = w * a, wb = w * b;
+        for (std::size_t c = 0; c < 3; ++c) {
+          const double wm = w * (x.m[c] - base);
+          s[c].aa += wa * wa, s[c].ab += wa * wb, s[c].bb += wb * wb;
+          s[c].am += wa * wm, s[c].bm += wb * wm, s[c].mm += wm * wm;
+        }
+      }
+      Material m;
+      m.model = options_.model;
+      double cost = 0;
+      for (std::size_t c = 0; c < 3; ++c) {
+        const auto [a, b] = SolveBox(s[c], two);
+        m.values[static_cast<std::size_t>(info_.parameters[0].offset) + c] = a;
+        if (two) {
+          m.values[static_cast<std::size_t>(info_.parameters[1].offset) + c] = b;
+          m.values[static_cast<std::size_t>(info_.parameters[2].offset) + c] = shape;
+        }
+        cost += SumsCost(s[c], a, b);
+      }
+      out->push_back({m, options_.loss == FitLoss::kNgan ? cost : Cost(m, stride)});
+    }
+  }
+
+  // Engine models: a grid over the shape slider and metallic (or a grey specular colour); the
+  // base colour per channel in closed form (affine in it once the others are fixed).
+  void SweepEngine(std::size_t stride, std::vector<Candidate>* out) const {
+    const ParameterInfo& shape_p =
+        info_.parameters[static_cast<std::size_t>(info_.shape_parameter)];
+    const ParameterInfo& second = info_.parameters[1];  // metallic or specular_color
+    const std::vector<double> second_grid =
+        second.rgb ? std::vector<double>{0.02, 0.04, 0.08, 0.2, 0.5, 0.9}
+                   : std::vector<double>{0.0, 0.5, 1.0};
+    for (const double shape : ShapeGrid(shape_p)) {
+      for (const double level : second_grid) {
+        Material m;
+        m.model = options_.model;
+        for (const ParameterInfo& p : info_.parameters)
+          for (int c = 0; c < p.Count(); ++c)
+            m.values[static_cast<std::size_t>(p.offset + c)] = p.start;
+        for (int c = 0; c < second.Count(); ++c)
+          m.values[static_cast<std::size_t>(second.offset + c)] = level;
+        for (int c = 0; c < shape_p.Count(); ++c)
+          m.values[static_cast<std::size_t>(shape_p.offset + c)] = shape;
+        Material zero = m, one = m;
+        for (std::size_t c = 0; c < 3; ++c) zero.values[c] = 0, one.values[c] = 1;
+        std::array<Sums, 3> s{};
+        for (std::size_t k = 0; k < geom_.size(); k += stride) {
+          double f0[3], f1[3];
+          K::Eval(geom_[k], zero.values.data(), f0, nullptr);
+          K::Eval(geom_[k], one.values.data(), f1, nullptr);
+          const FitSample& x = data_.samples[k];
+          const double w = x.sqrt_w * x.cos_in;
+          for (std::size_t c = 0; c < 3; ++c) {
+            const double wa = w * (f1[c] - f0[c]), wm = w * (x.m[c] - f0[c]);
+            s[c].aa += wa * wa, s[c].am += wa * wm, s[c].mm += wm * wm;
           }
         }
-      });
-    for (std::thread& w : workers) w.join();
-    if (error) std::rethrow_exception(error);
-  } else {
-    for (std::size_t b = 0; b < blocks.size(); ++b)
-      outcomes[b] = SolveBlock(samples, start, blocks[b], options, robust_scale, options.threads);
+        double cost = 0;
+        for (std::size_t c = 0; c < 3; ++c) {
+          m.values[c] = SolveBox(s[c], false).first;
+          cost += SumsCost(s[c], m.values[c], 0);
+        }
+        // Exact for the ngan loss wherever the model is affine in the base colour (Unreal's
+        // saturate(50·f0.g) is not, below f0.g = 0.02): FitMaterial recomputes the best ones.
+        out->push_back({m, options_.loss == FitLoss::kNgan ? cost : Cost(m, stride)});
+      }
+    }
   }
 
-  Refinement out;
-  out.material = start;
-  out.termination = ceres::CONVERGENCE;
-  for (std::size_t b = 0; b < blocks.size(); ++b) {
-    const ceres::Solver::Summary& summary = outcomes[b].summary;
-    for (std::size_t i = 0; i < blocks[b].value_index.size(); ++i) {
-      const ParameterInfo& p = ParameterOfValue(info, blocks[b].value_index[i]);
-      out.material.values[static_cast<std::size_t>(blocks[b].value_index[i])] =
-          p.log_scale ? std::exp(outcomes[b].x[i]) : outcomes[b].x[i];
+  // One block's refinement. Ceres handles bounds by projecting each step onto them; when the
+  // optimum lies on a bound (metallic 0, ks 0) with the gradient pointing out of the range, the
+  // projected steps' predicted decrease is mostly the part cut off, the trust region shrinks
+  // and Ceres crawls along the bound until the function tolerance stops it (57 iterations for
+  // URP's metallic). So a value that reaches a bound with the gradient pointing outwards is held
+  // there (an active set) and Ceres resumes on the others; a held value whose gradient turns
+  // inwards at the end is released and Ceres resumes again. The result satisfies the same
+  // optimality conditions (zero gradient in the free values, outward at the held ones).
+  BlockOutcome SolveBlock(const Material& start, const Block& block, double robust_scale,
+                          int threads) const {
+    BlockOutcome out;
+    out.x.resize(block.value_index.size());
+    std::array<bool, kN> log_scale{}, fixed{}, released{};
+    std::array<double, kN> lo{}, hi{};
+    for (std::size_t i = 0; i < block.value_index.size(); ++i) {
+      const ParameterInfo& p = ParameterOfValue(info_, block.value_index[i]);
+      const double v = start.values[static_cast<std::size_t>(block.value_index[i])];
+      out.x[i] = p.log_scale ? std::log(v) : v;
+      log_scale[i] = p.log_scale;
+      lo[i] = p.log_scale ? std::log(p.min) : p.min;
+      hi[i] = p.log_scale ? std::log(p.max) : p.max;
+      out.x[i] = std::clamp(out.x[i], lo[i], hi[i]);
     }
-    out.initial_cost += summary.initial_cost;
-    out.final_cost += summary.final_cost;
-    out.iterations += static_cast<int>(summary.iterations.size());
-    if (Rank(summary.termination_type) >= Rank(out.termination)) {
+    ceres::Problem problem;
+    // One residual block per thread (CompressedCost explains why not one per sample).
+    const std::size_t n = geom_.size();
+    const std::size_t parts = static_cast<std::size_t>(std::max(1, threads));
+    for (std::size_t t = 0; t < parts; ++t) {
+      const std::size_t begin = n * t / parts, end = n * (t + 1) / parts;
+      if (begin == end) continue;
+      problem.AddResidualBlock(
+          new CompressedCost<K>(&geom_, &loss_, begin, end, block.channel, options_.loss,
+                                robust_scale, log_scale, &fixed),
+          nullptr, out.x.data());
+    }
+    for (std::size_t i = 0; i < block.value_index.size(); ++i) {
+      problem.SetParameterLowerBound(out.x.data(), static_cast<int>(i), lo[i]);
+      problem.SetParameterUpperBound(out.x.data(), static_cast<int>(i), hi[i]);
+    }
+    ceres::Solver::Options so;
+    so.linear_solver_type = ceres::DENSE_NORMAL_CHOLESKY;
+    so.num_threads = threads;
+    so.function_tolerance = 1e-10;
+    so.parameter_tolerance = 1e-10;
+    so.gradient_tolerance = 1e-12;
+    so.logging_type = ceres::SILENT;
+    so.minimizer_progress_to_stdout = false;
+    so.update_state_every_iteration = true;
+    // The whole gradient (held values included) for the decisions between rounds.
+    const CompressedCost<K> whole(&geom_, &loss_, 0, n, block.channel, options_.loss, robust_scale,
+                                  log_scale);
+    auto gradient = [&] {
+      double residuals[kN + 1], jacobian[(kN + 1) * kN];
+      const double* parameters[] = {out.x.data()};
+      double* jacobians[] = {jacobian};
+      std::array<double, kN> g{};
+      if (!whole.Evaluate(parameters, residuals, jacobians)) return g;
+      for (std::size_t i = 0; i < kN; ++i)
+        for (std::size_t r = 0; r <= kN; ++r) g[i] += jacobian[r * kN + i] * residuals[r];
+      return g;
+    };
+    std::vector<const CompressedCost<K>*> costs;
+    {
+      std::vector<ceres::ResidualBlockId> ids;
+      problem.GetResidualBlocks(&ids);
+      for (ceres::ResidualBlockId id : ids)
+        costs.push_back(
+            static_cast<const CompressedCost<K>*>(problem.GetCostFunctionForResidualBlock(id)));
+    }
+    auto last_gradient = [&costs] {
+      std::array<double, kN> g{};
+      for (const CompressedCost<K>* c : costs)
+        for (std::size_t i = 0; i < kN; ++i) g[i] += c->last_gradient_[i];
+      return g;
+    };
+    BoundWatch<kN> watch(out.x.data(), lo, hi, fixed, released, last_gradient);
+    so.callbacks.push_back(&watch);
+    auto outward = [&](std::size_t i, const std::array<double, kN>& g) {
+      return watch.Outward(i, g);
+    };
+    int remaining = options_.max_iterations;
+    for (int round = 0; round < 2 * kN + 2 && remaining > 0; ++round) {
+      so.max_num_iterations = remaining;
+      ceres::Solver::Summary summary;
+      ceres::Solve(so, &problem, &summary);
+      if (round == 0) out.initial_cost = summary.initial_cost;
+      out.final_cost = summary.final_cost;
+      const int steps = std::max(1, static_cast<int>(summary.iterations.size()) - 1);
+      out.iterations += steps;
+      remaining -= steps;
       out.termination = summary.termination_type;
-      out.message = (blocks.size() > 1 ? "channel " + std::to_string(b) + ": " : std::string()) +
-                    summary.message;
+      out.message = summary.message;
+      if (summary.termination_type != ceres::USER_SUCCESS) {
+        if (summary.termination_type != ceres::CONVERGENCE) break;
+        // Converged on the free values: release held ones the gradient now pulls inwards.
+        const std::array<double, kN> g = gradient();
+        bool again = false;
+        for (std::size_t i = 0; i < kN; ++i)
+          if (fixed[i] && !outward(i, g)) fixed[i] = false, released[i] = true, again = true;
+        if (!again) break;
+        continue;
+      }
+      // A free value reached a bound: hold it if the gradient points out, else let Ceres go on.
+      const std::array<double, kN> g = gradient();
+      for (std::size_t i = 0; i < kN; ++i)
+        if (!fixed[i] && watch.AtBound(i)) {
+          if (outward(i, g))
+            fixed[i] = true, released[i] = false;
+          else
+            released[i] = true;
+        }
     }
+    if (out.termination == ceres::USER_SUCCESS) out.termination = ceres::NO_CONVERGENCE;
+    return out;
   }
-  out.material = ClampIntoRange(out.material);
-  return out;
+
+  const FitData& data_;
+  const FitOptions& options_;
+  const ModelInfo& info_;
+  std::vector<typename K::Geom> geom_;
+  std::vector<LossSample> loss_;
+};
+
+struct Search {
+  std::optional<Refinement> best;
+  int iterations = 0, starts = 0;
+};
+
+// The multi-start: candidates from the sweep (or the given start), Ceres from the best
+// options.starts distinct ones, the lowest final cost wins.
+template <class K>
+Search RunFit(const FitData& data, const FitOptions& options) {
+  const KernelFit<K> fit(data, options);
+  std::vector<Candidate> candidates;
+  if (options.start) {
+    candidates.push_back({ClampIntoRange(*options.start), 0});
+  } else {
+    // The sweep on a subsample (every k-th sample), its best few costs recomputed exactly.
+    const std::size_t stride = std::max<std::size_t>(1, data.samples.size() / 15000);
+    candidates = fit.Sweep(stride);
+    auto by_cost = [](const Candidate& a, const Candidate& b) { return a.cost < b.cost; };
+    std::stable_sort(candidates.begin(), candidates.end(), by_cost);
+    const std::size_t exact =
+        std::min(candidates.size(), static_cast<std::size_t>(2 * options.starts + 2));
+    for (std::size_t i = 0; i < exact; ++i)
+      candidates[i].cost = fit.Cost(candidates[i].material, stride);
+    std::stable_sort(candidates.begin(), candidates.begin() + static_cast<std::ptrdiff_t>(exact),
+                     by_cost);
+  }
+  std::vector<Material> starts;
+  for (const Candidate& c : candidates) {
+    if (static_cast<int>(starts.size()) >= options.starts) break;
+    bool seen = false;
+    for (const Material& s : starts) seen |= SameStart(s, c.material);
+    if (!seen) starts.push_back(ClampIntoRange(c.material));
+  }
+
+  double robust_scale = 0;
+  if (options.robust) {
+    robust_scale = options.robust_scale > 0
+                       ? options.robust_scale
+                       : 1.4826 * MedianAbsResidual(data.samples, starts.front(), options.loss);
+    robust_scale = std::max(robust_scale, 1e-12);
+  }
+
+  Search search;
+  std::optional<Refinement>& best = search.best;
+  for (const Material& start : starts) {
+    Refinement r = fit.Refine(start, robust_scale);
+    search.iterations += r.iterations;
+    ++search.starts;
+    if (r.termination == ceres::FAILURE || r.termination == ceres::USER_FAILURE) {
+      if (!best) best = r;
+      continue;
+    }
+    if (!best || best->termination == ceres::FAILURE || best->termination == ceres::USER_FAILURE ||
+        r.final_cost < best->final_cost)
+      best = std::move(r);
+  }
+  return search;
 }
 
+Search RunFitOf(const FitData& data, const FitOptions& options) {
+  switch (options.model) {
+    case Model::kLambert:
+      return RunFit<kernels::LambertKernel>(data, options);
+    case Model::kLafortune:
+      return RunFit<kernels::LafortuneKernel>(data, options);
+    case Model::kBlinnPhong:
+      return RunFit<kernels::BlinnPhongKernel>(data, options);
+    case Model::kGgx:
+      return RunFit<kernels::GgxKernel>(data, options);
+    case Model::kWard:
+      return RunFit<kernels::WardKernel>(data, options);
+    case Model::kUnrealDefaultLit:
+      return RunFit<kernels::UnrealKernel>(data, options);
+    case Model::kUnityHdrpLit:
+      return RunFit<kernels::HdrpKernel>(data, options);
+    case Model::kUnityHdrpLitSpecular:
+      return RunFit<kernels::HdrpSpecularKernel>(data, options);
+    case Model::kUnityUrpLit:
+      return RunFit<kernels::UrpKernel>(data, options);
+    case Model::kUnityUrpLitSpecular:
+      return RunFit<kernels::UrpSpecularKernel>(data, options);
+  }
+  throw InvalidArgument("fit: unknown model");
+}
 std::string Format(const char* fmt, double a, double b = 0, double c = 0, double d = 0) {
   char buf[256];
   std::snprintf(buf, sizeof buf, fmt, a, b, c, d);
@@ -499,54 +901,14 @@ FitResult FitMaterial(const Measurement& measurement, const FitOptions& options)
   const FitData data = PrepareFitData(measurement, options);
   const Model model = options.model;
 
-  // Candidates: the given start, or the sweep on a subsample (every k-th sample).
-  std::vector<Candidate> candidates;
-  if (options.start) {
-    candidates.push_back({ClampIntoRange(*options.start), 0});
-  } else {
-    const std::size_t stride = std::max<std::size_t>(1, data.samples.size() / 15000);
-    std::vector<FitSample> sub;
-    for (std::size_t k = 0; k < data.samples.size(); k += stride) sub.push_back(data.samples[k]);
-    if (models::ChannelsIndependent(model))
-      SweepLegacy(sub, model, options.loss, &candidates);
-    else
-      SweepEngine(sub, model, options.loss, &candidates);
-    std::stable_sort(candidates.begin(), candidates.end(),
-                     [](const Candidate& a, const Candidate& b) { return a.cost < b.cost; });
-  }
-  std::vector<Material> starts;
-  for (const Candidate& c : candidates) {
-    if (static_cast<int>(starts.size()) >= options.starts) break;
-    bool seen = false;
-    for (const Material& s : starts) seen |= SameStart(s, c.material);
-    if (!seen) starts.push_back(ClampIntoRange(c.material));
-  }
-
-  double robust_scale = 0;
-  if (options.robust) {
-    robust_scale = options.robust_scale > 0
-                       ? options.robust_scale
-                       : 1.4826 * MedianAbsResidual(data.samples, starts.front(), options.loss);
-    robust_scale = std::max(robust_scale, 1e-12);
-  }
-
+  Search search = RunFitOf(data, options);
+  const std::optional<Refinement>& best = search.best;
   FitReport report;
   report.model = model;
   report.loss = options.loss;
   report.robust = options.robust;
-  std::optional<Refinement> best;
-  for (const Material& start : starts) {
-    Refinement r = Refine(data.samples, start, options, robust_scale);
-    report.iterations += r.iterations;
-    ++report.starts;
-    if (r.termination == ceres::FAILURE || r.termination == ceres::USER_FAILURE) {
-      if (!best) best = r;
-      continue;
-    }
-    if (!best || best->termination == ceres::FAILURE || best->termination == ceres::USER_FAILURE ||
-        r.final_cost < best->final_cost)
-      best = std::move(r);
-  }
+  report.iterations = search.iterations;
+  report.starts = search.starts;
   report.converged = best->termination == ceres::CONVERGENCE;
   report.status = report.converged                             ? "converged"
                   : best->termination == ceres::NO_CONVERGENCE ? "no-convergence"
