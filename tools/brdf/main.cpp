@@ -495,9 +495,23 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"clamp", "reinhard"}));
   preview_cmd
       ->add_option("--estimator", preview.estimator,
-                   "mis (default), env, brdf, or quadrature (sphere and plane only)")
+                   "auto: on the sphere the deterministic hierarchical quadrature (about 1 s, "
+                   "within 0.3 % of the converged image), else mis; with --spp or --rms auto "
+                   "means mis. hierarchical (sphere, plane), mis (Monte Carlo: map and BRDF "
+                   "samples), env, brdf, or quadrature (brute force over every map pixel: the "
+                   "slow reference; sphere and plane)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"mis", "env", "brdf", "quadrature"}));
+      ->check(CLI::IsMember({"auto", "hierarchical", "mis", "env", "brdf", "quadrature"}));
+  preview_cmd
+      ->add_option("--subdivisions", preview.subdivisions,
+                   "quadrature: each map pixel split N × N (midpoint rule)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 16));
+  preview_cmd
+      ->add_option("--sample-pixels", preview.sample_pixels,
+                   "Render only N object pixels spread evenly over the image, the rest black "
+                   "(references with the slow estimators)")
+      ->check(CLI::Range(1, 1 << 26));
   preview_cmd->add_option("--extrapolate", preview.extrapolate,
                           "Captures: grazing extrapolation P,L (docs/design.md §6)");
   preview_cmd->add_option("--jobs", preview.jobs, "Worker threads")
@@ -515,6 +529,7 @@ int main(int argc, char** argv) {
       "behind the object. EXR: linear radiance; PNG: exposure, then the tone curve, then sRGB.\n");
   preview_cmd->callback([&] {
     preview.env_given = preview_env->count() > 0;
+    preview.spp_given = preview_spp->count() > 0;
     exit_code = brdf::cli::RunPreview(preview);
   });
 
