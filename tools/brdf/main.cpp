@@ -468,12 +468,13 @@ int main(int argc, char** argv) {
   preview_cmd->add_option("--size", preview.size, "Image width and height in pixels")
       ->capture_default_str()
       ->check(CLI::Range(1, 8192));
-  auto* preview_spp = preview_cmd->add_option("--spp", preview.spp, "Samples (passes) per pixel")
+  auto* preview_spp = preview_cmd->add_option("--spp", preview.spp,
+                                              "Monte Carlo passes per pixel (selects mis)")
                           ->capture_default_str()
                           ->check(CLI::Range(1, 1 << 20));
   preview_cmd
       ->add_option("--rms", preview.rms,
-                   "Instead of --spp: render until the estimated relative RMS error is below "
+                   "Instead of --spp: Monte Carlo until the estimated relative RMS error is below "
                    "this (e.g. 0.01)")
       ->check(CLI::Range(1e-6, 1.0))
       ->excludes(preview_spp);
@@ -495,11 +496,12 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"clamp", "reinhard"}));
   preview_cmd
       ->add_option("--estimator", preview.estimator,
-                   "auto: on the sphere the deterministic hierarchical quadrature (about 1 s, "
-                   "within 0.3 % of the converged image), else mis; with --spp or --rms auto "
-                   "means mis. hierarchical (sphere, plane), mis (Monte Carlo: map and BRDF "
-                   "samples), env, brdf, or quadrature (brute force over every map pixel: the "
-                   "slow reference; sphere and plane)")
+                   "auto (default): the sphere by the deterministic hierarchical quadrature "
+                   "(one pass, within about 0.1-0.4 % RMS of the converged image; "
+                   "docs/preview.md), planes and meshes by mis; with --spp or --rms, mis. "
+                   "Or: hierarchical (sphere, plane), mis (Monte Carlo, map and BRDF samples "
+                   "combined), env, brdf, quadrature (brute force over every map pixel, the slow "
+                   "reference; sphere, plane)")
       ->capture_default_str()
       ->check(CLI::IsMember({"auto", "hierarchical", "mis", "env", "brdf", "quadrature"}));
   preview_cmd

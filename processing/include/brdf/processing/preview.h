@@ -202,7 +202,7 @@ struct PreviewOptions {
   // at most image_tolerance·Ȳ in every channel, else split in four down to single pixels; 1:
   // every pixel computed. With the defaults the image is within about 0.1–0.4 % RMS of the
   // brute-force kQuadrature (docs/benchmarks.md).
-  double hierarchical_tolerance = 0.01;
+  double hierarchical_tolerance = 0.02;
   int image_block = 16;
   double image_tolerance = 0.03;
   // Kept for references at a subset of pixels: when non-empty, only these image pixels
