@@ -93,9 +93,14 @@ class PassProgress {
     const bool deterministic = image.estimator == preview::Estimator::kHierarchical ||
                                image.estimator == preview::Estimator::kQuadrature;
     if (deterministic) {
-      std::fprintf(stderr, "%s%s: %s quadrature, %llu BRDF evaluations, %s\n",
+      std::size_t object = 0;
+      for (std::uint8_t o : image.object) object += o;
+      std::fprintf(stderr,
+                   "%s%s: %s quadrature, %llu BRDF evaluations, %llu of %zu object pixels "
+                   "integrated (the rest interpolated), %s\n",
                    tty_ ? "\r\033[K" : "", label_.c_str(), EstimatorName(image.estimator),
                    static_cast<unsigned long long>(image.brdf_evaluations),
+                   static_cast<unsigned long long>(image.computed_pixels), object,
                    Progress::FormatDuration(image.seconds).c_str());
       return;
     }
