@@ -579,10 +579,11 @@ double HierarchicalError(const BrdfSource& source, const EnvironmentMap& map, in
   }
   EXPECT_GT(n, 3u * 150);
   const double error = std::sqrt(squares / n) / (total / n);
-  std::printf("%s under %s, %d²: %.3f %% RMS from the brute force at %zu pixels; %llu pixels "
-              "integrated, the rest interpolated\n",
-              source.Name().c_str(), map.name().c_str(), size, 100.0 * error,
-              n / 3, static_cast<unsigned long long>(fast.computed_pixels));
+  std::printf(
+      "%s under %s, %d²: %.3f %% RMS from the brute force at %zu pixels; %llu pixels "
+      "integrated, the rest interpolated\n",
+      source.Name().c_str(), map.name().c_str(), size, 100.0 * error, n / 3,
+      static_cast<unsigned long long>(fast.computed_pixels));
   return error;
 }
 
@@ -677,7 +678,8 @@ TEST(PreviewHierarchical, AutoPicksTheFastPathForTheSphereOnly) {
   EXPECT_EQ(RenderPreview(material, studio, o).estimator, Estimator::kMis);
   o.estimator = Estimator::kHierarchical;  // allowed on the plane when asked for
   EXPECT_EQ(RenderPreview(material, studio, o).estimator, Estimator::kHierarchical);
-  const Mesh mesh = {{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}}, {{0, 1, 2}}};
+  const Mesh mesh = {
+      {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, {{0, 0, 1}, {0, 0, 1}, {0, 0, 1}}, {{0, 1, 2}}};
   o.shape = Shape::kMesh;
   o.mesh = &mesh;
   EXPECT_THROW(RenderPreview(material, studio, o), InvalidArgument);

@@ -47,17 +47,21 @@ preview::Estimator EstimatorFromName(const std::string& name) {
   if (name == "brdf") return preview::Estimator::kBrdf;
   if (name == "quadrature") return preview::Estimator::kQuadrature;
   throw InvalidArgument(
-      "--estimator: expected auto, hierarchical, mis, env, brdf or quadrature, got '" + name +
-      "'");
+      "--estimator: expected auto, hierarchical, mis, env, brdf or quadrature, got '" + name + "'");
 }
 
 const char* EstimatorName(preview::Estimator e) {
   switch (e) {
-    case preview::Estimator::kHierarchical: return "hierarchical";
-    case preview::Estimator::kQuadrature: return "quadrature";
-    case preview::Estimator::kEnvironment: return "env";
-    case preview::Estimator::kBrdf: return "brdf";
-    default: return "mis";
+    case preview::Estimator::kHierarchical:
+      return "hierarchical";
+    case preview::Estimator::kQuadrature:
+      return "quadrature";
+    case preview::Estimator::kEnvironment:
+      return "env";
+    case preview::Estimator::kBrdf:
+      return "brdf";
+    default:
+      return "mis";
   }
 }
 
@@ -105,9 +109,8 @@ class PassProgress {
       return;
     }
     const double rms = image.relative_rms_estimate;
-    std::fprintf(stderr, "%s%s: %d passes (%s), estimated error %s, %s\n",
-                 tty_ ? "\r\033[K" : "", label_.c_str(), image.samples_per_pixel,
-                 EstimatorName(image.estimator),
+    std::fprintf(stderr, "%s%s: %d passes (%s), estimated error %s, %s\n", tty_ ? "\r\033[K" : "",
+                 label_.c_str(), image.samples_per_pixel, EstimatorName(image.estimator),
                  std::isfinite(rms) ? Percent(rms).c_str() : "unknown",
                  Progress::FormatDuration(image.seconds).c_str());
   }
@@ -219,10 +222,11 @@ int RunPreview(const PreviewCommandOptions& cli) {
 
   const preview::PreviewImage first = Render(*source, map, options, cli);
   preview::PreviewImage out = first;
-  std::vector<std::pair<std::string, std::string>> attributes = {{"brdf:source", cli.file},
-                                                                 {"brdf:environment", map.name()},
-                                                                 {"brdf:object", cli.mesh},
-                                                                 {"brdf:estimator", EstimatorName(first.estimator)}};
+  std::vector<std::pair<std::string, std::string>> attributes = {
+      {"brdf:source", cli.file},
+      {"brdf:environment", map.name()},
+      {"brdf:object", cli.mesh},
+      {"brdf:estimator", EstimatorName(first.estimator)}};
   if (second) {
     const preview::PreviewImage other = Render(*second, map, options, cli);
     const preview::ImageDifference d = preview::CompareImages(first, other);

@@ -468,10 +468,10 @@ int main(int argc, char** argv) {
   preview_cmd->add_option("--size", preview.size, "Image width and height in pixels")
       ->capture_default_str()
       ->check(CLI::Range(1, 8192));
-  auto* preview_spp = preview_cmd->add_option("--spp", preview.spp,
-                                              "Monte Carlo passes per pixel (selects mis)")
-                          ->capture_default_str()
-                          ->check(CLI::Range(1, 1 << 20));
+  auto* preview_spp =
+      preview_cmd->add_option("--spp", preview.spp, "Monte Carlo passes per pixel (selects mis)")
+          ->capture_default_str()
+          ->check(CLI::Range(1, 1 << 20));
   preview_cmd
       ->add_option("--rms", preview.rms,
                    "Instead of --spp: Monte Carlo until the estimated relative RMS error is below "

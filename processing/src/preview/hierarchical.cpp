@@ -32,8 +32,8 @@ void SetCone(double t0, double t1, double p0, double p1, MapHierarchy::Cell* cel
   double radius = 0.0;
   for (double t : {t0, t1})
     for (double p : {p0, p1})
-      radius = std::max(radius, std::acos(std::clamp(Dot(axis, SphericalDirection(t, p)), -1.0,
-                                                     1.0)));
+      radius =
+          std::max(radius, std::acos(std::clamp(Dot(axis, SphericalDirection(t, p)), -1.0, 1.0)));
   radius = std::min(0.5 * kPi, radius * 1.01 + 1e-5);
   Store(cell->axis, axis);
   cell->sin_radius = static_cast<float>(std::sin(radius));
@@ -177,7 +177,8 @@ void HierarchicalIntegrator::Clip(const Query& q, int level, int i, int j, int s
     for (int a = 2 * i; a < std::min(2 * i + 2, wd); ++a) Clip(q, level - 1, a, b, stop, out);
 }
 
-Rgb HierarchicalIntegrator::Estimate(const Query& q, int level, int i, int j, bool straddles) const {
+Rgb HierarchicalIntegrator::Estimate(const Query& q, int level, int i, int j,
+                                     bool straddles) const {
   const MapHierarchy::Cell& cell = map_.At(level, i, j);
   if (!(cell.luminance > 0.0f)) return {0, 0, 0};
   CellSums sums;
@@ -246,8 +247,8 @@ Rgb HierarchicalIntegrator::Refine(const Query& q, int level, int i, int j,
   }
   for (int k = 0; k < count; ++k) {
     const Child& c = children[k];
-    const Rgb v = (split_all || c.forced) ? Refine(q, child_level, c.i, c.j, c.estimate)
-                                          : c.estimate;
+    const Rgb v =
+        (split_all || c.forced) ? Refine(q, child_level, c.i, c.j, c.estimate) : c.estimate;
     for (int ch = 0; ch < 3; ++ch) total[ch] += v[ch];
   }
   return total;

@@ -222,14 +222,14 @@ struct PreviewOptions {
 // A linear HDR image and what produced it.
 struct PreviewImage {
   int width = 0, height = 0;
-  std::vector<float> rgb;              // width·height·3, row 0 at the top, linear radiance
-  std::vector<std::uint8_t> object;    // width·height: 1 where the camera ray hits the object
+  std::vector<float> rgb;                 // width·height·3, row 0 at the top, linear radiance
+  std::vector<std::uint8_t> object;       // width·height: 1 where the camera ray hits the object
   Estimator estimator = Estimator::kMis;  // what produced it (kAuto resolved)
   std::uint64_t brdf_evaluations = 0;     // kHierarchical and kQuadrature: f_r evaluations
   std::uint64_t computed_pixels = 0;      // deterministic estimators: pixels integrated, the
                                           // rest interpolated (kHierarchical)
-  int samples_per_pixel = 0;           // passes accumulated
-  double relative_rms_estimate = 0.0;  // EstimatedRelativeRms() when the image was taken
+  int samples_per_pixel = 0;              // passes accumulated
+  double relative_rms_estimate = 0.0;     // EstimatedRelativeRms() when the image was taken
   double seconds = 0.0;
   const float* Pixel(int x, int y) const {
     return &rgb[(static_cast<std::size_t>(y) * width + x) * 3];
