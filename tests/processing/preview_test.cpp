@@ -553,8 +553,9 @@ TEST(PreviewCapture, VirtualCaptureOfAnRglFilePreviewsWithin2PercentOfItsDirectE
 // the interpolation and their tolerances, and is itself checked by the furnace and closed-form
 // tests above.
 double HierarchicalError(const BrdfSource& source, const EnvironmentMap& map, int size,
-                         std::uint64_t* computed = nullptr) {
+                         std::uint64_t* computed = nullptr, const Camera& camera = Camera()) {
   PreviewOptions o = SmallOptions(size, Estimator::kHierarchical);
+  o.camera = camera;
   o.show_background = false;
   const PreviewImage fast = RenderPreview(source, map, o);
   EXPECT_EQ(fast.estimator, Estimator::kHierarchical);
@@ -603,6 +604,18 @@ TEST(PreviewHierarchical, AnalyticGgxMatchesTheBruteForceQuadrature) {
   EXPECT_GT(computed, 0u);
   // The sky's sun (0.53°, far brighter than the rest) under the sharper lobe.
   EXPECT_LT(HierarchicalError(metal, EnvironmentMap::Sky(40, 30, 512, 256), 64),
+            kHierarchicalBound);
+}
+
+TEST(PreviewHierarchical, PerspectiveViewOfTheSphereMatchesTheBruteForceQuadrature) {
+  // The view direction then changes from pixel to pixel; the sphere seen from above.
+  Camera camera;
+  camera.projection = Camera::Projection::kPerspective;
+  camera.fov_deg = 40.0;
+  camera.theta_deg = 50.0;
+  camera.phi_deg = 120.0;
+  EXPECT_LT(HierarchicalError(AnalyticBrdf(test::GgxAlpha03()), EnvironmentMap::Studio(512, 256),
+                              64, nullptr, camera),
             kHierarchicalBound);
 }
 
