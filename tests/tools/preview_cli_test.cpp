@@ -39,6 +39,28 @@ TEST_F(PreviewCli, WhiteLambertianUnderTheFurnaceIsOneInTheExr) {
   EXPECT_NE(r.err.find("ETA"), std::string::npos) << r.err;
 }
 
+// Without --spp or --rms the sphere is rendered by the hierarchical quadrature (the EXR says
+// which estimator ran); asking for passes selects Monte Carlo.
+TEST_F(PreviewCli, TheSphereDefaultsToTheHierarchicalQuadrature) {
+  std::ofstream(dir_ / "white.json") << R"({"model": "lambert", "rho": 1.0})";
+  const ToolRun fast = Run("preview " + Quote(dir_ / "white.json") +
+                           " --env furnace --size 48 --out " + Quote(dir_ / "h.exr"));
+  ASSERT_EQ(fast.exit_code, 0) << fast.err;
+  EXPECT_NE(fast.err.find("hierarchical quadrature"), std::string::npos) << fast.err;
+  const exporter::ExrFile exr = exporter::ReadExr((dir_ / "h.exr").string());
+  EXPECT_EQ(exr.Attribute("brdf:estimator"), "hierarchical");
+  for (int y = 12; y < 36; ++y)
+    for (int x = 12; x < 36; ++x) EXPECT_NEAR(exr.image.Pixel(x, y)[1], 1.0, 2e-3);
+  const ToolRun mc = Run("preview " + Quote(dir_ / "white.json") +
+                         " --env furnace --size 16 --spp 4 --out " + Quote(dir_ / "m.exr"));
+  ASSERT_EQ(mc.exit_code, 0) << mc.err;
+  EXPECT_EQ(exporter::ReadExr((dir_ / "m.exr").string()).Attribute("brdf:estimator"), "mis");
+  const ToolRun plane = Run("preview " + Quote(dir_ / "white.json") +
+                            " --env furnace --mesh plane --size 16 --out " + Quote(dir_ / "p.exr"));
+  ASSERT_EQ(plane.exit_code, 0) << plane.err;
+  EXPECT_EQ(exporter::ReadExr((dir_ / "p.exr").string()).Attribute("brdf:estimator"), "mis");
+}
+
 TEST_F(PreviewCli, CompareWritesThreePanelsAndPrintsTheRms) {
   const ToolRun same = Run("preview " + Quote(kMaterials + "gold.json") + " --compare " +
                            Quote(kMaterials + "gold.json") + " --size 32 --spp 4 --quiet --out " +

@@ -3,11 +3,13 @@
 // --compare, shows progress with an ETA on stderr.
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <memory>
 #include <optional>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -38,11 +40,29 @@ bool ParsePair(const std::string& text, double* a, double* b) {
 }
 
 preview::Estimator EstimatorFromName(const std::string& name) {
+  if (name == "auto") return preview::Estimator::kAuto;
+  if (name == "hierarchical") return preview::Estimator::kHierarchical;
   if (name == "mis") return preview::Estimator::kMis;
   if (name == "env") return preview::Estimator::kEnvironment;
   if (name == "brdf") return preview::Estimator::kBrdf;
   if (name == "quadrature") return preview::Estimator::kQuadrature;
-  throw InvalidArgument("--estimator: expected mis, env, brdf or quadrature, got '" + name + "'");
+  throw InvalidArgument(
+      "--estimator: expected auto, hierarchical, mis, env, brdf or quadrature, got '" + name + "'");
+}
+
+const char* EstimatorName(preview::Estimator e) {
+  switch (e) {
+    case preview::Estimator::kHierarchical:
+      return "hierarchical";
+    case preview::Estimator::kQuadrature:
+      return "quadrature";
+    case preview::Estimator::kEnvironment:
+      return "env";
+    case preview::Estimator::kBrdf:
+      return "brdf";
+    default:
+      return "mis";
+  }
 }
 
 // One line on stderr, redrawn on a terminal, at most one plain line a second otherwise.
@@ -72,11 +92,27 @@ class PassProgress {
                  Progress::FormatDuration(eta).c_str(), tty_ ? "" : "\n");
     std::fflush(stderr);
   }
-  void Done(int passes, double rms, double seconds) {
+  void Done(const preview::PreviewImage& image) {
     if (!enabled_) return;
-    std::fprintf(stderr, "%s%s: %d passes, estimated error %s, %s\n", tty_ ? "\r\033[K" : "",
-                 label_.c_str(), passes, std::isfinite(rms) ? Percent(rms).c_str() : "unknown",
-                 Progress::FormatDuration(seconds).c_str());
+    const bool deterministic = image.estimator == preview::Estimator::kHierarchical ||
+                               image.estimator == preview::Estimator::kQuadrature;
+    if (deterministic) {
+      std::size_t object = 0;
+      for (std::uint8_t o : image.object) object += o;
+      std::fprintf(stderr,
+                   "%s%s: %s quadrature, %llu BRDF evaluations, %llu of %zu object pixels "
+                   "integrated (the rest interpolated), %s\n",
+                   tty_ ? "\r\033[K" : "", label_.c_str(), EstimatorName(image.estimator),
+                   static_cast<unsigned long long>(image.brdf_evaluations),
+                   static_cast<unsigned long long>(image.computed_pixels), object,
+                   Progress::FormatDuration(image.seconds).c_str());
+      return;
+    }
+    const double rms = image.relative_rms_estimate;
+    std::fprintf(stderr, "%s%s: %d passes (%s), estimated error %s, %s\n", tty_ ? "\r\033[K" : "",
+                 label_.c_str(), image.samples_per_pixel, EstimatorName(image.estimator),
+                 std::isfinite(rms) ? Percent(rms).c_str() : "unknown",
+                 Progress::FormatDuration(image.seconds).c_str());
   }
 
  private:
@@ -94,11 +130,12 @@ preview::PreviewImage Render(const BrdfSource& source, const preview::Environmen
                              preview::PreviewOptions options, const PreviewCommandOptions& cli) {
   PassProgress progress("preview " + source.Name(), !cli.quiet);
   options.progress = [&](int passes, double rms, double seconds) {
+    if (rms == 0.0) return true;  // a deterministic estimator: done in one pass, Done() reports
     progress.Update(passes, options.samples_per_pixel, rms, options.target_relative_rms, seconds);
     return true;
   };
   preview::PreviewImage image = preview::RenderPreview(source, map, options);
-  progress.Done(image.samples_per_pixel, image.relative_rms_estimate, image.seconds);
+  progress.Done(image);
   return image;
 }
 
@@ -114,6 +151,20 @@ int RunPreview(const PreviewCommandOptions& cli) {
   preview::PreviewOptions options;
   options.width = options.height = cli.size;
   options.estimator = EstimatorFromName(cli.estimator);
+  // A pass count or an error target asks for Monte Carlo.
+  if (options.estimator == preview::Estimator::kAuto && (cli.spp_given || cli.rms > 0))
+    options.estimator = preview::Estimator::kMis;
+  options.quadrature_subdivisions = cli.subdivisions;
+  if (cli.sample_pixels > 0) {
+    // A fixed random choice of image pixels for this size (not the render seed), so that
+    // references at different settings cover the same pixels.
+    std::vector<std::uint32_t> all(static_cast<std::size_t>(cli.size) * cli.size);
+    for (std::size_t p = 0; p < all.size(); ++p) all[p] = static_cast<std::uint32_t>(p);
+    std::mt19937_64 shuffle(0x5eed);
+    std::shuffle(all.begin(), all.end(), shuffle);
+    all.resize(std::min(all.size(), static_cast<std::size_t>(cli.sample_pixels)));
+    options.pixel_subset = std::move(all);
+  }
   options.samples_per_pixel = cli.spp;
   options.target_relative_rms = cli.rms;
   options.jobs = cli.jobs;
@@ -171,10 +222,11 @@ int RunPreview(const PreviewCommandOptions& cli) {
 
   const preview::PreviewImage first = Render(*source, map, options, cli);
   preview::PreviewImage out = first;
-  std::vector<std::pair<std::string, std::string>> attributes = {{"brdf:source", cli.file},
-                                                                 {"brdf:environment", map.name()},
-                                                                 {"brdf:object", cli.mesh},
-                                                                 {"brdf:estimator", cli.estimator}};
+  std::vector<std::pair<std::string, std::string>> attributes = {
+      {"brdf:source", cli.file},
+      {"brdf:environment", map.name()},
+      {"brdf:object", cli.mesh},
+      {"brdf:estimator", EstimatorName(first.estimator)}};
   if (second) {
     const preview::PreviewImage other = Render(*second, map, options, cli);
     const preview::ImageDifference d = preview::CompareImages(first, other);

@@ -172,7 +172,10 @@ struct PreviewCommandOptions {
   double fov_deg = 0;           // > 0: perspective camera with this vertical field of view
   double exposure_ev = 0;
   std::string tone_map = "clamp";  // clamp or reinhard (PNG only)
-  std::string estimator = "mis";   // mis, env, brdf, quadrature
+  std::string estimator = "auto";  // auto, hierarchical, mis, env, brdf, quadrature
+  bool spp_given = false;          // --spp on the command line (auto then means mis)
+  int subdivisions = 2;            // quadrature: each map pixel split n × n
+  int sample_pixels = 0;           // > 0: render only this many object pixels (references)
   std::string extrapolate;         // captures: "P,L"
   std::string out;                 // .exr or .png
   bool force = false;              // overwrite an existing --out

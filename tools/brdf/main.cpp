@@ -473,12 +473,13 @@ int main(int argc, char** argv) {
   preview_cmd->add_option("--size", preview.size, "Image width and height in pixels")
       ->capture_default_str()
       ->check(CLI::Range(1, 8192));
-  auto* preview_spp = preview_cmd->add_option("--spp", preview.spp, "Samples (passes) per pixel")
-                          ->capture_default_str()
-                          ->check(CLI::Range(1, 1 << 20));
+  auto* preview_spp =
+      preview_cmd->add_option("--spp", preview.spp, "Monte Carlo passes per pixel (selects mis)")
+          ->capture_default_str()
+          ->check(CLI::Range(1, 1 << 20));
   preview_cmd
       ->add_option("--rms", preview.rms,
-                   "Instead of --spp: render until the estimated relative RMS error is below "
+                   "Instead of --spp: Monte Carlo until the estimated relative RMS error is below "
                    "this (e.g. 0.01)")
       ->check(CLI::Range(1e-6, 1.0))
       ->excludes(preview_spp);
@@ -500,9 +501,24 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"clamp", "reinhard"}));
   preview_cmd
       ->add_option("--estimator", preview.estimator,
-                   "mis (default), env, brdf, or quadrature (sphere and plane only)")
+                   "auto (default): the sphere by the deterministic hierarchical quadrature "
+                   "(one pass, within about 0.1-0.4 % RMS of the converged image; "
+                   "docs/preview.md), planes and meshes by mis; with --spp or --rms, mis. "
+                   "Or: hierarchical (sphere, plane), mis (Monte Carlo, map and BRDF samples "
+                   "combined), env, brdf, quadrature (brute force over every map pixel, the slow "
+                   "reference; sphere, plane)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"mis", "env", "brdf", "quadrature"}));
+      ->check(CLI::IsMember({"auto", "hierarchical", "mis", "env", "brdf", "quadrature"}));
+  preview_cmd
+      ->add_option("--subdivisions", preview.subdivisions,
+                   "quadrature: each map pixel split N × N (midpoint rule)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 16));
+  preview_cmd
+      ->add_option("--sample-pixels", preview.sample_pixels,
+                   "Render only N object pixels spread evenly over the image, the rest black "
+                   "(references with the slow estimators)")
+      ->check(CLI::Range(1, 1 << 26));
   preview_cmd->add_option("--extrapolate", preview.extrapolate,
                           "Captures: grazing extrapolation P,L (docs/design.md §6)");
   preview_cmd->add_option("--jobs", preview.jobs, "Worker threads")
@@ -520,6 +536,7 @@ int main(int argc, char** argv) {
       "behind the object. EXR: linear radiance; PNG: exposure, then the tone curve, then sRGB.\n");
   preview_cmd->callback([&] {
     preview.env_given = preview_env->count() > 0;
+    preview.spp_given = preview_spp->count() > 0;
     exit_code = brdf::cli::RunPreview(preview);
   });
 

@@ -6,6 +6,7 @@ add_library(brdf_preview
   ${CMAKE_CURRENT_LIST_DIR}/mesh.cpp
   ${CMAKE_CURRENT_LIST_DIR}/scene.cpp
   ${CMAKE_CURRENT_LIST_DIR}/renderer.cpp
+  ${CMAKE_CURRENT_LIST_DIR}/hierarchical.cpp
   ${CMAKE_CURRENT_LIST_DIR}/image.cpp
 )
 add_library(brdf::preview ALIAS brdf_preview)

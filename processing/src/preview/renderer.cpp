@@ -11,6 +11,7 @@
 
 #include "brdf/core/error.h"
 #include "brdf/processing/preview.h"
+#include "hierarchical.h"
 #include "preview_internal.h"
 #include "scene.h"
 
@@ -44,6 +45,10 @@ struct Kronecker {
     alpha = {1.0 / g, 1.0 / (g * g), 1.0 / g, 1.0 / (g * g), 0.5 * (std::sqrt(5.0) - 1.0)};
   }
 };
+
+// The hierarchy's top level: 16 × 8 cells of 22.5°, each of which is always compared with its
+// four children, so 32 × 16 is the coarsest resolution a pixel is integrated at.
+constexpr int kHierarchyTopColumns = 16;
 
 int ResolveJobs(int jobs) {
   if (jobs > 0) return jobs;
@@ -98,6 +103,8 @@ struct PreviewRenderer::Impl {
   int passes = 0;
   bool exact = false;  // quadrature or light-only: one pass is the answer
   double seconds = 0.0;
+  std::uint64_t evaluations = 0;     // f_r evaluations of the deterministic estimators
+  std::uint64_t computed_count = 0;  // kHierarchical: object pixels integrated (not interpolated)
 
   Impl(const BrdfSource& s, const EnvironmentMap& e, PreviewOptions o,
        std::shared_ptr<const BrdfSampler> sp)
@@ -126,6 +133,14 @@ struct PreviewRenderer::Impl {
       fail("camera angles and the map rotation must be finite");
     if (o.estimator == Estimator::kQuadrature && o.shape == Shape::kMesh)
       fail("the quadrature reference needs a convex object (sphere or plane), not a mesh");
+    if (o.estimator == Estimator::kHierarchical && o.shape == Shape::kMesh)
+      fail("the hierarchical quadrature needs a convex object (sphere or plane), not a mesh");
+    if (o.image_block < 1 || o.image_block > 64 || (o.image_block & (o.image_block - 1)) != 0)
+      fail("the image block must be a power of two from 1 to 64, got " +
+           std::to_string(o.image_block));
+    if (!(o.hierarchical_tolerance > 0.0) || !(o.image_tolerance >= 0.0) ||
+        !std::isfinite(o.hierarchical_tolerance) || !std::isfinite(o.image_tolerance))
+      fail("the hierarchical tolerances must be finite, the map one > 0 and the image one ≥ 0");
     if (o.quadrature_subdivisions < 1 || o.quadrature_subdivisions > 16)
       fail("quadrature subdivisions must be between 1 and 16");
     if (o.samples_per_pixel < 1 && !(o.target_relative_rms > 0.0))
@@ -171,6 +186,12 @@ struct PreviewRenderer::Impl {
     object.assign(pixels, 0);
     fixed.assign(pixels, Rgb{0, 0, 0});
     std::vector<PixelSetup> all(pixels);
+    std::vector<std::uint8_t> wanted;
+    if (!o.pixel_subset.empty()) {
+      wanted.assign(pixels, 0);
+      for (std::uint32_t p : o.pixel_subset)
+        if (p < pixels) wanted[p] = 1;
+    }
     ParallelChunks(
         static_cast<std::size_t>(o.height), 8, jobs, nullptr, [&](std::size_t y0, std::size_t y1) {
           for (std::size_t y = y0; y < y1; ++y)
@@ -186,6 +207,7 @@ struct PreviewRenderer::Impl {
                 dir = forward;
               }
               const std::size_t p = y * o.width + x;
+              if (!wanted.empty() && !wanted[p]) continue;
               detail::Hit hit;
               if (!scene.Intersect(origin, dir, &hit)) {
                 if (o.show_background) fixed[p] = environment.Radiance(ToMap(dir));
@@ -289,8 +311,12 @@ struct PreviewRenderer::Impl {
       passes = 1;
       return 1;
     }
-    if (options.estimator == Estimator::kQuadrature) {
-      Quadrature();
+    if (options.estimator == Estimator::kQuadrature ||
+        options.estimator == Estimator::kHierarchical) {
+      if (options.estimator == Estimator::kQuadrature)
+        Quadrature();
+      else
+        Hierarchical();
       if (cancel != nullptr && cancel->load()) return 0;
       exact = true;
       passes = 1;
@@ -342,7 +368,9 @@ struct PreviewRenderer::Impl {
           }
         }
       }
+    std::atomic<std::uint64_t> counted{0};
     ParallelChunks(setup.size(), 16, jobs, options.cancel, [&](std::size_t b, std::size_t e) {
+      std::uint64_t count = 0;
       for (std::size_t k = b; k < e; ++k) {
         const PixelSetup& s = setup[k];
         Rgb total = {0, 0, 0};
@@ -350,11 +378,186 @@ struct PreviewRenderer::Impl {
           const Vec3 wi = s.frame.ToLocal(d.w);
           if (!(wi.z > 0.0)) continue;
           const Rgb f = source.Eval(wi, s.wo);
+          ++count;
           for (int ch = 0; ch < 3; ++ch) total[ch] += d.radiance_solid_angle[ch] * f[ch] * wi.z;
         }
         for (int ch = 0; ch < 3; ++ch) sum[3 * k + ch] = total[ch];
       }
+      counted += count;
     });
+    evaluations = counted;
+  }
+
+  // The fast path (Estimator::kHierarchical, hierarchical.h): the adaptive map quadrature per
+  // computed pixel, bilinear interpolation over image blocks that pass the midpoint checks.
+  void Hierarchical() {
+    const detail::MapHierarchy hierarchy(environment, kHierarchyTopColumns);
+    detail::HierarchicalSettings settings;
+    settings.tolerance = options.hierarchical_tolerance;
+    const detail::HierarchicalIntegrator integrator(hierarchy, source, settings);
+    std::atomic<std::uint64_t> counted{0}, computed_pixels{0};
+    auto radiance = [&](std::size_t k, double scale, bool top_only, std::uint64_t* count) {
+      const PixelSetup& s = setup[k];
+      return integrator.Radiance(ToMap(s.frame.s), ToMap(s.frame.t), ToMap(s.frame.n), s.wo, scale,
+                                 top_only, count);
+    };
+    // The scale the tolerances are relative to: the mean object luminance, from the top
+    // level's estimate at about 1000 pixels spread over the object.
+    const std::size_t stride = std::max<std::size_t>(1, setup.size() / 1024);
+    std::vector<double> sample((setup.size() + stride - 1) / stride, 0.0);
+    ParallelChunks(sample.size(), 64, jobs, options.cancel, [&](std::size_t b, std::size_t e) {
+      std::uint64_t count = 0;
+      for (std::size_t k = b; k < e; ++k)
+        sample[k] = Luminance(radiance(k * stride, 0.0, true, &count));
+      counted += count;
+    });
+    double scale = 0.0;
+    for (double y : sample) scale += std::max(0.0, y);
+    scale /= std::max<std::size_t>(1, sample.size());
+    auto compute = [&](std::size_t k, std::uint64_t* count) {
+      ++computed_pixels;
+      return radiance(k, scale, false, count);
+    };
+    auto store = [&](std::size_t k, const Rgb& v) {
+      for (int ch = 0; ch < 3; ++ch) sum[3 * k + ch] = v[ch];
+    };
+    const int block = options.image_block;
+    if (block <= 1) {
+      ParallelChunks(setup.size(), 64, jobs, options.cancel, [&](std::size_t b, std::size_t e) {
+        std::uint64_t count = 0;
+        for (std::size_t k = b; k < e; ++k) store(k, compute(k, &count));
+        counted += count;
+      });
+      evaluations = counted;
+      computed_count = computed_pixels;
+      return;
+    }
+    const int width = options.width, height = options.height;
+    std::vector<std::int32_t> index(object.size(), -1);  // image pixel → object pixel
+    for (std::size_t k = 0; k < object_index.size(); ++k)
+      index[object_index[k]] = static_cast<std::int32_t>(k);
+    auto object_at = [&](int x, int y) { return index[static_cast<std::size_t>(y) * width + x]; };
+    // Phase 1: every object pixel on the lattice x, y ≡ 0 (mod block).
+    std::vector<Rgb> value(object.size(), Rgb{0, 0, 0});
+    const int lattice_rows = (height + block - 1) / block;
+    ParallelChunks(static_cast<std::size_t>(lattice_rows), 1, jobs, options.cancel,
+                   [&](std::size_t b, std::size_t e) {
+                     std::uint64_t count = 0;
+                     for (std::size_t r = b; r < e; ++r) {
+                       const int y = static_cast<int>(r) * block;
+                       for (int x = 0; x < width; x += block)
+                         if (const int k = object_at(x, y); k >= 0)
+                           value[static_cast<std::size_t>(y) * width + x] = compute(k, &count);
+                     }
+                     counted += count;
+                   });
+    const double tolerance = options.image_tolerance * scale;
+    // Phase 2: each block owns its pixels [x0, x0 + block) × [y0, y0 + block); points on its
+    // far edges that it computes are kept locally (the neighbour computes its own).
+    const int block_columns = (width + block - 1) / block;
+    ParallelChunks(
+        static_cast<std::size_t>(lattice_rows), 1, jobs, options.cancel,
+        [&](std::size_t b, std::size_t e) {
+          std::uint64_t count = 0;
+          const int side = block + 1;
+          std::vector<Rgb> local(static_cast<std::size_t>(side) * side);
+          std::vector<std::uint8_t> known(local.size());
+          for (std::size_t r = b; r < e; ++r)
+            for (int c = 0; c < block_columns; ++c) {
+              const int x0 = c * block, y0 = static_cast<int>(r) * block;
+              auto inside = [&](int dx, int dy) {
+                return x0 + dx < width && y0 + dy < height && object_at(x0 + dx, y0 + dy) >= 0;
+              };
+              auto at = [&](int dx, int dy) -> Rgb& { return local[dy * side + dx]; };
+              // known: 0 nothing, 1 computed (exact), 2 interpolated.
+              std::fill(known.begin(), known.end(), 0);
+              for (int dy : {0, block})
+                for (int dx : {0, block})
+                  if (inside(dx, dy)) {
+                    at(dx, dy) = value[static_cast<std::size_t>(y0 + dy) * width + x0 + dx];
+                    known[dy * side + dx] = 1;
+                  }
+              auto computed = [&](int dx, int dy) -> const Rgb& {
+                if (known[dy * side + dx] != 1) {
+                  at(dx, dy) = compute(object_at(x0 + dx, y0 + dy), &count);
+                  known[dy * side + dx] = 1;
+                }
+                return at(dx, dy);
+              };
+              auto close = [&](const Rgb& got, const Rgb& a, const Rgb& b2) {
+                for (int ch = 0; ch < 3; ++ch)
+                  if (std::fabs(got[ch] - 0.5 * (a[ch] + b2[ch])) > tolerance) return false;
+                return true;
+              };
+              // The square at (dx, dy) of `size`, all of it on the object, corners computed:
+              // interpolated when its centre and edge midpoints pass, else split in four.
+              auto refine = [&](auto&& self, int dx, int dy, int size) -> void {
+                if (size <= 1) return;
+                const int h = size / 2;
+                const Rgb c00 = at(dx, dy), c10 = at(dx + size, dy), c01 = at(dx, dy + size),
+                          c11 = at(dx + size, dy + size);
+                const Rgb diagonal = {0.5 * (c00[0] + c11[0]), 0.5 * (c00[1] + c11[1]),
+                                      0.5 * (c00[2] + c11[2])};
+                const Rgb other = {0.5 * (c10[0] + c01[0]), 0.5 * (c10[1] + c01[1]),
+                                   0.5 * (c10[2] + c01[2])};
+                bool ok = close(computed(dx + h, dy), c00, c10);
+                ok = close(computed(dx, dy + h), c00, c01) && ok;
+                ok = close(computed(dx + size, dy + h), c10, c11) && ok;
+                ok = close(computed(dx + h, dy + size), c01, c11) && ok;
+                ok = close(computed(dx + h, dy + h), diagonal, other) && ok;
+                if (!ok || h == 1) {
+                  for (int qy : {dy, dy + h})
+                    for (int qx : {dx, dx + h}) self(self, qx, qy, h);
+                  return;
+                }
+                // Bilinear from the nine computed points, over the four quarters.
+                for (int qy : {dy, dy + h})
+                  for (int qx : {dx, dx + h}) {
+                    const Rgb a = at(qx, qy), b1 = at(qx + h, qy), c1 = at(qx, qy + h),
+                              d1 = at(qx + h, qy + h);
+                    for (int y = 0; y <= h; ++y)
+                      for (int x = 0; x <= h; ++x) {
+                        if (known[(qy + y) * side + qx + x]) continue;
+                        const double u = static_cast<double>(x) / h, v = static_cast<double>(y) / h;
+                        Rgb& out = at(qx + x, qy + y);
+                        for (int ch = 0; ch < 3; ++ch)
+                          out[ch] = (1 - u) * (1 - v) * a[ch] + u * (1 - v) * b1[ch] +
+                                    (1 - u) * v * c1[ch] + u * v * d1[ch];
+                        known[(qy + y) * side + qx + x] = 2;
+                      }
+                  }
+              };
+              // The rim and the image edges: the largest squares wholly on the object are refined
+              // as above; what is left is computed pixel by pixel below.
+              auto cover = [&](auto&& self, int dx, int dy, int size) -> void {
+                bool whole = true;
+                for (int y = dy; whole && y <= dy + size; ++y)
+                  for (int x = dx; whole && x <= dx + size; ++x) whole = inside(x, y);
+                if (whole) {
+                  for (int qy : {dy, dy + size})
+                    for (int qx : {dx, dx + size}) computed(qx, qy);
+                  refine(refine, dx, dy, size);
+                } else if (size > 2) {
+                  const int h = size / 2;
+                  for (int qy : {dy, dy + h})
+                    for (int qx : {dx, dx + h}) self(self, qx, qy, h);
+                }
+              };
+              cover(cover, 0, 0, block);
+              for (int dy = 0; dy < block; ++dy)
+                for (int dx = 0; dx < block; ++dx) {
+                  if ((dx == 0 && dy == 0) || !inside(dx, dy)) continue;  // lattice corner, or off
+                  const Rgb v = known[dy * side + dx]
+                                    ? at(dx, dy)
+                                    : compute(object_at(x0 + dx, y0 + dy), &count);
+                  value[static_cast<std::size_t>(y0 + dy) * width + x0 + dx] = v;
+                }
+            }
+          counted += count;
+        });
+    for (std::size_t k = 0; k < object_index.size(); ++k) store(k, value[object_index[k]]);
+    evaluations = counted;
+    computed_count = computed_pixels;
   }
 
   double RelativeRms() const {
@@ -387,6 +590,9 @@ struct PreviewRenderer::Impl {
         for (int ch = 0; ch < 3; ++ch)
           image.rgb[3 * object_index[k] + ch] += static_cast<float>(sum[3 * k + ch] / passes);
     image.samples_per_pixel = passes;
+    image.estimator = options.estimator;
+    image.brdf_evaluations = evaluations;
+    image.computed_pixels = exact ? (computed_count > 0 ? computed_count : setup.size()) : 0;
     image.relative_rms_estimate = RelativeRms();
     image.seconds = seconds;
     return image;
@@ -397,10 +603,14 @@ PreviewRenderer::PreviewRenderer(const BrdfSource& source, const EnvironmentMap&
                                  PreviewOptions options, std::shared_ptr<const BrdfSampler> sampler)
     : impl_(std::make_unique<Impl>(source, environment, std::move(options), std::move(sampler))) {
   const auto start = std::chrono::steady_clock::now();
+  if (impl_->options.estimator == Estimator::kAuto)
+    impl_->options.estimator =
+        impl_->options.shape == Shape::kSphere ? Estimator::kHierarchical : Estimator::kMis;
   impl_->Validate();
   impl_->jobs = ResolveJobs(impl_->options.jobs);
-  const bool sampling =
-      impl_->options.environment_lighting && impl_->options.estimator != Estimator::kQuadrature;
+  const bool sampling = impl_->options.environment_lighting &&
+                        impl_->options.estimator != Estimator::kQuadrature &&
+                        impl_->options.estimator != Estimator::kHierarchical;
   if (sampling) {
     if (impl_->sampler == nullptr) impl_->sampler = MakeBrdfSampler(source, impl_->jobs);
     impl_->environment_sampler = std::make_unique<EnvironmentSampler>(environment);

@@ -24,7 +24,10 @@
 // by multiple importance sampling with the power heuristic. The pdf each sampler reports is the
 // exact density of the directions it draws (tests check this with χ² tests). For the sphere and
 // the plane a deterministic quadrature over every map pixel is also available; it is the
-// reference the tests compare the estimators against.
+// reference the tests compare the estimators against. For them too, Estimator::kHierarchical is
+// the fast deterministic path (an adaptive quadrature over a hierarchy of the map with image-space
+// interpolation, within about 0.5 % RMS of that reference; docs/preview.md), and kAuto picks it
+// for the sphere.
 //
 // World frame and map orientation (docs/preview.md): z is up. A direction ω(θ, φ) =
 // (sinθ cosφ, sinθ sinφ, cosθ) has θ measured from +z (the zenith) and φ from +x towards +y.
@@ -152,6 +155,17 @@ enum class Estimator {
   kEnvironment,  // map importance sampling only
   kBrdf,         // BRDF importance sampling only
   kQuadrature,   // deterministic sum over every map pixel (sphere and plane only)
+  // Sphere and plane only: the fast deterministic path. Per computed pixel, an adaptive
+  // quadrature over a hierarchy of the map: every level stores the exact integrals of L and of
+  // Y·ω over its cells (Y the luminance), a cell contributes f_r at its luminance centroid times
+  // those integrals (the cosine integrated exactly), and cells are split where a cell and its
+  // four children disagree, where they hold a large share of the pixel, around the mirror
+  // direction, and (without BRDF evaluations) at the horizon. Between computed pixels, bilinear
+  // interpolation over image blocks whose centre and edge midpoints, computed too, agree with
+  // it. Deterministic: one pass; the tolerances are the options below.
+  kHierarchical,
+  // kHierarchical for the sphere, kMis otherwise (what `brdf preview` uses by default).
+  kAuto,
 };
 
 // The documented tone map of the 8-bit output (ToneMap below).
@@ -182,6 +196,21 @@ struct PreviewOptions {
   std::uint64_t seed = 1;  // same seed, same options → the same image
   // kQuadrature: each map pixel is split into n × n parts (midpoint rule in solid angle).
   int quadrature_subdivisions = 2;
+  // kHierarchical. Both tolerances are relative to the image's mean object luminance Ȳ
+  // (estimated first from the coarsest level at about 1000 pixels), the scale the benchmark's
+  // RMS error is measured against. A map cell of solid angle Ω is split when the luminance of
+  // its estimate and its four children's differ by more than hierarchical_tolerance·Ȳ·√(Ω/2π).
+  // Image blocks of image_block × image_block pixels (a power of two) are filled by bilinear
+  // interpolation when the pixels computed at their centre and edge midpoints differ from it by
+  // at most image_tolerance·Ȳ in every channel, else split in four down to single pixels; 1:
+  // every pixel computed. With the defaults the image is within about 0.1–0.4 % RMS of the
+  // brute-force kQuadrature (docs/benchmarks.md).
+  double hierarchical_tolerance = 0.02;
+  int image_block = 16;
+  double image_tolerance = 0.03;
+  // Kept for references at a subset of pixels: when non-empty, only these image pixels
+  // (y · width + x) are rendered; the others are neither object nor lit (black, object 0).
+  std::vector<std::uint32_t> pixel_subset;
   // Called after every pass from the calling thread: passes done, the current estimate of the
   // relative RMS error, seconds since the start. Return false to stop early.
   std::function<bool(int passes, double relative_rms, double seconds)> progress;
@@ -193,10 +222,14 @@ struct PreviewOptions {
 // A linear HDR image and what produced it.
 struct PreviewImage {
   int width = 0, height = 0;
-  std::vector<float> rgb;              // width·height·3, row 0 at the top, linear radiance
-  std::vector<std::uint8_t> object;    // width·height: 1 where the camera ray hits the object
-  int samples_per_pixel = 0;           // passes accumulated
-  double relative_rms_estimate = 0.0;  // EstimatedRelativeRms() when the image was taken
+  std::vector<float> rgb;                 // width·height·3, row 0 at the top, linear radiance
+  std::vector<std::uint8_t> object;       // width·height: 1 where the camera ray hits the object
+  Estimator estimator = Estimator::kMis;  // what produced it (kAuto resolved)
+  std::uint64_t brdf_evaluations = 0;     // kHierarchical and kQuadrature: f_r evaluations
+  std::uint64_t computed_pixels = 0;      // deterministic estimators: pixels integrated, the
+                                          // rest interpolated (kHierarchical)
+  int samples_per_pixel = 0;              // passes accumulated
+  double relative_rms_estimate = 0.0;     // EstimatedRelativeRms() when the image was taken
   double seconds = 0.0;
   const float* Pixel(int x, int y) const {
     return &rgb[(static_cast<std::size_t>(y) * width + x) * 3];
