@@ -150,14 +150,10 @@ TEST_P(UsbCapture, PermissionDeniedIsOneLineNamingTheNodeTheCauseAndTheUdevRule)
   const std::string spec = std::string(usb ? "usb" : "hid") + ":1209:" + (usb ? "b7d1" : "b7d2");
   // The device (its IDs and node), the cause, and the remedy: the shipped rule, where it is
   // installed and where udev reads it, the reload, the replug.
-  const std::vector<std::string> wanted = {spec.substr(4),
-                                           emu.DeviceNode(),
-                                           "permission denied",
-                                           "70-brdf-scatterometer.rules",
-                                           "/lib/udev/rules.d",
-                                           "/etc/udev/rules.d",
-                                           "udevadm",
-                                           "plug the instrument in again"};
+  const std::vector<std::string> wanted = {spec.substr(4),      emu.DeviceNode(),
+                                           "permission denied", "70-brdf-scatterometer.rules",
+                                           "/lib/udev/rules.d", "/etc/udev/rules.d",
+                                           "udevadm",           "plug the instrument in again"};
   int code = -1;
   const std::string listed = RunTool("devices", &code, as_user);
   EXPECT_EQ(code, 0) << listed;
