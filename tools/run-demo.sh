@@ -44,11 +44,11 @@ mkdir -p "$out/atlas"
 echo "== environment-lit previews (studio map) -> $out/previews"
 mkdir -p "$out/previews"
 for material in gold plastic_glossy_red wood_oak; do
-  "$brdf" preview "$root/data-samples/materials/$material.json" --size 384 --spp 64 --quiet --force \
+  "$brdf" preview "$root/data-samples/materials/$material.json" --size 384 --quiet --force \
     --out "$out/previews/$material.png"
 done
 "$brdf" preview "$out/luts/gold.ktx2" --compare "$root/data-samples/materials/gold.json" \
-  --size 256 --spp 64 --quiet --force --out "$out/previews/gold_lut_vs_material.png"
+  --size 256 --quiet --force --out "$out/previews/gold_lut_vs_material.png"
 # Pictures to look at: the reflection lobe of a few captures (brdf-view renders under
 # xvfb-run by itself when there is no display).
 mkdir -p "$out/pictures"
