@@ -258,7 +258,8 @@ TEST_F(Repair, DamageFollowedByIntactSlicesNamesTheRepairCommand) {
   std::string b = ReadAll(ref);
   b[chunks[2].offset + 24 + 100] ^= 0x01;
   WriteText(dir_ / "flip.bpc", b);
-  for (const std::string& cmd : {"info", "eval", "convert"}) {
+  for (const char* name : {"info", "eval", "convert"}) {
+    const std::string cmd = name;
     std::string args = cmd + " " + Quote(dir_ / "flip.bpc");
     if (cmd == "eval") args += " --in 0,0 --out 10,10";
     if (cmd == "convert") args += " --out " + Quote(dir_ / "luts") + " --quiet";

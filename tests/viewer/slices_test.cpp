@@ -52,11 +52,15 @@ TEST(SliceProbe, MapsTexelsBackToTheOutgoingDirectionTheyHold) {
     // θd = 0 is the mirror direction (θin, 180°).
     SliceProbe p = ProbeSlice(source, k, Channel::kRed, 0.0, 0.0);
     EXPECT_NEAR(p.theta_out_deg, ti, 1e-9);
-    if (ti > 0) EXPECT_NEAR(p.phi_out_deg, 180.0, 1e-9);
+    if (ti > 0) {
+      EXPECT_NEAR(p.phi_out_deg, 180.0, 1e-9);
+    }
     // (θd, φd) = (θin, 0°): ω_d = (sinθin, 0, cosθin), S·ω_d = (−sin 2θin, 0, cos 2θin).
     p = ProbeSlice(source, k, Channel::kRed, 0.0, ti);
     EXPECT_NEAR(p.theta_out_deg, 2 * ti, 1e-9);
-    if (ti > 0) EXPECT_NEAR(p.phi_out_deg, 180.0, 1e-9);
+    if (ti > 0) {
+      EXPECT_NEAR(p.phi_out_deg, 180.0, 1e-9);
+    }
     EXPECT_EQ(p.below_horizon, 2 * ti > 90);
     // (θd, φd) = (θin, 180°) is the normal.
     p = ProbeSlice(source, k, Channel::kRed, 180.0, ti);
