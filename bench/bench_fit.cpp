@@ -38,6 +38,29 @@ void WriteData(const std::string& path, const processing::FitData& data) {
         << ',' << s.cos_in << ',' << s.sqrt_w << '\n';
 }
 
+// Runs FitMaterial `repeats` times with `options` and prints one JSON line with the median wall
+// and CPU seconds and the last run's iterations and final cost.
+void TimeFits(const Measurement& meas, const FitOptions& options, int repeats,
+              const std::string& name, const char* mode) {
+  std::vector<double> seconds, cpu;
+  double cost = 0;
+  int iterations = 0;
+  for (int r = 0; r < repeats; ++r) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const std::clock_t c0 = std::clock();
+    const processing::FitResult fit = processing::FitMaterial(meas, options);
+    seconds.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    cpu.push_back(static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC);
+    cost = fit.report.final_cost;
+    iterations = fit.report.iterations;
+  }
+  std::printf(
+      "{\"model\": \"%s\", \"mode\": \"%s\", \"threads\": %d, \"seconds\": %.4f, "
+      "\"cpu_seconds\": %.4f, \"iterations\": %d, \"cost\": %.10g}\n",
+      name.c_str(), mode, options.threads, Median(seconds), Median(cpu), iterations, cost);
+  std::fflush(stdout);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -58,27 +81,10 @@ int main(int argc, char** argv) {
     const std::string name(ModelName(model));
     if (argc > 4 && name != argv[4]) continue;
     for (int threads : {1, 2}) {
-      std::vector<double> seconds, cpu;
-      double cost = 0;
-      int iterations = 0;
-      for (int r = 0; r < repeats; ++r) {
-        FitOptions o;
-        o.model = model;
-        o.threads = threads;
-        const auto t0 = std::chrono::steady_clock::now();
-        const std::clock_t c0 = std::clock();
-        const processing::FitResult fit = processing::FitMaterial(meas, o);
-        seconds.push_back(
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-        cpu.push_back(static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC);
-        cost = fit.report.final_cost;
-        iterations = fit.report.iterations;
-      }
-      std::printf(
-          "{\"model\": \"%s\", \"mode\": \"multistart\", \"threads\": %d, \"seconds\": %.4f, "
-          "\"cpu_seconds\": %.4f, \"iterations\": %d, \"cost\": %.10g}\n",
-          name.c_str(), threads, Median(seconds), Median(cpu), iterations, cost);
-      std::fflush(stdout);
+      FitOptions o;
+      o.model = model;
+      o.threads = threads;
+      TimeFits(meas, o, repeats, name, "multistart");
     }
     {
       // One refinement from the models' generic start (ParameterInfo::start), on one thread.
@@ -88,28 +94,11 @@ int main(int argc, char** argv) {
         for (int c = 0; c < p.Count(); ++c)
           start.values[static_cast<std::size_t>(p.offset + c)] = p.start;
       std::ofstream(out_dir + "/start_" + name + ".json") << MaterialToJson(start);
-      std::vector<double> seconds, cpu;
-      double cost = 0;
-      int iterations = 0;
-      for (int r = 0; r < repeats; ++r) {
-        FitOptions o;
-        o.model = model;
-        o.start = start;
-        o.starts = 1;
-        const auto t0 = std::chrono::steady_clock::now();
-        const std::clock_t c0 = std::clock();
-        const processing::FitResult fit = processing::FitMaterial(meas, o);
-        seconds.push_back(
-            std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
-        cpu.push_back(static_cast<double>(std::clock() - c0) / CLOCKS_PER_SEC);
-        cost = fit.report.final_cost;
-        iterations = fit.report.iterations;
-      }
-      std::printf(
-          "{\"model\": \"%s\", \"mode\": \"single-start\", \"threads\": 1, \"seconds\": %.4f, "
-          "\"cpu_seconds\": %.4f, \"iterations\": %d, \"cost\": %.10g}\n",
-          name.c_str(), Median(seconds), Median(cpu), iterations, cost);
-      std::fflush(stdout);
+      FitOptions o;
+      o.model = model;
+      o.start = start;
+      o.starts = 1;
+      TimeFits(meas, o, repeats, name, "single-start");
     }
   }
   return 0;
