@@ -675,7 +675,7 @@ TEST(PreviewHierarchical, LutMatchesTheBruteForceQuadrature) {
       MakeMaterial(Model::kLafortune, {0.45, 0.3, 0.17}, {0.05, 0.05, 0.05}, {8, 8, 8}));
   std::vector<double> theta_in;
   for (int k = 0; k <= 8; ++k) theta_in.push_back(10.0 * k);
-  const sources::LutBrdf lut(processing::BuildLut(CaptureOf(oak, theta_in, 89)), "oak lut");
+  const brdf::LutBrdf lut(processing::BuildLut(CaptureOf(oak, theta_in, 89)), "oak lut");
   EXPECT_LT(HierarchicalError(lut, EnvironmentMap::Studio(512, 256), 96), kHierarchicalBound);
 }
 

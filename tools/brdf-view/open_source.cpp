@@ -37,7 +37,7 @@ viewer::LoadedSource OpenViewSource(const std::string& path_or_name) {
       }
       double theta_b = 90;
       if (t.sidecar && t.sidecar->extrapolation) theta_b = t.sidecar->extrapolation->theta_b_deg;
-      out.brdf = std::make_shared<sources::LutBrdf>(t.texture.lut, name);
+      out.brdf = std::make_shared<brdf::LutBrdf>(t.texture.lut, name);
       out.view = viewer::ViewSourceFromLut(std::move(t.texture.lut), name, theta_b);
       warnings.insert(warnings.end(), t.warnings.begin(), t.warnings.end());
     } else {

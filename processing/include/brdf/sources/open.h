@@ -92,9 +92,6 @@ struct OpenedTexture {
 // that texture. Throws IoError / FormatError / InvalidArgument (another kind of file).
 OpenedTexture OpenExportedTexture(const std::string& path);
 
-// A LUT evaluated by the one rule of docs/design.md §5 (brdf/core/lut_brdf.h).
-using brdf::LutBrdf;
-
 struct OpenOptions {
   // §6 parameters from the command line (captures and tables; ignored with a warning for
   // exported LUTs, where the extrapolation is baked in).
