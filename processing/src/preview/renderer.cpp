@@ -452,109 +452,133 @@ struct PreviewRenderer::Impl {
                      counted += count;
                    });
     const double tolerance = options.image_tolerance * scale;
-    // Phase 2: each block owns its pixels [x0, x0 + block) × [y0, y0 + block); points on its
-    // far edges that it computes are kept locally (the neighbour computes its own).
+    // Phase 2: each block owns its pixels [x0, x0 + block) × [y0, y0 + block) and reads its
+    // far edges too. A pixel integrated by one block is integrated once: `integrated` keeps it for
+    // the neighbours sharing that edge. Block rows run in two passes, even rows then odd ones,
+    // each row by one thread from left to right, so two blocks that run at the same time never
+    // share a pixel.
     const int block_columns = (width + block - 1) / block;
-    ParallelChunks(
-        static_cast<std::size_t>(lattice_rows), 1, jobs, options.cancel,
-        [&](std::size_t b, std::size_t e) {
-          std::uint64_t count = 0;
-          const int side = block + 1;
-          std::vector<Rgb> local(static_cast<std::size_t>(side) * side);
-          std::vector<std::uint8_t> known(local.size());
-          for (std::size_t r = b; r < e; ++r)
-            for (int c = 0; c < block_columns; ++c) {
-              const int x0 = c * block, y0 = static_cast<int>(r) * block;
-              auto inside = [&](int dx, int dy) {
-                return x0 + dx < width && y0 + dy < height && object_at(x0 + dx, y0 + dy) >= 0;
-              };
-              auto at = [&](int dx, int dy) -> Rgb& { return local[dy * side + dx]; };
-              // known: 0 nothing, 1 computed (exact), 2 interpolated.
-              std::fill(known.begin(), known.end(), 0);
-              for (int dy : {0, block})
-                for (int dx : {0, block})
-                  if (inside(dx, dy)) {
-                    at(dx, dy) = value[static_cast<std::size_t>(y0 + dy) * width + x0 + dx];
+    std::vector<Rgb> integrated(object.size(), Rgb{0, 0, 0});
+    std::vector<std::uint8_t> has_integral(object.size(), 0);
+    for (int c = 0; c < block_columns; ++c)
+      for (int r = 0; r < lattice_rows; ++r)
+        if (const std::size_t g = static_cast<std::size_t>(r) * block * width + c * block;
+            index[g] >= 0) {
+          integrated[g] = value[g];
+          has_integral[g] = 1;
+        }
+    for (int parity : {0, 1})
+      ParallelChunks(
+          static_cast<std::size_t>((lattice_rows + 1 - parity) / 2), 1, jobs, options.cancel,
+          [&](std::size_t b, std::size_t e) {
+            std::uint64_t count = 0;
+            const int side = block + 1;
+            std::vector<Rgb> local(static_cast<std::size_t>(side) * side);
+            std::vector<std::uint8_t> known(local.size());
+            for (std::size_t pair = b; pair < e; ++pair)
+              for (int c = 0; c < block_columns; ++c) {
+                const std::size_t r = 2 * pair + static_cast<std::size_t>(parity);
+                const int x0 = c * block, y0 = static_cast<int>(r) * block;
+                auto inside = [&](int dx, int dy) {
+                  return x0 + dx < width && y0 + dy < height && object_at(x0 + dx, y0 + dy) >= 0;
+                };
+                auto at = [&](int dx, int dy) -> Rgb& { return local[dy * side + dx]; };
+                // known: 0 nothing, 1 computed (exact), 2 interpolated.
+                std::fill(known.begin(), known.end(), 0);
+                for (int dy : {0, block})
+                  for (int dx : {0, block})
+                    if (inside(dx, dy)) {
+                      at(dx, dy) = value[static_cast<std::size_t>(y0 + dy) * width + x0 + dx];
+                      known[dy * side + dx] = 1;
+                    }
+                // The integral at (dx, dy), from `integrated` when another block or an earlier step
+                // integrated it.
+                auto integral = [&](int dx, int dy) -> const Rgb& {
+                  const std::size_t g = static_cast<std::size_t>(y0 + dy) * width + x0 + dx;
+                  if (!has_integral[g]) {
+                    integrated[g] = compute(object_at(x0 + dx, y0 + dy), &count);
+                    has_integral[g] = 1;
+                  }
+                  return integrated[g];
+                };
+                auto computed = [&](int dx, int dy) -> const Rgb& {
+                  if (known[dy * side + dx] != 1) {
+                    at(dx, dy) = integral(dx, dy);
                     known[dy * side + dx] = 1;
                   }
-              auto computed = [&](int dx, int dy) -> const Rgb& {
-                if (known[dy * side + dx] != 1) {
-                  at(dx, dy) = compute(object_at(x0 + dx, y0 + dy), &count);
-                  known[dy * side + dx] = 1;
-                }
-                return at(dx, dy);
-              };
-              auto close = [&](const Rgb& got, const Rgb& a, const Rgb& b2) {
-                for (int ch = 0; ch < 3; ++ch)
-                  if (std::fabs(got[ch] - 0.5 * (a[ch] + b2[ch])) > tolerance) return false;
-                return true;
-              };
-              // The square at (dx, dy) of `size`, all of it on the object, corners computed:
-              // interpolated when its centre and edge midpoints pass, else split in four.
-              auto refine = [&](auto&& self, int dx, int dy, int size) -> void {
-                if (size <= 1) return;
-                const int h = size / 2;
-                const Rgb c00 = at(dx, dy), c10 = at(dx + size, dy), c01 = at(dx, dy + size),
-                          c11 = at(dx + size, dy + size);
-                const Rgb diagonal = {0.5 * (c00[0] + c11[0]), 0.5 * (c00[1] + c11[1]),
-                                      0.5 * (c00[2] + c11[2])};
-                const Rgb other = {0.5 * (c10[0] + c01[0]), 0.5 * (c10[1] + c01[1]),
-                                   0.5 * (c10[2] + c01[2])};
-                bool ok = close(computed(dx + h, dy), c00, c10);
-                ok = close(computed(dx, dy + h), c00, c01) && ok;
-                ok = close(computed(dx + size, dy + h), c10, c11) && ok;
-                ok = close(computed(dx + h, dy + size), c01, c11) && ok;
-                ok = close(computed(dx + h, dy + h), diagonal, other) && ok;
-                if (!ok || h == 1) {
-                  for (int qy : {dy, dy + h})
-                    for (int qx : {dx, dx + h}) self(self, qx, qy, h);
-                  return;
-                }
-                // Bilinear from the nine computed points, over the four quarters.
-                for (int qy : {dy, dy + h})
-                  for (int qx : {dx, dx + h}) {
-                    const Rgb a = at(qx, qy), b1 = at(qx + h, qy), c1 = at(qx, qy + h),
-                              d1 = at(qx + h, qy + h);
-                    for (int y = 0; y <= h; ++y)
-                      for (int x = 0; x <= h; ++x) {
-                        if (known[(qy + y) * side + qx + x]) continue;
-                        const double u = static_cast<double>(x) / h, v = static_cast<double>(y) / h;
-                        Rgb& out = at(qx + x, qy + y);
-                        for (int ch = 0; ch < 3; ++ch)
-                          out[ch] = (1 - u) * (1 - v) * a[ch] + u * (1 - v) * b1[ch] +
-                                    (1 - u) * v * c1[ch] + u * v * d1[ch];
-                        known[(qy + y) * side + qx + x] = 2;
-                      }
-                  }
-              };
-              // The rim and the image edges: the largest squares wholly on the object are refined
-              // as above; what is left is computed pixel by pixel below.
-              auto cover = [&](auto&& self, int dx, int dy, int size) -> void {
-                bool whole = true;
-                for (int y = dy; whole && y <= dy + size; ++y)
-                  for (int x = dx; whole && x <= dx + size; ++x) whole = inside(x, y);
-                if (whole) {
-                  for (int qy : {dy, dy + size})
-                    for (int qx : {dx, dx + size}) computed(qx, qy);
-                  refine(refine, dx, dy, size);
-                } else if (size > 2) {
+                  return at(dx, dy);
+                };
+                auto close = [&](const Rgb& got, const Rgb& a, const Rgb& b2) {
+                  for (int ch = 0; ch < 3; ++ch)
+                    if (std::fabs(got[ch] - 0.5 * (a[ch] + b2[ch])) > tolerance) return false;
+                  return true;
+                };
+                // The square at (dx, dy) of `size`, all of it on the object, corners computed:
+                // interpolated when its centre and edge midpoints pass, else split in four.
+                auto refine = [&](auto&& self, int dx, int dy, int size) -> void {
+                  if (size <= 1) return;
                   const int h = size / 2;
+                  const Rgb c00 = at(dx, dy), c10 = at(dx + size, dy), c01 = at(dx, dy + size),
+                            c11 = at(dx + size, dy + size);
+                  const Rgb diagonal = {0.5 * (c00[0] + c11[0]), 0.5 * (c00[1] + c11[1]),
+                                        0.5 * (c00[2] + c11[2])};
+                  const Rgb other = {0.5 * (c10[0] + c01[0]), 0.5 * (c10[1] + c01[1]),
+                                     0.5 * (c10[2] + c01[2])};
+                  bool ok = close(computed(dx + h, dy), c00, c10);
+                  ok = close(computed(dx, dy + h), c00, c01) && ok;
+                  ok = close(computed(dx + size, dy + h), c10, c11) && ok;
+                  ok = close(computed(dx + h, dy + size), c01, c11) && ok;
+                  ok = close(computed(dx + h, dy + h), diagonal, other) && ok;
+                  if (!ok || h == 1) {
+                    for (int qy : {dy, dy + h})
+                      for (int qx : {dx, dx + h}) self(self, qx, qy, h);
+                    return;
+                  }
+                  // Bilinear from the nine computed points, over the four quarters.
                   for (int qy : {dy, dy + h})
-                    for (int qx : {dx, dx + h}) self(self, qx, qy, h);
-                }
-              };
-              cover(cover, 0, 0, block);
-              for (int dy = 0; dy < block; ++dy)
-                for (int dx = 0; dx < block; ++dx) {
-                  if ((dx == 0 && dy == 0) || !inside(dx, dy)) continue;  // lattice corner, or off
-                  const Rgb v = known[dy * side + dx]
-                                    ? at(dx, dy)
-                                    : compute(object_at(x0 + dx, y0 + dy), &count);
-                  value[static_cast<std::size_t>(y0 + dy) * width + x0 + dx] = v;
-                }
-            }
-          counted += count;
-        });
+                    for (int qx : {dx, dx + h}) {
+                      const Rgb a = at(qx, qy), b1 = at(qx + h, qy), c1 = at(qx, qy + h),
+                                d1 = at(qx + h, qy + h);
+                      for (int y = 0; y <= h; ++y)
+                        for (int x = 0; x <= h; ++x) {
+                          if (known[(qy + y) * side + qx + x]) continue;
+                          const double u = static_cast<double>(x) / h,
+                                       v = static_cast<double>(y) / h;
+                          Rgb& out = at(qx + x, qy + y);
+                          for (int ch = 0; ch < 3; ++ch)
+                            out[ch] = (1 - u) * (1 - v) * a[ch] + u * (1 - v) * b1[ch] +
+                                      (1 - u) * v * c1[ch] + u * v * d1[ch];
+                          known[(qy + y) * side + qx + x] = 2;
+                        }
+                    }
+                };
+                // The rim and the image edges: the largest squares wholly on the object are refined
+                // as above; what is left is computed pixel by pixel below.
+                auto cover = [&](auto&& self, int dx, int dy, int size) -> void {
+                  bool whole = true;
+                  for (int y = dy; whole && y <= dy + size; ++y)
+                    for (int x = dx; whole && x <= dx + size; ++x) whole = inside(x, y);
+                  if (whole) {
+                    for (int qy : {dy, dy + size})
+                      for (int qx : {dx, dx + size}) computed(qx, qy);
+                    refine(refine, dx, dy, size);
+                  } else if (size > 2) {
+                    const int h = size / 2;
+                    for (int qy : {dy, dy + h})
+                      for (int qx : {dx, dx + h}) self(self, qx, qy, h);
+                  }
+                };
+                cover(cover, 0, 0, block);
+                for (int dy = 0; dy < block; ++dy)
+                  for (int dx = 0; dx < block; ++dx) {
+                    if ((dx == 0 && dy == 0) || !inside(dx, dy))
+                      continue;  // lattice corner, or off
+                    const Rgb v = known[dy * side + dx] ? at(dx, dy) : integral(dx, dy);
+                    value[static_cast<std::size_t>(y0 + dy) * width + x0 + dx] = v;
+                  }
+              }
+            counted += count;
+          });
     for (std::size_t k = 0; k < object_index.size(); ++k) store(k, value[object_index[k]]);
     evaluations = counted;
     computed_count = computed_pixels;
