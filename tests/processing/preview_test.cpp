@@ -19,6 +19,8 @@
 #include <random>
 #include <sstream>
 #include <string>
+#include <thread>
+#include <utility>
 #include <vector>
 
 #include "brdf/core/brdf_source.h"
@@ -962,6 +964,81 @@ TEST(PreviewProgressive, PassesAccumulateAndCancelStopsEarly) {
   PreviewRenderer again(material, studio, same, renderer.sampler());
   again.RenderPasses(64);
   EXPECT_EQ(again.Image().rgb, renderer.Image().rgb);
+}
+
+// The one pass of the deterministic estimators reports the fraction of the object's pixels
+// finished, from the calling thread. With one thread every piece of work is the caller's, so the
+// reports of the hierarchical pass are known in advance from the sphere's geometry alone: its
+// 64 × 64 image has four rows of 16-pixel blocks, done even rows first (0, 2), then odd ones
+// (1, 3); after each block row the fraction is the share of the sphere's pixels in the rows done.
+TEST(PreviewProgressive, DeterministicPassReportsTheFractionOfPixelsDoneFromTheCallingThread) {
+  const AnalyticBrdf material(test::GgxAlpha03());
+  const EnvironmentMap studio = EnvironmentMap::Studio(64, 32);
+  const int size = 64;
+  PreviewOptions o = SmallOptions(size, Estimator::kHierarchical);
+  std::vector<double> row_share(4, 0.0);
+  double all = 0.0;
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x)
+      if (Vec3 n; SphereNormal(x, y, size, size, o.camera.fill, &n)) {
+        row_share[y / 16] += 1.0;
+        all += 1.0;
+      }
+  for (double& share : row_share) share /= all;
+  const std::vector<double> expected = {row_share[0], row_share[0] + row_share[2],
+                                        row_share[0] + row_share[2] + row_share[1], 1.0, 1.0};
+  const PreviewImage silent = RenderPreview(material, studio, o);
+  std::vector<double> fractions, seconds;
+  std::vector<std::thread::id> threads;
+  o.pass_progress = [&](double fraction, double s) {
+    fractions.push_back(fraction);
+    seconds.push_back(s);
+    threads.push_back(std::this_thread::get_id());
+  };
+  o.jobs = 1;
+  const PreviewImage reported = RenderPreview(material, studio, o);
+  ASSERT_EQ(fractions.size(), expected.size());
+  for (std::size_t k = 0; k < expected.size(); ++k) EXPECT_NEAR(fractions[k], expected[k], 1e-12);
+  EXPECT_EQ(reported.rgb, silent.rgb) << "reporting changes nothing in the image";
+
+  // Two threads, both deterministic estimators and single-pixel blocks: fractions never
+  // decrease, times never decrease, every call is on the calling thread, the last is 1.
+  o.jobs = 2;
+  for (const auto& [estimator, block] :
+       std::vector<std::pair<Estimator, int>>{{Estimator::kHierarchical, 16},
+                                              {Estimator::kHierarchical, 1},
+                                              {Estimator::kQuadrature, 16}}) {
+    o.estimator = estimator;
+    o.image_block = block;
+    fractions.clear();
+    seconds.clear();
+    threads.clear();
+    RenderPreview(material, studio, o);
+    ASSERT_GE(fractions.size(), 2u);
+    for (std::size_t k = 1; k < fractions.size(); ++k) {
+      EXPECT_GE(fractions[k], fractions[k - 1]);
+      EXPECT_GE(seconds[k], seconds[k - 1]);
+    }
+    EXPECT_GE(fractions.front(), 0.0);
+    EXPECT_EQ(fractions.back(), 1.0);
+    for (const std::thread::id& id : threads) EXPECT_EQ(id, std::this_thread::get_id());
+  }
+
+  // Cancelled from the callback: the pass stops, and no report claims it finished.
+  std::atomic<bool> cancel{false};
+  o.estimator = Estimator::kHierarchical;
+  o.image_block = 16;
+  o.jobs = 1;
+  o.cancel = &cancel;
+  fractions.clear();
+  o.pass_progress = [&](double fraction, double) {
+    fractions.push_back(fraction);
+    cancel = true;
+  };
+  PreviewRenderer renderer(material, studio, o);
+  EXPECT_EQ(renderer.RenderPasses(1), 0);
+  ASSERT_EQ(fractions.size(), 1u);
+  EXPECT_LT(fractions.back(), 1.0);
 }
 
 }  // namespace

@@ -4,7 +4,9 @@
 
 #include <cmath>
 #include <fstream>
+#include <regex>
 #include <string>
+#include <vector>
 
 #include "brdf/exporter/exr.h"
 #include "tool_test_util.h"
@@ -95,6 +97,43 @@ TEST_F(PreviewCli, BadArgumentsFailWithOneLine) {
                            Quote(dir_ / "none.obj") + " --out " + Quote(dir_ / "x.png"));
   EXPECT_EQ(mesh.exit_code, 1);
   EXPECT_NE(mesh.err.find("none.obj"), std::string::npos) << mesh.err;
+}
+
+// The hierarchical quadrature (the sphere's default) is one long pass: stderr (a file here, not a
+// terminal) gets plain progress lines with the percentage of the sphere's pixels done, the time
+// elapsed and an ETA, at least at every further 10 %, percentages never decreasing, the last at
+// 100 % with nothing left to wait for. With one thread every block row is reported.
+TEST_F(PreviewCli, TheHierarchicalPassShowsProgressWithAnEta) {
+  const ToolRun r = Run("preview " + Quote(kMaterials + "gold.json") +
+                        " --size 96 --jobs 1 --out " + Quote(dir_ / "g.exr"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::regex line(
+      R"(^preview gold: (\d+) % of the pixels, ([0-9.]+)s elapsed, ETA (--|[0-9.]+s)$)");
+  std::vector<int> percent;
+  std::vector<double> elapsed;
+  std::string last_eta;
+  for (const std::string& l : r.ErrLines()) {
+    std::smatch m;
+    if (!std::regex_match(l, m, line)) continue;
+    percent.push_back(std::stoi(m[1]));
+    elapsed.push_back(std::stod(m[2]));
+    last_eta = m[3];
+  }
+  ASSERT_GE(percent.size(), 4u) << r.err;
+  for (std::size_t k = 1; k < percent.size(); ++k) {
+    EXPECT_GE(percent[k], percent[k - 1]) << r.err;
+    EXPECT_LE(percent[k] - percent[k - 1], 100 * 16 * 2 / 96 + 10) << r.err;  // ≤ 2 block rows
+    EXPECT_GE(elapsed[k], elapsed[k - 1]) << r.err;
+  }
+  EXPECT_LT(percent.front(), 100) << r.err;
+  EXPECT_EQ(percent.back(), 100) << r.err;
+  EXPECT_EQ(last_eta, "0.0s") << r.err;
+  EXPECT_NE(r.err.find("hierarchical quadrature"), std::string::npos) << r.err;
+  // --quiet: nothing on stderr.
+  const ToolRun quiet = Run("preview " + Quote(kMaterials + "gold.json") +
+                            " --size 32 --quiet --out " + Quote(dir_ / "q.exr"));
+  ASSERT_EQ(quiet.exit_code, 0) << quiet.err;
+  EXPECT_EQ(quiet.err, "");
 }
 
 }  // namespace

@@ -92,6 +92,28 @@ class PassProgress {
                  Progress::FormatDuration(eta).c_str(), tty_ ? "" : "\n");
     std::fflush(stderr);
   }
+  // The one pass of a deterministic estimator: the fraction of the object's pixels done. On a
+  // terminal the line is redrawn up to ten times a second; otherwise a plain line is printed at
+  // each further 10 % or after a second, and always at 100 %.
+  void UpdateFraction(double fraction, double seconds) {
+    if (!enabled_) return;
+    const int decile = static_cast<int>(fraction * 10.0 + 1e-9);
+    const bool done = fraction >= 1.0;
+    if (!done) {
+      if (tty_ && seconds - last_ < 0.1) return;
+      if (!tty_ && decile <= last_decile_ && seconds - last_ < 1.0) return;
+    }
+    if (done && printed_done_) return;
+    last_ = seconds;
+    last_decile_ = decile;
+    printed_done_ = done;
+    const double eta = fraction > 0.0 ? seconds / fraction * (1.0 - fraction) : 0.0;
+    std::fprintf(stderr, "%s%s: %.0f %% of the pixels, %s elapsed, ETA %s%s",
+                 tty_ ? "\r\033[K" : "", label_.c_str(), std::floor(100.0 * fraction),
+                 Progress::FormatDuration(seconds).c_str(),
+                 fraction > 0.0 ? Progress::FormatDuration(eta).c_str() : "--", tty_ ? "" : "\n");
+    std::fflush(stderr);
+  }
   void Done(const preview::PreviewImage& image) {
     if (!enabled_) return;
     const bool deterministic = image.estimator == preview::Estimator::kHierarchical ||
@@ -124,6 +146,8 @@ class PassProgress {
   std::string label_;
   bool enabled_, tty_;
   double last_ = -1.0;
+  int last_decile_ = 0;
+  bool printed_done_ = false;
 };
 
 preview::PreviewImage Render(const BrdfSource& source, const preview::EnvironmentMap& map,
@@ -134,6 +158,10 @@ preview::PreviewImage Render(const BrdfSource& source, const preview::Environmen
     progress.Update(passes, options.samples_per_pixel, rms, options.target_relative_rms, seconds);
     return true;
   };
+  if (!cli.quiet)
+    options.pass_progress = [&](double fraction, double seconds) {
+      progress.UpdateFraction(fraction, seconds);
+    };
   preview::PreviewImage image = preview::RenderPreview(source, map, options);
   progress.Done(image);
   return image;

@@ -214,6 +214,12 @@ struct PreviewOptions {
   // Called after every pass from the calling thread: passes done, the current estimate of the
   // relative RMS error, seconds since the start. Return false to stop early.
   std::function<bool(int passes, double relative_rms, double seconds)> progress;
+  // The deterministic estimators (kHierarchical, kQuadrature) finish in one long pass; during
+  // it this is called from the calling thread (after each piece of work that thread finishes,
+  // so often: throttle the printing) with the fraction of the object's pixels finished, never
+  // decreasing, and the seconds since the pass started; the last call of a pass that was not
+  // cancelled has fraction 1. The workers only count (no locks, no calls).
+  std::function<void(double fraction_done, double seconds)> pass_progress;
   // Checked between tiles; when it becomes true the current pass is abandoned and the render
   // returns with the passes completed so far.
   const std::atomic<bool>* cancel = nullptr;
