@@ -943,6 +943,134 @@ TEST_F(PreviewFiles, BrokenMeshesAndMapsFailWithTheFileAndPosition) {
   EXPECT_THROW(EnvironmentMap::FromName("no-such-map"), InvalidArgument);
 }
 
+// A damaged map is refused in one line that names the file, the scanline (or block of
+// scanlines) and the byte where the layout breaks, what was expected there and what was found,
+// in the file format's terms. The files are made here with their layout written out from the
+// published descriptions (Radiance RGBE: header, resolution line, run-length scanlines;
+// OpenEXR: header attributes, offset table, blocks of 16 scanlines for ZIP), so the positions
+// the messages must name are known independently of the readers.
+std::string LoadError(const std::string& path) {
+  try {
+    EnvironmentMap::Load(path);
+  } catch (const FormatError& e) {
+    return e.what();
+  } catch (const Error& e) {
+    return std::string("not a FormatError: ") + e.what();
+  }
+  return "no error";
+}
+
+void ExpectDamageMessage(const std::string& message, const std::string& file,
+                         const std::vector<std::string>& parts) {
+  EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  EXPECT_EQ(message.rfind(file, 0), 0u) << message;
+  EXPECT_NE(message.find("expected"), std::string::npos) << message;
+  EXPECT_NE(message.find(", got "), std::string::npos) << message;
+  for (const char* internal : {"OpenImageIO", "Imf", "::", "Iex", "oiio"})
+    EXPECT_EQ(message.find(internal), std::string::npos) << message;
+  for (const std::string& part : parts) EXPECT_NE(message.find(part), std::string::npos) << message;
+}
+
+TEST_F(PreviewFiles, DamagedRadianceMapsNameTheScanlineAndByte) {
+  // 16 × 8 pixels; every scanline run-length encoded: 2 2 0 16, then per component one run of
+  // 16 equal bytes (count 128 + 16 = 144, value): 12 bytes a scanline.
+  const std::string header = "#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y 8 +X 16\n";
+  std::string scanline = {2, 2, 0, 16};
+  for (unsigned char v : {128, 64, 32, 129})
+    scanline += {static_cast<char>(144), static_cast<char>(v)};
+  std::string file = header;
+  for (int row = 0; row < 8; ++row) file += scanline;
+  const std::size_t start = header.size();  // byte of scanline 1
+  const EnvironmentMap intact = EnvironmentMap::Load(Write("intact.hdr", file));
+  ASSERT_EQ(intact.width(), 16);
+  // RGBE (128, 64, 32, 129): (m + 0.5)/256 · 2^(129 − 128) per the format's decoding rule, or
+  // m/256 · 2 for decoders without the half-step.
+  EXPECT_NEAR(intact.Pixel(3, 5)[0], 1.0, 0.005);
+  EXPECT_NEAR(intact.Pixel(3, 5)[2], 0.25, 0.005);
+
+  // Cut 7 bytes into scanline 6: its head (4), the red run (2) and the green count are there.
+  const std::size_t cut = start + 5 * 12 + 7;
+  ExpectDamageMessage(LoadError(Write("cut.hdr", file.substr(0, cut))), (dir_ / "cut.hdr").string(),
+                      {"scanline 6 of 8", "byte " + std::to_string(start + 60), "green",
+                       "end of the file at byte " + std::to_string(cut)});
+  // One bit flipped in scanline 3's green run count: 144 → 145, a run of 17 in 16 pixels.
+  std::string flipped = file;
+  const std::size_t count_byte = start + 2 * 12 + 4 + 2;
+  flipped[count_byte] = static_cast<char>(flipped[count_byte] ^ 0x01);
+  ExpectDamageMessage(
+      LoadError(Write("flip.hdr", flipped)), (dir_ / "flip.hdr").string(),
+      {"scanline 3 of 8", "run at byte " + std::to_string(count_byte), "green", "a run of 17"});
+  // One bit flipped in scanline 8's head: its width 16 → 48.
+  flipped = file;
+  flipped[start + 7 * 12 + 3] = static_cast<char>(16 ^ 0x20);
+  ExpectDamageMessage(
+      LoadError(Write("width.hdr", flipped)), (dir_ / "width.hdr").string(),
+      {"scanline 8 of 8", "byte " + std::to_string(start + 84), "16 pixels", "48 pixels"});
+  // The header cut inside the resolution line's line: line 4 (byte 35) never ends.
+  ExpectDamageMessage(LoadError(Write("head.hdr", file.substr(0, header.size() - 4))),
+                      (dir_ / "head.hdr").string(),
+                      {"line 4 of the header", "byte " + std::to_string(header.find("-Y"))});
+}
+
+TEST_F(PreviewFiles, DamagedExrMapsNameTheBlockOfScanlinesAndByte) {
+  // 128 × 64, smooth (so ZIP compresses it and its blocks hold deflate streams): 4 blocks of
+  // 16 scanlines.
+  exporter::FloatImage image;
+  image.width = 128;
+  image.height = 64;
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 128; ++x)
+      for (float v : {x / 128.0f, y / 64.0f, 0.5f}) image.rgb.push_back(v);
+  const std::string path = (dir_ / "intact.exr").string();
+  exporter::WriteExr(path, image, {exporter::ExrPixelType::kFloat, exporter::ExrCompression::kZip},
+                     {});
+  ASSERT_EQ(EnvironmentMap::Load(path).height(), 64);
+  std::string file;
+  {
+    std::ifstream in(path, std::ios::binary);
+    file.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  // The layout: magic and version (8 bytes), attributes "name\0type\0" + 4-byte size + value
+  // up to an empty name, then 4 little-endian 8-byte block offsets.
+  auto le32 = [&](std::size_t at) {
+    std::uint32_t v = 0;
+    for (int k = 3; k >= 0; --k) v = (v << 8) | static_cast<unsigned char>(file[at + k]);
+    return v;
+  };
+  std::size_t at = 8;
+  while (file[at] != '\0') {
+    at = file.find('\0', at) + 1;  // name
+    at = file.find('\0', at) + 1;  // type
+    at += 4 + le32(at);
+  }
+  const std::size_t table = at + 1;
+  std::vector<std::size_t> block(4);
+  for (int k = 0; k < 4; ++k) block[k] = le32(table + 8 * k);  // offsets below 4 GiB
+  for (int k = 0; k < 4; ++k) ASSERT_EQ(le32(block[k]), 16u * k) << "block " << k << "'s first row";
+
+  // Cut in the middle of block 3's data.
+  const std::size_t cut = block[2] + 8 + le32(block[2] + 4) / 2;
+  ExpectDamageMessage(
+      LoadError(Write("cut.exr", file.substr(0, cut))), (dir_ / "cut.exr").string(),
+      {"pixel block 3 of 4", "scanlines 33–48 of 64", "byte " + std::to_string(block[2]),
+       "end of the file at byte " + std::to_string(cut)});
+  // One bit flipped in the middle of block 2's deflate stream.
+  std::string flipped = file;
+  const std::size_t middle = block[1] + 8 + le32(block[1] + 4) / 2;
+  flipped[middle] = static_cast<char>(flipped[middle] ^ 0x10);
+  ExpectDamageMessage(LoadError(Write("flip.exr", flipped)), (dir_ / "flip.exr").string(),
+                      {"pixel block 2 of 4", "scanlines 17–32 of 64",
+                       "byte " + std::to_string(block[1]), "does not decode"});
+  // One bit flipped in the table's third offset (bit 40: far past the end of the file): OpenEXR
+  // rebuilds a damaged table from the blocks themselves, so this map still reads.
+  flipped = file;
+  flipped[table + 8 * 2 + 5] = static_cast<char>(flipped[table + 8 * 2 + 5] ^ 0x01);
+  EXPECT_EQ(LoadError(Write("table.exr", flipped)), "no error");
+  // The header cut at byte 20.
+  ExpectDamageMessage(LoadError(Write("head.exr", file.substr(0, 20))),
+                      (dir_ / "head.exr").string(), {"header attribute", "byte 8"});
+}
+
 TEST(PreviewProgressive, PassesAccumulateAndCancelStopsEarly) {
   const AnalyticBrdf material(test::GgxAlpha03());
   const EnvironmentMap studio = EnvironmentMap::Studio(64, 32);
