@@ -180,5 +180,64 @@ TEST_F(PreviewCli, ASimulatedCaptureOfTheWholeSphereGeometryPreviewsWithin2Perce
   }
 }
 
+// The plane lies at z = 0, edge-on to the sphere's default camera (θ = 90°); without --view it is
+// seen from θ = 60°, φ = 0. Orthographically, a point (x, y, 0) then appears at image right = y
+// and image up = −x·cos60° (camera right (0, 1, 0), up (−cos60°, 0, sin60°)), the frame height
+// spanning 2/0.9: the pixels whose centres fall inside |y| ≤ 1/√2, |x| ≤ 1/√2 show it, and under
+// the furnace a white Lambertian shows 1 there. --view 90,0 still means edge-on: nothing.
+TEST_F(PreviewCli, ThePlaneIsSeenFromAboveUnlessAViewIsGiven) {
+  std::ofstream(dir_ / "white.json") << R"({"model": "lambert", "rho": 1.0})";
+  const int size = 40;
+  const std::string common =
+      " --env furnace --mesh plane --estimator hierarchical --no-background "
+      "--size " +
+      std::to_string(size) + " --quiet --out ";
+  ASSERT_EQ(Run("preview " + Quote(dir_ / "white.json") + common + Quote(dir_ / "p.exr")).exit_code,
+            0);
+  const exporter::ExrFile exr = exporter::ReadExr((dir_ / "p.exr").string());
+  const double half = 1.0 / 0.9, edge = 1.0 / std::sqrt(2.0), c60 = 0.5;
+  int expected = 0, lit = 0;
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      const double right = ((x + 0.5) / size * 2.0 - 1.0) * half;
+      const double up = (1.0 - (y + 0.5) / size * 2.0) * half;
+      const bool on_plane = std::fabs(right) <= edge && std::fabs(up) <= edge * c60;
+      expected += on_plane;
+      const float g = exr.image.Pixel(x, y)[1];
+      lit += g > 0.5f;
+      if (on_plane) {
+        EXPECT_NEAR(g, 1.0, 2e-3) << x << "," << y;
+      }
+    }
+  EXPECT_EQ(lit, expected);
+  EXPECT_GT(expected, 250);
+  ASSERT_EQ(Run("preview " + Quote(dir_ / "white.json") + " --view 90,0" + common +
+                Quote(dir_ / "edge.exr"))
+                .exit_code,
+            0);
+  const exporter::ExrFile edge_on = exporter::ReadExr((dir_ / "edge.exr").string());
+  for (float v : edge_on.image.rgb) ASSERT_EQ(v, 0.0f);
+}
+
+// --light alone: one directional light of irradiance π from (90°, 0), the camera's side. A white
+// Lambertian then shows ρ/π · π · cosθ = n·(1, 0, 0) at the pixel whose normal is n (the
+// sphere's normal at a pixel from the orthographic framing), and stderr says what ran.
+TEST_F(PreviewCli, ADirectionalLightAloneLightsAWhiteLambertianByTheCosine) {
+  std::ofstream(dir_ / "white.json") << R"({"model": "lambert", "rho": 1.0})";
+  const int size = 32;
+  const ToolRun r = Run("preview " + Quote(dir_ / "white.json") + " --light 90,0 --size " +
+                        std::to_string(size) + " --out " + Quote(dir_ / "l.exr"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("the directional light only"), std::string::npos) << r.err;
+  const exporter::ExrFile exr = exporter::ReadExr((dir_ / "l.exr").string());
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      const double s = ((x + 0.5) / size * 2.0 - 1.0) / 0.9,
+                   t = (1.0 - (y + 0.5) / size * 2.0) / 0.9;
+      const double cos_theta = s * s + t * t < 1.0 ? std::sqrt(1.0 - s * s - t * t) : 0.0;
+      EXPECT_NEAR(exr.image.Pixel(x, y)[1], cos_theta, 1e-5) << x << "," << y;
+    }
+}
+
 }  // namespace
 }  // namespace brdf::tooltest

@@ -114,8 +114,16 @@ class PassProgress {
                  fraction > 0.0 ? Progress::FormatDuration(eta).c_str() : "--", tty_ ? "" : "\n");
     std::fflush(stderr);
   }
-  void Done(const preview::PreviewImage& image) {
+  void Done(const preview::PreviewImage& image, bool light_only) {
     if (!enabled_) return;
+    if (light_only) {  // no integral over the map: one BRDF evaluation per pixel, exact
+      std::size_t object = 0;
+      for (std::uint8_t o : image.object) object += o;
+      std::fprintf(stderr, "%s%s: the directional light only (exact), %zu object pixels, %s\n",
+                   tty_ ? "\r\033[K" : "", label_.c_str(), object,
+                   Progress::FormatDuration(image.seconds).c_str());
+      return;
+    }
     const bool deterministic = image.estimator == preview::Estimator::kHierarchical ||
                                image.estimator == preview::Estimator::kQuadrature;
     if (deterministic) {
@@ -163,7 +171,7 @@ preview::PreviewImage Render(const BrdfSource& source, const preview::Environmen
       progress.UpdateFraction(fraction, seconds);
     };
   preview::PreviewImage image = preview::RenderPreview(source, map, options);
-  progress.Done(image);
+  progress.Done(image, !options.environment_lighting);
   return image;
 }
 
@@ -199,11 +207,24 @@ int RunPreview(const PreviewCommandOptions& cli) {
   options.seed = cli.seed;
   options.environment_rotation_deg = cli.env_rotation_deg;
   double a = 0, b = 0;
-  if (!ParsePair(cli.view, &a, &b) || a < 0 || a > 180)
-    throw InvalidArgument("--view: expected THETA,PHI in degrees with THETA in [0, 180], got '" +
-                          cli.view + "'");
-  options.camera.theta_deg = a;
-  options.camera.phi_deg = b;
+  preview::Mesh mesh;
+  if (cli.mesh == "sphere") {
+    options.shape = preview::Shape::kSphere;
+  } else if (cli.mesh == "plane") {
+    options.shape = preview::Shape::kPlane;
+  } else {
+    mesh = preview::LoadMesh(cli.mesh);
+    options.shape = preview::Shape::kMesh;
+    options.mesh = &mesh;
+  }
+  options.camera = preview::DefaultCamera(options.shape);
+  if (!cli.view.empty()) {
+    if (!ParsePair(cli.view, &a, &b) || a < 0 || a > 180)
+      throw InvalidArgument("--view: expected THETA,PHI in degrees with THETA in [0, 180], got '" +
+                            cli.view + "'");
+    options.camera.theta_deg = a;
+    options.camera.phi_deg = b;
+  }
   if (cli.fov_deg > 0) {
     options.camera.projection = preview::Camera::Projection::kPerspective;
     options.camera.fov_deg = cli.fov_deg;
@@ -218,16 +239,6 @@ int RunPreview(const PreviewCommandOptions& cli) {
     options.show_background = cli.env_given;
   }
   if (cli.no_background) options.show_background = false;
-  preview::Mesh mesh;
-  if (cli.mesh == "sphere") {
-    options.shape = preview::Shape::kSphere;
-  } else if (cli.mesh == "plane") {
-    options.shape = preview::Shape::kPlane;
-  } else {
-    mesh = preview::LoadMesh(cli.mesh);
-    options.shape = preview::Shape::kMesh;
-    options.mesh = &mesh;
-  }
   // The overwrite rule of every writing command, checked before any rendering work.
   ReportRemovedTemporaries(CheckWritableOutput(cli.out, cli.force));
   const preview::EnvironmentMap map = preview::EnvironmentMap::FromName(cli.env);

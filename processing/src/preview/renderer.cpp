@@ -723,6 +723,12 @@ const std::shared_ptr<const BrdfSampler>& PreviewRenderer::sampler() const {
   return impl_->sampler;
 }
 
+Camera DefaultCamera(Shape shape) {
+  Camera camera;
+  if (shape == Shape::kPlane) camera.theta_deg = 60.0;
+  return camera;
+}
+
 PreviewImage RenderPreview(const BrdfSource& source, const EnvironmentMap& environment,
                            const PreviewOptions& options) {
   PreviewRenderer renderer(source, environment, options);

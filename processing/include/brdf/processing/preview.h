@@ -141,6 +141,11 @@ struct Camera {
   double fill = 0.9;
 };
 
+// The camera a picture of `shape` gets when the user names none: Camera{} (θ = 90°, on +x) for
+// the sphere and meshes; for the plane, which lies at z = 0 and that camera sees edge-on, the
+// camera at θ = 60°, φ = 0, which sees it obliquely from above.
+Camera DefaultCamera(Shape shape);
+
 // One distant directional light (for direct-lighting pictures): it arrives from world direction
 // (theta_deg, phi_deg) (the direction towards the light) with irradiance `irradiance` on a
 // surface facing it.
