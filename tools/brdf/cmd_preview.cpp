@@ -107,11 +107,21 @@ class PassProgress {
     last_ = seconds;
     last_decile_ = decile;
     printed_done_ = done;
-    const double eta = fraction > 0.0 ? seconds / fraction * (1.0 - fraction) : 0.0;
+    // The rate since the first report, so that the set-up before the first pixels (the map
+    // hierarchy, the lattice pass) does not count as the pixels' cost.
+    if (first_seconds_ < 0.0) {
+      first_fraction_ = fraction;
+      first_seconds_ = seconds;
+    }
+    const bool known = done || fraction > first_fraction_;
+    const double eta =
+        done    ? 0.0
+        : known ? (seconds - first_seconds_) / (fraction - first_fraction_) * (1.0 - fraction)
+                : 0.0;
     std::fprintf(stderr, "%s%s: %.0f %% of the pixels, %s elapsed, ETA %s%s",
                  tty_ ? "\r\033[K" : "", label_.c_str(), std::floor(100.0 * fraction),
                  Progress::FormatDuration(seconds).c_str(),
-                 fraction > 0.0 ? Progress::FormatDuration(eta).c_str() : "--", tty_ ? "" : "\n");
+                 known ? Progress::FormatDuration(eta).c_str() : "--", tty_ ? "" : "\n");
     std::fflush(stderr);
   }
   void Done(const preview::PreviewImage& image, bool light_only) {
@@ -155,6 +165,7 @@ class PassProgress {
   bool enabled_, tty_;
   double last_ = -1.0;
   int last_decile_ = 0;
+  double first_fraction_ = 0.0, first_seconds_ = -1.0;
   bool printed_done_ = false;
 };
 
