@@ -58,16 +58,21 @@ const char* CompressionName(Imf::Compression c) {
     try {
       Imf::InputFile file(path.c_str(), /*numThreads=*/0);
       const Imath::Box2i window = file.header().dataWindow();
-      const int width = window.max.x - window.min.x + 1;
-      std::vector<float> rgb(static_cast<std::size_t>(width) * 3 * layout.lines_per_block);
-      for (std::uint64_t k = 0; k < layout.blocks; ++k) {
+      const long long width = static_cast<long long>(window.max.x) - window.min.x + 1;
+      // Within the reader's limit, as ReadExrImage checked before reading pixels.
+      const bool fits =
+          width >= 1 &&
+          static_cast<unsigned long long>(width) * layout.lines_per_block <= kMaxReadPixels;
+      std::vector<float> rgb(fits ? static_cast<std::size_t>(width) * 3 * layout.lines_per_block
+                                  : 0);
+      for (std::uint64_t k = 0; fits && k < layout.blocks; ++k) {
         const int y0 = window.min.y + static_cast<int>(k * layout.lines_per_block);
         const int y1 = std::min(window.max.y, y0 + static_cast<int>(layout.lines_per_block) - 1);
         // A frame buffer for this block's rows only: its origin moved so row y0 is its first.
         Imath::Box2i rows = window;
         rows.min.y = y0;
         rows.max.y = y1;
-        file.setFrameBuffer(InterleavedRgb(rgb.data(), rows, width));
+        file.setFrameBuffer(InterleavedRgb(rgb.data(), rows, static_cast<int>(width)));
         try {
           file.readPixels(y0, y1);
         } catch (const std::exception&) {
