@@ -239,5 +239,33 @@ TEST_F(PreviewCli, ADirectionalLightAloneLightsAWhiteLambertianByTheCosine) {
     }
 }
 
+// A capture whose θin range stops short of grazing says so when previewed on the sphere: the
+// instrument's default list (0, 20, 40, 60°) ends at 60°; a list up to 85° and a material (no
+// measured range) get no note, and --quiet prints nothing.
+TEST_F(PreviewCli, ACaptureThatStopsShortOfGrazingSaysSoOnTheSphere) {
+  const std::string coarse = " --theta-out-step 5 --phi-out-step 10 --sim-pace-ms 0 --quiet";
+  ASSERT_EQ(Run("capture --device sim --material gold --sample n" + coarse + " --out " +
+                Quote(dir_ / "four.bpc"))
+                .exit_code,
+            0);
+  ASSERT_EQ(Run("capture --device sim --material gold --sample n --theta-in 0,30,60,85" + coarse +
+                " --out " + Quote(dir_ / "grazing.bpc"))
+                .exit_code,
+            0);
+  const std::string render = " --size 16 --force --out " + Quote(dir_ / "n.png");
+  const ToolRun four = Run("preview " + Quote(dir_ / "four.bpc") + render);
+  ASSERT_EQ(four.exit_code, 0) << four.err;
+  EXPECT_NE(four.err.find((dir_ / "four.bpc").string() + ": note: θin measured up to 60°"),
+            std::string::npos)
+      << four.err;
+  const ToolRun grazing = Run("preview " + Quote(dir_ / "grazing.bpc") + " --compare " +
+                              Quote(kMaterials + "gold.json") + render);
+  ASSERT_EQ(grazing.exit_code, 0) << grazing.err;
+  EXPECT_EQ(grazing.err.find("note:"), std::string::npos) << grazing.err;
+  const ToolRun quiet = Run("preview " + Quote(dir_ / "four.bpc") + " --quiet" + render);
+  ASSERT_EQ(quiet.exit_code, 0) << quiet.err;
+  EXPECT_EQ(quiet.err, "");
+}
+
 }  // namespace
 }  // namespace brdf::tooltest

@@ -261,14 +261,20 @@ int RunPreview(const PreviewCommandOptions& cli) {
   open_options.extrapolation = extrapolate;
   sources::OpenedSource opened = sources::OpenBrdf(cli.file, open_options);
   warnings.insert(warnings.end(), opened.warnings.begin(), opened.warnings.end());
+  std::vector<std::string> notes;
+  if (const auto note = opened.SphereCoverageNote(cli.file)) notes.push_back(*note);
   const std::unique_ptr<BrdfSource> source = std::move(opened.brdf);
   std::unique_ptr<BrdfSource> second;
   if (!cli.compare.empty()) {
     sources::OpenedSource other = sources::OpenBrdf(cli.compare, open_options);
     warnings.insert(warnings.end(), other.warnings.begin(), other.warnings.end());
+    if (const auto note = other.SphereCoverageNote(cli.compare)) notes.push_back(*note);
     second = std::move(other.brdf);
   }
   for (const std::string& w : warnings) std::fprintf(stderr, "%s\n", w.c_str());
+  // A sphere (and a mesh) shows every pair of directions; a capture measured only some of them.
+  if (!cli.quiet && options.shape != preview::Shape::kPlane)
+    for (const std::string& n : notes) std::fprintf(stderr, "%s\n", n.c_str());
 
   const preview::PreviewImage first = Render(*source, map, options, cli);
   preview::PreviewImage out = first;
