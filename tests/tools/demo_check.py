@@ -117,6 +117,28 @@ def check_lut(path, material, theta_in_deg):
              "(limit 0.15) too far from the analytic material")
 
 
+def check_not_blank(path, name):
+    """Something to look at: at least 5 % of the picture differs by more than 10 of 255 levels
+    from its most common colour (the background), and the sphere of the preview, framed at
+    90 % of the height around the centre, differs from the corners."""
+    import OpenImageIO as oiio
+    pixels = oiio.ImageBuf(path).get_pixels(oiio.UINT8)
+    if pixels is None or pixels.size == 0:
+        fail(f"{name}: cannot be read as an image")
+    rgb = pixels[:, :, :3].astype(int).reshape(-1, 3)
+    colours, counts = np.unique(rgb, axis=0, return_counts=True)
+    background = colours[np.argmax(counts)]
+    differing = np.mean(np.max(np.abs(rgb - background), axis=1) > 10)
+    if differing < 0.05:
+        fail(f"{name}: only {100 * differing:.1f} % of the picture differs from its background")
+    if name.startswith("previews/"):
+        h, w = pixels.shape[:2]
+        centre = pixels[h // 2 - h // 8:h // 2 + h // 8, w // 2 - w // 8:w // 2 + w // 8, :3]
+        corner = pixels[:h // 16, :w // 16, :3]
+        if abs(float(centre.mean()) - float(corner.mean())) < 5:
+            fail(f"{name}: the sphere cannot be told from the background")
+
+
 def png_size(path):
     data = open(path, "rb").read(24)
     if data[:8] != b"\x89PNG\r\n\x1a\n":
@@ -143,6 +165,7 @@ def main():
         got = png_size(os.path.join(out, picture))
         if tuple(got) != size:
             fail(f"{picture}: {got[0]}x{got[1]}, expected {size[0]}x{size[1]}")
+        check_not_blank(os.path.join(out, picture), picture)
     print(f"demo_check: {len(names)} LUTs, the atlas and the pictures agree with the physics")
 
 

@@ -11,7 +11,8 @@ the simulator and everything `brdf convert`, `export-csv`, `atlas` and `fit` mak
 files from data-samples/materials, a MERL file written here in the published layout, and
 third-party files read from BRDF_DATA_DIR (default SOURCE_DIR/../shared/brdf-data; missing, the
 run fails naming the variable): RGL .bsdf, Zemax, goniometer table. A LightTools table, PLY/OBJ
-meshes and .hdr/.exr environment maps are written here in their published layouts.
+meshes and .hdr/.exr environment maps (flat and run-length RGBE, raw and ZIP EXR) are written
+here in their published layouts.
 
 Each seed gets variants, all derived from one fixed seed (the same files on every run):
 truncations (0, 1, end of header, middle, last byte), bit flips at seeded positions, lying
@@ -131,14 +132,31 @@ def write_hdr(path, width=16, height=8):
     open(path, "wb").write(header + pixel * (width * height))
 
 
-def write_exr_env(path, width=16, height=8):
+def write_hdr_rle(path, width=16, height=8):
+    """Radiance RGBE with run-length encoded scanlines (2 2 W>>8 W&255, then per component one
+    run of W equal bytes: count 128 + W, value), the layout most writers produce."""
+    header = f"#?RADIANCE\nFORMAT=32-bit_rle_rgbe\n\n-Y {height} +X {width}\n".encode()
+    line = bytes((2, 2, width >> 8, width & 255))
+    for value in (128, 64, 32, 129):
+        line += bytes((128 + width, value))
+    open(path, "wb").write(header + line * height)
+
+
+def write_exr_env(path, width=16, height=8, compression=None):
     import numpy as np
     import OpenImageIO as oiio
     spec = oiio.ImageSpec(width, height, 3, "float")
+    if compression:
+        spec.attribute("compression", compression)
     out = oiio.ImageOutput.create(path)
     if not out or not out.open(path, spec):
         raise SystemExit(f"hostile_inputs: cannot write {path} with OpenImageIO")
-    out.write_image(np.ones((height, width, 3), dtype=np.float32))
+    if compression:  # smooth, so that the blocks hold real compressed streams
+        y, x = np.mgrid[0:height, 0:width]
+        out.write_image(np.stack([x / width, y / height, np.full(x.shape, 0.5)], -1)
+                        .astype(np.float32))
+    else:
+        out.write_image(np.ones((height, width, 3), dtype=np.float32))
     out.close()
 
 
@@ -664,6 +682,8 @@ def make_seeds(tool, source_dir, data_dir, work):
     write_obj(s("mesh.obj"))
     write_hdr(s("env.hdr"))
     write_exr_env(s("env.exr"))
+    write_hdr_rle(s("env_rle.hdr"))
+    write_exr_env(s("env_zip.exr"), 128, 64, "zip")
 
     bpc_head = bpc_chunks(open(s("cap.bpc"), "rb").read())[0]
     # convert reads captures and material files; third-party tables are imported first.
@@ -707,6 +727,8 @@ def make_seeds(tool, source_dir, data_dir, work):
         Seed("mesh.obj", s("mesh.obj"), "mesh", ["mesh", "info"], lies_obj, binary=False),
         Seed("env.hdr", s("env.hdr"), "env", ["env", "info"], lies_hdr, header_end=60),
         Seed("env.exr", s("env.exr"), "env", ["env", "info"], None, header_end=300),
+        Seed("env_rle.hdr", s("env_rle.hdr"), "env", ["env"], lies_hdr, header_end=60),
+        Seed("env_zip.exr", s("env_zip.exr"), "env", ["env"], None, header_end=300),
     ]
     return seeds
 
@@ -908,6 +930,14 @@ def check_run(variant, command, code, out, err, findings):
             findings.append(f"{where}: JSON error without line and column: {err.strip()[:300]}")
         if position_expected(variant, command) and code == 1 and not has_position(err, name):
             findings.append(f"{where}: error names no position: {err.strip()[:300]}")
+        # Environment maps: the position in the file's terms (byte, header line, scanline or
+        # the header's image size), and no decoder library's words.
+        if command == "preview-env" and code == 1 and not variant.special:
+            if not re.search(r"\b(byte|line|scanline|header|image size)\b", err):
+                findings.append(f"{where}: map error names no byte, line or scanline: "
+                                f"{err.strip()[:300]}")
+            if re.search(r"OpenImageIO|OpenEXR image|Iex|Imf", err):
+                findings.append(f"{where}: map error in a decoder's words: {err.strip()[:300]}")
     if command == "eval" and code == 0:
         values = re.findall(r"[-+]?(?:nan|inf|\d[\d.e+-]*)", out, re.I)
         if any(v.lower().lstrip("+-") in ("nan", "inf") for v in values):

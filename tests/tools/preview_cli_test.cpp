@@ -4,7 +4,10 @@
 
 #include <cmath>
 #include <fstream>
+#include <regex>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "brdf/exporter/exr.h"
 #include "tool_test_util.h"
@@ -95,6 +98,173 @@ TEST_F(PreviewCli, BadArgumentsFailWithOneLine) {
                            Quote(dir_ / "none.obj") + " --out " + Quote(dir_ / "x.png"));
   EXPECT_EQ(mesh.exit_code, 1);
   EXPECT_NE(mesh.err.find("none.obj"), std::string::npos) << mesh.err;
+}
+
+// The hierarchical quadrature (the sphere's default) is one long pass: stderr (a file here, not a
+// terminal) gets plain progress lines with the percentage of the sphere's pixels done, the time
+// elapsed and an ETA, at least at every further 10 %, percentages never decreasing, the last at
+// 100 % with nothing left to wait for. With one thread every block row is reported.
+TEST_F(PreviewCli, TheHierarchicalPassShowsProgressWithAnEta) {
+  const ToolRun r = Run("preview " + Quote(kMaterials + "gold.json") +
+                        " --size 96 --jobs 1 --out " + Quote(dir_ / "g.exr"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::regex line(
+      R"(^preview gold: (\d+) % of the pixels, ([0-9.]+)s elapsed, ETA (--|[0-9.]+s)$)");
+  std::vector<int> percent;
+  std::vector<double> elapsed;
+  std::string last_eta;
+  for (const std::string& l : r.ErrLines()) {
+    std::smatch m;
+    if (!std::regex_match(l, m, line)) continue;
+    percent.push_back(std::stoi(m[1]));
+    elapsed.push_back(std::stod(m[2]));
+    last_eta = m[3];
+  }
+  ASSERT_GE(percent.size(), 4u) << r.err;
+  for (std::size_t k = 1; k < percent.size(); ++k) {
+    EXPECT_GE(percent[k], percent[k - 1]) << r.err;
+    EXPECT_LE(percent[k] - percent[k - 1], 100 * 16 * 2 / 96 + 10) << r.err;  // ≤ 2 block rows
+    EXPECT_GE(elapsed[k], elapsed[k - 1]) << r.err;
+  }
+  EXPECT_LT(percent.front(), 100) << r.err;
+  EXPECT_EQ(percent.back(), 100) << r.err;
+  EXPECT_EQ(last_eta, "0.0s") << r.err;
+  EXPECT_NE(r.err.find("hierarchical quadrature"), std::string::npos) << r.err;
+  // --quiet: nothing on stderr.
+  const ToolRun quiet = Run("preview " + Quote(kMaterials + "gold.json") +
+                            " --size 32 --quiet --out " + Quote(dir_ / "q.exr"));
+  ASSERT_EQ(quiet.exit_code, 0) << quiet.err;
+  EXPECT_EQ(quiet.err, "");
+}
+
+// A capture against the material it was simulated from, over every lit pixel of the sphere:
+// `brdf capture --device sim` (the reference instrument's detector noise, seed 1) with a geometry
+// that covers what a sphere under a map shows (θin every 5° from 0 to 85°, θout to 89°), then
+// `brdf preview CAPTURE --compare MATERIAL`. The printed RMS difference (over every pixel where
+// either render shows the sphere; their number is the sphere's, from the camera's framing) is
+// under 2 % for a rough dielectric and for polished gold. With the instrument's own geometry
+// (θin 0/20/40/60°, θout ≤ 75°) only the pixels seen within 60° are covered; that scope is
+// tested in tests/processing/preview_test.cpp (PreviewCapture) and explained in docs/preview.md.
+TEST_F(PreviewCli, ASimulatedCaptureOfTheWholeSphereGeometryPreviewsWithin2PercentOfItsMaterial) {
+  std::ofstream(dir_ / "rough.json")
+      << R"({"name": "rough", "model": "ggx", "kd": [0.35, 0.2, 0.1], "f0": 0.04, "alpha": 0.35})";
+  const int size = 64;
+  std::size_t sphere = 0;  // pixel centres inside the unit sphere framed at 90 % of the height
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      const double s = ((x + 0.5) / size * 2.0 - 1.0) / 0.9,
+                   t = (1.0 - (y + 0.5) / size * 2.0) / 0.9;
+      if (s * s + t * t < 1.0) ++sphere;
+    }
+  for (const auto& [material, file] : std::vector<std::pair<std::string, std::string>>{
+           {(dir_ / "rough.json").string(), (dir_ / "rough.json").string()},
+           {"gold", kMaterials + "gold.json"}}) {
+    const std::string capture =
+        (dir_ / (std::filesystem::path(file).stem().string() + ".bpc")).string();
+    const ToolRun c = Run("capture --device sim --material " + Quote(material) +
+                          " --sample whole-sphere --theta-in "
+                          "0,5,10,15,20,25,30,35,40,45,50,55,60,65,70,75,80,85 "
+                          "--theta-out-max 89 --sim-pace-ms 0 --quiet --out " +
+                          Quote(capture));
+    ASSERT_EQ(c.exit_code, 0) << c.err;
+    const ToolRun p = Run("preview " + Quote(capture) + " --compare " + Quote(file) + " --size " +
+                          std::to_string(size) + " --quiet --out " +
+                          Quote(dir_ / (std::filesystem::path(file).stem().string() + ".exr")));
+    ASSERT_EQ(p.exit_code, 0) << p.err;
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(
+        p.out, m, std::regex(R"(\(([0-9.]+) % of the mean of .*\) over (\d+) pixels)")))
+        << p.out;
+    EXPECT_LT(std::stod(m[1]), 2.0) << material << ": " << p.out;
+    EXPECT_EQ(std::stoul(m[2]), sphere) << material << ": every lit pixel of the sphere";
+  }
+}
+
+// The plane lies at z = 0, edge-on to the sphere's default camera (θ = 90°); without --view it is
+// seen from θ = 60°, φ = 0. Orthographically, a point (x, y, 0) then appears at image right = y
+// and image up = −x·cos60° (camera right (0, 1, 0), up (−cos60°, 0, sin60°)), the frame height
+// spanning 2/0.9: the pixels whose centres fall inside |y| ≤ 1/√2, |x| ≤ 1/√2 show it, and under
+// the furnace a white Lambertian shows 1 there. --view 90,0 still means edge-on: nothing.
+TEST_F(PreviewCli, ThePlaneIsSeenFromAboveUnlessAViewIsGiven) {
+  std::ofstream(dir_ / "white.json") << R"({"model": "lambert", "rho": 1.0})";
+  const int size = 40;
+  const std::string common =
+      " --env furnace --mesh plane --estimator hierarchical --no-background "
+      "--size " +
+      std::to_string(size) + " --quiet --out ";
+  ASSERT_EQ(Run("preview " + Quote(dir_ / "white.json") + common + Quote(dir_ / "p.exr")).exit_code,
+            0);
+  const exporter::ExrFile exr = exporter::ReadExr((dir_ / "p.exr").string());
+  const double half = 1.0 / 0.9, edge = 1.0 / std::sqrt(2.0), c60 = 0.5;
+  int expected = 0, lit = 0;
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      const double right = ((x + 0.5) / size * 2.0 - 1.0) * half;
+      const double up = (1.0 - (y + 0.5) / size * 2.0) * half;
+      const bool on_plane = std::fabs(right) <= edge && std::fabs(up) <= edge * c60;
+      expected += on_plane;
+      const float g = exr.image.Pixel(x, y)[1];
+      lit += g > 0.5f;
+      if (on_plane) {
+        EXPECT_NEAR(g, 1.0, 2e-3) << x << "," << y;
+      }
+    }
+  EXPECT_EQ(lit, expected);
+  EXPECT_GT(expected, 250);
+  ASSERT_EQ(Run("preview " + Quote(dir_ / "white.json") + " --view 90,0" + common +
+                Quote(dir_ / "edge.exr"))
+                .exit_code,
+            0);
+  const exporter::ExrFile edge_on = exporter::ReadExr((dir_ / "edge.exr").string());
+  for (float v : edge_on.image.rgb) ASSERT_EQ(v, 0.0f);
+}
+
+// --light alone: one directional light of irradiance π from (90°, 0), the camera's side. A white
+// Lambertian then shows ρ/π · π · cosθ = n·(1, 0, 0) at the pixel whose normal is n (the
+// sphere's normal at a pixel from the orthographic framing), and stderr says what ran.
+TEST_F(PreviewCli, ADirectionalLightAloneLightsAWhiteLambertianByTheCosine) {
+  std::ofstream(dir_ / "white.json") << R"({"model": "lambert", "rho": 1.0})";
+  const int size = 32;
+  const ToolRun r = Run("preview " + Quote(dir_ / "white.json") + " --light 90,0 --size " +
+                        std::to_string(size) + " --out " + Quote(dir_ / "l.exr"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("the directional light only"), std::string::npos) << r.err;
+  const exporter::ExrFile exr = exporter::ReadExr((dir_ / "l.exr").string());
+  for (int y = 0; y < size; ++y)
+    for (int x = 0; x < size; ++x) {
+      const double s = ((x + 0.5) / size * 2.0 - 1.0) / 0.9,
+                   t = (1.0 - (y + 0.5) / size * 2.0) / 0.9;
+      const double cos_theta = s * s + t * t < 1.0 ? std::sqrt(1.0 - s * s - t * t) : 0.0;
+      EXPECT_NEAR(exr.image.Pixel(x, y)[1], cos_theta, 1e-5) << x << "," << y;
+    }
+}
+
+// A capture whose θin range stops short of grazing says so when previewed on the sphere: the
+// instrument's default list (0, 20, 40, 60°) ends at 60°; a list up to 85° and a material (no
+// measured range) get no note, and --quiet prints nothing.
+TEST_F(PreviewCli, ACaptureThatStopsShortOfGrazingSaysSoOnTheSphere) {
+  const std::string coarse = " --theta-out-step 5 --phi-out-step 10 --sim-pace-ms 0 --quiet";
+  ASSERT_EQ(Run("capture --device sim --material gold --sample n" + coarse + " --out " +
+                Quote(dir_ / "four.bpc"))
+                .exit_code,
+            0);
+  ASSERT_EQ(Run("capture --device sim --material gold --sample n --theta-in 0,30,60,85" + coarse +
+                " --out " + Quote(dir_ / "grazing.bpc"))
+                .exit_code,
+            0);
+  const std::string render = " --size 16 --force --out " + Quote(dir_ / "n.png");
+  const ToolRun four = Run("preview " + Quote(dir_ / "four.bpc") + render);
+  ASSERT_EQ(four.exit_code, 0) << four.err;
+  EXPECT_NE(four.err.find((dir_ / "four.bpc").string() + ": note: θin measured up to 60°"),
+            std::string::npos)
+      << four.err;
+  const ToolRun grazing = Run("preview " + Quote(dir_ / "grazing.bpc") + " --compare " +
+                              Quote(kMaterials + "gold.json") + render);
+  ASSERT_EQ(grazing.exit_code, 0) << grazing.err;
+  EXPECT_EQ(grazing.err.find("note:"), std::string::npos) << grazing.err;
+  const ToolRun quiet = Run("preview " + Quote(dir_ / "four.bpc") + " --quiet" + render);
+  ASSERT_EQ(quiet.exit_code, 0) << quiet.err;
+  EXPECT_EQ(quiet.err, "");
 }
 
 }  // namespace

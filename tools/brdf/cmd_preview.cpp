@@ -92,8 +92,48 @@ class PassProgress {
                  Progress::FormatDuration(eta).c_str(), tty_ ? "" : "\n");
     std::fflush(stderr);
   }
-  void Done(const preview::PreviewImage& image) {
+  // The one pass of a deterministic estimator: the fraction of the object's pixels done. On a
+  // terminal the line is redrawn up to ten times a second; otherwise a plain line is printed at
+  // each further 10 % or after a second, and always at 100 %.
+  void UpdateFraction(double fraction, double seconds) {
     if (!enabled_) return;
+    const int decile = static_cast<int>(fraction * 10.0 + 1e-9);
+    const bool done = fraction >= 1.0;
+    if (!done) {
+      if (tty_ && seconds - last_ < 0.1) return;
+      if (!tty_ && decile <= last_decile_ && seconds - last_ < 1.0) return;
+    }
+    if (done && printed_done_) return;
+    last_ = seconds;
+    last_decile_ = decile;
+    printed_done_ = done;
+    // The rate since the first report, so that the set-up before the first pixels (the map
+    // hierarchy, the lattice pass) does not count as the pixels' cost.
+    if (first_seconds_ < 0.0) {
+      first_fraction_ = fraction;
+      first_seconds_ = seconds;
+    }
+    const bool known = done || fraction > first_fraction_;
+    const double eta =
+        done    ? 0.0
+        : known ? (seconds - first_seconds_) / (fraction - first_fraction_) * (1.0 - fraction)
+                : 0.0;
+    std::fprintf(stderr, "%s%s: %.0f %% of the pixels, %s elapsed, ETA %s%s",
+                 tty_ ? "\r\033[K" : "", label_.c_str(), std::floor(100.0 * fraction),
+                 Progress::FormatDuration(seconds).c_str(),
+                 known ? Progress::FormatDuration(eta).c_str() : "--", tty_ ? "" : "\n");
+    std::fflush(stderr);
+  }
+  void Done(const preview::PreviewImage& image, bool light_only) {
+    if (!enabled_) return;
+    if (light_only) {  // no integral over the map: one BRDF evaluation per pixel, exact
+      std::size_t object = 0;
+      for (std::uint8_t o : image.object) object += o;
+      std::fprintf(stderr, "%s%s: the directional light only (exact), %zu object pixels, %s\n",
+                   tty_ ? "\r\033[K" : "", label_.c_str(), object,
+                   Progress::FormatDuration(image.seconds).c_str());
+      return;
+    }
     const bool deterministic = image.estimator == preview::Estimator::kHierarchical ||
                                image.estimator == preview::Estimator::kQuadrature;
     if (deterministic) {
@@ -124,6 +164,9 @@ class PassProgress {
   std::string label_;
   bool enabled_, tty_;
   double last_ = -1.0;
+  int last_decile_ = 0;
+  double first_fraction_ = 0.0, first_seconds_ = -1.0;
+  bool printed_done_ = false;
 };
 
 preview::PreviewImage Render(const BrdfSource& source, const preview::EnvironmentMap& map,
@@ -134,8 +177,12 @@ preview::PreviewImage Render(const BrdfSource& source, const preview::Environmen
     progress.Update(passes, options.samples_per_pixel, rms, options.target_relative_rms, seconds);
     return true;
   };
+  if (!cli.quiet)
+    options.pass_progress = [&](double fraction, double seconds) {
+      progress.UpdateFraction(fraction, seconds);
+    };
   preview::PreviewImage image = preview::RenderPreview(source, map, options);
-  progress.Done(image);
+  progress.Done(image, !options.environment_lighting);
   return image;
 }
 
@@ -171,11 +218,24 @@ int RunPreview(const PreviewCommandOptions& cli) {
   options.seed = cli.seed;
   options.environment_rotation_deg = cli.env_rotation_deg;
   double a = 0, b = 0;
-  if (!ParsePair(cli.view, &a, &b) || a < 0 || a > 180)
-    throw InvalidArgument("--view: expected THETA,PHI in degrees with THETA in [0, 180], got '" +
-                          cli.view + "'");
-  options.camera.theta_deg = a;
-  options.camera.phi_deg = b;
+  preview::Mesh mesh;
+  if (cli.mesh == "sphere") {
+    options.shape = preview::Shape::kSphere;
+  } else if (cli.mesh == "plane") {
+    options.shape = preview::Shape::kPlane;
+  } else {
+    mesh = preview::LoadMesh(cli.mesh);
+    options.shape = preview::Shape::kMesh;
+    options.mesh = &mesh;
+  }
+  options.camera = preview::DefaultCamera(options.shape);
+  if (!cli.view.empty()) {
+    if (!ParsePair(cli.view, &a, &b) || a < 0 || a > 180)
+      throw InvalidArgument("--view: expected THETA,PHI in degrees with THETA in [0, 180], got '" +
+                            cli.view + "'");
+    options.camera.theta_deg = a;
+    options.camera.phi_deg = b;
+  }
   if (cli.fov_deg > 0) {
     options.camera.projection = preview::Camera::Projection::kPerspective;
     options.camera.fov_deg = cli.fov_deg;
@@ -190,16 +250,6 @@ int RunPreview(const PreviewCommandOptions& cli) {
     options.show_background = cli.env_given;
   }
   if (cli.no_background) options.show_background = false;
-  preview::Mesh mesh;
-  if (cli.mesh == "sphere") {
-    options.shape = preview::Shape::kSphere;
-  } else if (cli.mesh == "plane") {
-    options.shape = preview::Shape::kPlane;
-  } else {
-    mesh = preview::LoadMesh(cli.mesh);
-    options.shape = preview::Shape::kMesh;
-    options.mesh = &mesh;
-  }
   // The overwrite rule of every writing command, checked before any rendering work.
   ReportRemovedTemporaries(CheckWritableOutput(cli.out, cli.force));
   const preview::EnvironmentMap map = preview::EnvironmentMap::FromName(cli.env);
@@ -211,14 +261,20 @@ int RunPreview(const PreviewCommandOptions& cli) {
   open_options.extrapolation = extrapolate;
   sources::OpenedSource opened = sources::OpenBrdf(cli.file, open_options);
   warnings.insert(warnings.end(), opened.warnings.begin(), opened.warnings.end());
+  std::vector<std::string> notes;
+  if (const auto note = opened.SphereCoverageNote(cli.file)) notes.push_back(*note);
   const std::unique_ptr<BrdfSource> source = std::move(opened.brdf);
   std::unique_ptr<BrdfSource> second;
   if (!cli.compare.empty()) {
     sources::OpenedSource other = sources::OpenBrdf(cli.compare, open_options);
     warnings.insert(warnings.end(), other.warnings.begin(), other.warnings.end());
+    if (const auto note = other.SphereCoverageNote(cli.compare)) notes.push_back(*note);
     second = std::move(other.brdf);
   }
   for (const std::string& w : warnings) std::fprintf(stderr, "%s\n", w.c_str());
+  // A sphere (and a mesh) shows every pair of directions; a capture measured only some of them.
+  if (!cli.quiet && options.shape != preview::Shape::kPlane)
+    for (const std::string& n : notes) std::fprintf(stderr, "%s\n", n.c_str());
 
   const preview::PreviewImage first = Render(*source, map, options, cli);
   preview::PreviewImage out = first;

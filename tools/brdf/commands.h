@@ -168,7 +168,7 @@ struct PreviewCommandOptions {
   int spp = 64;                 // passes per pixel (ignored with rms > 0)
   double rms = 0;               // target relative RMS error, e.g. 0.01; 0: use spp
   std::string light;            // "THETA,PHI" in degrees (world frame); empty: none
-  std::string view = "90,0";    // camera position THETA,PHI seen from the object
+  std::string view;             // camera position THETA,PHI; empty: preview::DefaultCamera
   double fov_deg = 0;           // > 0: perspective camera with this vertical field of view
   double exposure_ev = 0;
   std::string tone_map = "clamp";  // clamp or reinhard (PNG only)

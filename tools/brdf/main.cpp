@@ -488,8 +488,10 @@ int main(int argc, char** argv) {
                    "A directional light from THETA,PHI (degrees, world frame, z up); without "
                    "--env the map then does not light the object")
       ->check(AnglePairValidator());
-  preview_cmd->add_option("--view", preview.view, "Camera position THETA,PHI seen from the object")
-      ->capture_default_str()
+  preview_cmd
+      ->add_option("--view", preview.view,
+                   "Camera position THETA,PHI seen from the object (default 90,0; 60,0 for the "
+                   "plane, which 90,0 sees edge-on)")
       ->check(AnglePairValidator());
   preview_cmd->add_option("--fov", preview.fov_deg,
                           "Perspective camera with this vertical field of view, degrees "

@@ -9,7 +9,9 @@
 #include <ImfOutputFile.h>
 #include <ImfStringAttribute.h>
 
+#include <algorithm>
 #include <cerrno>
+#include <cstdint>
 #include <cstring>
 #include <exception>
 #include <string>
@@ -37,6 +39,62 @@ Imf::FrameBuffer InterleavedRgb(const T* data, const Imath::Box2i& window, int w
     frame.insert(kChannels[c], Imf::Slice::Make(kType, data + c, window, kPixelBytes,
                                                 kPixelBytes * static_cast<std::size_t>(width)));
   return frame;
+}
+
+const char* CompressionName(Imf::Compression c) {
+  static const char* const kNames[] = {"uncompressed", "RLE", "ZIPS", "ZIP",  "PIZ",
+                                       "PXR24",        "B44", "B44A", "DWAA", "DWAB"};
+  const int k = static_cast<int>(c);
+  return k >= 0 && k < 10 ? kNames[k] : "compressed";
+}
+
+// OpenEXR refused `path` with `why`: the FormatError that says where, when the file's layout
+// shows it (damage.cpp), or which block of scanlines does not decode; else OpenEXR's words.
+[[noreturn]] void ThrowDamaged(const std::string& path, std::string why) {
+  detail::ExrLayout layout;
+  if (const auto damage = detail::LocateExrDamage(path, &layout))
+    throw FormatError(path, damage->position, damage->expected, damage->got);
+  if (layout.blocks > 0) {
+    try {
+      Imf::InputFile file(path.c_str(), /*numThreads=*/0);
+      const Imath::Box2i window = file.header().dataWindow();
+      const long long width = static_cast<long long>(window.max.x) - window.min.x + 1;
+      // Within the reader's limit, as ReadExrImage checked before reading pixels.
+      const bool fits =
+          width >= 1 &&
+          static_cast<unsigned long long>(width) * layout.lines_per_block <= kMaxReadPixels;
+      std::vector<float> rgb(fits ? static_cast<std::size_t>(width) * 3 * layout.lines_per_block
+                                  : 0);
+      for (std::uint64_t k = 0; fits && k < layout.blocks; ++k) {
+        const int y0 = window.min.y + static_cast<int>(k * layout.lines_per_block);
+        const int y1 = std::min(window.max.y, y0 + static_cast<int>(layout.lines_per_block) - 1);
+        // A frame buffer for this block's rows only: its origin moved so row y0 is its first.
+        Imath::Box2i rows = window;
+        rows.min.y = y0;
+        rows.max.y = y1;
+        file.setFrameBuffer(InterleavedRgb(rgb.data(), rows, static_cast<int>(width)));
+        try {
+          file.readPixels(y0, y1);
+        } catch (const std::exception&) {
+          throw FormatError(path, detail::ExrBlockPosition(layout, k),
+                            std::string(CompressionName(file.header().compression())) +
+                                " pixel data that decodes to the block's scanlines",
+                            "data that does not decode (damaged bytes)");
+        }
+      }
+    } catch (const Error&) {
+      throw;
+    } catch (const std::exception&) {
+      // The header itself is refused: OpenEXR's words below.
+    }
+  }
+  // OpenEXR's own words ("Cannot read image file "F". Early end of file: read 1 out of 4
+  // requested bytes.") when the layout shows nothing; the sentence that repeats the file name
+  // is dropped, since the message starts with it already.
+  const std::string named = "\"" + path + "\". ";
+  if (const std::size_t at = why.find(named); at != std::string::npos)
+    why = why.substr(at + named.size());
+  throw FormatError(path, "EXR content", "a readable OpenEXR image", why);
 }
 
 }  // namespace
@@ -130,14 +188,7 @@ ExrImage ReadExrImage(const std::string& path) {
   } catch (const Error&) {
     throw;
   } catch (const std::exception& e) {
-    // OpenEXR's own words ("Cannot read image file "F". Early end of file: read 1 out of 4
-    // requested bytes.") are the best description of the damage it found; the sentence that
-    // repeats the file name is dropped, since the message starts with it already.
-    std::string why = e.what();
-    const std::string named = "\"" + path + "\". ";
-    if (const std::size_t at = why.find(named); at != std::string::npos)
-      why = why.substr(at + named.size());
-    throw FormatError(path, "EXR content", "a readable OpenEXR image", why);
+    ThrowDamaged(path, e.what());
   }
   return out;
 }

@@ -4,6 +4,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <memory>
 #include <thread>
@@ -64,23 +65,71 @@ struct PixelSetup {
   Rgb fixed{};  // background (misses) or the directional light's contribution (hits)
 };
 
+// `after_caller_chunk`, when set, runs on the calling thread after each chunk it completed
+// (progress reports come from there, so callbacks never run on a worker).
 template <class F>
 void ParallelChunks(std::size_t count, std::size_t chunk, int jobs, const std::atomic<bool>* cancel,
-                    F work) {
+                    F work, const std::function<void()>& after_caller_chunk = {}) {
   std::atomic<std::size_t> next{0};
-  auto loop = [&] {
+  auto loop = [&](bool caller) {
     for (std::size_t begin = next.fetch_add(chunk); begin < count; begin = next.fetch_add(chunk)) {
       if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) return;
       work(begin, std::min(count, begin + chunk));
+      if (caller && after_caller_chunk) after_caller_chunk();
     }
   };
   const int threads =
       std::max(1, std::min<int>(jobs, static_cast<int>((count + chunk - 1) / chunk)));
   std::vector<std::thread> workers;
-  for (int t = 1; t < threads; ++t) workers.emplace_back(loop);
-  loop();
+  for (int t = 1; t < threads; ++t) workers.emplace_back(loop, false);
+  loop(true);
   for (auto& w : workers) w.join();
 }
+
+// The fraction of a deterministic pass done, counted by the workers (one relaxed atomic add per
+// chunk, no lock) and reported to PreviewOptions::pass_progress from the calling thread.
+class PassFraction {
+ public:
+  PassFraction(const PreviewOptions& options, std::size_t total,
+               std::chrono::steady_clock::time_point start)
+      : callback_(options.pass_progress),
+        cancel_(options.cancel),
+        total_(std::max<std::size_t>(1, total)),
+        start_(start) {}
+  void Add(std::size_t units) {
+    if (callback_) done_.fetch_add(units, std::memory_order_relaxed);
+  }
+  // Reports the current fraction (never less than the last one reported).
+  void Report() {
+    if (!callback_) return;
+    const double f = std::min(1.0, static_cast<double>(done_.load(std::memory_order_relaxed)) /
+                                       static_cast<double>(total_));
+    last_ = std::max(last_, f);
+    callback_(last_, Seconds());
+  }
+  // The end of a pass that was not cancelled: reports 1.
+  void Finish() {
+    if (!callback_ || (cancel_ != nullptr && cancel_->load())) return;
+    last_ = 1.0;
+    callback_(1.0, Seconds());
+  }
+  // What ParallelChunks calls on the calling thread.
+  std::function<void()> Reporter() {
+    if (!callback_) return {};
+    return [this] { Report(); };
+  }
+
+ private:
+  double Seconds() const {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  }
+  const std::function<void(double, double)>& callback_;
+  const std::atomic<bool>* cancel_;
+  std::size_t total_;
+  std::atomic<std::size_t> done_{0};
+  double last_ = 0.0;
+  std::chrono::steady_clock::time_point start_;
+};
 
 }  // namespace
 
@@ -105,6 +154,7 @@ struct PreviewRenderer::Impl {
   double seconds = 0.0;
   std::uint64_t evaluations = 0;     // f_r evaluations of the deterministic estimators
   std::uint64_t computed_count = 0;  // kHierarchical: object pixels integrated (not interpolated)
+  std::chrono::steady_clock::time_point pass_start;  // of the running RenderPasses call
 
   Impl(const BrdfSource& s, const EnvironmentMap& e, PreviewOptions o,
        std::shared_ptr<const BrdfSampler> sp)
@@ -305,6 +355,7 @@ struct PreviewRenderer::Impl {
     if (count < 1) return 0;
     if (exact) return 0;
     const auto start = std::chrono::steady_clock::now();
+    pass_start = start;
     const std::atomic<bool>* cancel = options.cancel;
     if (!options.environment_lighting) {  // the directional light alone is already exact
       exact = true;
@@ -369,22 +420,28 @@ struct PreviewRenderer::Impl {
         }
       }
     std::atomic<std::uint64_t> counted{0};
-    ParallelChunks(setup.size(), 16, jobs, options.cancel, [&](std::size_t b, std::size_t e) {
-      std::uint64_t count = 0;
-      for (std::size_t k = b; k < e; ++k) {
-        const PixelSetup& s = setup[k];
-        Rgb total = {0, 0, 0};
-        for (const Direction& d : dirs) {
-          const Vec3 wi = s.frame.ToLocal(d.w);
-          if (!(wi.z > 0.0)) continue;
-          const Rgb f = source.Eval(wi, s.wo);
-          ++count;
-          for (int ch = 0; ch < 3; ++ch) total[ch] += d.radiance_solid_angle[ch] * f[ch] * wi.z;
-        }
-        for (int ch = 0; ch < 3; ++ch) sum[3 * k + ch] = total[ch];
-      }
-      counted += count;
-    });
+    PassFraction progress(options, setup.size(), pass_start);
+    ParallelChunks(
+        setup.size(), 16, jobs, options.cancel,
+        [&](std::size_t b, std::size_t e) {
+          std::uint64_t count = 0;
+          for (std::size_t k = b; k < e; ++k) {
+            const PixelSetup& s = setup[k];
+            Rgb total = {0, 0, 0};
+            for (const Direction& d : dirs) {
+              const Vec3 wi = s.frame.ToLocal(d.w);
+              if (!(wi.z > 0.0)) continue;
+              const Rgb f = source.Eval(wi, s.wo);
+              ++count;
+              for (int ch = 0; ch < 3; ++ch) total[ch] += d.radiance_solid_angle[ch] * f[ch] * wi.z;
+            }
+            for (int ch = 0; ch < 3; ++ch) sum[3 * k + ch] = total[ch];
+          }
+          counted += count;
+          progress.Add(e - b);
+        },
+        progress.Reporter());
+    progress.Finish();
     evaluations = counted;
   }
 
@@ -422,12 +479,20 @@ struct PreviewRenderer::Impl {
       for (int ch = 0; ch < 3; ++ch) sum[3 * k + ch] = v[ch];
     };
     const int block = options.image_block;
+    // Progress counts the object pixels of finished blocks (the lattice pass before them is
+    // about 1/block² of the work).
+    PassFraction progress(options, setup.size(), pass_start);
     if (block <= 1) {
-      ParallelChunks(setup.size(), 64, jobs, options.cancel, [&](std::size_t b, std::size_t e) {
-        std::uint64_t count = 0;
-        for (std::size_t k = b; k < e; ++k) store(k, compute(k, &count));
-        counted += count;
-      });
+      ParallelChunks(
+          setup.size(), 64, jobs, options.cancel,
+          [&](std::size_t b, std::size_t e) {
+            std::uint64_t count = 0;
+            for (std::size_t k = b; k < e; ++k) store(k, compute(k, &count));
+            counted += count;
+            progress.Add(e - b);
+          },
+          progress.Reporter());
+      progress.Finish();
       evaluations = counted;
       computed_count = computed_pixels;
       return;
@@ -458,6 +523,8 @@ struct PreviewRenderer::Impl {
     // each row by one thread from left to right, so two blocks that run at the same time never
     // share a pixel.
     const int block_columns = (width + block - 1) / block;
+    std::vector<std::size_t> row_pixels(static_cast<std::size_t>(lattice_rows), 0);
+    for (std::uint32_t p : object_index) ++row_pixels[p / width / block];
     std::vector<Rgb> integrated(object.size(), Rgb{0, 0, 0});
     std::vector<std::uint8_t> has_integral(object.size(), 0);
     for (int c = 0; c < block_columns; ++c)
@@ -578,7 +645,11 @@ struct PreviewRenderer::Impl {
                   }
               }
             counted += count;
-          });
+            for (std::size_t pair = b; pair < e; ++pair)
+              progress.Add(row_pixels[2 * pair + static_cast<std::size_t>(parity)]);
+          },
+          progress.Reporter());
+    progress.Finish();
     for (std::size_t k = 0; k < object_index.size(); ++k) store(k, value[object_index[k]]);
     evaluations = counted;
     computed_count = computed_pixels;
@@ -650,6 +721,12 @@ PreviewImage PreviewRenderer::Image() const { return impl_->Image(); }
 double PreviewRenderer::EstimatedRelativeRms() const { return impl_->RelativeRms(); }
 const std::shared_ptr<const BrdfSampler>& PreviewRenderer::sampler() const {
   return impl_->sampler;
+}
+
+Camera DefaultCamera(Shape shape) {
+  Camera camera;
+  if (shape == Shape::kPlane) camera.theta_deg = 60.0;
+  return camera;
 }
 
 PreviewImage RenderPreview(const BrdfSource& source, const EnvironmentMap& environment,

@@ -239,6 +239,16 @@ std::optional<std::string> OpenedSource::BeyondMeasuredWarning(double theta_in_d
          "° slice's at the same specular-frame angles (clamped, not measured)";
 }
 
+std::optional<std::string> OpenedSource::SphereCoverageNote(const std::string& path) const {
+  if (measured_theta_in_deg.empty()) return std::nullopt;
+  const double hi = measured_theta_in_deg.back();
+  if (hi >= kSphereCoverageThetaInDeg - Lut::kThetaInToleranceDeg) return std::nullopt;
+  return path + ": note: θin measured up to " + Deg(hi) +
+         "°: where the sphere is both lit and seen more than " + Deg(hi) +
+         "° from its normal (towards its rim) the picture shows the " + Deg(hi) +
+         "° slice's values, not measured ones (docs/preview.md, \"Captures\")";
+}
+
 OpenedSource OpenBrdf(const std::string& path, const OpenOptions& options) {
   OpenedSource out;
   out.kind = DetectFileKind(path);

@@ -141,6 +141,11 @@ struct Camera {
   double fill = 0.9;
 };
 
+// The camera a picture of `shape` gets when the user names none: Camera{} (θ = 90°, on +x) for
+// the sphere and meshes; for the plane, which lies at z = 0 and that camera sees edge-on, the
+// camera at θ = 60°, φ = 0, which sees it obliquely from above.
+Camera DefaultCamera(Shape shape);
+
 // One distant directional light (for direct-lighting pictures): it arrives from world direction
 // (theta_deg, phi_deg) (the direction towards the light) with irradiance `irradiance` on a
 // surface facing it.
@@ -214,6 +219,12 @@ struct PreviewOptions {
   // Called after every pass from the calling thread: passes done, the current estimate of the
   // relative RMS error, seconds since the start. Return false to stop early.
   std::function<bool(int passes, double relative_rms, double seconds)> progress;
+  // The deterministic estimators (kHierarchical, kQuadrature) finish in one long pass; during
+  // it this is called from the calling thread (after each piece of work that thread finishes,
+  // so often: throttle the printing) with the fraction of the object's pixels finished, never
+  // decreasing, and the seconds since the pass started; the last call of a pass that was not
+  // cancelled has fraction 1. The workers only count (no locks, no calls).
+  std::function<void(double fraction_done, double seconds)> pass_progress;
   // Checked between tiles; when it becomes true the current pass is abandoned and the render
   // returns with the passes completed so far.
   const std::atomic<bool>* cancel = nullptr;

@@ -124,6 +124,13 @@ struct OpenedSource {
   // measured slices).
   std::optional<std::string> BeyondMeasuredWarning(double theta_in_deg, double theta_out_deg,
                                                    const std::string& path) const;
+
+  // For pictures that show every pair of directions up to grazing (a sphere or a mesh under a
+  // map, as `brdf preview` renders them): a note, starting with the path, when the measured θin
+  // range ends before kSphereCoverageThetaInDeg, so the pixels lit and seen beyond it (the sphere's
+  // rim) show the last slice's values rather than measured ones; nullopt otherwise.
+  static constexpr double kSphereCoverageThetaInDeg = 85.0;
+  std::optional<std::string> SphereCoverageNote(const std::string& path) const;
 };
 
 // Opens any evaluable file: material .json, .bpc capture, .ktx2 / .dds LUT or LUT sidecar,
