@@ -26,6 +26,7 @@ TEST_F(CliErrors, EveryParseErrorIsOneShortLineNamingOptionAndValue) {
       {"convert in --out o --exr-compression foo", {"--exr-compression", "foo"}},
       {"eval", {"brdf: eval: ", "file", "brdf eval --help"}},
       {"nonsense", {"brdf"}},
+      {"eval x.json --in 30,0 --out 30,180 --bogus 1", {"brdf: eval: ", "'--bogus 1'"}},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.args);

@@ -72,6 +72,12 @@ std::string OneLineParseError(const CLI::App& app, const CLI::Error& e) {
     where += sub->get_name() + ": ";
   }
   std::string what = e.what();
+  if (dynamic_cast<const CLI::ExtrasError*>(&e) != nullptr) {
+    // CLI11 lists the extras last-first ("1 --bogus"); say them in the order they were typed.
+    std::string typed;
+    for (const std::string& a : app.remaining(true)) typed += (typed.empty() ? "" : " ") + a;
+    if (!typed.empty()) what = "unexpected argument(s) '" + typed + "'";
+  }
   for (char& c : what)
     if (c == '\n') c = ' ';
   return where + what + " (see '" + command + " --help')";
