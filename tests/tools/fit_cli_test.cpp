@@ -77,5 +77,92 @@ TEST_F(FitCommand, BadInputsAreReportedAndSkipped) {
   EXPECT_NE(r.out.find("fitted 1 of 2"), std::string::npos) << r.out;
 }
 
+// Bad option values: one line naming the option and the value as typed, exit code 2, before
+// any work (the expected words are the documented ranges: --starts and --jobs at least 1,
+// --max-theta-out an angle in (0, 90]).
+TEST_F(FitCommand, BadOptionValuesGiveOneLineNamingOptionAndValue) {
+  WriteText(dir_ / "m.json", R"({"model":"lambert","rho":0.5})");
+  struct Case {
+    std::string args;
+    std::vector<std::string> expected;
+  };
+  const std::vector<Case> cases = {
+      {"--starts 0", {"brdf: fit: --starts", "whole number >= 1", "'0'"}},
+      {"--starts x", {"--starts", "'x'"}},
+      {"--jobs 1.5", {"--jobs", "'1.5'"}},
+      {"--max-theta-out 0", {"--max-theta-out", "(0, 90] degrees", "'0'"}},
+      {"--max-theta-out 95", {"--max-theta-out", "'95'"}},
+      {"--max-theta-out abc", {"--max-theta-out", "'abc'"}},
+      {"--loss l2", {"--loss", "l2", "ngan"}},
+      {"--model phong", {"--model", "phong", "blinn-phong"}},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.args);
+    const ToolRun r =
+        Run("fit " + Quote(dir_ / "m.json") + " --out " + Quote(dir_ / "o.json") + " " + c.args);
+    EXPECT_EQ(r.exit_code, 2);
+    const std::vector<std::string> lines = r.ErrLines();
+    ASSERT_EQ(lines.size(), 1u) << r.err;
+    EXPECT_LT(lines[0].size(), 250u) << lines[0];
+    for (const std::string& e : c.expected)
+      EXPECT_NE(lines[0].find(e), std::string::npos) << lines[0] << " lacks " << e;
+    EXPECT_EQ(lines[0].find("Value "), std::string::npos) << "CLI11's wording: " << lines[0];
+    EXPECT_FALSE(fs::exists(dir_ / "o.json"));
+  }
+}
+
+// --robust, --loss, --max-theta-out and --starts reach the report: a material file captured
+// noise-free on the reference geometry (4 × 76 × 360 samples), so the counts are the geometry's.
+TEST_F(FitCommand, OptionsAreRecordedInTheReport) {
+  WriteText(dir_ / "m.json", R"({"model":"ggx","kd":[0.3,0.2,0.1],"f0":0.05,"alpha":0.2})");
+  const ToolRun r = Run("fit " + Quote(dir_ / "m.json") + " --out " + Quote(dir_ / "o.json") +
+                        " --robust --loss log --max-theta-out 60 --starts 3");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Json fit = Json::parse(ReadAll(dir_ / "o.json"))["fit"];
+  EXPECT_EQ(fit["loss"], "log");
+  EXPECT_EQ(fit["robust"], true);
+  EXPECT_GT(fit["robust_scale"].get<double>(), 0);
+  EXPECT_EQ(fit["starts"], 3);
+  EXPECT_EQ(fit["samples_used"].get<int>(), 4 * 61 * 360);             // θout 0…60
+  EXPECT_EQ(fit["excluded"]["theta_out"].get<int>(), 4 * 15 * 360);  // θout 61…75
+  EXPECT_NEAR(Json::parse(ReadAll(dir_ / "o.json"))["alpha"][1].get<double>(), 0.2, 0.002);
+}
+
+// --extrapolate auto in convert and atlas: the chosen p, l and the GGX fit are recorded (the
+// sidecar's and the manifest's "extrapolation" and "fitted_models"), the fit is the material
+// file's own GGX (its parameters are the truth), and both commands choose the same p, l for
+// the same input.
+TEST_F(FitCommand, ExtrapolateAutoIsRecordedByConvertAndAtlas) {
+  WriteText(dir_ / "g.json", R"({"model":"ggx","kd":0.05,"f0":[0.6,0.5,0.4],"alpha":0.2})");
+  const ToolRun c = Run("convert " + Quote(dir_ / "g.json") + " --out " + Quote(dir_ / "luts") +
+                        " --extrapolate auto --formats json --quiet");
+  ASSERT_EQ(c.exit_code, 0) << c.err;
+  const Json sidecar = Json::parse(ReadAll(dir_ / "luts" / "g.json"));
+  ASSERT_EQ(sidecar["fitted_models"].size(), 1u);
+  const Json& record = sidecar["fitted_models"][0];
+  EXPECT_EQ(record["kind"], "extrapolation-auto");
+  EXPECT_EQ(sidecar["extrapolation"]["p"], record["p"]);
+  EXPECT_EQ(sidecar["extrapolation"]["l"], record["l"]);
+  EXPECT_DOUBLE_EQ(record["theta_b_deg"].get<double>(), 75.0);
+  EXPECT_LT(record["band_rmse"].get<double>(), record["band_rmse_clamp"].get<double>());
+  const double f0[] = {0.6, 0.5, 0.4};
+  for (int ch = 0; ch < 3; ++ch) {
+    EXPECT_NEAR(record["ggx_fit"]["alpha"][ch].get<double>(), 0.2, 0.002) << ch;
+    EXPECT_NEAR(record["ggx_fit"]["f0"][ch].get<double>(), f0[ch], 0.01 * f0[ch]) << ch;
+  }
+  EXPECT_EQ(record["ggx_fit"]["fit"]["status"], "converged");
+
+  const ToolRun a = Run("atlas " + Quote(dir_ / "g.json") + " --out " +
+                        Quote(dir_ / "atlas" / "lib") + " --extrapolate auto --quiet");
+  ASSERT_EQ(a.exit_code, 0) << a.err;
+  const Json entry = Json::parse(ReadAll(dir_ / "atlas" / "lib.json"))["materials"][0];
+  ASSERT_TRUE(entry.contains("extrapolation")) << entry.dump();
+  ASSERT_TRUE(entry.contains("fitted_models")) << entry.dump();
+  EXPECT_EQ(entry["extrapolation"]["p"], record["p"]);
+  EXPECT_EQ(entry["extrapolation"]["l"], record["l"]);
+  EXPECT_EQ(entry["fitted_models"][0]["p"], record["p"]);
+  EXPECT_NEAR(entry["fitted_models"][0]["ggx_fit"]["alpha"][0].get<double>(), 0.2, 0.002);
+}
+
 }  // namespace
 }  // namespace brdf::tooltest
