@@ -107,8 +107,8 @@ TEST(FitRecovery, NoiseFreeCapturesGiveTheParametersBackWithinOnePercent) {
     FitOptions o;
     o.model = c.truth.model;
     const FitResult r = FitMaterial(NoiseFreeCapture(c.truth), o);
-    EXPECT_NE(r.report.status, "failed") << c.label << ": " << r.report.message;
-    ExpectParameters(r.material, c.truth, 0.01, 1e-3, c.label);
+    EXPECT_EQ(r.report.status, "converged") << c.label << ": " << r.report.message;
+    ExpectParameters(r.material, c.truth, 0.01, 1e-4, c.label);
     EXPECT_LT(r.report.median_relative_error, 1e-3) << c.label;
     EXPECT_EQ(r.report.slices.size(), 4u) << c.label;
     EXPECT_TRUE(r.report.representable) << c.label << ": " << r.report.chromaticity_error;
@@ -123,27 +123,20 @@ TEST(FitRecovery, NoiseFreeCapturesGiveTheParametersBackWithinOnePercent) {
 // the fewest samples. Unreal's Specular is the exception: it only adds 0.08·Specular·(1 −
 // Metallic) to f0 (0.016 of 0.55 here), so a 0.1 % error in f0 moves it by 0.025; it is held to
 // 0.05 absolute.
+// Every recovery case, sharp and rough, every model (test::NoisyRecoveryTolerance).
 TEST(FitRecovery, NoisyCapturesGiveTheParametersBackWithinStatedTolerances) {
-  const std::vector<Case> cases = RecoveryCases();
-  for (const char* label : {"ggx sharp alpha 0.05", "ggx rough alpha 0.5", "lafortune sharp n 500",
-                            "unreal metal-ish", "hdrp lit"}) {
-    const Case* c = nullptr;
-    for (const Case& x : cases)
-      if (std::string(x.label) == label) c = &x;
-    ASSERT_NE(c, nullptr);
+  for (const Case& c : RecoveryCases()) {
     FitOptions o;
-    o.model = c->truth.model;
-    const FitResult r = FitMaterial(NoisyCapture(c->truth), o);
-    EXPECT_NE(r.report.status, "failed") << label;
-    const ModelInfo& info = DescribeModel(c->truth.model);
+    o.model = c.truth.model;
+    const FitResult r = FitMaterial(NoisyCapture(c.truth), o);
+    EXPECT_EQ(r.report.status, "converged") << c.label << ": " << r.report.message;
+    const ModelInfo& info = DescribeModel(c.truth.model);
     for (const ParameterInfo& p : info.parameters)
       for (int ch = 0; ch < p.Count(); ++ch) {
-        const double t = c->truth.values[static_cast<std::size_t>(p.offset + ch)];
-        const double f = r.material.values[static_cast<std::size_t>(p.offset + ch)];
-        const bool shape = static_cast<int>(&p - info.parameters.data()) == info.shape_parameter;
-        const double tolerance =
-            p.name == "specular" ? 0.05 : std::max((shape ? 0.05 : 0.03) * std::fabs(t), 0.005);
-        EXPECT_NEAR(f, t, tolerance) << label << ": " << p.name << "[" << ch << "]";
+        const double t = c.truth.values[static_cast<std::size_t>(p.offset + ch)];
+        EXPECT_NEAR(r.material.values[static_cast<std::size_t>(p.offset + ch)], t,
+                    test::NoisyRecoveryTolerance(info, p, t))
+            << c.label << ": " << p.name << "[" << ch << "]";
       }
   }
 }
@@ -226,19 +219,27 @@ Material NaiveFromGgx(const Material& ggx, Model engine) {
   }
 }
 
+// A red plastic and a gold-like metal (no diffuse, coloured f0): the naive mapping has no
+// metallic for the metal, so it is the harder case for the mapping, not for the fit.
 TEST(FitEngines, EngineFitsAreNeverWorseThanTheNaiveMappingOfTheGgxFit) {
   const Material plastic =
       Material::Make(Model::kGgx, {{0.5, 0.1, 0.05}, {0.05, 0.05, 0.05}, {0.15, 0.15, 0.15}});
-  const Measurement meas = NoiseFreeCapture(plastic, 4.0);
-  FitOptions o;
-  o.model = Model::kGgx;
-  const Material ggx = FitMaterial(meas, o).material;
-  for (Model engine : {Model::kUnrealDefaultLit, Model::kUnityHdrpLit, Model::kUnityHdrpLitSpecular,
-                       Model::kUnityUrpLit, Model::kUnityUrpLitSpecular}) {
-    o.model = engine;
-    const FitReport fit = FitMaterial(meas, o).report;
-    const FitReport naive = EvaluateFit(meas, NaiveFromGgx(ggx, engine), o);
-    EXPECT_LE(fit.final_cost, naive.final_cost) << ModelName(engine);
+  const Material metal =
+      Material::Make(Model::kGgx, {{0, 0, 0}, {0.95, 0.75, 0.35}, {0.25, 0.25, 0.25}});
+  for (const Material* truth : {&plastic, &metal}) {
+    const Measurement meas = NoiseFreeCapture(*truth, 4.0);
+    FitOptions o;
+    o.model = Model::kGgx;
+    const Material ggx = FitMaterial(meas, o).material;
+    for (Model engine : {Model::kUnrealDefaultLit, Model::kUnityHdrpLit,
+                         Model::kUnityHdrpLitSpecular, Model::kUnityUrpLit,
+                         Model::kUnityUrpLitSpecular}) {
+      o.model = engine;
+      const FitReport fit = FitMaterial(meas, o).report;
+      const FitReport naive = EvaluateFit(meas, NaiveFromGgx(ggx, engine), o);
+      EXPECT_LE(fit.final_cost, naive.final_cost)
+          << ModelName(engine) << (truth == &metal ? " metal" : " plastic");
+    }
   }
 }
 
