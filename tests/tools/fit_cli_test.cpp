@@ -47,17 +47,22 @@ TEST_F(FitCommand, FitsAMaterialFileBackToItsOwnParameters) {
 
 TEST_F(FitCommand, AllModelsWriteOneFileEachAndSayWhatToTypeInTheEngines) {
   WriteText(dir_ / "red.json", R"({"model":"ggx","kd":[0.5,0.05,0.05],"f0":0.04,"alpha":0.2})");
+  // Into a folder that does not exist yet; progress on stderr, one line per model (not a
+  // terminal), the last one "10/10".
   const ToolRun r = RunTool(
-      "fit " + Quote(dir_ / "red.json") + " --model all --out " + Quote(dir_ / "fits") + " --quiet",
+      "fit " + Quote(dir_ / "red.json") + " --model all --out " + Quote(dir_ / "new" / "fits"),
       dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   for (const char* m :
        {"lambert", "lafortune", "ggx", "blinn-phong", "ward", "unreal-defaultlit", "unity-hdrp-lit",
         "unity-hdrp-lit-specular", "unity-urp-lit", "unity-urp-lit-specular"}) {
-    const fs::path f = dir_ / "fits" / (std::string("red.") + m + ".json");
+    const fs::path f = dir_ / "new" / "fits" / (std::string("red.") + m + ".json");
     ASSERT_TRUE(fs::exists(f)) << f;
     EXPECT_EQ(Json::parse(ReadAll(f))["model"], m);
+    EXPECT_NE(r.err.find(std::string(" ") + m + " (converged, "), std::string::npos) << r.err;
   }
+  EXPECT_EQ(r.ErrLines().size(), 10u) << r.err;
+  EXPECT_NE(r.err.find("fit 10/10 "), std::string::npos) << r.err;
   EXPECT_NE(r.out.find("Unreal Engine: Base Color "), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("Unity HDRP: Base Map "), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("Unity URP: Base Map "), std::string::npos) << r.out;
@@ -67,7 +72,7 @@ TEST_F(FitCommand, BadInputsAreReportedAndSkipped) {
   WriteText(dir_ / "good.json", R"({"model":"lambert","rho":0.5})");
   WriteText(dir_ / "bad.json", R"({"model":"lambert","rho":-0.5})");
   const ToolRun r = RunTool("fit " + Quote(dir_ / "good.json") + " " + Quote(dir_ / "bad.json") +
-                                " --model lambert --out " + Quote(dir_ / "out") + " --quiet",
+                                " --model lambert --out " + Quote(dir_ / "out"),
                             dir_);
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_TRUE(fs::exists(dir_ / "out" / "good.lambert.json"));
@@ -75,6 +80,16 @@ TEST_F(FitCommand, BadInputsAreReportedAndSkipped) {
   EXPECT_NE(r.err.find("bad.json"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("'rho'"), std::string::npos) << r.err;
   EXPECT_NE(r.out.find("fitted 1 of 2"), std::string::npos) << r.out;
+  // Progress: one step per input and model, the bad input counted as failed.
+  EXPECT_NE(r.err.find("fit 1/2 "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("fit 2/2 "), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("bad.json FAILED"), std::string::npos) << r.err;
+  // One input and one model into a file in a folder that does not exist yet.
+  const ToolRun one = RunTool("fit " + Quote(dir_ / "good.json") + " --model lambert --out " +
+                                  Quote(dir_ / "a" / "b" / "good.json"),
+                              dir_);
+  EXPECT_EQ(one.exit_code, 0) << one.err;
+  EXPECT_TRUE(fs::exists(dir_ / "a" / "b" / "good.json"));
 }
 
 // --robust, --loss, --max-theta-out and --starts reach the report: a material file captured

@@ -128,14 +128,7 @@ int RunAtlas(const AtlasOptions& options) {
   for (std::size_t i = 0; i < luts.size(); ++i)
     materials.push_back({found.inputs[i].name, &luts[i], found.inputs[i].path, saturated[i],
                          extrapolation[i], fitted[i]});
-  const fs::path parent = fs::path(options.out).parent_path();
-  if (!parent.empty()) {
-    std::error_code ec;
-    fs::create_directories(parent, ec);
-    if (!fs::is_directory(parent))
-      throw IoError(parent.string() + ": cannot create the output folder" +
-                    (ec ? ": " + ec.message() : std::string()));
-  }
+  CreateOutputFolder(fs::path(options.out).parent_path().string());
   const OutputGuard guard(outputs);
   std::vector<std::string> written;
   try {

@@ -21,6 +21,7 @@
 #include "cli_support.h"
 #include "commands.h"
 #include "fit_support.h"
+#include "progress.h"
 
 namespace brdf::cli {
 
@@ -133,14 +134,14 @@ int RunFit(const FitCommandOptions& options) {
     }
     return (fs::path(options.out) / (in.name + "." + std::string(ModelName(m)) + ".json")).string();
   };
+  // The folder the results go to exists before any fit runs (the parent of a .json --out).
   if (single) {
     CheckOutputPath(options.out, inputs.front().path, ".json", options.force);
-  } else if (!(inputs.size() == 1 && LowerExtension(options.out) == ".json")) {
-    std::error_code ec;
-    fs::create_directories(options.out, ec);
-    if (!fs::is_directory(options.out))
-      throw IoError(options.out + ": cannot create the output folder" +
-                    (ec ? ": " + ec.message() : std::string()));
+    CreateOutputFolder(fs::path(options.out).parent_path().string());
+  } else if (inputs.size() == 1 && LowerExtension(options.out) == ".json") {
+    CreateOutputFolder(fs::path(options.out).parent_path().string());
+  } else {
+    CreateOutputFolder(options.out);
   }
   for (const FitInput& in : inputs)
     for (Model m : models) {
@@ -152,7 +153,10 @@ int RunFit(const FitCommandOptions& options) {
 
   for (const BatchFailure& f : failures)
     std::fprintf(stderr, "%s: FAILED: %s\n", f.path.c_str(), f.reason.c_str());
-  const bool progress = !options.quiet && (inputs.size() > 1 || models.size() > 1);
+  // One step per input and model, as `brdf convert` shows its inputs (bar and ETA on a terminal,
+  // a line per fit otherwise); one fit of one input needs none.
+  Progress progress("fit", inputs.size() * models.size(),
+                    !options.quiet && (inputs.size() > 1 || models.size() > 1));
   // Inputs in parallel when there are several; Ceres' threads for a single input.
   fit.threads = inputs.size() == 1 ? options.jobs : 1;
   std::vector<std::vector<processing::FitResult>> results(inputs.size());
@@ -166,19 +170,25 @@ int RunFit(const FitCommandOptions& options) {
           processing::FitResult r = processing::FitMaterial(meas, o);
           r.material.name = inputs[i].name;
           WriteFileAtomically(output_of(inputs[i], m), MaterialToJson(r.material));
-          if (progress)
-            std::fprintf(stderr, "%s: %s fitted in %.2f s (%s)\n", inputs[i].path.c_str(),
-                         std::string(ModelName(m)).c_str(), r.report.seconds,
-                         r.report.status.c_str());
+          char done[96];
+          std::snprintf(done, sizeof done, " %s (%s, %.2f s)", std::string(ModelName(m)).c_str(),
+                        r.report.status.c_str(), r.report.seconds);
           results[i].push_back(std::move(r));
+          progress.Advance(inputs[i].path + done);
         }
       },
       [&](std::size_t i, const JobResult& job) {
-        for (const std::string& w : job.warnings) std::fprintf(stderr, "%s\n", w.c_str());
-        if (!job.ok)
-          std::fprintf(stderr, "%s: FAILED: %s\n", inputs[i].path.c_str(),
-                       ReasonWithoutPath(inputs[i].path, job.error).c_str());
+        for (const std::string& w : job.warnings) progress.Message(w);
+        if (!job.ok) {
+          progress.Message(inputs[i].path + ": FAILED: " +
+                           ReasonWithoutPath(inputs[i].path, job.error));
+          if (results[i].size() < models.size()) {
+            progress.Advance(inputs[i].path, true);
+            progress.Drop(models.size() - results[i].size() - 1);
+          }
+        }
       });
+  progress.Finish();
 
   const std::size_t total = inputs.size() + failures.size();
   std::size_t fitted = 0;
