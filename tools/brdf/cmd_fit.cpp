@@ -1,13 +1,16 @@
 // `brdf fit INPUT... --model M|all --out OUT [--loss ...] [--robust] [--max-theta-out DEG]
 // [--starts N] [--jobs N]`: every input becomes a measurement (captures through the LUT rule
 // for damaged files, material files captured noise-free on the reference geometry, RGL and MERL
-// files captured virtually as `brdf import` does), processing::FitMaterial fits each model, and
+// files and exported LUTs captured virtually as `brdf import` does, third-party tables
+// imported: sources::PrepareMeasurement), processing::FitMaterial fits each model, and
 // the result is written as a material file with the report under "fit". A comparison table
 // (model, RMSE per θin slice and overall, median relative error, seconds, and for engine models
 // what to type where) goes to stdout; progress and skipped inputs to stderr.
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -37,6 +40,30 @@ struct FitInput {
 bool IsEvaluableFile(const std::string& path) {
   const std::string ext = LowerExtension(path);
   return ext == ".bsdf" || ext == ".binary";
+}
+
+// A file named on the command line that is fitted as it is, not through the convert rules:
+// measured databases, imported tables and exported LUTs (sources::PrepareMeasurement).
+bool IsDirectInput(const std::string& path) {
+  if (IsEvaluableFile(path)) return true;
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return false;
+  try {
+    switch (sources::DetectFileKind(path)) {
+      case sources::FileKind::kZemax:
+      case sources::FileKind::kLightTools:
+      case sources::FileKind::kCsv:
+      case sources::FileKind::kGonio:
+      case sources::FileKind::kKtx2:
+      case sources::FileKind::kDds:
+      case sources::FileKind::kSidecar:
+        return true;
+      default:
+        return false;
+    }
+  } catch (const Error&) {
+    return false;  // the convert rules report it
+  }
 }
 
 Measurement OpenForFit(const std::string& path, std::vector<std::string>* warnings) {
@@ -103,7 +130,7 @@ int RunFit(const FitCommandOptions& options) {
       std::sort(evaluable.begin(), evaluable.end());
       for (const std::string& f : evaluable) inputs.push_back({f, sources::OutputNameOf(f)});
       rest.push_back(arg);
-    } else if (IsEvaluableFile(arg)) {
+    } else if (IsDirectInput(arg)) {
       inputs.push_back({arg, sources::OutputNameOf(arg)});
     } else {
       rest.push_back(arg);
@@ -121,6 +148,29 @@ int RunFit(const FitCommandOptions& options) {
   if (inputs.empty() && failures.empty()) {
     throw InvalidArgument("no captures, material files or measured BRDF files found in " +
                           JoinArguments(options.inputs));
+  }
+
+  // Inputs of one name (a/red.bpc, b/red.bpc) would write each other's results into a --out
+  // folder: both fail before any fit, as `brdf convert` refuses them.
+  if (inputs.size() > 1) {
+    std::map<std::string, std::vector<std::size_t>> by_name;
+    for (std::size_t i = 0; i < inputs.size(); ++i) by_name[inputs[i].name].push_back(i);
+    std::vector<FitInput> kept;
+    for (std::size_t i = 0; i < inputs.size(); ++i) {
+      const std::vector<std::size_t>& same = by_name[inputs[i].name];
+      if (same.size() < 2) {
+        kept.push_back(inputs[i]);
+        continue;
+      }
+      std::string others;
+      for (std::size_t o : same)
+        if (o != i) others += (others.empty() ? "" : ", ") + inputs[o].path;
+      failures.push_back({inputs[i].path, "its results " +
+                                              (fs::path(options.out) / (inputs[i].name + ".*.json")).string() +
+                                              " would also be written for " + others +
+                                              "; rename one of them"});
+    }
+    inputs = std::move(kept);
   }
 
   // Output names: one input and one model write --out itself.
@@ -143,9 +193,14 @@ int RunFit(const FitCommandOptions& options) {
   } else {
     CreateOutputFolder(options.out);
   }
+  std::set<std::string> input_paths;
+  for (const FitInput& in : inputs) input_paths.insert(Identity(in.path));
   for (const FitInput& in : inputs)
     for (Model m : models) {
       const std::string out = output_of(in, m);
+      if (input_paths.count(Identity(out)))
+        throw InvalidArgument(out + ": the result of " + in.path +
+                              " would overwrite an input; choose another --out");
       std::error_code ec;
       if (!options.force && fs::exists(out, ec))
         throw InvalidArgument(out + ": already exists; pass --force to overwrite it");

@@ -428,8 +428,10 @@ int main(int argc, char** argv) {
       "report under \"fit\"");
   fit_cmd
       ->add_option("inputs", fit.inputs,
-                   "Captures (.bpc), material files (.json), RGL .bsdf or MERL .binary files, or "
-                   "folders of them")
+                   "Captures (.bpc), material files (.json), RGL .bsdf or MERL .binary files, "
+                   "third-party tables (Zemax, LightTools, CSV, goniometer), exported LUTs "
+                   "(.ktx2, .dds, sidecar .json), or folders of captures, material files and "
+                   ".bsdf/.binary files")
       ->required();
   fit_cmd
       ->add_option("--model", fit.model,
