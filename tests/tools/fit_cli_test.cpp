@@ -143,6 +143,19 @@ TEST_F(FitCommand, ExtrapolateAutoIsRecordedByConvertAndAtlas) {
   EXPECT_EQ(entry["extrapolation"]["l"], record["l"]);
   EXPECT_EQ(entry["fitted_models"][0]["p"], record["p"]);
   EXPECT_NEAR(entry["fitted_models"][0]["ggx_fit"]["alpha"][0].get<double>(), 0.2, 0.002);
+
+  // A material with its own "extrapolate" keeps it (it comes before the command line): no fit
+  // is made or recorded.
+  WriteText(dir_ / "own.json",
+            R"({"model":"ggx","kd":0.05,"f0":0.6,"alpha":0.2,"extrapolate":{"p":0.3,"l":0.7}})");
+  ASSERT_EQ(Run("convert " + Quote(dir_ / "own.json") + " --out " + Quote(dir_ / "luts") +
+                " --extrapolate auto --formats json --quiet")
+                .exit_code,
+            0);
+  const Json own = Json::parse(ReadAll(dir_ / "luts" / "own.json"));
+  EXPECT_EQ(own["extrapolation"]["p"], 0.3);
+  EXPECT_EQ(own["extrapolation"]["l"], 0.7);
+  EXPECT_TRUE(own["fitted_models"].empty()) << own["fitted_models"].dump();
 }
 
 // Any BRDF the toolchain reads is fitted: an exported LUT (sampled as a GPU samples it) and a

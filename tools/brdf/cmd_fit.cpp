@@ -90,6 +90,9 @@ std::optional<AutoExtrapolationChoice> AutoExtrapolationFor(const std::string& p
   if (kind != sources::FileKind::kCapture && kind != sources::FileKind::kMaterial)
     return std::nullopt;
   const sources::PreparedMeasurement p = sources::PrepareMeasurement(path, kind, std::nullopt);
+  // The input's own choice (a .extrapolate.json beside it, a material's "extrapolate") comes
+  // before the command line's, so there is nothing to fit and nothing to record.
+  if (p.extrapolation.origin != sources::ExtrapolationChoice::Origin::kDefaults) return std::nullopt;
   const processing::AutoExtrapolationResult r = processing::ChooseExtrapolationAuto(p.measurement);
   return AutoExtrapolationChoice{r.params, processing::AutoExtrapolationJson(r)};
 }
@@ -254,11 +257,15 @@ int RunFit(const FitCommandOptions& options) {
     }
     ++fitted;
     std::printf("%s\n", inputs[i].path.c_str());
-    std::printf("  %-24s %-15s %-40s %10s %8s %7s\n", "model", "status", "rmse per theta_in (1/sr)",
-                "rmse", "med.rel", "seconds");
+    // The per-slice column as wide as its widest entry, so the columns after it line up.
+    int width = 40;
+    for (const processing::FitResult& r : results[i])
+      width = std::max(width, static_cast<int>(SliceErrors(r.report).size()));
+    std::printf("  %-24s %-15s %-*s %10s %8s %7s\n", "model", "status", width,
+                "rmse per theta_in (1/sr)", "rmse", "med.rel", "seconds");
     for (const processing::FitResult& r : results[i]) {
-      std::printf("  %-24s %-15s %-40s %10.4g %8.4f %7.2f\n",
-                  std::string(ModelName(r.material.model)).c_str(), r.report.status.c_str(),
+      std::printf("  %-24s %-15s %-*s %10.4g %8.4f %7.2f\n",
+                  std::string(ModelName(r.material.model)).c_str(), r.report.status.c_str(), width,
                   SliceErrors(r.report).c_str(), r.report.rmse, r.report.median_relative_error,
                   r.report.seconds);
       const std::string engine = EngineInstructions(r.material);
