@@ -127,33 +127,57 @@ ENGINE = {"unreal-defaultlit": (unreal, ["base_color", "metallic", "specular", "
           "unity-urp-lit": (urp, ["base_color", "metallic", "smoothness"])}
 
 
+def as_rgb(v):
+    return np.array(v if isinstance(v, list) else [v, v, v], dtype=float)
+
+
+def vector_of(model, material):
+    """The parameter vector of a material file's values in this script's order (legacy models:
+    the first parameter's r, g, b, then the second's, then the shape's; engine models: base colour
+    r, g, b, then the scalars)."""
+    if model in LEGACY:
+        return np.concatenate([as_rgb(material[n]) for n in LEGACY[model][1]])
+    names = ENGINE[model][1]
+    return np.concatenate([as_rgb(material[n]) if n == "base_color" else [float(material[n])] for n in names])
+
+
+def problem(d, model, start, loss="ngan"):
+    """(residuals(x), x0, lo, hi) of fitting `model` to the samples `d` from the material `start`
+    under `loss`: ngan sqrt(w)·cosθin·(f − m), log sqrt(w)·(ln(1 + cosθin·f) − ln(1 + cosθin·m))."""
+    c_in, sqrt_w = d["cos_in"], d["sqrt_w"]
+    meas = [d["m_r"], d["m_g"], d["m_b"]]
+    if loss == "ngan":
+        def r(f, m):
+            return sqrt_w * c_in * (f - m)
+    elif loss == "log":
+        def r(f, m):
+            return sqrt_w * (np.log1p(c_in * f) - np.log1p(c_in * m))
+    else:
+        raise ValueError("loss " + loss)
+    x0 = vector_of(model, start)
+    if model in LEGACY:
+        f, _, bounds = LEGACY[model]
+        lo = np.concatenate([[b[0]] * 3 for b in bounds])
+        hi = np.concatenate([[b[1]] * 3 for b in bounds])
+
+        def residuals(x):
+            return np.concatenate([r(f(d, x[c], x[3 + c], x[6 + c]), meas[c]) for c in range(3)])
+    else:
+        f = ENGINE[model][0]
+        lo, hi = np.zeros(len(x0)), np.ones(len(x0))
+
+        def residuals(x):
+            fx = f(d, x)
+            return np.concatenate([r(fx[c], meas[c]) for c in range(3)])
+    return residuals, x0, lo, hi
+
+
 def main():
     out_dir, model = sys.argv[1], sys.argv[2]
     repeats = int(sys.argv[3]) if len(sys.argv) > 3 else 3
     d = load(out_dir)
     start = json.load(open(out_dir + "/start_" + model + ".json"))
-    w = d["sqrt_w"] * d["cos_in"]
-    meas = [d["m_r"], d["m_g"], d["m_b"]]
-
-    def as_rgb(v):
-        return np.array(v if isinstance(v, list) else [v, v, v], dtype=float)
-
-    if model in LEGACY:
-        f, names, bounds = LEGACY[model]
-        x0 = np.concatenate([as_rgb(start[n]) for n in names])  # a rgb, b rgb, shape rgb
-        lo = np.concatenate([[b[0]] * 3 for b in bounds])
-        hi = np.concatenate([[b[1]] * 3 for b in bounds])
-
-        def residuals(x):
-            return np.concatenate([w * (f(d, x[c], x[3 + c], x[6 + c]) - meas[c]) for c in range(3)])
-    else:
-        f, names = ENGINE[model]
-        x0 = np.concatenate([as_rgb(start[n]) if n == "base_color" else [float(start[n])] for n in names])
-        lo, hi = np.zeros(len(x0)), np.ones(len(x0))
-
-        def residuals(x):
-            fx = f(d, x)
-            return np.concatenate([w * (fx[c] - meas[c]) for c in range(3)])
+    residuals, x0, lo, hi = problem(d, model, start)
 
     times, cpu, result = [], [], None
     for _ in range(repeats):

@@ -71,6 +71,8 @@ Atlas BuildAtlas(const std::vector<AtlasMaterial>& materials) {
     atlas.names.push_back(materials[m].name);
     atlas.sources.push_back(materials[m].source);
     atlas.saturated_samples.push_back(materials[m].saturated_samples);
+    atlas.extrapolation.push_back(materials[m].extrapolation);
+    atlas.fitted_models_json.push_back(materials[m].fitted_models_json);
     const Lut& lut = *materials[m].lut;
     const int x0 = atlas.layout.cells.CellColumn(static_cast<int>(m)) * Lut::kWidth;
     const int y0 = atlas.layout.cells.CellRow(static_cast<int>(m)) * Lut::kHeight;
@@ -155,6 +157,15 @@ std::string AtlasManifestJson(const Atlas& atlas, const std::vector<std::string>
     if (static_cast<std::size_t>(m) < atlas.saturated_samples.size() && atlas.saturated_samples[m])
       materials.back()["saturated_samples"] =
           detail::SaturatedCountsJson(*atlas.saturated_samples[m]);
+    const auto i = static_cast<std::size_t>(m);
+    if (i < atlas.extrapolation.size() && atlas.extrapolation[i])
+      materials.back()["extrapolation"] = detail::ExtrapolationJson(*atlas.extrapolation[i]);
+    if (i < atlas.fitted_models_json.size() && !atlas.fitted_models_json[i].empty()) {
+      ordered_json fitted = ordered_json::array();
+      for (const std::string& text : atlas.fitted_models_json[i])
+        fitted.push_back(detail::ParseEmbeddedJson(text, "fitted model"));
+      materials.back()["fitted_models"] = std::move(fitted);
+    }
   }
   j["materials"] = std::move(materials);
   j["grid"] = {
@@ -248,6 +259,17 @@ AtlasManifest ParseAtlasManifest(std::string_view json_text, const std::string& 
     if (list[i].contains("saturated_samples"))
       entry.saturated_samples = detail::ParseSaturatedCounts(list[i]["saturated_samples"], file,
                                                              prefix + "saturated_samples");
+    if (list[i].contains("extrapolation")) {
+      detail::JsonFields x(e.Object("extrapolation"), file, prefix + "extrapolation.");
+      entry.extrapolation = ExtrapolationInfo{x.Number("p"), x.Number("l"), x.Number("theta_b_deg")};
+    }
+    if (list[i].contains("fitted_models")) {
+      const ordered_json& fitted = list[i]["fitted_models"];
+      if (!fitted.is_array())
+        throw FormatError(file, "member '" + prefix + "fitted_models'", "an array",
+                          fitted.type_name());
+      for (const ordered_json& x : fitted) entry.fitted_models_json.push_back(x.dump());
+    }
     m.materials.push_back(std::move(entry));
   }
   detail::JsonFields p(f.Object("payload"), file, "payload.");

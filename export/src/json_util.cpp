@@ -152,6 +152,14 @@ std::vector<std::string> JsonFields::StringArray(const char* name) const {
   return out;
 }
 
+ordered_json ExtrapolationJson(const ExtrapolationInfo& e) {
+  return {{"method",
+           "restricted quadratic Bezier beyond the last measured theta_out (docs/design.md §6)"},
+          {"p", e.p},
+          {"l", e.l},
+          {"theta_b_deg", e.theta_b_deg}};
+}
+
 ordered_json SaturatedCountsJson(const std::vector<SaturatedCount>& counts) {
   ordered_json a = ordered_json::array();
   for (const SaturatedCount& c : counts)

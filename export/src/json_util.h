@@ -31,6 +31,10 @@ ordered_json ParseEmbeddedJson(const std::string& text, const std::string& what)
 // Parses a whole document; throws FormatError with the parser's byte position.
 ordered_json ParseJsonDocument(std::string_view text, const std::string& file);
 
+// {"method": ..., "p": P, "l": L, "theta_b_deg": θb} (docs/design.md §6), as the sidecar and
+// the atlas manifest record it.
+ordered_json ExtrapolationJson(const ExtrapolationInfo& e);
+
 // [{"theta_in_deg": 0, "count": 0}, ...] and back; the parser throws FormatError naming
 // "member '<member>[k].count'" etc.
 ordered_json SaturatedCountsJson(const std::vector<SaturatedCount>& counts);

@@ -27,13 +27,7 @@ std::string SidecarJson(const PackedVolume& payload, const std::vector<double>& 
   j["values"] = "f_r in 1/sr, linear Rec.709 RGB, not multiplied by cos(theta)";
   j["texel_convention"] = detail::TexelConventionJson(theta_in_deg);
   if (metadata.extrapolation) {
-    const ExtrapolationInfo& e = *metadata.extrapolation;
-    j["extrapolation"] = {
-        {"method",
-         "restricted quadratic Bezier beyond the last measured theta_out (docs/design.md §6)"},
-        {"p", e.p},
-        {"l", e.l},
-        {"theta_b_deg", e.theta_b_deg}};
+    j["extrapolation"] = detail::ExtrapolationJson(*metadata.extrapolation);
   } else {
     j["extrapolation"] = nullptr;
   }

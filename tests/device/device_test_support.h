@@ -64,6 +64,16 @@ inline Metadata RunCapture(SimulatedFirmware& firmware, CaptureRun* run,
   return run->metadata;
 }
 
+// A whole capture by `firmware` (θin 0, 20, 40, 60°) as a measurement.
+inline Measurement CaptureMeasurement(SimulatedFirmware& firmware) {
+  CaptureRun run;
+  RunCapture(firmware, &run);
+  Measurement meas;
+  meas.metadata = run.metadata;
+  meas.slices = run.slices;
+  return meas;
+}
+
 // f_r of `m` at a sample's own recorded angles.
 inline Rgb Truth(const Material& m, const Sample& s) {
   return m.Evaluate(SphericalDirectionDeg(s.theta_in_deg, s.phi_in_deg),

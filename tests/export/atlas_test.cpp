@@ -136,6 +136,23 @@ TEST(Atlas, ManifestNamesEveryMaterialItsCellAndTheConventions) {
   EXPECT_EQ(parsed.layout.cells.columns, 3);
 }
 
+// The extrapolation a material's cell was filled with and its fitted models (--extrapolate
+// auto's record) are written per material and read back; materials without them have none.
+TEST(Atlas, ManifestRecordsEachMaterialsExtrapolationAndFits) {
+  Five five;
+  five.materials[1].extrapolation = ExtrapolationInfo{0.25, 0.8, 75};
+  five.materials[1].fitted_models_json = {R"({"kind":"extrapolation-auto","p":0.25,"l":0.8})"};
+  const AtlasManifest parsed = ParseAtlasManifest(AtlasManifestJson(BuildAtlas(five.materials), {}));
+  ASSERT_TRUE(parsed.materials[1].extrapolation.has_value());
+  EXPECT_EQ(parsed.materials[1].extrapolation->p, 0.25);
+  EXPECT_EQ(parsed.materials[1].extrapolation->l, 0.8);
+  EXPECT_EQ(parsed.materials[1].extrapolation->theta_b_deg, 75);
+  ASSERT_EQ(parsed.materials[1].fitted_models_json.size(), 1u);
+  EXPECT_EQ(nlohmann::json::parse(parsed.materials[1].fitted_models_json[0])["l"], 0.8);
+  EXPECT_FALSE(parsed.materials[0].extrapolation.has_value());
+  EXPECT_TRUE(parsed.materials[0].fitted_models_json.empty());
+}
+
 TEST(Atlas, RefusesMaterialsWithDifferentThetaSetsNamingThem) {
   const Lut a = test::AnalyticLut(test::Lambert(0.5), {0, 20, 40, 60});
   const Lut b = test::AnalyticLut(test::Lambert(0.5), {0, 30, 60});

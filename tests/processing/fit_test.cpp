@@ -15,7 +15,7 @@
 
 #include "../device/device_test_support.h"
 #include "brdf/core/error.h"
-#include "brdf/processing/extrapolation.h"
+#include "synthetic_capture.h"
 
 namespace brdf::processing {
 namespace {
@@ -48,12 +48,7 @@ Measurement NoiseFreeCapture(const Material& m, double phi_step_deg = 2.0) {
 // A capture by the simulated reference instrument at noise level 1, φout every 2°.
 Measurement NoisyCapture(const Material& m, std::uint64_t seed = 7) {
   device::SimulatedFirmware firmware(device::testing::Config(m, 1.0, 1, 2, seed));
-  device::testing::CaptureRun run;
-  device::testing::RunCapture(firmware, &run);
-  Measurement meas;
-  meas.metadata = run.metadata;
-  meas.slices = run.slices;
-  return meas;
+  return device::testing::CaptureMeasurement(firmware);
 }
 
 struct Case {
@@ -112,8 +107,8 @@ TEST(FitRecovery, NoiseFreeCapturesGiveTheParametersBackWithinOnePercent) {
     FitOptions o;
     o.model = c.truth.model;
     const FitResult r = FitMaterial(NoiseFreeCapture(c.truth), o);
-    EXPECT_NE(r.report.status, "failed") << c.label << ": " << r.report.message;
-    ExpectParameters(r.material, c.truth, 0.01, 1e-3, c.label);
+    EXPECT_EQ(r.report.status, "converged") << c.label << ": " << r.report.message;
+    ExpectParameters(r.material, c.truth, 0.01, 1e-4, c.label);
     EXPECT_LT(r.report.median_relative_error, 1e-3) << c.label;
     EXPECT_EQ(r.report.slices.size(), 4u) << c.label;
     EXPECT_TRUE(r.report.representable) << c.label << ": " << r.report.chromaticity_error;
@@ -128,27 +123,20 @@ TEST(FitRecovery, NoiseFreeCapturesGiveTheParametersBackWithinOnePercent) {
 // the fewest samples. Unreal's Specular is the exception: it only adds 0.08·Specular·(1 −
 // Metallic) to f0 (0.016 of 0.55 here), so a 0.1 % error in f0 moves it by 0.025; it is held to
 // 0.05 absolute.
+// Every recovery case, sharp and rough, every model (test::NoisyRecoveryTolerance).
 TEST(FitRecovery, NoisyCapturesGiveTheParametersBackWithinStatedTolerances) {
-  const std::vector<Case> cases = RecoveryCases();
-  for (const char* label : {"ggx sharp alpha 0.05", "ggx rough alpha 0.5", "lafortune sharp n 500",
-                            "unreal metal-ish", "hdrp lit"}) {
-    const Case* c = nullptr;
-    for (const Case& x : cases)
-      if (std::string(x.label) == label) c = &x;
-    ASSERT_NE(c, nullptr);
+  for (const Case& c : RecoveryCases()) {
     FitOptions o;
-    o.model = c->truth.model;
-    const FitResult r = FitMaterial(NoisyCapture(c->truth), o);
-    EXPECT_NE(r.report.status, "failed") << label;
-    const ModelInfo& info = DescribeModel(c->truth.model);
+    o.model = c.truth.model;
+    const FitResult r = FitMaterial(NoisyCapture(c.truth), o);
+    EXPECT_EQ(r.report.status, "converged") << c.label << ": " << r.report.message;
+    const ModelInfo& info = DescribeModel(c.truth.model);
     for (const ParameterInfo& p : info.parameters)
       for (int ch = 0; ch < p.Count(); ++ch) {
-        const double t = c->truth.values[static_cast<std::size_t>(p.offset + ch)];
-        const double f = r.material.values[static_cast<std::size_t>(p.offset + ch)];
-        const bool shape = static_cast<int>(&p - info.parameters.data()) == info.shape_parameter;
-        const double tolerance =
-            p.name == "specular" ? 0.05 : std::max((shape ? 0.05 : 0.03) * std::fabs(t), 0.005);
-        EXPECT_NEAR(f, t, tolerance) << label << ": " << p.name << "[" << ch << "]";
+        const double t = c.truth.values[static_cast<std::size_t>(p.offset + ch)];
+        EXPECT_NEAR(r.material.values[static_cast<std::size_t>(p.offset + ch)], t,
+                    test::NoisyRecoveryTolerance(info, p, t))
+            << c.label << ": " << p.name << "[" << ch << "]";
       }
   }
 }
@@ -231,19 +219,27 @@ Material NaiveFromGgx(const Material& ggx, Model engine) {
   }
 }
 
+// A red plastic and a gold-like metal (no diffuse, coloured f0): the naive mapping has no
+// metallic for the metal, so it is the harder case for the mapping, not for the fit.
 TEST(FitEngines, EngineFitsAreNeverWorseThanTheNaiveMappingOfTheGgxFit) {
   const Material plastic =
       Material::Make(Model::kGgx, {{0.5, 0.1, 0.05}, {0.05, 0.05, 0.05}, {0.15, 0.15, 0.15}});
-  const Measurement meas = NoiseFreeCapture(plastic, 4.0);
-  FitOptions o;
-  o.model = Model::kGgx;
-  const Material ggx = FitMaterial(meas, o).material;
-  for (Model engine : {Model::kUnrealDefaultLit, Model::kUnityHdrpLit, Model::kUnityHdrpLitSpecular,
-                       Model::kUnityUrpLit, Model::kUnityUrpLitSpecular}) {
-    o.model = engine;
-    const FitReport fit = FitMaterial(meas, o).report;
-    const FitReport naive = EvaluateFit(meas, NaiveFromGgx(ggx, engine), o);
-    EXPECT_LE(fit.final_cost, naive.final_cost) << ModelName(engine);
+  const Material metal =
+      Material::Make(Model::kGgx, {{0, 0, 0}, {0.95, 0.75, 0.35}, {0.25, 0.25, 0.25}});
+  for (const Material* truth : {&plastic, &metal}) {
+    const Measurement meas = NoiseFreeCapture(*truth, 4.0);
+    FitOptions o;
+    o.model = Model::kGgx;
+    const Material ggx = FitMaterial(meas, o).material;
+    for (Model engine : {Model::kUnrealDefaultLit, Model::kUnityHdrpLit,
+                         Model::kUnityHdrpLitSpecular, Model::kUnityUrpLit,
+                         Model::kUnityUrpLitSpecular}) {
+      o.model = engine;
+      const FitReport fit = FitMaterial(meas, o).report;
+      const FitReport naive = EvaluateFit(meas, NaiveFromGgx(ggx, engine), o);
+      EXPECT_LE(fit.final_cost, naive.final_cost)
+          << ModelName(engine) << (truth == &metal ? " metal" : " plastic");
+    }
   }
 }
 
@@ -335,7 +331,9 @@ TEST(FitLosses, ReportedCostIsTheCostOfTheFittedMaterial) {
 }
 
 // --extrapolate auto on a noise-free GGX capture: between 75° and 90° the §6 band with the
-// chosen p, l is closer to the true GGX values than clamping (p = 1).
+// chosen p, l is closer to the true GGX values than clamping (p = 1). The band is computed with
+// the test's own §6 curve (synthetic_capture.h: the Bézier solved by bisection), not with the
+// library's ExtrapolationFactor.
 TEST(AutoExtrapolation, BeatsClampingOnANoiseFreeGgxCapture) {
   const Material truth =
       Material::Make(Model::kGgx, {{0.05, 0.05, 0.05}, {0.6, 0.5, 0.4}, {0.2, 0.2, 0.2}});
@@ -351,7 +349,7 @@ TEST(AutoExtrapolation, BeatsClampingOnANoiseFreeGgxCapture) {
       const Rgb at_b = truth.Evaluate(l, SphericalDirectionDeg(75, po));  // the measured f(θb)
       for (double t = 76; t <= 89.5; t += 0.5) {
         const Rgb want = truth.Evaluate(l, SphericalDirectionDeg(t, po));
-        const double fa = ExtrapolationFactor(t, 75.0, r.params);
+        const double fa = test::FactorReference(t, 75.0, r.params.p, r.params.l);
         for (int c = 0; c < 3; ++c) {
           err_auto += std::pow(at_b[c] * fa - want[c], 2);
           err_clamp += std::pow(at_b[c] - want[c], 2);

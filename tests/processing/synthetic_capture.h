@@ -79,6 +79,15 @@ inline double FactorReference(double theta_deg, double theta_b_deg, double p, do
   return (1.0 - alpha) + alpha * p;
 }
 
+// How far a fitted value may be from the truth when the capture was taken by the simulated
+// reference instrument at noise level 1 (the reasons: fit_test.cpp, FitRecovery.NoisyCaptures...):
+// 5 % for the lobe's shape, 3 % (or 0.005 absolute) for everything else, Unreal's Specular 0.05.
+inline double NoisyRecoveryTolerance(const ModelInfo& info, const ParameterInfo& p, double truth) {
+  if (p.name == "specular") return 0.05;
+  const bool shape = static_cast<int>(&p - info.parameters.data()) == info.shape_parameter;
+  return std::max((shape ? 0.05 : 0.03) * std::fabs(truth), 0.005);
+}
+
 inline Material MakeMaterial(Model model, Rgb kd, Rgb ks, Rgb shape) {
   Material m;
   m.model = model;

@@ -25,6 +25,15 @@ TEST_F(CliErrors, EveryParseErrorIsOneShortLineNamingOptionAndValue) {
       {"atlas in --out o --jobs -1", {"brdf: atlas: --jobs", "'-1'"}},
       {"convert in --out o --exr-compression foo", {"--exr-compression", "foo"}},
       {"eval", {"brdf: eval: ", "file", "brdf eval --help"}},
+      // brdf fit: --starts and --jobs at least 1, --max-theta-out an angle in (0, 90].
+      {"fit in --out o.json --starts 0", {"brdf: fit: --starts", "whole number >= 1", "'0'"}},
+      {"fit in --out o.json --starts x", {"--starts", "'x'"}},
+      {"fit in --out o.json --jobs 1.5", {"--jobs", "'1.5'"}},
+      {"fit in --out o.json --max-theta-out 0", {"--max-theta-out", "(0, 90] degrees", "'0'"}},
+      {"fit in --out o.json --max-theta-out 95", {"--max-theta-out", "'95'"}},
+      {"fit in --out o.json --max-theta-out abc", {"--max-theta-out", "'abc'"}},
+      {"fit in --out o.json --loss l2", {"--loss", "l2", "ngan"}},
+      {"fit in --out o.json --model phong", {"--model", "phong", "blinn-phong"}},
       {"nonsense", {"brdf"}},
       {"eval x.json --in 30,0 --out 30,180 --bogus 1", {"brdf: eval: ", "'--bogus 1'"}},
   };
@@ -37,6 +46,7 @@ TEST_F(CliErrors, EveryParseErrorIsOneShortLineNamingOptionAndValue) {
     EXPECT_LT(lines[0].size(), 200u) << lines[0];
     for (const std::string& e : c.expected)
       EXPECT_NE(lines[0].find(e), std::string::npos) << lines[0] << " lacks " << e;
+    EXPECT_EQ(lines[0].find("Value "), std::string::npos) << "CLI11's range wording";
   }
 }
 

@@ -31,14 +31,13 @@ std::string Accepted(const InputKinds& kinds) {
              : "a capture (.bpc) or a material .json";
 }
 
-// Identity of a path for de-duplication: the canonical path when it exists.
+}  // namespace
+
 std::string Identity(const fs::path& p) {
   std::error_code ec;
   const fs::path c = fs::weakly_canonical(p, ec);
   return ec ? p.lexically_normal().string() : c.string();
 }
-
-}  // namespace
 
 DiscoveredInputs DiscoverInputs(const std::vector<std::string>& arguments,
                                 const InputKinds& kinds) {

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstddef>
+#include <filesystem>
 #include <functional>
 #include <string>
 #include <vector>
@@ -86,6 +87,10 @@ class OutputGuard {
 // --exr-type ("float" or "half") and --exr-compression ("zip" or "none") as the exporter's EXR
 // options; throws InvalidArgument naming a bad value.
 exporter::ExrOptions ParseExrOptions(const std::string& type, const std::string& compression);
+
+// Identity of a path for de-duplication and collision checks: the canonical path when it
+// exists, else the lexically normal one.
+std::string Identity(const std::filesystem::path& p);
 
 // "<path>: <reason>" → reason, for the summary (messages of this toolchain start with the path).
 std::string ReasonWithoutPath(const std::string& path, const std::string& message);

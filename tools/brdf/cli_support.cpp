@@ -115,6 +115,15 @@ std::string LowerExtension(const std::string& path) {
   return ext;
 }
 
+void CreateOutputFolder(const std::string& folder) {
+  if (folder.empty()) return;
+  std::error_code ec;
+  std::filesystem::create_directories(folder, ec);
+  if (!std::filesystem::is_directory(folder))
+    throw IoError(folder + ": cannot create the output folder" +
+                  (ec ? ": " + ec.message() : std::string()));
+}
+
 void CheckOutputPath(const std::string& out, const std::string& input, const char* extension,
                      bool force, const char* option) {
   if (LowerExtension(out) != extension)

@@ -42,6 +42,10 @@ std::string LowerExtension(const std::string& path);
 void CheckOutputPath(const std::string& out, const std::string& input, const char* extension,
                      bool force, const char* option = "--out");
 
+// Creates `folder` and its parents (nothing for an empty path); throws IoError naming it when
+// that fails ("x: cannot create the output folder: Not a directory").
+void CreateOutputFolder(const std::string& folder);
+
 // Prints one note on stderr naming the temporary files of killed runs that
 // brdf::CheckWritableOutputs removed (nothing when there were none).
 void ReportRemovedTemporaries(const std::vector<std::string>& removed);

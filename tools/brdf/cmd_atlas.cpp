@@ -81,6 +81,8 @@ int RunAtlas(const AtlasOptions& options) {
   resample.parallel = found.inputs.size() == 1 && options.jobs > 1;
   std::vector<Lut> luts(found.inputs.size());
   std::vector<std::optional<std::vector<exporter::SaturatedCount>>> saturated(found.inputs.size());
+  std::vector<std::optional<exporter::ExtrapolationInfo>> extrapolation(found.inputs.size());
+  std::vector<std::vector<std::string>> fitted(found.inputs.size());  // --extrapolate auto's record
 
   Progress progress("atlas", found.inputs.size(), !options.quiet);
   const std::vector<JobResult> results = RunJobs(
@@ -89,14 +91,17 @@ int RunAtlas(const AtlasOptions& options) {
         const BatchInput& in = found.inputs[i];
         std::optional<processing::ExtrapolationParams> chosen = extrapolate;
         if (auto_extrapolate)
-          if (const auto automatic = AutoExtrapolationFor(in.path, in.kind))
+          if (const auto automatic = AutoExtrapolationFor(in.path, in.kind)) {
             chosen = automatic->params;
+            fitted[i].push_back(automatic->record_json);
+          }
         sources::InputLut built = sources::LutFromInput(in.path, in.kind, chosen, resample);
         exporter::ValidateLutForExport(built.lut);
         result.warnings = std::move(built.warnings);
         if (auto note = sources::SaturationNote(in.path, built.saturated_samples))
           result.warnings.push_back(std::move(*note));
         saturated[i] = std::move(built.saturated_samples);
+        extrapolation[i] = built.extrapolation;
         luts[i] = std::move(built.lut);
       },
       [&](std::size_t i, const JobResult& result) {
@@ -121,15 +126,9 @@ int RunAtlas(const AtlasOptions& options) {
 
   std::vector<exporter::AtlasMaterial> materials;
   for (std::size_t i = 0; i < luts.size(); ++i)
-    materials.push_back({found.inputs[i].name, &luts[i], found.inputs[i].path, saturated[i]});
-  const fs::path parent = fs::path(options.out).parent_path();
-  if (!parent.empty()) {
-    std::error_code ec;
-    fs::create_directories(parent, ec);
-    if (!fs::is_directory(parent))
-      throw IoError(parent.string() + ": cannot create the output folder" +
-                    (ec ? ": " + ec.message() : std::string()));
-  }
+    materials.push_back({found.inputs[i].name, &luts[i], found.inputs[i].path, saturated[i],
+                         extrapolation[i], fitted[i]});
+  CreateOutputFolder(fs::path(options.out).parent_path().string());
   const OutputGuard guard(outputs);
   std::vector<std::string> written;
   try {

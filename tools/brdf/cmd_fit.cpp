@@ -1,13 +1,16 @@
 // `brdf fit INPUT... --model M|all --out OUT [--loss ...] [--robust] [--max-theta-out DEG]
 // [--starts N] [--jobs N]`: every input becomes a measurement (captures through the LUT rule
 // for damaged files, material files captured noise-free on the reference geometry, RGL and MERL
-// files captured virtually as `brdf import` does), processing::FitMaterial fits each model, and
+// files and exported LUTs captured virtually as `brdf import` does, third-party tables
+// imported: sources::PrepareMeasurement), processing::FitMaterial fits each model, and
 // the result is written as a material file with the report under "fit". A comparison table
 // (model, RMSE per θin slice and overall, median relative error, seconds, and for engine models
 // what to type where) goes to stdout; progress and skipped inputs to stderr.
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
+#include <map>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -21,6 +24,7 @@
 #include "cli_support.h"
 #include "commands.h"
 #include "fit_support.h"
+#include "progress.h"
 
 namespace brdf::cli {
 
@@ -36,6 +40,30 @@ struct FitInput {
 bool IsEvaluableFile(const std::string& path) {
   const std::string ext = LowerExtension(path);
   return ext == ".bsdf" || ext == ".binary";
+}
+
+// A file named on the command line that is fitted as it is, not through the convert rules:
+// measured databases, imported tables and exported LUTs (sources::PrepareMeasurement).
+bool IsDirectInput(const std::string& path) {
+  if (IsEvaluableFile(path)) return true;
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return false;
+  try {
+    switch (sources::DetectFileKind(path)) {
+      case sources::FileKind::kZemax:
+      case sources::FileKind::kLightTools:
+      case sources::FileKind::kCsv:
+      case sources::FileKind::kGonio:
+      case sources::FileKind::kKtx2:
+      case sources::FileKind::kDds:
+      case sources::FileKind::kSidecar:
+        return true;
+      default:
+        return false;
+    }
+  } catch (const Error&) {
+    return false;  // the convert rules report it
+  }
 }
 
 Measurement OpenForFit(const std::string& path, std::vector<std::string>* warnings) {
@@ -62,6 +90,9 @@ std::optional<AutoExtrapolationChoice> AutoExtrapolationFor(const std::string& p
   if (kind != sources::FileKind::kCapture && kind != sources::FileKind::kMaterial)
     return std::nullopt;
   const sources::PreparedMeasurement p = sources::PrepareMeasurement(path, kind, std::nullopt);
+  // The input's own choice (a .extrapolate.json beside it, a material's "extrapolate") comes
+  // before the command line's, so there is nothing to fit and nothing to record.
+  if (p.extrapolation.origin != sources::ExtrapolationChoice::Origin::kDefaults) return std::nullopt;
   const processing::AutoExtrapolationResult r = processing::ChooseExtrapolationAuto(p.measurement);
   return AutoExtrapolationChoice{r.params, processing::AutoExtrapolationJson(r)};
 }
@@ -102,7 +133,7 @@ int RunFit(const FitCommandOptions& options) {
       std::sort(evaluable.begin(), evaluable.end());
       for (const std::string& f : evaluable) inputs.push_back({f, sources::OutputNameOf(f)});
       rest.push_back(arg);
-    } else if (IsEvaluableFile(arg)) {
+    } else if (IsDirectInput(arg)) {
       inputs.push_back({arg, sources::OutputNameOf(arg)});
     } else {
       rest.push_back(arg);
@@ -122,6 +153,29 @@ int RunFit(const FitCommandOptions& options) {
                           JoinArguments(options.inputs));
   }
 
+  // Inputs of one name (a/red.bpc, b/red.bpc) would write each other's results into a --out
+  // folder: both fail before any fit, as `brdf convert` refuses them.
+  if (inputs.size() > 1) {
+    std::map<std::string, std::vector<std::size_t>> by_name;
+    for (std::size_t i = 0; i < inputs.size(); ++i) by_name[inputs[i].name].push_back(i);
+    std::vector<FitInput> kept;
+    for (std::size_t i = 0; i < inputs.size(); ++i) {
+      const std::vector<std::size_t>& same = by_name[inputs[i].name];
+      if (same.size() < 2) {
+        kept.push_back(inputs[i]);
+        continue;
+      }
+      std::string others;
+      for (std::size_t o : same)
+        if (o != i) others += (others.empty() ? "" : ", ") + inputs[o].path;
+      failures.push_back({inputs[i].path, "its results " +
+                                              (fs::path(options.out) / (inputs[i].name + ".*.json")).string() +
+                                              " would also be written for " + others +
+                                              "; rename one of them"});
+    }
+    inputs = std::move(kept);
+  }
+
   // Output names: one input and one model write --out itself.
   const bool single = inputs.size() == 1 && failures.empty() && models.size() == 1;
   auto output_of = [&](const FitInput& in, Model m) {
@@ -133,18 +187,23 @@ int RunFit(const FitCommandOptions& options) {
     }
     return (fs::path(options.out) / (in.name + "." + std::string(ModelName(m)) + ".json")).string();
   };
+  // The folder the results go to exists before any fit runs (the parent of a .json --out).
   if (single) {
     CheckOutputPath(options.out, inputs.front().path, ".json", options.force);
-  } else if (!(inputs.size() == 1 && LowerExtension(options.out) == ".json")) {
-    std::error_code ec;
-    fs::create_directories(options.out, ec);
-    if (!fs::is_directory(options.out))
-      throw IoError(options.out + ": cannot create the output folder" +
-                    (ec ? ": " + ec.message() : std::string()));
+    CreateOutputFolder(fs::path(options.out).parent_path().string());
+  } else if (inputs.size() == 1 && LowerExtension(options.out) == ".json") {
+    CreateOutputFolder(fs::path(options.out).parent_path().string());
+  } else {
+    CreateOutputFolder(options.out);
   }
+  std::set<std::string> input_paths;
+  for (const FitInput& in : inputs) input_paths.insert(Identity(in.path));
   for (const FitInput& in : inputs)
     for (Model m : models) {
       const std::string out = output_of(in, m);
+      if (input_paths.count(Identity(out)))
+        throw InvalidArgument(out + ": the result of " + in.path +
+                              " would overwrite an input; choose another --out");
       std::error_code ec;
       if (!options.force && fs::exists(out, ec))
         throw InvalidArgument(out + ": already exists; pass --force to overwrite it");
@@ -152,7 +211,10 @@ int RunFit(const FitCommandOptions& options) {
 
   for (const BatchFailure& f : failures)
     std::fprintf(stderr, "%s: FAILED: %s\n", f.path.c_str(), f.reason.c_str());
-  const bool progress = !options.quiet && (inputs.size() > 1 || models.size() > 1);
+  // One step per input and model, as `brdf convert` shows its inputs (bar and ETA on a terminal,
+  // a line per fit otherwise); one fit of one input needs none.
+  Progress progress("fit", inputs.size() * models.size(),
+                    !options.quiet && (inputs.size() > 1 || models.size() > 1));
   // Inputs in parallel when there are several; Ceres' threads for a single input.
   fit.threads = inputs.size() == 1 ? options.jobs : 1;
   std::vector<std::vector<processing::FitResult>> results(inputs.size());
@@ -166,19 +228,25 @@ int RunFit(const FitCommandOptions& options) {
           processing::FitResult r = processing::FitMaterial(meas, o);
           r.material.name = inputs[i].name;
           WriteFileAtomically(output_of(inputs[i], m), MaterialToJson(r.material));
-          if (progress)
-            std::fprintf(stderr, "%s: %s fitted in %.2f s (%s)\n", inputs[i].path.c_str(),
-                         std::string(ModelName(m)).c_str(), r.report.seconds,
-                         r.report.status.c_str());
+          char done[96];
+          std::snprintf(done, sizeof done, " %s (%s, %.2f s)", std::string(ModelName(m)).c_str(),
+                        r.report.status.c_str(), r.report.seconds);
           results[i].push_back(std::move(r));
+          progress.Advance(inputs[i].path + done);
         }
       },
       [&](std::size_t i, const JobResult& job) {
-        for (const std::string& w : job.warnings) std::fprintf(stderr, "%s\n", w.c_str());
-        if (!job.ok)
-          std::fprintf(stderr, "%s: FAILED: %s\n", inputs[i].path.c_str(),
-                       ReasonWithoutPath(inputs[i].path, job.error).c_str());
+        for (const std::string& w : job.warnings) progress.Message(w);
+        if (!job.ok) {
+          progress.Message(inputs[i].path + ": FAILED: " +
+                           ReasonWithoutPath(inputs[i].path, job.error));
+          if (results[i].size() < models.size()) {
+            progress.Advance(inputs[i].path, true);
+            progress.Drop(models.size() - results[i].size() - 1);
+          }
+        }
       });
+  progress.Finish();
 
   const std::size_t total = inputs.size() + failures.size();
   std::size_t fitted = 0;
@@ -189,11 +257,15 @@ int RunFit(const FitCommandOptions& options) {
     }
     ++fitted;
     std::printf("%s\n", inputs[i].path.c_str());
-    std::printf("  %-24s %-15s %-40s %10s %8s %7s\n", "model", "status", "rmse per theta_in (1/sr)",
-                "rmse", "med.rel", "seconds");
+    // The per-slice column as wide as its widest entry, so the columns after it line up.
+    int width = 40;
+    for (const processing::FitResult& r : results[i])
+      width = std::max(width, static_cast<int>(SliceErrors(r.report).size()));
+    std::printf("  %-24s %-15s %-*s %10s %8s %7s\n", "model", "status", width,
+                "rmse per theta_in (1/sr)", "rmse", "med.rel", "seconds");
     for (const processing::FitResult& r : results[i]) {
-      std::printf("  %-24s %-15s %-40s %10.4g %8.4f %7.2f\n",
-                  std::string(ModelName(r.material.model)).c_str(), r.report.status.c_str(),
+      std::printf("  %-24s %-15s %-*s %10.4g %8.4f %7.2f\n",
+                  std::string(ModelName(r.material.model)).c_str(), r.report.status.c_str(), width,
                   SliceErrors(r.report).c_str(), r.report.rmse, r.report.median_relative_error,
                   r.report.seconds);
       const std::string engine = EngineInstructions(r.material);

@@ -16,7 +16,8 @@ struct AutoExtrapolationChoice {
 };
 
 // For a capture or material file: opens it as `brdf convert` does, fits GGX and chooses p, l.
-// Other kinds (exported LUTs carry their extrapolation): nullopt.
+// Inputs with their own extrapolation (beside file, material member), which comes first, and
+// other kinds (exported LUTs carry their extrapolation): nullopt.
 std::optional<AutoExtrapolationChoice> AutoExtrapolationFor(const std::string& path,
                                                             sources::FileKind kind);
 

@@ -63,6 +63,25 @@ CLI::Validator WholeNumberAtLeast(long long min) {
       "INT>=" + std::to_string(min));
 }
 
+// A number in (lo, hi] as typed, with its unit: "abc", "0" and "95" are refused with the value
+// quoted (CLI::Range said "Value abc not in range 0.001000 to 90.000000").
+CLI::Validator NumberAboveUpTo(double lo, double hi, const std::string& unit) {
+  char bounds[64];
+  std::snprintf(bounds, sizeof bounds, "(%g, %g]", lo, hi);
+  const std::string range = bounds + (" " + unit);
+  return CLI::Validator(
+      [lo, hi, range](std::string& text) -> std::string {
+        try {
+          std::size_t used = 0;
+          const double v = std::stod(text, &used);
+          if (used == text.size() && v > lo && v <= hi) return {};
+        } catch (const std::exception&) {
+        }
+        return "expected a number in " + range + ", got '" + text + "'";
+      },
+      "NUMBER in " + range);
+}
+
 // One line for every command-line error, like every other error of the tool: CLI11's message
 // (for "--jobs: ..." it already names the option) and where help is.
 std::string OneLineParseError(const CLI::App& app, const CLI::Error& e) {
@@ -415,8 +434,10 @@ int main(int argc, char** argv) {
       "report under \"fit\"");
   fit_cmd
       ->add_option("inputs", fit.inputs,
-                   "Captures (.bpc), material files (.json), RGL .bsdf or MERL .binary files, or "
-                   "folders of them")
+                   "Captures (.bpc), material files (.json), RGL .bsdf or MERL .binary files, "
+                   "third-party tables (Zemax, LightTools, CSV, goniometer), exported LUTs "
+                   "(.ktx2, .dds, sidecar .json), or folders of captures, material files and "
+                   ".bsdf/.binary files")
       ->required();
   fit_cmd
       ->add_option("--model", fit.model,
@@ -438,19 +459,21 @@ int main(int argc, char** argv) {
                    "(cube roots)")
       ->capture_default_str()
       ->check(CLI::IsMember({"ngan", "log", "cbrt"}));
-  fit_cmd->add_flag("--robust", fit.robust, "Cauchy loss against outliers");
+  fit_cmd->add_flag("--robust", fit.robust,
+                    "Cauchy loss against outliers, per sample and channel; its scale is 1.4826 "
+                    "x the median residual at the start (recorded as fit.robust_scale)");
   fit_cmd
       ->add_option("--max-theta-out", fit.max_theta_out_deg,
                    "Leave out samples beyond this theta_out (degrees); default: all measured")
-      ->check(CLI::Range(0.001, 90.0));
+      ->check(NumberAboveUpTo(0, 90, "degrees"));
   fit_cmd->add_option("--starts", fit.starts, "Sweep candidates refined by Ceres")
       ->capture_default_str()
-      ->check(CLI::Range(1, 100));
+      ->check(WholeNumberAtLeast(1));
   fit_cmd
       ->add_option("--jobs", fit.jobs,
                    "Threads: inputs fitted in parallel, or Ceres threads for a single input")
       ->capture_default_str()
-      ->check(CLI::Range(1, 256));
+      ->check(WholeNumberAtLeast(1));
   fit_cmd->add_flag("--force", fit.force, "Overwrite existing output files");
   fit_cmd->add_flag("--quiet", fit.quiet, "No progress on stderr");
   fit_cmd->callback([&] { exit_code = brdf::cli::RunFit(fit); });

@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdio>
 
 namespace brdf::cli {
@@ -63,6 +64,12 @@ void Progress::Advance(const std::string& item, bool failed) {
                  item.c_str(), failed ? " FAILED" : "", FormatDuration(elapsed).c_str(),
                  FormatDuration(eta).c_str());
   }
+}
+
+void Progress::Drop(std::size_t count) {
+  std::lock_guard lock(mutex_);
+  total_ -= std::min(count, total_ - done_);
+  if (enabled_ && tty_) DrawLocked();
 }
 
 void Progress::Message(const std::string& text) {

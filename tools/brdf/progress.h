@@ -19,6 +19,9 @@ class Progress {
 
   // Marks one item done; `item` names it in non-terminal output, `failed` counts it as failed.
   void Advance(const std::string& item, bool failed = false);
+  // `count` items that will not be done after all (e.g. the other models of an input that
+  // failed): the total shrinks, nothing is printed.
+  void Drop(std::size_t count);
   // Prints a message above the bar without breaking it.
   void Message(const std::string& text);
   void Finish();

@@ -337,6 +337,21 @@ double Cost(const std::vector<FitSample>& samples, const Material& m, FitLoss lo
   return 0.5 * sum;
 }
 
+// ½ Σ b²·ln(1 + r²/b²) over `samples`: the cost under the robust (Cauchy) loss of scale b.
+double RobustCost(const std::vector<FitSample>& samples, const Material& m, FitLoss loss,
+                  double scale) {
+  const double b2 = scale * scale;
+  double sum = 0;
+  for (const FitSample& s : samples) {
+    const std::array<double, 3> f = models::EvaluateRgb(m.model, s.g, m.values.data());
+    for (int c = 0; c < 3; ++c) {
+      const double r = Residual(loss, f[c], s.m[c], s.cos_in, s.sqrt_w);
+      sum += b2 * std::log1p(r * r / b2);
+    }
+  }
+  return 0.5 * sum;
+}
+
 double MedianAbsResidual(const std::vector<FitSample>& samples, const Material& m, FitLoss loss) {
   std::vector<double> r;
   r.reserve(samples.size() * 3);
@@ -349,6 +364,16 @@ double MedianAbsResidual(const std::vector<FitSample>& samples, const Material& 
   auto mid = r.begin() + static_cast<std::ptrdiff_t>(r.size() / 2);
   std::nth_element(r.begin(), mid, r.end());
   return *mid;
+}
+
+// The Cauchy scale b: options.robust_scale, or 1.4826 × the median |r| at `start` (the
+// normal distribution's σ from its median absolute deviation), never below 1e-12.
+double RobustScale(const std::vector<FitSample>& samples, const Material& start,
+                   const FitOptions& options) {
+  const double b = options.robust_scale > 0
+                       ? options.robust_scale
+                       : 1.4826 * MedianAbsResidual(samples, start, options.loss);
+  return std::max(b, 1e-12);
 }
 
 // ----------------------------------------------------------------------------------------------
@@ -765,6 +790,7 @@ class KernelFit {
 struct Search {
   std::optional<Refinement> best;
   int iterations = 0, starts = 0;
+  double robust_scale = 0;  // the Cauchy scale used, 0 without a robust loss
 };
 
 // The multi-start: candidates from the sweep (or the given start), Ceres from the best
@@ -796,15 +822,11 @@ Search RunFit(const FitData& data, const FitOptions& options) {
     if (!seen) starts.push_back(ClampIntoRange(c.material));
   }
 
-  double robust_scale = 0;
-  if (options.robust) {
-    robust_scale = options.robust_scale > 0
-                       ? options.robust_scale
-                       : 1.4826 * MedianAbsResidual(data.samples, starts.front(), options.loss);
-    robust_scale = std::max(robust_scale, 1e-12);
-  }
+  const double robust_scale =
+      options.robust ? RobustScale(data.samples, starts.front(), options) : 0.0;
 
   Search search;
+  search.robust_scale = robust_scale;
   std::optional<Refinement>& best = search.best;
   for (const Material& start : starts) {
     Refinement r = fit.Refine(start, robust_scale);
@@ -880,7 +902,13 @@ FitReport EvaluateFit(const Measurement& measurement, const Material& material,
   report.loss = options.loss;
   report.robust = options.robust;
   report.status = "evaluated";
-  report.final_cost = report.initial_cost = Cost(data.samples, material, options.loss);
+  if (options.robust) {
+    report.robust_scale = RobustScale(data.samples, material, options);
+    report.final_cost = RobustCost(data.samples, material, options.loss, report.robust_scale);
+  } else {
+    report.final_cost = Cost(data.samples, material, options.loss);
+  }
+  report.initial_cost = report.final_cost;
   FillErrors(data, material, &report);
   return report;
 }
@@ -907,6 +935,7 @@ FitResult FitMaterial(const Measurement& measurement, const FitOptions& options)
   report.model = model;
   report.loss = options.loss;
   report.robust = options.robust;
+  report.robust_scale = search.robust_scale;
   report.iterations = search.iterations;
   report.starts = search.starts;
   report.converged = best->termination == ceres::CONVERGENCE;
@@ -948,6 +977,7 @@ std::string FitReportJson(const FitReport& report) {
   j["model"] = std::string(ModelName(report.model));
   j["loss"] = std::string(FitLossName(report.loss));
   j["robust"] = report.robust;
+  if (report.robust) j["robust_scale"] = report.robust_scale;
   j["status"] = report.status;
   j["message"] = report.message;
   j["initial_cost"] = report.initial_cost;

@@ -52,6 +52,16 @@ Measurement CaptureFile(const BrdfSource& source, const std::string& path, FileK
   return m;
 }
 
+// An exported texture that must hold one material's LUT: OpenExportedTexture, its warnings
+// appended to `warnings`; an atlas is refused.
+OpenedTexture OpenSingleLut(const std::string& path, std::vector<std::string>* warnings) {
+  OpenedTexture t = OpenExportedTexture(path);
+  for (std::string& w : t.warnings) warnings->push_back(std::move(w));
+  if (!t.texture.IsSingleLut())
+    throw InvalidArgument(path + ": an atlas, not a single material's LUT");
+  return t;
+}
+
 }  // namespace
 
 ExtrapolationChoice ChooseExtrapolation(
@@ -102,6 +112,15 @@ PreparedMeasurement PrepareMeasurement(
     case FileKind::kMerl:
       out.measurement = CaptureFile(MerlBrdf::Load(path), path, kind);
       break;
+    case FileKind::kKtx2:
+    case FileKind::kDds:
+    case FileKind::kSidecar: {
+      // Sampled as a GPU samples the texture (LutBrdf), on the reference geometry.
+      OpenedTexture t = OpenSingleLut(path, &out.warnings);
+      out.measurement =
+          CaptureFile(LutBrdf(std::move(t.texture.lut), OutputNameOf(path)), path, kind);
+      break;
+    }
     case FileKind::kZemax:
     case FileKind::kLightTools:
     case FileKind::kCsv:
@@ -118,8 +137,8 @@ PreparedMeasurement PrepareMeasurement(
     }
     default:
       throw InvalidArgument(path +
-                            ": expected a capture (.bpc), a material file or a measured "
-                            "table, got a " +
+                            ": expected a capture (.bpc), a material file, a measured "
+                            "table or an exported LUT, got a " +
                             std::string(FileKindName(kind)));
   }
   out.extrapolation = ChooseExtrapolation(path, kind, command_line, &out.warnings);
@@ -311,10 +330,7 @@ InputLut LutFromInput(const std::string& path, FileKind kind,
                       const processing::ResampleOptions& resample_options) {
   InputLut out;
   if (IsExportedLut(kind)) {
-    OpenedTexture t = OpenExportedTexture(path);
-    out.warnings = std::move(t.warnings);
-    if (!t.texture.IsSingleLut())
-      throw InvalidArgument(path + ": an atlas, not a single material's LUT");
+    OpenedTexture t = OpenSingleLut(path, &out.warnings);
     if (command_line) out.warnings.push_back(ExtrapolationIgnored(path));
     if (t.sidecar) {
       out.extrapolation = t.sidecar->extrapolation;

@@ -44,6 +44,12 @@ struct AtlasMaterial {
   std::string source;        // where the LUT came from (for the manifest)
   // Saturated samples per measured slice (the manifest's "saturated_samples"); absent: unknown.
   std::optional<std::vector<SaturatedCount>> saturated_samples = std::nullopt;
+  // What filled θout > θb (the manifest's "extrapolation"); absent: nothing was extrapolated
+  // or it is unknown (an exported LUT).
+  std::optional<ExtrapolationInfo> extrapolation = std::nullopt;
+  // Fitted models as complete JSON texts, e.g. `--extrapolate auto`'s choice with its GGX fit:
+  // the manifest's "fitted_models" of the material, as a LUT sidecar's (sidecar.h).
+  std::vector<std::string> fitted_models_json = {};
 };
 
 struct Atlas {
@@ -51,6 +57,8 @@ struct Atlas {
   std::vector<double> theta_in_deg;
   std::vector<std::string> names, sources;
   std::vector<std::optional<std::vector<SaturatedCount>>> saturated_samples;  // per material
+  std::vector<std::optional<ExtrapolationInfo>> extrapolation;               // per material
+  std::vector<std::vector<std::string>> fitted_models_json;                  // per material
   PackedVolume volume;  // Cm·361 × Rm·181 × K, RGB9E5
 };
 
@@ -82,6 +90,8 @@ struct AtlasManifestEntry {
   int index = 0, column = 0, row = 0, x0 = 0, y0 = 0;
   // Absent: the manifest did not record them.
   std::optional<std::vector<SaturatedCount>> saturated_samples = std::nullopt;
+  std::optional<ExtrapolationInfo> extrapolation = std::nullopt;
+  std::vector<std::string> fitted_models_json = {};  // each a compact JSON text
 };
 struct AtlasManifest {
   std::vector<double> theta_in_deg;

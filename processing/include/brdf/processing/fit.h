@@ -77,6 +77,9 @@ struct FitReport {
   Model model = Model::kGgx;
   FitLoss loss = FitLoss::kNgan;
   bool robust = false;
+  // The Cauchy scale b the robust loss used (FitOptions::robust_scale, or the one chosen from
+  // the data), in residual units; 0 without `robust`. final_cost is ½·Σ b²·ln(1 + r²/b²).
+  double robust_scale = 0;
   // "converged" (Ceres reached a tolerance), "no-convergence" (iteration limit reached; the
   // result is still the best found) or "failed" (no usable result).
   std::string status;
@@ -121,8 +124,10 @@ FitResult FitMaterial(const Measurement& measurement, const FitOptions& options)
 // The report as a JSON object text (compact).
 std::string FitReportJson(const FitReport& report);
 
-// The error `material` has on `measurement` under `options` (loss, exclusions), without
-// fitting: the same numbers FitMaterial reports for its result (status "evaluated").
+// The error `material` has on `measurement` under `options` (loss, exclusions, robust), without
+// fitting: the same numbers FitMaterial reports for its result (status "evaluated"). With
+// `robust` and robust_scale 0 the scale is chosen at `material` as FitMaterial chooses it at
+// its start.
 FitReport EvaluateFit(const Measurement& measurement, const Material& material,
                       const FitOptions& options);
 

@@ -68,7 +68,8 @@ struct PreparedMeasurement {
 // Captures follow the damaged-capture rule (capture.h); material files are captured noise-free
 // on the reference geometry (brdf/core/virtual_capture.h); third-party tables (Zemax,
 // LightTools, CSV, gonio) are imported (transmission tables only with `allow_btdf`), RGL and
-// MERL files captured noise-free. InvalidArgument for any other kind.
+// MERL files and exported single-material LUTs (.ktx2, .dds, sidecar, sampled as a GPU samples
+// them) captured noise-free. InvalidArgument for any other kind (an atlas included).
 PreparedMeasurement PrepareMeasurement(
     const std::string& path, FileKind kind,
     const std::optional<processing::ExtrapolationParams>& command_line, bool allow_btdf = false);
