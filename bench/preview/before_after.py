@@ -18,7 +18,7 @@ import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from convergence import read, relative_rms  # noqa: E402
-from fast_path import SIZE, run  # noqa: E402
+from fast_path import SIZE, parse, run  # noqa: E402
 
 
 def counts(stderr):
@@ -31,20 +31,8 @@ def counts(stderr):
 
 
 def main(argv):
-    tools, out_dir, sources = argv[0:2], argv[2], []
-    runs, ref_pixels, jobs, keep = 5, 1500, 2, False
-    i = 3
-    while i < len(argv):
-        if argv[i] == "--runs":
-            runs = int(argv[i + 1]); i += 2
-        elif argv[i] == "--ref-pixels":
-            ref_pixels = int(argv[i + 1]); i += 2
-        elif argv[i] == "--jobs":
-            jobs = int(argv[i + 1]); i += 2
-        elif argv[i] == "--keep-reference":
-            keep = True; i += 1
-        else:
-            sources.append(argv[i]); i += 1
+    positional, runs, ref_pixels, jobs, keep = parse(argv)
+    tools, out_dir, sources = positional[0:2], positional[2], positional[3:]
     os.makedirs(out_dir, exist_ok=True)
     common = ["--size", str(SIZE), "--jobs", str(jobs), "--no-background", "--force"]
     print("load average before: %.2f %.2f %.2f" % os.getloadavg())
