@@ -47,10 +47,11 @@ def run(args):
     return wall, cpu, done.stderr
 
 
-def main(argv):
-    tool, out_dir, sources = argv[0], argv[1], []
+def parse(argv):
+    """(positional arguments, runs, ref_pixels, jobs, keep) from the command line."""
+    positional = []
     runs, ref_pixels, jobs, keep = 5, 1500, 2, False
-    i = 2
+    i = 0
     while i < len(argv):
         if argv[i] == "--runs":
             runs = int(argv[i + 1]); i += 2
@@ -61,7 +62,13 @@ def main(argv):
         elif argv[i] == "--keep-reference":
             keep = True; i += 1
         else:
-            sources.append(argv[i]); i += 1
+            positional.append(argv[i]); i += 1
+    return positional, runs, ref_pixels, jobs, keep
+
+
+def main(argv):
+    positional, runs, ref_pixels, jobs, keep = parse(argv)
+    tool, out_dir, sources = positional[0], positional[1], positional[2:]
     os.makedirs(out_dir, exist_ok=True)
     common = ["--size", str(SIZE), "--jobs", str(jobs), "--no-background", "--force"]
     print("load average before: %.1f %.1f %.1f" % os.getloadavg())

@@ -50,6 +50,8 @@ struct Kronecker {
 // The hierarchy's top level: 16 × 8 cells of 22.5°, each of which is always compared with its
 // four children, so 32 × 16 is the coarsest resolution a pixel is integrated at.
 constexpr int kHierarchyTopColumns = 16;
+// The image size PreviewOptions::image_tolerance is stated for.
+constexpr double kImageToleranceSize = 512.0;
 
 int ResolveJobs(int jobs) {
   if (jobs > 0) return jobs;
@@ -516,7 +518,11 @@ struct PreviewRenderer::Impl {
                      }
                      counted += count;
                    });
-    const double tolerance = options.image_tolerance * scale;
+    // image_tolerance holds at 512 pixels across and scales with the size (preview.h): the
+    // biquadratic fill's error relative to the midpoints' deviation from the bilinear grows
+    // with the block's angular size, which is larger in a smaller image.
+    const double tolerance = options.image_tolerance * scale *
+                             std::min(options.width, options.height) / kImageToleranceSize;
     // Phase 2: each block owns its pixels [x0, x0 + block) × [y0, y0 + block) and reads its
     // far edges too. A pixel integrated by one block is integrated once: `integrated` keeps it for
     // the neighbours sharing that edge. Block rows run in two passes, even rows then odd ones,
@@ -601,23 +607,39 @@ struct PreviewRenderer::Impl {
                       for (int qx : {dx, dx + h}) self(self, qx, qy, h);
                     return;
                   }
-                  // Bilinear from the nine computed points, over the four quarters.
-                  for (int qy : {dy, dy + h})
-                    for (int qx : {dx, dx + h}) {
-                      const Rgb a = at(qx, qy), b1 = at(qx + h, qy), c1 = at(qx, qy + h),
-                                d1 = at(qx + h, qy + h);
-                      for (int y = 0; y <= h; ++y)
-                        for (int x = 0; x <= h; ++x) {
-                          if (known[(qy + y) * side + qx + x]) continue;
-                          const double u = static_cast<double>(x) / h,
-                                       v = static_cast<double>(y) / h;
-                          Rgb& out = at(qx + x, qy + y);
-                          for (int ch = 0; ch < 3; ++ch)
-                            out[ch] = (1 - u) * (1 - v) * a[ch] + u * (1 - v) * b1[ch] +
-                                      (1 - u) * v * c1[ch] + u * v * d1[ch];
-                          known[(qy + y) * side + qx + x] = 2;
-                        }
+                  // Biquadratic through the nine computed points over the whole square: they
+                  // passed the check, so the image is smooth here, and the quadratic's error is of
+                  // third order in the square's size where the bilinear's is of second order
+                  // (at the default tolerance, half the interpolation error for the same pixels;
+                  // docs/benchmarks.md).
+                  Rgb node[3][3];
+                  for (int row = 0; row < 3; ++row)
+                    for (int col = 0; col < 3; ++col)
+                      node[row][col] = at(dx + col * h, dy + row * h);
+                  // The Lagrange basis of the nodes 0, ½, 1.
+                  auto basis = [](double u, double* l) {
+                    l[0] = 2.0 * (u - 0.5) * (u - 1.0);
+                    l[1] = -4.0 * u * (u - 1.0);
+                    l[2] = 2.0 * u * (u - 0.5);
+                  };
+                  for (int y = 0; y <= size; ++y) {
+                    double lv[3];
+                    basis(static_cast<double>(y) / size, lv);
+                    for (int x = 0; x <= size; ++x) {
+                      if (known[(dy + y) * side + dx + x]) continue;
+                      double lu[3];
+                      basis(static_cast<double>(x) / size, lu);
+                      Rgb& out = at(dx + x, dy + y);
+                      for (int ch = 0; ch < 3; ++ch) {
+                        double v = 0.0;
+                        for (int row = 0; row < 3; ++row)
+                          for (int col = 0; col < 3; ++col)
+                            v += lv[row] * lu[col] * node[row][col][ch];
+                        out[ch] = v;
+                      }
+                      known[(dy + y) * side + dx + x] = 2;
                     }
+                  }
                 };
                 // The rim and the image edges: the largest squares wholly on the object are refined
                 // as above; what is left is computed pixel by pixel below.

@@ -205,14 +205,17 @@ struct PreviewOptions {
   // (estimated first from the coarsest level at about 1000 pixels), the scale the benchmark's
   // RMS error is measured against. A map cell of solid angle Ω is split when the luminance of
   // its estimate and its four children's differ by more than hierarchical_tolerance·Ȳ·√(Ω/2π).
-  // Image blocks of image_block × image_block pixels (a power of two) are filled by bilinear
-  // interpolation when the pixels computed at their centre and edge midpoints differ from it by
-  // at most image_tolerance·Ȳ in every channel, else split in four down to single pixels; 1:
-  // every pixel computed. With the defaults the image is within about 0.1–0.4 % RMS of the
-  // brute-force kQuadrature (docs/benchmarks.md).
+  // Image blocks of image_block × image_block pixels (a power of two) are filled by
+  // biquadratic interpolation through the pixels computed at their corners, centre and edge
+  // midpoints when those midpoints differ from the bilinear interpolation of the corners by at
+  // most image_tolerance·Ȳ·min(width, height)/512 in every channel, else split in four down to
+  // single pixels; 1: every pixel computed. The tolerance is stated for 512 pixels across and
+  // shrinks in smaller images, where a block spans a larger part of the object. With the
+  // defaults the image is within about 0.1–0.6 % RMS of the brute-force kQuadrature
+  // (docs/benchmarks.md).
   double hierarchical_tolerance = 0.02;
   int image_block = 16;
-  double image_tolerance = 0.03;
+  double image_tolerance = 0.1;
   // Kept for references at a subset of pixels: when non-empty, only these image pixels
   // (y · width + x) are rendered; the others are neither object nor lit (black, object 0).
   std::vector<std::uint32_t> pixel_subset;
