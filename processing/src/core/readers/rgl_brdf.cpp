@@ -92,9 +92,43 @@ inline void Interval(const std::vector<double>& grid, double x, int& i, double& 
     w = 0.0;
     return;
   }
-  const auto it = std::upper_bound(grid.begin(), grid.end(), x);
-  i = std::clamp(static_cast<int>(it - grid.begin()) - 1, 0, n - 2);
+  // The upper-bound position by counting (grids hold a handful of entries, so a branch-free
+  // count beats a binary search whose branches the predictor cannot learn).
+  int above = 0;
+  for (const double g : grid) above += g <= x ? 1 : 0;
+  i = std::clamp(above - 1, 0, n - 2);
   w = Clamp01((x - grid[i]) / (grid[i + 1] - grid[i]));
+}
+
+// atan2(y, x) in radians, within ~2e-15 relative of the library's, and several times faster
+// (the evaluator needs two or three per call; std::atan2 was a quarter of its time). The
+// quotient min/max of |x|, |y| is in [0, 1]; above tan(π/8) it is mapped through
+// atan t = π/4 + atan((t − 1)/(t + 1)) so that the polynomial only spans |s| ≤ tan(π/8).
+// The coefficients are a least-squares fit of (atan(s)/s − 1)/s² in s² on that interval
+// (relative error 1.3e-15; the oracle's tolerance is 1e-6). Both zero, or NaN: std::atan2,
+// whose conventions at the pole (atan2(0, −0) = π) the reference follows.
+inline double FastAtan2(double y, double x) {
+  const double ax = std::abs(x), ay = std::abs(y);
+  const double lo = ay < ax ? ay : ax, hi = ay < ax ? ax : ay;
+  if (!(hi > 0.0) || !std::isfinite(hi)) return std::atan2(y, x);
+  constexpr double kTanPiOver8 = 0.41421356237309503;
+  const bool reduced = lo > kTanPiOver8 * hi;
+  // One division for either branch: (t − 1)/(t + 1) = (lo − hi)/(lo + hi).
+  const double s = (reduced ? lo - hi : lo) / (reduced ? lo + hi : hi);
+  const double w = s * s;
+  double p = -0.025445275546824294;
+  p = p * w + 0.050351028123015215;
+  p = p * w - 0.0650947129124945;
+  p = p * w + 0.07674177368739588;
+  p = p * w - 0.09089599958686255;
+  p = p * w + 0.11111053452336944;
+  p = p * w - 0.14285712838546033;
+  p = p * w + 0.19999999982070268;
+  p = p * w - 0.33333333333256443;
+  double r = (reduced ? 0.25 * kPi : 0.0) + (s + s * w * p);
+  if (ay > ax) r = 0.5 * kPi - r;
+  if (x < 0.0) r = kPi - r;
+  return std::signbit(y) ? -r : r;
 }
 
 }  // namespace
@@ -193,19 +227,21 @@ struct RglBrdf::Tables {
   Rgb EvalCosine(const Vec3& wi, const Vec3& wo) const {
     if (!(wi.z > 0.0) || !(wo.z > 0.0)) return {0.0, 0.0, 0.0};
     if (!std::isfinite(wi.x + wi.y + wi.z + wo.x + wo.y + wo.z)) return {0.0, 0.0, 0.0};
-    Vec3 h = wi + wo;
-    h = h * (1.0 / std::sqrt(Dot(h, h)));
-    const double theta_i_rad = std::acos(wi.z < 1.0 ? wi.z : 1.0);
-    const double theta_m = std::acos(h.z < 1.0 ? h.z : 1.0);
+    // θ and φ of ωi and of the half vector, all from atan2: both are invariant to the length
+    // of their arguments, so h = ωi + ωo needs no normalisation, and atan2(ρ, z) is the acos
+    // of a unit vector's z (better conditioned near the pole).
+    const Vec3 h = wi + wo;
+    const double theta_i_rad = FastAtan2(std::sqrt(wi.x * wi.x + wi.y * wi.y), wi.z);
+    const double theta_m = FastAtan2(std::sqrt(h.x * h.x + h.y * h.y), h.z);
     // The reference takes atan2 of each vector (atan2(0, ±0) = 0 or π at the pole); the
     // relative angle of the general case is the same number from one atan2 of the cross and
     // dot products of the projections.
     double phi_i_rad = 0.0, phi;
     if (relative_phi_only && (wi.x != 0.0 || wi.y != 0.0) && (h.x != 0.0 || h.y != 0.0)) {
-      phi = std::atan2(wi.x * h.y - wi.y * h.x, wi.x * h.x + wi.y * h.y);
+      phi = FastAtan2(wi.x * h.y - wi.y * h.x, wi.x * h.x + wi.y * h.y);
     } else {
-      phi_i_rad = std::atan2(wi.y, wi.x);
-      const double phi_m = std::atan2(h.y, h.x);
+      phi_i_rad = FastAtan2(wi.y, wi.x);
+      const double phi_m = FastAtan2(h.y, h.x);
       phi = info.isotropic ? phi_m - phi_i_rad : phi_m;
     }
     const double um_x = ThetaToU(theta_m);
