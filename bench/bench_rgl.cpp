@@ -4,6 +4,7 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <random>
 #include <string>
 #include <vector>
@@ -21,7 +22,11 @@
 namespace brdf {
 namespace {
 
-const std::string kRglDir = std::string(BRDF_SHARED_DATA_DIR) + "/rgl/";
+// $BRDF_DATA_DIR (as the tests read it), else the folder configured at build time.
+const std::string kRglDir = [] {
+  const char* env = std::getenv("BRDF_DATA_DIR");
+  return std::string(env && *env ? env : BRDF_SHARED_DATA_DIR) + "/rgl/";
+}();
 
 struct Pair {
   Vec3 wi, wo;
