@@ -116,15 +116,17 @@ inline double FastAtan2(double y, double x) {
   // One division for either branch: (t − 1)/(t + 1) = (lo − hi)/(lo + hi).
   const double s = (reduced ? lo - hi : lo) / (reduced ? lo + hi : hi);
   const double w = s * s;
-  double p = -0.025445275546824294;
-  p = p * w + 0.050351028123015215;
-  p = p * w - 0.0650947129124945;
-  p = p * w + 0.07674177368739588;
-  p = p * w - 0.09089599958686255;
-  p = p * w + 0.11111053452336944;
-  p = p * w - 0.14285712838546033;
-  p = p * w + 0.19999999982070268;
-  p = p * w - 0.33333333333256443;
+  // Estrin's scheme: the evaluator is latency-bound, and this halves the dependency chain of
+  // Horner's.
+  constexpr double c0 = -0.33333333333256443, c1 = 0.19999999982070268,
+                   c2 = -0.14285712838546033, c3 = 0.11111053452336944,
+                   c4 = -0.09089599958686255, c5 = 0.07674177368739588,
+                   c6 = -0.0650947129124945, c7 = 0.050351028123015215,
+                   c8 = -0.025445275546824294;
+  const double w2 = w * w, w4 = w2 * w2;
+  const double p01 = c0 + c1 * w, p23 = c2 + c3 * w, p45 = c4 + c5 * w, p67 = c6 + c7 * w;
+  const double p0_3 = p01 + p23 * w2, p4_7 = p45 + p67 * w2;
+  const double p = p0_3 + (p4_7 + c8 * w4) * w4;
   double r = (reduced ? 0.25 * kPi : 0.0) + (s + s * w * p);
   if (ay > ax) r = 0.5 * kPi - r;
   if (x < 0.0) r = kPi - r;
@@ -246,7 +248,13 @@ struct RglBrdf::Tables {
     }
     const double um_x = ThetaToU(theta_m);
     double um_y = PhiToU(phi);
-    um_y -= std::floor(um_y);
+    // Wrap into [0, 1) as u − floor(u) does (φ − φi spans two turns, so u ∈ [−½, 3/2)),
+    // without floor: baseline x86-64 has no rounding instruction and calls a function.
+    if (um_y < 0.0) {
+      um_y += 1.0;
+    } else if (um_y >= 1.0) {
+      um_y -= 1.0;
+    }
     const Corners c = SlicesFor(phi_i_rad, theta_i_rad);
     double sx, sy;
     InvertWarp(um_x, um_y, c, sx, sy);
