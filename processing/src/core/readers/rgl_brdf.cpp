@@ -226,7 +226,9 @@ struct RglBrdf::Tables {
     return {r > 0.0 ? r : 0.0, g > 0.0 ? g : 0.0, b > 0.0 ? b : 0.0};
   }
 
-  Rgb EvalCosine(const Vec3& wi, const Vec3& wo) const {
+  // f_r·cosθo, divided by cosθo when `divide_by_cos` (then f_r): one division serves both
+  // that and the 1/(4σ) of the jacobian.
+  Rgb EvalCosine(const Vec3& wi, const Vec3& wo, bool divide_by_cos) const {
     if (!(wi.z > 0.0) || !(wo.z > 0.0)) return {0.0, 0.0, 0.0};
     if (!std::isfinite(wi.x + wi.y + wi.z + wo.x + wo.y + wo.z)) return {0.0, 0.0, 0.0};
     // θ and φ of ωi and of the half vector, all from atan2: both are invariant to the length
@@ -260,9 +262,12 @@ struct RglBrdf::Tables {
     InvertWarp(um_x, um_y, c, sx, sy);
     Rgb f = InterpolateRgb(sx, sy, c);
     if (info.jacobian) {
-      const double scale =
-          ndf.Eval(um_x, um_y) / (4.0 * sigma.Eval(ThetaToU(theta_i_rad), PhiToU(phi_i_rad)));
+      const double area = 4.0 * sigma.Eval(ThetaToU(theta_i_rad), PhiToU(phi_i_rad));
+      const double scale = ndf.Eval(um_x, um_y) / (divide_by_cos ? area * wo.z : area);
       for (double& v : f) v *= scale;
+    } else if (divide_by_cos) {
+      const double inv = 1.0 / wo.z;
+      for (double& v : f) v *= inv;
     }
     return f;
   }
@@ -369,16 +374,11 @@ RglBrdf::~RglBrdf() = default;
 const RglInfo& RglBrdf::info() const { return tables_->info; }
 
 Rgb RglBrdf::EvalCosine(const Vec3& wi, const Vec3& wo) const {
-  return tables_->EvalCosine(wi, wo);
+  return tables_->EvalCosine(wi, wo, false);
 }
 
 Rgb RglBrdf::Eval(const Vec3& wi, const Vec3& wo) const {
-  Rgb f = tables_->EvalCosine(wi, wo);
-  if (wo.z > 0.0) {
-    const double inv = 1.0 / wo.z;
-    for (double& v : f) v *= inv;
-  }
-  return f;
+  return tables_->EvalCosine(wi, wo, true);
 }
 
 RglBrdf RglBrdf::Load(const std::string& path) {
