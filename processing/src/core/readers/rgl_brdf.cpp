@@ -85,7 +85,10 @@ struct Corners {
 
 // Left vertex (clamped to [0, n−2]) and weight of the right one for linear interpolation of a
 // tabulated parameter, as the reference's find_interval; a single-entry grid is constant.
-inline void Interval(const std::vector<double>& grid, double x, int& i, double& w) {
+// `inv_step[k]` = 1 / (grid[k + 1] − grid[k]), tabulated so that the blend weights (which
+// every later step waits for) need no division.
+inline void Interval(const std::vector<double>& grid, const std::vector<double>& inv_step,
+                     double x, int& i, double& w) {
   const int n = static_cast<int>(grid.size());
   if (n == 1) {
     i = 0;
@@ -97,7 +100,7 @@ inline void Interval(const std::vector<double>& grid, double x, int& i, double& 
   int above = 0;
   for (const double g : grid) above += g <= x ? 1 : 0;
   i = std::clamp(above - 1, 0, n - 2);
-  w = Clamp01((x - grid[i]) / (grid[i + 1] - grid[i]));
+  w = Clamp01((x - grid[i]) * inv_step[i]);
 }
 
 // atan2(y, x) in radians, within ~2e-15 relative of the library's, and several times faster
@@ -137,7 +140,7 @@ inline double FastAtan2(double y, double x) {
 
 struct RglBrdf::Tables {
   RglInfo info;
-  std::vector<double> theta_i, phi_i;
+  std::vector<double> theta_i, phi_i, theta_i_inv_step, phi_i_inv_step;
   Interpolant2 ndf, sigma;
   // VNDF warp of each slice s = p·T + t (vx × vy vertices), normalised so that the bilinear
   // density integrates to 1 over the index domain, as the reference does. `warp` interleaves,
@@ -157,8 +160,8 @@ struct RglBrdf::Tables {
     Corners c;
     int ip, it;
     double wp, wt;
-    Interval(phi_i, phi_i_rad, ip, wp);
-    Interval(theta_i, theta_i_rad, it, wt);
+    Interval(phi_i, phi_i_inv_step, phi_i_rad, ip, wp);
+    Interval(theta_i, theta_i_inv_step, theta_i_rad, it, wt);
     const std::size_t t_count = theta_i.size();
     const int np = phi_i.size() == 1 ? 1 : 2, nt = theta_i.size() == 1 ? 1 : 2;
     for (int a = 0; a < np; ++a) {
@@ -408,6 +411,10 @@ RglBrdf RglBrdf::FromTensorFile(const TensorFile& tf, std::string name) {
   t->phi_i = StrictlyIncreasing(ck, phi_f, "azimuths in radians");
   t->theta_i = StrictlyIncreasing(ck, theta_f, "elevations in radians");
   const std::uint64_t np = t->phi_i.size(), nt = t->theta_i.size();
+  for (auto [grid, inv] : {std::pair{&t->phi_i, &t->phi_i_inv_step},
+                           std::pair{&t->theta_i, &t->theta_i_inv_step}})
+    for (std::size_t k = 0; k + 1 < grid->size(); ++k)
+      inv->push_back(1.0 / ((*grid)[k + 1] - (*grid)[k]));
   info.phi_i_rad = t->phi_i;
   info.theta_i_rad = t->theta_i;
   info.isotropic = np <= 2;
