@@ -53,7 +53,11 @@ struct Cell {
   int i;
   double f;
 };
-inline double Clamp01(double u) { return u > 0.0 ? (u < 1.0 ? u : 1.0) : 0.0; }
+// Written as two selects so that the compiler emits maxsd/minsd, not branches.
+inline double Clamp01(double u) {
+  const double a = u > 0.0 ? u : 0.0;
+  return a < 1.0 ? a : 1.0;
+}
 inline Cell Locate(double u, int n) {
   const double s = Clamp01(u) * (n - 1);
   const int i = std::min(static_cast<int>(s), n - 2);
@@ -115,9 +119,13 @@ inline double FastAtan2(double y, double x) {
   const double lo = ay < ax ? ay : ax, hi = ay < ax ? ax : ay;
   if (!(hi > 0.0) || !std::isfinite(hi)) return std::atan2(y, x);
   constexpr double kTanPiOver8 = 0.41421356237309503;
-  const bool reduced = lo > kTanPiOver8 * hi;
-  // One division for either branch: (t − 1)/(t + 1) = (lo − hi)/(lo + hi).
-  const double s = (reduced ? lo - hi : lo) / (reduced ? lo + hi : hi);
+  // The octant logic is arithmetic on 0/1 flags rather than branches (random directions make
+  // them unpredictable); multiplying by 0 or 1 and adding 0 are exact, so the result is the
+  // same number the branches would give.
+  const double reduced = lo > kTanPiOver8 * hi ? 1.0 : 0.0;
+  const double swapped = ay > ax ? 1.0 : 0.0, negative_x = x < 0.0 ? 1.0 : 0.0;
+  // One division for either case: (t − 1)/(t + 1) = (lo − hi)/(lo + hi).
+  const double s = (lo - reduced * hi) / (hi + reduced * lo);
   const double w = s * s;
   // Estrin's scheme: the evaluator is latency-bound, and this halves the dependency chain of
   // Horner's.
@@ -130,10 +138,10 @@ inline double FastAtan2(double y, double x) {
   const double p01 = c0 + c1 * w, p23 = c2 + c3 * w, p45 = c4 + c5 * w, p67 = c6 + c7 * w;
   const double p0_3 = p01 + p23 * w2, p4_7 = p45 + p67 * w2;
   const double p = p0_3 + (p4_7 + c8 * w4) * w4;
-  double r = (reduced ? 0.25 * kPi : 0.0) + (s + s * w * p);
-  if (ay > ax) r = 0.5 * kPi - r;
-  if (x < 0.0) r = kPi - r;
-  return std::signbit(y) ? -r : r;
+  double r = reduced * (0.25 * kPi) + (s + s * w * p);
+  r = swapped * (0.5 * kPi) + (1.0 - 2.0 * swapped) * r;    // π/2 − r above the diagonal
+  r = negative_x * kPi + (1.0 - 2.0 * negative_x) * r;      // π − r for x < 0
+  return std::copysign(r, y);                               // r ≥ 0: −r for y < 0 (or −0)
 }
 
 }  // namespace
