@@ -3,8 +3,15 @@
 // Everything that depends only on the file is computed once here: each incidence slice's VNDF
 // is normalised and its conditional (along u(θ)) and marginal (along u(φ)) CDFs are tabulated,
 // and the RGB table is interleaved per texel so one evaluation touches a few cache lines. Eval
-// then costs two acos, one atan2 (two for anisotropic files), the warp inversion on a 2×2 cell
-// blended over (at most four) incidence slices, and three bilinear lookups.
+// then costs three atan2 (θi, θm and φm − φi; four for anisotropic files, all by FastAtan2's
+// polynomial, not libm), the warp inversion on a 2×2 cell blended over (at most four)
+// incidence slices, and three bilinear lookups.
+//
+// Tried and measured slower or no faster (bench_rgl and `brdf preview`, docs/benchmarks.md,
+// "RGL evaluation speed-up (rgl2, session 4)"): a per-cell warp layout (one 32-byte block per
+// cell and slice: one cache line instead of two, but twice the table), 12-byte packed
+// vertices (float density, double CDF), and a 32-bit fixed-point CDF (half the table, but the
+// oracle then differs by 1e-5: X needs double).
 //
 // The warp tables are double where the reference loader keeps float. Measured against the
 // float64 NumPy oracle, float tables move f_r by up to ~5e-5 relative at moderate angles and
