@@ -4,6 +4,7 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <random>
 #include <string>
 #include <vector>
@@ -21,7 +22,11 @@
 namespace brdf {
 namespace {
 
-const std::string kRglDir = std::string(BRDF_SHARED_DATA_DIR) + "/rgl/";
+// $BRDF_DATA_DIR (as the tests read it), else the folder configured at build time.
+const std::string kRglDir = [] {
+  const char* env = std::getenv("BRDF_DATA_DIR");
+  return std::string(env && *env ? env : BRDF_SHARED_DATA_DIR) + "/rgl/";
+}();
 
 struct Pair {
   Vec3 wi, wo;
@@ -65,6 +70,8 @@ void BM_RglEval(benchmark::State& state, const std::string& file) {
 BENCHMARK_CAPTURE(BM_RglEval, paper_white, std::string("paper_white_rgb.bsdf"));
 BENCHMARK_CAPTURE(BM_RglEval, chm_mint, std::string("chm_mint_rgb.bsdf"));
 BENCHMARK_CAPTURE(BM_RglEval, cg_sunflower_64, std::string("cg_sunflower_rgb.bsdf"));
+// The material of issue 10's preview benchmark.
+BENCHMARK_CAPTURE(BM_RglEval, cc_ibiza_sunset, std::string("cc_ibiza_sunset_rgb.bsdf"));
 
 // A virtual capture at the reference instrument's geometry (docs/design.md §1): θin ∈ {0, 20, 40,
 // 60}°, θout 0…75° and φout 0…359° at 1° steps: 4 × 76 × 360 = 109,440 evaluations.

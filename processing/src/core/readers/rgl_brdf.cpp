@@ -3,8 +3,15 @@
 // Everything that depends only on the file is computed once here: each incidence slice's VNDF
 // is normalised and its conditional (along u(θ)) and marginal (along u(φ)) CDFs are tabulated,
 // and the RGB table is interleaved per texel so one evaluation touches a few cache lines. Eval
-// then costs two acos, one atan2 (two for anisotropic files), the warp inversion on a 2×2 cell
-// blended over (at most four) incidence slices, and three bilinear lookups.
+// then costs three atan2 (θi, θm and φm − φi; four for anisotropic files, all by FastAtan2's
+// polynomial, not libm), the warp inversion on a 2×2 cell blended over (at most four)
+// incidence slices, and three bilinear lookups.
+//
+// Tried and measured slower or no faster (bench_rgl and `brdf preview`, docs/benchmarks.md,
+// "RGL evaluation speed-up (rgl2, session 4)"): a per-cell warp layout (one 32-byte block per
+// cell and slice: one cache line instead of two, but twice the table), 12-byte packed
+// vertices (float density, double CDF), and a 32-bit fixed-point CDF (half the table, but the
+// oracle then differs by 1e-5: X needs double).
 //
 // The warp tables are double where the reference loader keeps float. Measured against the
 // float64 NumPy oracle, float tables move f_r by up to ~5e-5 relative at moderate angles and
@@ -16,6 +23,10 @@
 #include <cstddef>
 #include <filesystem>
 #include <utility>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
 
 #include "brdf/core/error.h"
 #include "brdf/core/rgl.h"
@@ -53,14 +64,17 @@ struct Cell {
   int i;
   double f;
 };
-inline double Clamp01(double u) { return u > 0.0 ? (u < 1.0 ? u : 1.0) : 0.0; }
+// Written as two selects so that the compiler emits maxsd/minsd, not branches.
+inline double Clamp01(double u) {
+  const double a = u > 0.0 ? u : 0.0;
+  return a < 1.0 ? a : 1.0;
+}
 inline Cell Locate(double u, int n) {
   const double s = Clamp01(u) * (n - 1);
   const int i = std::min(static_cast<int>(s), n - 2);
   return {i, s - i};
 }
 
-inline double ThetaToU(double theta) { return std::sqrt(theta * (2.0 / kPi)); }
 inline double PhiToU(double phi) { return (phi + kPi) * (0.5 / kPi); }
 
 // A bilinear interpolant over the unit square: nx vertices along x (u(θ)), ny along y (u(φ)),
@@ -85,23 +99,107 @@ struct Corners {
 
 // Left vertex (clamped to [0, n−2]) and weight of the right one for linear interpolation of a
 // tabulated parameter, as the reference's find_interval; a single-entry grid is constant.
-inline void Interval(const std::vector<double>& grid, double x, int& i, double& w) {
+// `inv_step[k]` = 1 / (grid[k + 1] − grid[k]), tabulated so that the blend weights (which
+// every later step waits for) need no division.
+inline void Interval(const std::vector<double>& grid, const std::vector<double>& inv_step, double x,
+                     int& i, double& w) {
   const int n = static_cast<int>(grid.size());
   if (n == 1) {
     i = 0;
     w = 0.0;
     return;
   }
-  const auto it = std::upper_bound(grid.begin(), grid.end(), x);
-  i = std::clamp(static_cast<int>(it - grid.begin()) - 1, 0, n - 2);
-  w = Clamp01((x - grid[i]) / (grid[i + 1] - grid[i]));
+  // The upper-bound position by counting (grids hold a handful of entries, so a branch-free
+  // count beats a binary search whose branches the predictor cannot learn).
+  int above = 0;
+  for (const double g : grid) above += g <= x ? 1 : 0;
+  i = std::clamp(above - 1, 0, n - 2);
+  w = Clamp01((x - grid[i]) * inv_step[i]);
+}
+
+// atan2(y, x) in radians, within ~2e-15 relative of the library's, without a libm call (the
+// evaluator needs three or four per call; libm's acos and atan2 were ~18 % of its time). The
+// quotient min/max of |x|, |y| is in [0, 1]; above tan(π/8) it is mapped through
+// atan t = π/4 + atan((t − 1)/(t + 1)) so that the polynomial only spans |s| ≤ tan(π/8).
+// The coefficients are a least-squares fit of (atan(s)/s − 1)/s² in s² on that interval
+// (relative error 1.3e-15; the oracle's tolerance is 1e-6). Both zero, or NaN: std::atan2,
+// whose conventions at the pole (atan2(0, −0) = π) the reference follows.
+constexpr double kAtanCoefficients[9] = {
+    -0.33333333333256443, 0.19999999982070268,  -0.14285712838546033,
+    0.11111053452336944,  -0.09089599958686255, 0.07674177368739588,
+    -0.0650947129124945,  0.050351028123015215, -0.025445275546824294};
+constexpr double kTanPiOver8 = 0.41421356237309503;
+
+inline double FastAtan2(double y, double x) {
+  const double ax = std::abs(x), ay = std::abs(y);
+  const double lo = ay < ax ? ay : ax, hi = ay < ax ? ax : ay;
+  if (!(hi > 0.0) || !std::isfinite(hi)) return std::atan2(y, x);
+  // The octant logic is arithmetic on 0/1 flags rather than branches (random directions make
+  // them unpredictable); multiplying by 0 or 1 and adding 0 are exact, so the result is the
+  // same number the branches would give.
+  const double reduced = lo > kTanPiOver8 * hi ? 1.0 : 0.0;
+  const double swapped = ay > ax ? 1.0 : 0.0, negative_x = x < 0.0 ? 1.0 : 0.0;
+  // One division for either case: (t − 1)/(t + 1) = (lo − hi)/(lo + hi).
+  const double s = (lo - reduced * hi) / (hi + reduced * lo);
+  const double w = s * s;
+  // Estrin's scheme: the evaluator is latency-bound, and this halves the dependency chain of
+  // Horner's.
+  constexpr const double* c = kAtanCoefficients;
+  const double c0 = c[0], c1 = c[1], c2 = c[2], c3 = c[3], c4 = c[4], c5 = c[5], c6 = c[6],
+               c7 = c[7], c8 = c[8];
+  const double w2 = w * w, w4 = w2 * w2;
+  const double p01 = c0 + c1 * w, p23 = c2 + c3 * w, p45 = c4 + c5 * w, p67 = c6 + c7 * w;
+  const double p0_3 = p01 + p23 * w2, p4_7 = p45 + p67 * w2;
+  const double p = p0_3 + (p4_7 + c8 * w4) * w4;
+  double r = reduced * (0.25 * kPi) + (s + s * w * p);
+  r = swapped * (0.5 * kPi) + (1.0 - 2.0 * swapped) * r;  // π/2 − r above the diagonal
+  r = negative_x * kPi + (1.0 - 2.0 * negative_x) * r;    // π − r for x < 0
+  return std::copysign(r, y);                             // r ≥ 0: −r for y < 0 (or −0)
+}
+
+// θ = atan2(ρ, z) and u(θ) = √(θ / (π/2)) of two directions at once in the two lanes of an
+// SSE2 register (baseline x86-64): the same operations in the same order as FastAtan2 and
+// √(θ·2/π), so the same numbers, for half the instructions. Needs z > 0 and finite inputs
+// (then max(ρ, z) > 0 and neither the pole fallback nor the signs of FastAtan2 apply).
+// `rho2` holds ρ².
+inline void ThetaAndU(double rho2_a, double z_a, double rho2_b, double z_b, double theta[2],
+                      double u[2]) {
+#if !defined(__SSE2__)
+  theta[0] = FastAtan2(std::sqrt(rho2_a), z_a);
+  theta[1] = FastAtan2(std::sqrt(rho2_b), z_b);
+  for (int k = 0; k < 2; ++k) u[k] = std::sqrt(theta[k] * (2.0 / kPi));
+#else
+  const __m128d y = _mm_sqrt_pd(_mm_set_pd(rho2_b, rho2_a)), x = _mm_set_pd(z_b, z_a);
+  const __m128d one = _mm_set1_pd(1.0);
+  const __m128d lo = _mm_min_pd(y, x), hi = _mm_max_pd(x, y);
+  const __m128d reduced =
+      _mm_and_pd(_mm_cmpgt_pd(lo, _mm_mul_pd(_mm_set1_pd(kTanPiOver8), hi)), one);
+  const __m128d swapped = _mm_and_pd(_mm_cmpgt_pd(y, x), one);
+  const __m128d s =
+      _mm_div_pd(_mm_sub_pd(lo, _mm_mul_pd(reduced, hi)), _mm_add_pd(hi, _mm_mul_pd(reduced, lo)));
+  const __m128d w = _mm_mul_pd(s, s), w2 = _mm_mul_pd(w, w), w4 = _mm_mul_pd(w2, w2);
+  auto pair = [&](int k) {  // c[k] + c[k + 1]·w
+    return _mm_add_pd(_mm_set1_pd(kAtanCoefficients[k]),
+                      _mm_mul_pd(_mm_set1_pd(kAtanCoefficients[k + 1]), w));
+  };
+  const __m128d p0_3 = _mm_add_pd(pair(0), _mm_mul_pd(pair(2), w2));
+  const __m128d p4_7 = _mm_add_pd(pair(4), _mm_mul_pd(pair(6), w2));
+  const __m128d p = _mm_add_pd(
+      p0_3, _mm_mul_pd(_mm_add_pd(p4_7, _mm_mul_pd(_mm_set1_pd(kAtanCoefficients[8]), w4)), w4));
+  __m128d r = _mm_add_pd(_mm_mul_pd(reduced, _mm_set1_pd(0.25 * kPi)),
+                         _mm_add_pd(s, _mm_mul_pd(_mm_mul_pd(s, w), p)));
+  r = _mm_add_pd(_mm_mul_pd(swapped, _mm_set1_pd(0.5 * kPi)),
+                 _mm_mul_pd(_mm_sub_pd(one, _mm_mul_pd(_mm_set1_pd(2.0), swapped)), r));
+  _mm_storeu_pd(theta, r);
+  _mm_storeu_pd(u, _mm_sqrt_pd(_mm_mul_pd(r, _mm_set1_pd(2.0 / kPi))));
+#endif
 }
 
 }  // namespace
 
 struct RglBrdf::Tables {
   RglInfo info;
-  std::vector<double> theta_i, phi_i;
+  std::vector<double> theta_i, phi_i, theta_i_inv_step, phi_i_inv_step;
   Interpolant2 ndf, sigma;
   // VNDF warp of each slice s = p·T + t (vx × vy vertices), normalised so that the bilinear
   // density integrates to 1 over the index domain, as the reference does. `warp` interleaves,
@@ -121,8 +219,8 @@ struct RglBrdf::Tables {
     Corners c;
     int ip, it;
     double wp, wt;
-    Interval(phi_i, phi_i_rad, ip, wp);
-    Interval(theta_i, theta_i_rad, it, wt);
+    Interval(phi_i, phi_i_inv_step, phi_i_rad, ip, wp);
+    Interval(theta_i, theta_i_inv_step, theta_i_rad, it, wt);
     const std::size_t t_count = theta_i.size();
     const int np = phi_i.size() == 1 ? 1 : 2, nt = theta_i.size() == 1 ? 1 : 2;
     for (int a = 0; a < np; ++a) {
@@ -190,35 +288,49 @@ struct RglBrdf::Tables {
     return {r > 0.0 ? r : 0.0, g > 0.0 ? g : 0.0, b > 0.0 ? b : 0.0};
   }
 
-  Rgb EvalCosine(const Vec3& wi, const Vec3& wo) const {
+  // f_r·cosθo, divided by cosθo when `divide_by_cos` (then f_r): one division serves both
+  // that and the 1/(4σ) of the jacobian.
+  Rgb EvalCosine(const Vec3& wi, const Vec3& wo, bool divide_by_cos) const {
     if (!(wi.z > 0.0) || !(wo.z > 0.0)) return {0.0, 0.0, 0.0};
     if (!std::isfinite(wi.x + wi.y + wi.z + wo.x + wo.y + wo.z)) return {0.0, 0.0, 0.0};
-    Vec3 h = wi + wo;
-    h = h * (1.0 / std::sqrt(Dot(h, h)));
-    const double theta_i_rad = std::acos(wi.z < 1.0 ? wi.z : 1.0);
-    const double theta_m = std::acos(h.z < 1.0 ? h.z : 1.0);
+    // θ and φ of ωi and of the half vector, all from atan2: both are invariant to the length
+    // of their arguments, so h = ωi + ωo needs no normalisation, and atan2(ρ, z) is the acos
+    // of a unit vector's z (better conditioned near the pole).
+    const Vec3 h = wi + wo;
+    double theta[2], u[2];  // ωi, h
+    ThetaAndU(wi.x * wi.x + wi.y * wi.y, wi.z, h.x * h.x + h.y * h.y, h.z, theta, u);
+    const double theta_i_rad = theta[0];
     // The reference takes atan2 of each vector (atan2(0, ±0) = 0 or π at the pole); the
     // relative angle of the general case is the same number from one atan2 of the cross and
     // dot products of the projections.
     double phi_i_rad = 0.0, phi;
     if (relative_phi_only && (wi.x != 0.0 || wi.y != 0.0) && (h.x != 0.0 || h.y != 0.0)) {
-      phi = std::atan2(wi.x * h.y - wi.y * h.x, wi.x * h.x + wi.y * h.y);
+      phi = FastAtan2(wi.x * h.y - wi.y * h.x, wi.x * h.x + wi.y * h.y);
     } else {
-      phi_i_rad = std::atan2(wi.y, wi.x);
-      const double phi_m = std::atan2(h.y, h.x);
+      phi_i_rad = FastAtan2(wi.y, wi.x);
+      const double phi_m = FastAtan2(h.y, h.x);
       phi = info.isotropic ? phi_m - phi_i_rad : phi_m;
     }
-    const double um_x = ThetaToU(theta_m);
+    const double um_x = u[1];
     double um_y = PhiToU(phi);
-    um_y -= std::floor(um_y);
+    // Wrap into [0, 1) as u − floor(u) does (φ − φi spans two turns, so u ∈ [−½, 3/2)),
+    // without floor: baseline x86-64 has no rounding instruction and calls a function.
+    if (um_y < 0.0) {
+      um_y += 1.0;
+    } else if (um_y >= 1.0) {
+      um_y -= 1.0;
+    }
     const Corners c = SlicesFor(phi_i_rad, theta_i_rad);
     double sx, sy;
     InvertWarp(um_x, um_y, c, sx, sy);
     Rgb f = InterpolateRgb(sx, sy, c);
     if (info.jacobian) {
-      const double scale =
-          ndf.Eval(um_x, um_y) / (4.0 * sigma.Eval(ThetaToU(theta_i_rad), PhiToU(phi_i_rad)));
+      const double area = 4.0 * sigma.Eval(u[0], PhiToU(phi_i_rad));
+      const double scale = ndf.Eval(um_x, um_y) / (divide_by_cos ? area * wo.z : area);
       for (double& v : f) v *= scale;
+    } else if (divide_by_cos) {
+      const double inv = 1.0 / wo.z;
+      for (double& v : f) v *= inv;
     }
     return f;
   }
@@ -325,16 +437,11 @@ RglBrdf::~RglBrdf() = default;
 const RglInfo& RglBrdf::info() const { return tables_->info; }
 
 Rgb RglBrdf::EvalCosine(const Vec3& wi, const Vec3& wo) const {
-  return tables_->EvalCosine(wi, wo);
+  return tables_->EvalCosine(wi, wo, false);
 }
 
 Rgb RglBrdf::Eval(const Vec3& wi, const Vec3& wo) const {
-  Rgb f = tables_->EvalCosine(wi, wo);
-  if (wo.z > 0.0) {
-    const double inv = 1.0 / wo.z;
-    for (double& v : f) v *= inv;
-  }
-  return f;
+  return tables_->EvalCosine(wi, wo, true);
 }
 
 RglBrdf RglBrdf::Load(const std::string& path) {
@@ -364,6 +471,10 @@ RglBrdf RglBrdf::FromTensorFile(const TensorFile& tf, std::string name) {
   t->phi_i = StrictlyIncreasing(ck, phi_f, "azimuths in radians");
   t->theta_i = StrictlyIncreasing(ck, theta_f, "elevations in radians");
   const std::uint64_t np = t->phi_i.size(), nt = t->theta_i.size();
+  for (auto [grid, inv] :
+       {std::pair{&t->phi_i, &t->phi_i_inv_step}, std::pair{&t->theta_i, &t->theta_i_inv_step}})
+    for (std::size_t k = 0; k + 1 < grid->size(); ++k)
+      inv->push_back(1.0 / ((*grid)[k + 1] - (*grid)[k]));
   info.phi_i_rad = t->phi_i;
   info.theta_i_rad = t->theta_i;
   info.isotropic = np <= 2;
