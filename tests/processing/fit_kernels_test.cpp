@@ -131,6 +131,13 @@ void CheckLinear(Model model, double shape_lo, double shape_hi, bool smooth = fa
     for (int i = 0; i < kN; ++i) x[i] = J(v[i], i);
     const std::array<J, 3> jet = models::EvaluateRgb(model, g, x);
     for (int j = 0; j < kB; ++j) EXPECT_EQ(b_only[j], b[j]);
+    // The entry of u = (b, db) LinearCost leaves out of its sums enters no column.
+    if (L::kUnused >= kB) {
+      EXPECT_EQ(db[L::kUnused - kB], 0.0);
+    } else {
+      for (int c = 0; c < 3; ++c)
+        for (int i = 0; i + 1 < kN; ++i) EXPECT_EQ(dcoef[c][L::kUnused][i], 0.0);
+    }
     for (int c = 0; c < 3; ++c) {
       const std::string where = std::string(ModelName(model)) + " linear trial " +
                                 std::to_string(trial) + " channel " + std::to_string(c);

@@ -359,12 +359,14 @@ class LinearCost final : public SummedCost<L::kN> {
         const double r = s.w * (f - s.m[static_cast<std::size_t>(c)]);
         cost[c] += r * r;
         const double wr = s.w * r;
-        for (int j = 0; j < kU; ++j) wru[c][j] += wr * u[j];
+        for (int j = 0; j < kU; ++j)
+          if (j != L::kUnused) wru[c][j] += wr * u[j];
       }
       double wu[kU];
       for (int j = 0; j < kU; ++j) wu[j] = s.w * u[j];
       for (int i = 0; i < kU; ++i)
-        for (int j = i; j < kU; ++j) mom[i][j] += wu[i] * wu[j];
+        for (int j = i; j < kU; ++j)
+          if (i != L::kUnused && j != L::kUnused) mom[i][j] += wu[i] * wu[j];
     }
     for (int i = 0; i < kU; ++i)
       for (int j = 0; j < i; ++j) mom[i][j] = mom[j][i];
@@ -608,25 +610,35 @@ class KernelFit {
 
   KernelFit(const FitData& data, const FitOptions& options)
       : data_(data), options_(options), info_(DescribeModel(options.model)) {
-    geom_.reserve(data.samples.size());
-    loss_.reserve(data.samples.size());
-    for (const FitSample& s : data.samples) {
-      geom_.push_back(K::Prepare(s.g));
-      LossSample l{s.sqrt_w, s.cos_in, {}};
-      for (std::size_t c = 0; c < 3; ++c) l.target[c] = LossTarget(options.loss, s.m[c], s.cos_in);
-      loss_.push_back(l);
-    }
     if constexpr (kHasLinear) {
       if (options.loss == FitLoss::kNgan && !options.robust) {
         linear_.reserve(data.samples.size());
         for (const FitSample& s : data.samples)
           linear_.push_back({Linear::Prepare(s.g), s.sqrt_w * s.cos_in, s.m});
+        return;  // the kernel's geometry only if the sweep needs it (PrepareKernel)
       }
+    }
+    PrepareKernel();
+  }
+
+  // The kernel's geometry and the loss' targets, for the sweep, Cost and CompressedCost. Not
+  // thread-safe: RunFit calls it (through Sweep and Cost) before any refinement starts.
+  void PrepareKernel() const {
+    if (!geom_.empty()) return;
+    geom_.reserve(data_.samples.size());
+    loss_.reserve(data_.samples.size());
+    for (const FitSample& s : data_.samples) {
+      geom_.push_back(K::Prepare(s.g));
+      LossSample l{s.sqrt_w, s.cos_in, {}};
+      for (std::size_t c = 0; c < 3; ++c)
+        l.target[c] = LossTarget(options_.loss, s.m[c], s.cos_in);
+      loss_.push_back(l);
     }
   }
 
   // ½ Σ r² of `m` over every `stride`-th sample, without a robust loss.
   double Cost(const Material& m, std::size_t stride = 1) const {
+    PrepareKernel();
     double sum = 0, slope;
     for (std::size_t k = 0; k < geom_.size(); k += stride) {
       const LossSample& l = loss_[k];
@@ -650,6 +662,7 @@ class KernelFit {
 
   // The sweep on every `stride`-th sample: candidates with their cost on those samples.
   std::vector<Candidate> Sweep(std::size_t stride) const {
+    PrepareKernel();
     std::vector<Candidate> out;
     if constexpr (K::kLegacy)
       SweepLegacy(stride, &out);
@@ -852,7 +865,7 @@ class KernelFit {
     }
     ceres::Problem problem;
     // One residual block per thread (CompressedCost explains why not one per sample).
-    const std::size_t n = geom_.size();
+    const std::size_t n = data_.samples.size();
     const std::size_t parts = static_cast<std::size_t>(std::max(1, threads));
     auto make_cost = [&](std::size_t begin, std::size_t end,
                          const std::array<bool, kN>* held) -> SummedCost<kN>* {
@@ -958,8 +971,8 @@ class KernelFit {
   const FitData& data_;
   const FitOptions& options_;
   const ModelInfo& info_;
-  std::vector<typename K::Geom> geom_;
-  std::vector<LossSample> loss_;
+  mutable std::vector<typename K::Geom> geom_;
+  mutable std::vector<LossSample> loss_;
   std::vector<LinearSample<Linear>> linear_;  // when LinearCost applies (engine model, ngan)
 };
 

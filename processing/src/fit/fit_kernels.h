@@ -315,12 +315,15 @@ struct UrpKernel {
 //   Basis(geom, shape, b, db)              basis functions, and their slopes in the shape value
 //                                          when db is not null;
 //   Coefficients(v, smooth, coef, dcoef)   coefficients and their slopes in v[0 … kN − 2];
+//   kUnused                                the entry of u = (b, db) no Jacobian column uses
+//                                          (LinearCost leaves it out of the sums);
 //   kKink, OnSmoothPiece(v)                Unreal's saturate(50·f0.g) (below): with `smooth` the
 //                                          coefficient is its value above the kink, 1.
 
 // Unreal DefaultLit: f_c = b_c(1 − m)·(1/π) + F90·(D·Vis·Fc) + f0_c·(D·Vis·(1 − Fc)).
 struct UnrealLinear {
   static constexpr int kN = 6, kBasis = 3;
+  static constexpr int kUnused = 3;  // db[0] = 0
   static constexpr bool kKink = true;
   struct Geom {
     double cos_h2, lv2, k, fc;  // lv2 = 2·NoL·NoV, k = NoL + NoV − 2·NoL·NoV
@@ -408,6 +411,7 @@ void UnityMetallicCoefficients(const double* v, double (*coef)[kBasis],
 // Unity HDRP Lit (metallic): f_c = b_c(1 − m)·Disney + f0_c·(D·V·(1 − Fc)) + 1·(D·V·Fc).
 struct HdrpLinear {
   static constexpr int kN = 5, kBasis = 3;
+  static constexpr int kUnused = 2;  // b[2]: its coefficient 1 has no slope
   static constexpr bool kKink = false;
   struct Geom {
     double cos_h2, n_dot_l, n_dot_v, lv1, p5l, p5v, fc;  // lv1 = 1 + l·v
@@ -436,7 +440,10 @@ struct HdrpLinear {
     const double qv = std::sqrt(nv2 + s.a2 * (1.0 - nv2));
     const double ql = std::sqrt(nl2 + s.a2 * (1.0 - nl2));
     const double lambda = g.n_dot_l * qv + g.n_dot_v * ql;
-    const double inv_sd = 1.0 / sd, inv_lambda = 1.0 / lambda;
+    // One division for 1/s, 1/λ, 1/qv and 1/ql.
+    const double sl = sd * lambda, qq = qv * ql;
+    const double inv = 1.0 / (sl * qq);
+    const double inv_sd = inv * qq * lambda, inv_lambda = inv * qq * sd;
     const double dv = s.half_a2_pi * inv_sd * inv_sd * inv_lambda;  // D·V
     const double fd90m1 = s.perceptual * g.lv1 - 0.5;
     const double light = 1.0 + fd90m1 * g.p5l, view = 1.0 + fd90m1 * g.p5v;
@@ -445,8 +452,9 @@ struct HdrpLinear {
     b[1] = dv - b[2];
     if (db) {
       // d ln(D·V)/d a2 = 1/a2 − 2cos²θh/s − (dλ/d a2)/λ; d Disney/d smoothness = −d/d perceptual.
+      const double inv_qv = inv * sl * ql, inv_ql = inv * sl * qv;
       const double dlambda =
-          0.5 * (g.n_dot_l * (1.0 - nv2) / qv + g.n_dot_v * (1.0 - nl2) / ql);
+          0.5 * (g.n_dot_l * (1.0 - nv2) * inv_qv + g.n_dot_v * (1.0 - nl2) * inv_ql);
       const double ddv = dv * (s.inv_a2 - 2.0 * g.cos_h2 * inv_sd - dlambda * inv_lambda) * s.da2;
       db[0] = -kDisney * g.lv1 * (g.p5l * view + light * g.p5v);
       db[2] = ddv * g.fc;
@@ -464,6 +472,7 @@ struct HdrpLinear {
 // Unity URP Lit (metallic): f_c = 0.96·b_c(1 − m)·(1/π) + (0.04(1 − m) + b_c·m)·(specularTerm/π).
 struct UrpLinear {
   static constexpr int kN = 5, kBasis = 2;
+  static constexpr int kUnused = 2;  // db[0] = 0
   static constexpr bool kKink = false;
   struct Geom {
     double cos_h2, inv_lo_h2;  // 1/max(0.1, LoH²)
