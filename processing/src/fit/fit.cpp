@@ -954,7 +954,8 @@ class KernelFit {
         continue;
       }
       // A free value reached a bound: hold it if the gradient points out, else let Ceres go on.
-      const std::array<double, kN> g = gradient();
+      // (Without the line search the Jacobian Ceres evaluated last is the current point's.)
+      const std::array<double, kN> g = linear ? last_gradient() : gradient();
       for (std::size_t i = 0; i < kN; ++i)
         if (fixed[i] && watch.release_early_ && !outward(i, g)) fixed[i] = false, released[i] = true;
         else if (!fixed[i] && watch.AtBound(i)) {
