@@ -102,6 +102,70 @@ TEST(FitKernels, EngineModelsMatchTheirFormulaAndItsJetDerivatives) {
   CheckEngine<UrpKernel>(Model::kUnityUrpLit, 0.0, 0.9);           // smoothness, floor at 0.9116
 }
 
+// Linear forms (LinearCost): f_c = Σ_j coef[c][j]·basis_j against the formula, and the
+// derivatives LinearCost assembles from them (Σ_j dcoef·basis for the non-shape values,
+// Σ_j coef·dbasis for the shape) against Jets. `smooth` tests Unreal's F90 held at 1, which
+// must equal the formula wherever 50·f0.g ≥ 1.
+template <class L>
+void CheckLinear(Model model, double shape_lo, double shape_hi, bool smooth = false) {
+  constexpr int kN = L::kN, kB = L::kBasis;
+  ASSERT_EQ(kN, DescribeModel(model).value_count) << ModelName(model);
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> unit(0.0, 1.0), shape(shape_lo, shape_hi);
+  using J = ceres::Jet<double, kN>;
+  int kinked = 0;
+  for (int trial = 0; trial < 400; ++trial) {
+    const ShadingGeometry g = RandomGeometry(rng);
+    double v[kN];
+    for (int i = 0; i < kN; ++i) v[i] = unit(rng);
+    v[kN - 1] = shape(rng);
+    if (smooth && !L::OnSmoothPiece(v)) continue;
+    kinked += L::OnSmoothPiece(v) ? 0 : 1;
+    double b[kB], db[kB], b_only[kB], coef[3][kB], dcoef[3][kB][kN];
+    const typename L::Geom geom = L::Prepare(g);
+    L::Basis(geom, L::ShapeOf(v[kN - 1]), b, db);
+    L::Basis(geom, L::ShapeOf(v[kN - 1]), b_only, nullptr);
+    L::Coefficients(v, smooth, coef, dcoef);
+    const std::array<double, 3> want = models::EvaluateRgb(model, g, v);
+    J x[kN];
+    for (int i = 0; i < kN; ++i) x[i] = J(v[i], i);
+    const std::array<J, 3> jet = models::EvaluateRgb(model, g, x);
+    for (int j = 0; j < kB; ++j) EXPECT_EQ(b_only[j], b[j]);
+    // The entry of u = (b, db) LinearCost leaves out of its sums enters no column.
+    if (L::kUnused >= kB) {
+      EXPECT_EQ(db[L::kUnused - kB], 0.0);
+    } else {
+      for (int c = 0; c < 3; ++c)
+        for (int i = 0; i + 1 < kN; ++i) EXPECT_EQ(dcoef[c][L::kUnused][i], 0.0);
+    }
+    for (int c = 0; c < 3; ++c) {
+      const std::string where = std::string(ModelName(model)) + " linear trial " +
+                                std::to_string(trial) + " channel " + std::to_string(c);
+      double f = 0, grad[kN] = {};
+      for (int j = 0; j < kB; ++j) {
+        f += coef[c][j] * b[j];
+        for (int i = 0; i + 1 < kN; ++i) grad[i] += dcoef[c][j][i] * b[j];
+        grad[kN - 1] += coef[c][j] * db[j];
+      }
+      ExpectClose(f, want[static_cast<std::size_t>(c)], 1e-11, where + " value");
+      for (int i = 0; i < kN; ++i)
+        ExpectClose(grad[i], jet[static_cast<std::size_t>(c)].v[i], 1e-9,
+                    where + " d/dvalue " + std::to_string(i));
+    }
+  }
+  // Unreal's random points fall on both sides of the kink (F90 < 1 needs f0.g < 0.02).
+  if (model == Model::kUnrealDefaultLit && !smooth) {
+    EXPECT_GT(kinked, 0);
+  }
+}
+
+TEST(FitKernels, LinearFormsMatchTheFormulaAndItsJetDerivatives) {
+  CheckLinear<UnrealLinear>(Model::kUnrealDefaultLit, 0.05, 1.0);
+  CheckLinear<UnrealLinear>(Model::kUnrealDefaultLit, 0.05, 1.0, /*smooth=*/true);
+  CheckLinear<HdrpLinear>(Model::kUnityHdrpLit, 0.0, 0.95);
+  CheckLinear<UrpLinear>(Model::kUnityUrpLit, 0.0, 0.9);
+}
+
 // Below the floors the shape no longer changes the value: the slope in it is 0, as for Jets.
 TEST(FitKernels, RoughnessFloorsHaveZeroSlope) {
   std::mt19937_64 rng(3);

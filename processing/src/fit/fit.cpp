@@ -137,8 +137,72 @@ struct LossSample {
 // A robust loss is applied here per sample and channel, as Ceres applies one per residual
 // block (Cauchy's ρ'' < 0, so Ceres' corrector scales r and J by √ρ'): the cost sums ρ(r²),
 // JᵀJ and Jᵀr carry ρ'.
+template <int kN>
+class SummedCost : public ceres::CostFunction {
+ public:
+  SummedCost() {
+    set_num_residuals(kN + 1);
+    mutable_parameter_block_sizes()->push_back(kN);
+  }
+  // The gradient at the last point the Jacobian was evaluated, held values included (in the
+  // fitter's coordinates), for BoundWatch: Ceres evaluates the Jacobian at every accepted point
+  // before its callbacks run.
+  mutable std::array<double, kN> last_gradient_{};
+
+ protected:
+  // Hands Ceres the equivalent residuals of `cost` = Σ r² (or Σ ρ), h = JᵀJ (upper triangle
+  // used) and g = Jᵀr in the material's values, with dvdx the slopes of the values in the
+  // fitter's coordinates (0 for held values) and dvdx_all the slopes without holding.
+  bool Compress(double cost, const Eigen::Matrix<double, kN, kN>& h,
+                const Eigen::Matrix<double, kN, 1>& g, const double* dvdx,
+                const double* dvdx_all, double* residuals, double* jo) const {
+    if (!std::isfinite(cost)) return false;
+    if (jo == nullptr) {
+      for (int i = 0; i < kN; ++i) residuals[i] = 0;
+      residuals[kN] = std::sqrt(cost);
+      return true;
+    }
+    Eigen::Matrix<double, kN, kN> hx;
+    Eigen::Matrix<double, kN, 1> gx;
+    for (int i = 0; i < kN; ++i) {
+      gx(i) = g(i) * dvdx[i];
+      for (int k = i; k < kN; ++k) hx(i, k) = hx(k, i) = h(i, k) * dvdx[i] * dvdx[k];
+    }
+    if (!hx.allFinite() || !gx.allFinite()) return false;
+    for (int i = 0; i < kN; ++i) last_gradient_[static_cast<std::size_t>(i)] = g(i) * dvdx_all[i];
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, kN, kN>> eig(hx);
+    const auto& lambda = eig.eigenvalues();
+    const auto& q = eig.eigenvectors();
+    const double floor = std::max(0.0, lambda.maxCoeff()) * 1e-14;
+    double projected = 0;
+    // jo: row-major, (kN + 1) × kN
+    for (int i = 0; i < kN; ++i) {
+      const double l = std::max(0.0, lambda(i));
+      const double root = std::sqrt(l);
+      for (int k = 0; k < kN; ++k) jo[i * kN + k] = root * q(k, i);
+      residuals[i] = l > floor ? q.col(i).dot(gx) / root : 0.0;
+      projected += residuals[i] * residuals[i];
+    }
+    for (int k = 0; k < kN; ++k) jo[kN * kN + k] = 0;
+    residuals[kN] = std::sqrt(std::max(0.0, cost - projected));
+    return true;
+  }
+  // The values v of the fitter's coordinates x, their slopes dv/dx, and those without holding.
+  static void Values(const double* x, const std::array<bool, kN>& log_scale,
+                     const std::array<bool, kN>* fixed, double* v, double* dvdx,
+                     double* dvdx_all) {
+    for (int i = 0; i < kN; ++i) {
+      const bool log = log_scale[static_cast<std::size_t>(i)];
+      v[i] = log ? std::exp(x[i]) : x[i];
+      dvdx_all[i] = log ? v[i] : 1.0;
+      // A value held at its bound (SolveBlock) has no slope: Levenberg-Marquardt leaves it.
+      dvdx[i] = fixed != nullptr && (*fixed)[static_cast<std::size_t>(i)] ? 0.0 : dvdx_all[i];
+    }
+  }
+};
+
 template <class K>
-class CompressedCost final : public ceres::CostFunction {
+class CompressedCost final : public SummedCost<K::kN> {
  public:
   static constexpr int kN = K::kN;
 
@@ -154,23 +218,12 @@ class CompressedCost final : public ceres::CostFunction {
         loss_kind_(loss_kind),
         b2_(robust_scale * robust_scale),
         log_scale_(log_scale),
-        fixed_(fixed) {
-    set_num_residuals(kN + 1);
-    mutable_parameter_block_sizes()->push_back(kN);
-  }
+        fixed_(fixed) {}
 
   bool Evaluate(double const* const* parameters, double* residuals,
                 double** jacobians) const override {
-    const double* x = parameters[0];
-    double v[kN], dvdx[kN];
-    for (int i = 0; i < kN; ++i) {
-      const bool log = log_scale_[static_cast<std::size_t>(i)];
-      v[i] = log ? std::exp(x[i]) : x[i];
-      // A value held at its bound (SolveBlock) has no slope: Levenberg-Marquardt leaves it.
-      dvdx[i] = fixed_ != nullptr && (*fixed_)[static_cast<std::size_t>(i)] ? 0.0
-                : log                                                       ? v[i]
-                                                                            : 1.0;
-    }
+    double v[kN], dvdx[kN], dvdx_all[kN];
+    this->Values(parameters[0], log_scale_, fixed_, v, dvdx, dvdx_all);
     const bool jac = jacobians != nullptr && jacobians[0] != nullptr;
     // Samples in chunks: the first pass evaluates the chunk's residuals and their slopes (times
     // √ρ' under a robust loss) into columns, the second sums JᵀJ and Jᵀr over the chunk as dot
@@ -225,41 +278,7 @@ class CompressedCost final : public ceres::CostFunction {
       if (row == kRows) flush();
     }
     if (row > 0) flush();
-    if (!std::isfinite(cost)) return false;
-    if (!jac) {
-      for (int i = 0; i < kN; ++i) residuals[i] = 0;
-      residuals[kN] = std::sqrt(cost);
-      return true;
-    }
-    Eigen::Matrix<double, kN, kN> hx;
-    Eigen::Matrix<double, kN, 1> gx;
-    for (int i = 0; i < kN; ++i) {
-      gx(i) = g(i) * dvdx[i];
-      for (int k = i; k < kN; ++k) hx(i, k) = hx(k, i) = h(i, k) * dvdx[i] * dvdx[k];
-    }
-    if (!hx.allFinite() || !gx.allFinite()) return false;
-    // The whole gradient at this point, held values included, for BoundWatch: Ceres evaluates
-    // the Jacobian at every accepted point before its callbacks run.
-    for (int i = 0; i < kN; ++i) {
-      const bool log = log_scale_[static_cast<std::size_t>(i)];
-      last_gradient_[static_cast<std::size_t>(i)] = g(i) * (log ? v[i] : 1.0);
-    }
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, kN, kN>> eig(hx);
-    const auto& lambda = eig.eigenvalues();
-    const auto& q = eig.eigenvectors();
-    const double floor = std::max(0.0, lambda.maxCoeff()) * 1e-14;
-    double projected = 0;
-    double* jo = jacobians[0];  // row-major, (kN + 1) × kN
-    for (int i = 0; i < kN; ++i) {
-      const double l = std::max(0.0, lambda(i));
-      const double root = std::sqrt(l);
-      for (int k = 0; k < kN; ++k) jo[i * kN + k] = root * q(k, i);
-      residuals[i] = l > floor ? q.col(i).dot(gx) / root : 0.0;
-      projected += residuals[i] * residuals[i];
-    }
-    for (int k = 0; k < kN; ++k) jo[kN * kN + k] = 0;
-    residuals[kN] = std::sqrt(std::max(0.0, cost - projected));
-    return true;
+    return this->Compress(cost, h, g, dvdx, dvdx_all, residuals, jac ? jacobians[0] : nullptr);
   }
 
  private:
@@ -271,14 +290,130 @@ class CompressedCost final : public ceres::CostFunction {
   double b2_;
   std::array<bool, kN> log_scale_;
   const std::array<bool, kN>* fixed_;
+};
 
+// What LinearCost needs of a sample: the linear form's geometry, the ngan weight
+// w = √(solid-angle weight)·cosθin and the measurement (r_c = w·(f_c − m_c)).
+template <class L>
+struct LinearSample {
+  typename L::Geom g;
+  double w;
+  std::array<double, 3> m;
+};
+
+// The same residual block as CompressedCost for an engine model under the ngan loss without a
+// robust loss, from the model's linear form (fit_kernels.h explains it): per sample the basis
+// functions u = (b, db/d shape), the three residuals, Σ r², Σ w·r_c·u and the moments Σ w²·u·uᵀ;
+// JᵀJ and Jᵀr follow from those sums and the coefficients' slopes, once per evaluation. A
+// cost-only evaluation (Ceres testing a step) computes b and Σ r² only.
+template <class L>
+class LinearCost final : public SummedCost<L::kN> {
  public:
-  mutable std::array<double, kN> last_gradient_{};
+  static constexpr int kN = L::kN, kB = L::kBasis, kU = 2 * L::kBasis;
+
+  LinearCost(const std::vector<LinearSample<L>>* samples, std::size_t begin, std::size_t end,
+             const std::array<bool, kN>& log_scale, const std::array<bool, kN>* fixed,
+             const bool* smooth)
+      : samples_(samples),
+        begin_(begin),
+        end_(end),
+        log_scale_(log_scale),
+        fixed_(fixed),
+        smooth_(smooth) {}
+
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override {
+    double v[kN], dvdx[kN], dvdx_all[kN];
+    this->Values(parameters[0], log_scale_, fixed_, v, dvdx, dvdx_all);
+    const bool jac = jacobians != nullptr && jacobians[0] != nullptr;
+    const typename L::Shape shape = L::ShapeOf(v[kN - 1]);
+    double coef[3][kB], dcoef[3][kB][kN];
+    L::Coefficients(v, smooth_ != nullptr && *smooth_, coef, dcoef);
+    const LinearSample<L>* samples = samples_->data();
+    double cost[3] = {0, 0, 0};
+    Eigen::Matrix<double, kN, kN> h = Eigen::Matrix<double, kN, kN>::Zero();
+    Eigen::Matrix<double, kN, 1> g = Eigen::Matrix<double, kN, 1>::Zero();
+    if (!jac) {
+      for (std::size_t k = begin_; k < end_; ++k) {
+        const LinearSample<L>& s = samples[k];
+        double b[kB];
+        L::Basis(s.g, shape, b, nullptr);
+        for (int c = 0; c < 3; ++c) {
+          double f = 0;
+          for (int j = 0; j < kB; ++j) f += coef[c][j] * b[j];
+          const double r = s.w * (f - s.m[static_cast<std::size_t>(c)]);
+          cost[c] += r * r;
+        }
+      }
+      return this->Compress(cost[0] + cost[1] + cost[2], h, g, dvdx, dvdx_all, residuals,
+                            nullptr);
+    }
+    double mom[kU][kU] = {}, wru[3][kU] = {};
+    for (std::size_t k = begin_; k < end_; ++k) {
+      const LinearSample<L>& s = samples[k];
+      double u[kU];
+      L::Basis(s.g, shape, u, u + kB);
+      for (int c = 0; c < 3; ++c) {
+        double f = 0;
+        for (int j = 0; j < kB; ++j) f += coef[c][j] * u[j];
+        const double r = s.w * (f - s.m[static_cast<std::size_t>(c)]);
+        cost[c] += r * r;
+        const double wr = s.w * r;
+        for (int j = 0; j < kU; ++j)
+          if (j != L::kUnused) wru[c][j] += wr * u[j];
+      }
+      double wu[kU];
+      for (int j = 0; j < kU; ++j) wu[j] = s.w * u[j];
+      for (int i = 0; i < kU; ++i)
+        for (int j = i; j < kU; ++j)
+          if (i != L::kUnused && j != L::kUnused) mom[i][j] += wu[i] * wu[j];
+    }
+    for (int i = 0; i < kU; ++i)
+      for (int j = 0; j < i; ++j) mom[i][j] = mom[j][i];
+    // Column i of channel c in terms of u: (dcoef[c][·][i], 0) for the non-shape values,
+    // (0, coef[c][·]) for the shape value.
+    for (int c = 0; c < 3; ++c) {
+      double a[kN][kU] = {};
+      for (int i = 0; i + 1 < kN; ++i)
+        for (int j = 0; j < kB; ++j) a[i][j] = dcoef[c][j][i];
+      for (int j = 0; j < kB; ++j) a[kN - 1][kB + j] = coef[c][j];
+      double ma[kN][kU];  // mom·a_i
+      for (int i = 0; i < kN; ++i)
+        for (int p = 0; p < kU; ++p) {
+          double sum = 0;
+          for (int q = 0; q < kU; ++q) sum += mom[p][q] * a[i][q];
+          ma[i][p] = sum;
+        }
+      for (int i = 0; i < kN; ++i) {
+        double gi = 0;
+        for (int q = 0; q < kU; ++q) gi += a[i][q] * wru[c][q];
+        g(i) += gi;
+        for (int k = i; k < kN; ++k) {
+          double hik = 0;
+          for (int q = 0; q < kU; ++q) hik += a[i][q] * ma[k][q];
+          h(i, k) += hik;
+        }
+      }
+    }
+    return this->Compress(cost[0] + cost[1] + cost[2], h, g, dvdx, dvdx_all, residuals,
+                          jacobians[0]);
+  }
+
+ private:
+  const std::vector<LinearSample<L>>* samples_;
+  std::size_t begin_, end_;
+  std::array<bool, kN> log_scale_;
+  const std::array<bool, kN>* fixed_;
+  const bool* smooth_;
 };
 
 // Stops Ceres when a free value sits on one of its bounds with the gradient pointing out of
 // the range (SolveBlock then holds it there). `released` values are ones found at their bound
-// with the gradient pointing inwards; the gradient is only evaluated for them.
+// with the gradient pointing inwards; the gradient is only evaluated for them. With
+// release_early_, also when a held value's gradient has turned inwards: SolveBlock then lets it
+// go at once instead of after the free values have converged (Unreal from the generic start held
+// specular at 0 for 11 slowly converging iterations). Only without the projected line search:
+// then the last Jacobian Ceres evaluated is the one at the current point, not at a candidate.
 template <int kN>
 class BoundWatch final : public ceres::IterationCallback {
  public:
@@ -299,12 +434,17 @@ class BoundWatch final : public ceres::IterationCallback {
       if (!released_[i]) return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
       check = true;
     }
-    if (!check) return ceres::SOLVER_CONTINUE;
+    bool held = false;
+    for (std::size_t i = 0; i < kN; ++i) held |= fixed_[i];
+    if (!check && !(held && release_early_)) return ceres::SOLVER_CONTINUE;
     const std::array<double, kN> g = gradient_();
-    for (std::size_t i = 0; i < kN; ++i)
-      if (!fixed_[i] && Outward(i, g)) return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
+    for (std::size_t i = 0; i < kN; ++i) {
+      if (!fixed_[i] && check && Outward(i, g)) return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
+      if (fixed_[i] && release_early_ && !Outward(i, g)) return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
+    }
     return ceres::SOLVER_CONTINUE;
   }
+  bool release_early_ = false;
   bool AtBound(std::size_t i) const { return AtLower(i) || AtUpper(i); }
   bool AtLower(std::size_t i) const { return x_[i] <= lo_[i] + 1e-12 * (1 + std::fabs(lo_[i])); }
   bool AtUpper(std::size_t i) const { return x_[i] >= hi_[i] - 1e-12 * (1 + std::fabs(hi_[i])); }
@@ -477,24 +617,53 @@ int Rank(ceres::TerminationType t) {  // worse outcomes rank higher
 // Everything of a fit that runs over the samples, for one model's kernel K (fit_kernels.h):
 // the geometry prepared once, the sweep and the Ceres refinements.
 template <class K>
+struct LinearOf {
+  using type = K;  // none: LinearCost is not used
+};
+template <class K>
+  requires requires { typename K::Linear; }
+struct LinearOf<K> {
+  using type = typename K::Linear;
+};
+
+template <class K>
 class KernelFit {
  public:
   static constexpr int kN = K::kN;
+  static constexpr bool kHasLinear = requires { typename K::Linear; };
+  using Linear = typename LinearOf<K>::type;
 
   KernelFit(const FitData& data, const FitOptions& options)
       : data_(data), options_(options), info_(DescribeModel(options.model)) {
-    geom_.reserve(data.samples.size());
-    loss_.reserve(data.samples.size());
-    for (const FitSample& s : data.samples) {
+    if constexpr (kHasLinear) {
+      if (options.loss == FitLoss::kNgan && !options.robust) {
+        linear_.reserve(data.samples.size());
+        for (const FitSample& s : data.samples)
+          linear_.push_back({Linear::Prepare(s.g), s.sqrt_w * s.cos_in, s.m});
+        return;  // the kernel's geometry only if the sweep needs it (PrepareKernel)
+      }
+    }
+    PrepareKernel();
+  }
+
+  // The kernel's geometry and the loss' targets, for the sweep, Cost and CompressedCost. Not
+  // thread-safe: RunFit calls it (through Sweep and Cost) before any refinement starts.
+  void PrepareKernel() const {
+    if (!geom_.empty()) return;
+    geom_.reserve(data_.samples.size());
+    loss_.reserve(data_.samples.size());
+    for (const FitSample& s : data_.samples) {
       geom_.push_back(K::Prepare(s.g));
       LossSample l{s.sqrt_w, s.cos_in, {}};
-      for (std::size_t c = 0; c < 3; ++c) l.target[c] = LossTarget(options.loss, s.m[c], s.cos_in);
+      for (std::size_t c = 0; c < 3; ++c)
+        l.target[c] = LossTarget(options_.loss, s.m[c], s.cos_in);
       loss_.push_back(l);
     }
   }
 
   // ½ Σ r² of `m` over every `stride`-th sample, without a robust loss.
   double Cost(const Material& m, std::size_t stride = 1) const {
+    PrepareKernel();
     double sum = 0, slope;
     for (std::size_t k = 0; k < geom_.size(); k += stride) {
       const LossSample& l = loss_[k];
@@ -518,6 +687,7 @@ class KernelFit {
 
   // The sweep on every `stride`-th sample: candidates with their cost on those samples.
   std::vector<Candidate> Sweep(std::size_t stride) const {
+    PrepareKernel();
     std::vector<Candidate> out;
     if constexpr (K::kLegacy)
       SweepLegacy(stride, &out);
@@ -540,7 +710,7 @@ class KernelFit {
         workers.emplace_back([&] {
           for (std::size_t b; (b = next++) < blocks.size();) {
             try {
-              outcomes[b] = SolveBlock(start, blocks[b], robust_scale, 1);
+              outcomes[b] = Solve(start, blocks[b], robust_scale, 1);
             } catch (...) {
               const std::lock_guard<std::mutex> lock(error_mutex);
               error = std::current_exception();
@@ -551,7 +721,7 @@ class KernelFit {
       if (error) std::rethrow_exception(error);
     } else {
       for (std::size_t b = 0; b < blocks.size(); ++b)
-        outcomes[b] = SolveBlock(start, blocks[b], robust_scale, options_.threads);
+        outcomes[b] = Solve(start, blocks[b], robust_scale, options_.threads);
     }
 
     Refinement out;
@@ -559,11 +729,7 @@ class KernelFit {
     out.termination = ceres::CONVERGENCE;
     for (std::size_t b = 0; b < blocks.size(); ++b) {
       const BlockOutcome& summary = outcomes[b];
-      for (std::size_t i = 0; i < blocks[b].value_index.size(); ++i) {
-        const ParameterInfo& p = ParameterOfValue(info_, blocks[b].value_index[i]);
-        out.material.values[static_cast<std::size_t>(blocks[b].value_index[i])] =
-            p.log_scale ? std::exp(outcomes[b].x[i]) : outcomes[b].x[i];
-      }
+      SetBlock(blocks[b], outcomes[b].x, &out.material);
       out.initial_cost += summary.initial_cost;
       out.final_cost += summary.final_cost;
       out.iterations += summary.iterations;
@@ -664,6 +830,41 @@ class KernelFit {
     }
   }
 
+  // The values of `block` from the fitter's coordinates x.
+  void SetBlock(const Block& block, const std::vector<double>& x, Material* m) const {
+    for (std::size_t i = 0; i < block.value_index.size(); ++i) {
+      const ParameterInfo& p = ParameterOfValue(info_, block.value_index[i]);
+      m->values[static_cast<std::size_t>(block.value_index[i])] = p.log_scale ? std::exp(x[i]) : x[i];
+    }
+  }
+
+  // One block's refinement, piece by piece where the model has a kink. Unreal's
+  // F90 = saturate(50·f0.g) bends at f0.g = 0.02; Levenberg-Marquardt's local model is wrong
+  // across it, and from the generic start Ceres bounced across it for 37 iterations (59 without
+  // the projected line search) before it reached an optimum that lies above it. So from a start
+  // above the kink the block is first solved with F90 held at 1, which is the engine's formula
+  // itself wherever f0.g ≥ 0.02. A result strictly above the kink is then a solution of the
+  // engine's formula too (the two agree in a neighbourhood of it: same cost, gradient and
+  // optimality conditions); otherwise the engine's formula is solved from that result.
+  BlockOutcome Solve(const Material& start, const Block& block, double robust_scale,
+                     int threads) const {
+    if constexpr (kHasLinear) {
+      if (Linear::kKink && !linear_.empty() && Linear::OnSmoothPiece(start.values.data())) {
+        const BlockOutcome smooth = SolveBlock(start, block, robust_scale, threads, true);
+        Material end = start;
+        SetBlock(block, smooth.x, &end);
+        if (smooth.termination != ceres::FAILURE && smooth.termination != ceres::USER_FAILURE &&
+            Linear::OnSmoothPiece(end.values.data()))
+          return smooth;
+        BlockOutcome rest = SolveBlock(end, block, robust_scale, threads, false);
+        rest.initial_cost = smooth.initial_cost;
+        rest.iterations += smooth.iterations;
+        return rest;
+      }
+    }
+    return SolveBlock(start, block, robust_scale, threads);
+  }
+
   // One block's refinement. Ceres handles bounds by projecting each step onto them; when the
   // optimum lies on a bound (metallic 0, ks 0) with the gradient pointing out of the range, the
   // projected steps' predicted decrease is mostly the part cut off, the trust region shrinks
@@ -673,7 +874,7 @@ class KernelFit {
   // inwards at the end is released and Ceres resumes again. The result satisfies the same
   // optimality conditions (zero gradient in the free values, outward at the held ones).
   BlockOutcome SolveBlock(const Material& start, const Block& block, double robust_scale,
-                          int threads) const {
+                          int threads, bool smooth = false) const {
     BlockOutcome out;
     out.x.resize(block.value_index.size());
     std::array<bool, kN> log_scale{}, fixed{}, released{};
@@ -689,15 +890,20 @@ class KernelFit {
     }
     ceres::Problem problem;
     // One residual block per thread (CompressedCost explains why not one per sample).
-    const std::size_t n = geom_.size();
+    const std::size_t n = data_.samples.size();
     const std::size_t parts = static_cast<std::size_t>(std::max(1, threads));
+    auto make_cost = [&](std::size_t begin, std::size_t end,
+                         const std::array<bool, kN>* held) -> SummedCost<kN>* {
+      if constexpr (kHasLinear)
+        if (!linear_.empty())
+          return new LinearCost<Linear>(&linear_, begin, end, log_scale, held, &smooth);
+      return new CompressedCost<K>(&geom_, &loss_, begin, end, block.channel, options_.loss,
+                                   robust_scale, log_scale, held);
+    };
     for (std::size_t t = 0; t < parts; ++t) {
       const std::size_t begin = n * t / parts, end = n * (t + 1) / parts;
       if (begin == end) continue;
-      problem.AddResidualBlock(
-          new CompressedCost<K>(&geom_, &loss_, begin, end, block.channel, options_.loss,
-                                robust_scale, log_scale, &fixed),
-          nullptr, out.x.data());
+      problem.AddResidualBlock(make_cost(begin, end, &fixed), nullptr, out.x.data());
     }
     for (std::size_t i = 0; i < block.value_index.size(); ++i) {
       problem.SetParameterLowerBound(out.x.data(), static_cast<int>(i), lo[i]);
@@ -712,34 +918,40 @@ class KernelFit {
     so.logging_type = ceres::SILENT;
     so.minimizer_progress_to_stdout = false;
     so.update_state_every_iteration = true;
+    // LinearCost (engine models, ngan loss): Ceres' projected line search would evaluate the
+    // Jacobian at every candidate step as well as at every accepted point; the active set below
+    // handles the bounds, the plain trust-region step needs the cost only (HDRP: the same 8
+    // iterations with one Jacobian evaluation each instead of two).
+    const bool linear = kHasLinear && !linear_.empty();
+    if (linear) so.max_num_line_search_step_size_iterations = 0;
     // The whole gradient (held values included) for the decisions between rounds.
-    const CompressedCost<K> whole(&geom_, &loss_, 0, n, block.channel, options_.loss, robust_scale,
-                                  log_scale);
+    const std::unique_ptr<SummedCost<kN>> whole(make_cost(0, n, nullptr));
     auto gradient = [&] {
       double residuals[kN + 1], jacobian[(kN + 1) * kN];
       const double* parameters[] = {out.x.data()};
       double* jacobians[] = {jacobian};
       std::array<double, kN> g{};
-      if (!whole.Evaluate(parameters, residuals, jacobians)) return g;
+      if (!whole->Evaluate(parameters, residuals, jacobians)) return g;
       for (std::size_t i = 0; i < kN; ++i)
         for (std::size_t r = 0; r <= kN; ++r) g[i] += jacobian[r * kN + i] * residuals[r];
       return g;
     };
-    std::vector<const CompressedCost<K>*> costs;
+    std::vector<const SummedCost<kN>*> costs;
     {
       std::vector<ceres::ResidualBlockId> ids;
       problem.GetResidualBlocks(&ids);
       for (ceres::ResidualBlockId id : ids)
         costs.push_back(
-            static_cast<const CompressedCost<K>*>(problem.GetCostFunctionForResidualBlock(id)));
+            static_cast<const SummedCost<kN>*>(problem.GetCostFunctionForResidualBlock(id)));
     }
     auto last_gradient = [&costs] {
       std::array<double, kN> g{};
-      for (const CompressedCost<K>* c : costs)
+      for (const SummedCost<kN>* c : costs)
         for (std::size_t i = 0; i < kN; ++i) g[i] += c->last_gradient_[i];
       return g;
     };
     BoundWatch<kN> watch(out.x.data(), lo, hi, fixed, released, last_gradient);
+    watch.release_early_ = linear;
     so.callbacks.push_back(&watch);
     auto outward = [&](std::size_t i, const std::array<double, kN>& g) {
       return watch.Outward(i, g);
@@ -767,9 +979,11 @@ class KernelFit {
         continue;
       }
       // A free value reached a bound: hold it if the gradient points out, else let Ceres go on.
-      const std::array<double, kN> g = gradient();
+      // (Without the line search the Jacobian Ceres evaluated last is the current point's.)
+      const std::array<double, kN> g = linear ? last_gradient() : gradient();
       for (std::size_t i = 0; i < kN; ++i)
-        if (!fixed[i] && watch.AtBound(i)) {
+        if (fixed[i] && watch.release_early_ && !outward(i, g)) fixed[i] = false, released[i] = true;
+        else if (!fixed[i] && watch.AtBound(i)) {
           if (outward(i, g))
             fixed[i] = true, released[i] = false;
           else
@@ -783,8 +997,9 @@ class KernelFit {
   const FitData& data_;
   const FitOptions& options_;
   const ModelInfo& info_;
-  std::vector<typename K::Geom> geom_;
-  std::vector<LossSample> loss_;
+  mutable std::vector<typename K::Geom> geom_;
+  mutable std::vector<LossSample> loss_;
+  std::vector<LinearSample<Linear>> linear_;  // when LinearCost applies (engine model, ngan)
 };
 
 struct Search {

@@ -1,10 +1,13 @@
 #include "fit_data.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <map>
 #include <string>
+#include <unordered_map>
+#include <utility>
 
 #include "brdf/core/error.h"
 #include "brdf/core/geometry.h"
@@ -32,6 +35,37 @@ std::vector<std::pair<double, double>> RowEdges(const std::vector<double>& rows_
   return edges;
 }
 
+// SphericalDirectionDeg of the float angles of samples, each distinct angle's sine and cosine
+// computed once: a capture repeats the same 76 θ and 360 φ values in every slice, and four
+// sincos per sample were most of the data preparation. Bit-identical to SphericalDirectionDeg.
+class DirectionCache {
+ public:
+  Vec3 Of(float theta_deg, float phi_deg) {
+    const auto& [st, ct] = SinCos(theta_deg);
+    const auto& [sp, cp] = SinCos(phi_deg);
+    return {st * cp, st * sp, ct};
+  }
+
+ private:
+  // The last angle looked up first: θin and φin are the same for a whole slice, θout for a row.
+  const std::pair<double, double>& SinCos(float deg) {
+    for (const Entry* e : last_)
+      if (e != nullptr && e->first == deg) return e->second;
+    auto it = cache_.find(deg);
+    if (it == cache_.end()) {
+      const double rad = DegToRad(deg);
+      it = cache_.emplace(deg, std::make_pair(std::sin(rad), std::cos(rad))).first;
+    }
+    last_[next_] = &*it;
+    next_ = (next_ + 1) % last_.size();
+    return it->second;
+  }
+  using Entry = std::pair<const float, std::pair<double, double>>;
+  std::unordered_map<float, std::pair<double, double>> cache_;  // references stay valid
+  std::array<const Entry*, 3> last_{};
+  std::size_t next_ = 0;
+};
+
 double Median(std::vector<double>& v) {
   if (v.empty()) return 0;
   auto mid = v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2);
@@ -47,12 +81,19 @@ FitData PrepareFitData(const Measurement& measurement, const FitOptions& options
     throw InvalidArgument("fit: the largest θout must be in (0°, 90°], got " +
                           std::to_string(*options.max_theta_out_deg));
   FitData data;
+  data.samples.reserve(measurement.SampleCount());
+  DirectionCache directions;
   for (std::size_t si = 0; si < measurement.slices.size(); ++si) {
     const Slice& slice = measurement.slices[si];
     data.theta_in_deg.push_back(slice.theta_in_deg);
     // Rows of this slice (θout rounded to 1e-3°) and their sample counts, for the weights.
     std::map<long, std::size_t> rows;
     std::vector<const Sample*> kept;
+    std::vector<long> kept_row;  // each kept sample's key into rows
+    kept.reserve(slice.samples.size());
+    kept_row.reserve(slice.samples.size());
+    long last_key = 0;
+    std::size_t* last_count = nullptr;  // rows[last_key]: samples come row by row
     for (const Sample& s : slice.samples) {
       bool finite = std::isfinite(s.theta_in_deg) && std::isfinite(s.phi_in_deg) &&
                     std::isfinite(s.theta_out_deg) && std::isfinite(s.phi_out_deg);
@@ -71,23 +112,29 @@ FitData PrepareFitData(const Measurement& measurement, const FitOptions& options
         ++data.excluded_theta_out;
         continue;
       }
-      ++rows[std::lround(s.theta_out_deg * 1000.0)];
+      const long key = std::lround(s.theta_out_deg * 1000.0);
+      if (last_count == nullptr || key != last_key) last_count = &rows[key], last_key = key;
+      ++*last_count;
       kept.push_back(&s);
+      kept_row.push_back(key);
     }
     std::vector<double> row_deg;
     for (const auto& [key, count] : rows) row_deg.push_back(static_cast<double>(key) / 1000.0);
     const auto edges = RowEdges(row_deg);
     std::map<long, double> cell;  // solid angle per sample of each row
+    long cell_key = 0;
+    double cell_area = -1;  // cell[cell_key] once looked up (-1: none yet)
     std::size_t r = 0;
     for (const auto& [key, count] : rows) {
       const double area = 2.0 * kPi * (std::cos(edges[r].first) - std::cos(edges[r].second));
       cell[key] = area / static_cast<double>(count);
       ++r;
     }
-    for (const Sample* s : kept) {
+    for (std::size_t ki = 0; ki < kept.size(); ++ki) {
+      const Sample* s = kept[ki];
       FitSample x;
-      const Vec3 l = SphericalDirectionDeg(s->theta_in_deg, s->phi_in_deg);
-      const Vec3 v = SphericalDirectionDeg(s->theta_out_deg, s->phi_out_deg);
+      const Vec3 l = directions.Of(s->theta_in_deg, s->phi_in_deg);
+      const Vec3 v = directions.Of(s->theta_out_deg, s->phi_out_deg);
       x.g = ShadingGeometry::Of(l, v);
       if (!x.g.AboveHorizon()) {
         ++data.excluded_theta_out;
@@ -95,7 +142,8 @@ FitData PrepareFitData(const Measurement& measurement, const FitOptions& options
       }
       for (int c = 0; c < 3; ++c) x.m[c] = s->rgb[c];
       x.cos_in = l.z;
-      x.sqrt_w = cell[std::lround(s->theta_out_deg * 1000.0)];  // squared below, after normalising
+      if (cell_area < 0 || cell_key != kept_row[ki]) cell_key = kept_row[ki], cell_area = cell[cell_key];
+      x.sqrt_w = cell_area;  // squared below, after normalising
       x.theta_h_deg = RadToDeg(std::acos(std::clamp(x.g.n_dot_h, -1.0, 1.0)));
       x.slice = static_cast<int>(si);
       data.samples.push_back(x);
@@ -123,6 +171,12 @@ void FillErrors(const FitData& data, const Material& material, FitReport* report
   std::vector<std::size_t> count(n_slices, 0);
   std::vector<std::vector<double>> rel(n_slices);
   std::vector<double> all_rel;
+  all_rel.reserve(3 * data.samples.size());
+  {
+    std::vector<std::size_t> per_slice(n_slices, 0);
+    for (const FitSample& x : data.samples) ++per_slice[static_cast<std::size_t>(x.slice)];
+    for (std::size_t s = 0; s < n_slices; ++s) rel[s].reserve(3 * per_slice[s]);
+  }
   double all_sq = 0;
   // Chromaticity bins: per slice, θh edges below.
   static constexpr double kThetaHEdges[] = {0, 2, 5, 10, 20, 35, 60, 90};

@@ -22,6 +22,7 @@
 
 #include <ceres/jet.h>
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 
@@ -137,9 +138,14 @@ struct WardKernel {
 // ---------------------------------------------------------------------------------------------
 // Engine models (models.h documents each formula and its source).
 
+struct UnrealLinear;
+struct HdrpLinear;
+struct UrpLinear;
+
 // Unreal DefaultLit. v = {base r, g, b, metallic, specular, roughness}.
 struct UnrealKernel {
   static constexpr bool kLegacy = false;
+  using Linear = UnrealLinear;  // its linear form (below)
   static constexpr int kN = 6;
   struct Geom {
     double n_dot_h, no_l, no_v, fc;
@@ -191,6 +197,7 @@ struct UnrealKernel {
 // Unity HDRP Lit, metallic workflow. v = {base r, g, b, metallic, smoothness}.
 struct HdrpKernel {
   static constexpr bool kLegacy = false;
+  using Linear = HdrpLinear;
   static constexpr int kN = 5;
   struct Geom {
     double n_dot_h, n_dot_l, n_dot_v, l_dot_v, p5l, p5v, fc;
@@ -250,6 +257,7 @@ struct HdrpKernel {
 // Unity URP Lit, metallic workflow. v = {albedo r, g, b, metallic, smoothness}.
 struct UrpKernel {
   static constexpr bool kLegacy = false;
+  using Linear = UrpLinear;
   static constexpr int kN = 5;
   struct Geom {
     double cos_h2, lo_h2;
@@ -283,6 +291,221 @@ struct UrpKernel {
       gr[3] = (-0.96 * v[c] + term * (v[c] - 0.04)) * kInvPi;
       gr[4] = -specular * dterm * kInvPi;
     }
+  }
+};
+
+// ---------------------------------------------------------------------------------------------
+// Linear forms of the engine models (LinearCost in fit.cpp).
+//
+// For a fixed shape slider (roughness or smoothness) each engine model is linear in a few
+// coefficients made of the other values: f_c = Σ_j coef[c][j]·basis_j, where the basis functions
+// depend only on the geometry and the shape, and the coefficients only on the base colour,
+// metallic and specular. So every column of a sample's Jacobian is a combination of the same
+// 2·kBasis numbers (the basis functions and their slopes in the shape), with coefficients that
+// are the same for every sample: d f_c/d v_i = Σ_j dcoef[c][j][i]·basis_j for the non-shape
+// values, d f_c/d shape = Σ_j coef[c][j]·dbasis_j. Under the ngan loss (a fixed weight per
+// sample) JᵀJ is then a fixed combination of the moments Σ w²·u·uᵀ of u = (basis, dbasis), and
+// Jᵀr of Σ w·r_c·u: a few sums per sample instead of a Jacobian per channel. Same formulas as
+// the kernels above (and models.h); tests/processing/fit_kernels_test.cpp checks the values
+// against models::EvaluateRgb and the assembled derivatives against Jets.
+//
+// Interface: kN values, kBasis basis functions, the shape value is the last one (kN − 1);
+//   Geom Prepare(ShadingGeometry)          the geometric part, once per fit;
+//   Shape ShapeOf(shape value)             what depends only on the shape, once per evaluation;
+//   Basis(geom, shape, b, db)              basis functions, and their slopes in the shape value
+//                                          when db is not null;
+//   Coefficients(v, smooth, coef, dcoef)   coefficients and their slopes in v[0 … kN − 2];
+//   kUnused                                the entry of u = (b, db) no Jacobian column uses
+//                                          (LinearCost leaves it out of the sums);
+//   kKink, OnSmoothPiece(v)                Unreal's saturate(50·f0.g) (below): with `smooth` the
+//                                          coefficient is its value above the kink, 1.
+
+// Unreal DefaultLit: f_c = b_c(1 − m)·(1/π) + F90·(D·Vis·Fc) + f0_c·(D·Vis·(1 − Fc)).
+struct UnrealLinear {
+  static constexpr int kN = 6, kBasis = 3;
+  static constexpr int kUnused = 3;  // db[0] = 0
+  static constexpr bool kKink = true;
+  struct Geom {
+    double cos_h2, lv2, k, fc;  // lv2 = 2·NoL·NoV, k = NoL + NoV − 2·NoL·NoV
+  };
+  static Geom Prepare(const ShadingGeometry& g) {
+    const double no_l = g.n_dot_l, no_v = std::min(1.0, std::fabs(g.n_dot_v) + 1e-5);
+    return {g.n_dot_h * g.n_dot_h, 2.0 * no_l * no_v, no_l + no_v - 2.0 * no_l * no_v,
+            models::Pow5(1.0 - g.v_dot_h)};
+  }
+  struct Shape {
+    double a2, a, half_a2_pi, dln_a2, two_da2, da;  // dln_a2 = (d a2/d roughness)/a2
+  };
+  static Shape ShapeOf(double roughness) {
+    const double r2 = roughness * roughness;
+    double a2 = r2 * r2, da2 = 4.0 * r2 * roughness, da = 2.0 * roughness;
+    if (a2 < 1e-12) a2 = 1e-12, da2 = 0, da = 0;
+    return {a2, std::sqrt(a2), 0.5 * a2 * kInvPi, da2 / a2, 2.0 * da2, da};
+  }
+  [[gnu::always_inline]] static void Basis(const Geom& g, const Shape& s, double* b, double* db) {
+    // D·Vis = a2/(π d²) · 0.5/den, den = NoL(NoV(1 − a) + a) + NoV(NoL(1 − a) + a).
+    const double d = g.cos_h2 * (s.a2 - 1.0) + 1.0;
+    const double den = g.lv2 + s.a * g.k;
+    const double inv_d = 1.0 / d, inv_den = 1.0 / den;
+    const double dv = s.half_a2_pi * inv_d * inv_d * inv_den;
+    b[0] = kInvPi;
+    b[1] = dv * g.fc;
+    b[2] = dv - b[1];
+    if (db) {
+      // d ln(D·Vis)/d roughness = (1/a2 − 2cos²θh/d)·da2 − k/den·da.
+      const double ddv = dv * (s.dln_a2 - s.two_da2 * g.cos_h2 * inv_d - s.da * g.k * inv_den);
+      db[0] = 0;
+      db[1] = ddv * g.fc;
+      db[2] = ddv - db[1];
+    }
+  }
+  static double F0g(const double* v) { return 0.08 * v[4] * (1.0 - v[3]) + v[1] * v[3]; }
+  static bool OnSmoothPiece(const double* v) { return 50.0 * F0g(v) > 1.0; }
+  static void Coefficients(const double* v, bool smooth, double (*coef)[kBasis],
+                           double (*dcoef)[kBasis][kN]) {
+    const double m = v[3], spec = v[4];
+    double f90 = 50.0 * F0g(v);
+    const bool free = !smooth && f90 <= 1.0 && f90 >= 0.0;
+    f90 = smooth ? 1.0 : std::clamp(f90, 0.0, 1.0);
+    for (int c = 0; c < 3; ++c) {
+      coef[c][0] = v[c] * (1.0 - m);
+      coef[c][1] = f90;
+      coef[c][2] = 0.08 * spec * (1.0 - m) + v[c] * m;
+      for (int j = 0; j < kBasis; ++j)
+        for (int i = 0; i < kN; ++i) dcoef[c][j][i] = 0;
+      dcoef[c][0][c] = 1.0 - m;
+      dcoef[c][0][3] = -v[c];
+      if (free) {
+        dcoef[c][1][1] = 50.0 * m;
+        dcoef[c][1][3] = 50.0 * (v[1] - 0.08 * spec);
+        dcoef[c][1][4] = 4.0 * (1.0 - m);
+      }
+      dcoef[c][2][c] = m;
+      dcoef[c][2][3] = v[c] - 0.08 * spec;
+      dcoef[c][2][4] = 0.08 * (1.0 - m);
+    }
+  }
+};
+
+// The Unity metallic workflow's coefficients of the diffuse basis function, b_c(1 − m), and of
+// the F0 one, lerp(0.04, b_c, m) = 0.04(1 − m) + b_c·m (both pipelines), and their slopes in
+// v = {b r, g, b, metallic, …}; the other coefficients are set to 0 and have no slope.
+template <int kBasis, int kN>
+void UnityMetallicCoefficients(const double* v, double (*coef)[kBasis],
+                               double (*dcoef)[kBasis][kN]) {
+  const double m = v[3];
+  for (int c = 0; c < 3; ++c) {
+    for (int j = 0; j < kBasis; ++j) {
+      coef[c][j] = 0;
+      for (int i = 0; i < kN; ++i) dcoef[c][j][i] = 0;
+    }
+    coef[c][0] = v[c] * (1.0 - m);
+    coef[c][1] = 0.04 * (1.0 - m) + v[c] * m;
+    dcoef[c][0][c] = 1.0 - m;
+    dcoef[c][0][3] = -v[c];
+    dcoef[c][1][c] = m;
+    dcoef[c][1][3] = v[c] - 0.04;
+  }
+}
+
+// Unity HDRP Lit (metallic): f_c = b_c(1 − m)·Disney + f0_c·(D·V·(1 − Fc)) + 1·(D·V·Fc).
+struct HdrpLinear {
+  static constexpr int kN = 5, kBasis = 3;
+  static constexpr int kUnused = 2;  // b[2]: its coefficient 1 has no slope
+  static constexpr bool kKink = false;
+  struct Geom {
+    double cos_h2, n_dot_l, n_dot_v, lv1, p5l, p5v, fc;  // lv1 = 1 + l·v
+  };
+  static Geom Prepare(const ShadingGeometry& g) {
+    const double n_dot_v = std::max(g.n_dot_v, 0.0001);
+    return {g.n_dot_h * g.n_dot_h,         g.n_dot_l,
+            n_dot_v,                       1.0 + g.l_dot_v,
+            models::Pow5(1.0 - g.n_dot_l), models::Pow5(1.0 - n_dot_v),
+            models::Pow5(1.0 - g.v_dot_h)};
+  }
+  struct Shape {
+    double perceptual, a2, half_a2_pi, inv_a2, da2;  // da2 = d a2/d smoothness
+  };
+  static Shape ShapeOf(double smoothness) {
+    const double perceptual = 1.0 - smoothness;
+    double alpha = perceptual * perceptual, dalpha = 2.0 * perceptual;
+    if (alpha < 1e-4) alpha = 1e-4, dalpha = 0;
+    const double a2 = alpha * alpha;
+    return {perceptual, a2, 0.5 * a2 * kInvPi, 1.0 / a2, -2.0 * alpha * dalpha};
+  }
+  [[gnu::always_inline]] static void Basis(const Geom& g, const Shape& s, double* b, double* db) {
+    constexpr double kDisney = kInvPi / 1.03571;
+    const double nl2 = g.n_dot_l * g.n_dot_l, nv2 = g.n_dot_v * g.n_dot_v;
+    const double sd = g.cos_h2 * (s.a2 - 1.0) + 1.0;
+    const double qv = std::sqrt(nv2 + s.a2 * (1.0 - nv2));
+    const double ql = std::sqrt(nl2 + s.a2 * (1.0 - nl2));
+    const double lambda = g.n_dot_l * qv + g.n_dot_v * ql;
+    // One division for 1/s, 1/λ, 1/qv and 1/ql.
+    const double sl = sd * lambda, qq = qv * ql;
+    const double inv = 1.0 / (sl * qq);
+    const double inv_sd = inv * qq * lambda, inv_lambda = inv * qq * sd;
+    const double dv = s.half_a2_pi * inv_sd * inv_sd * inv_lambda;  // D·V
+    const double fd90m1 = s.perceptual * g.lv1 - 0.5;
+    const double light = 1.0 + fd90m1 * g.p5l, view = 1.0 + fd90m1 * g.p5v;
+    b[0] = kDisney * light * view;
+    b[2] = dv * g.fc;
+    b[1] = dv - b[2];
+    if (db) {
+      // d ln(D·V)/d a2 = 1/a2 − 2cos²θh/s − (dλ/d a2)/λ; d Disney/d smoothness = −d/d perceptual.
+      const double inv_qv = inv * sl * ql, inv_ql = inv * sl * qv;
+      const double dlambda =
+          0.5 * (g.n_dot_l * (1.0 - nv2) * inv_qv + g.n_dot_v * (1.0 - nl2) * inv_ql);
+      const double ddv = dv * (s.inv_a2 - 2.0 * g.cos_h2 * inv_sd - dlambda * inv_lambda) * s.da2;
+      db[0] = -kDisney * g.lv1 * (g.p5l * view + light * g.p5v);
+      db[2] = ddv * g.fc;
+      db[1] = ddv - db[2];
+    }
+  }
+  static bool OnSmoothPiece(const double*) { return true; }
+  static void Coefficients(const double* v, bool, double (*coef)[kBasis],
+                           double (*dcoef)[kBasis][kN]) {
+    UnityMetallicCoefficients<kBasis, kN>(v, coef, dcoef);
+    for (int c = 0; c < 3; ++c) coef[c][2] = 1.0;
+  }
+};
+
+// Unity URP Lit (metallic): f_c = 0.96·b_c(1 − m)·(1/π) + (0.04(1 − m) + b_c·m)·(specularTerm/π).
+struct UrpLinear {
+  static constexpr int kN = 5, kBasis = 2;
+  static constexpr int kUnused = 2;  // db[0] = 0
+  static constexpr bool kKink = false;
+  struct Geom {
+    double cos_h2, inv_lo_h2;  // 1/max(0.1, LoH²)
+  };
+  static Geom Prepare(const ShadingGeometry& g) {
+    return {g.n_dot_h * g.n_dot_h, 1.0 / std::max(0.1, g.v_dot_h * g.v_dot_h)};
+  }
+  struct Shape {
+    double r2, k, d1, d2;  // k = roughness2/((4ρ + 2)π); slope factors d1, d2 (Basis)
+  };
+  static Shape ShapeOf(double smoothness) {
+    const double perceptual = 1.0 - smoothness;
+    double roughness = perceptual * perceptual, drough = 2.0 * perceptual;
+    if (roughness < 0.0078125) roughness = 0.0078125, drough = 0;
+    const double r2 = std::max(roughness * roughness, 6.103515625e-5);
+    // d term/d roughness = term·(2/ρ − 4/(4ρ + 2) − 4ρcos²θh/d); d/d smoothness = −d/d ρ · drough.
+    return {r2, r2 * kInvPi / (4.0 * roughness + 2.0),
+            -drough * (2.0 / roughness - 4.0 / (4.0 * roughness + 2.0)), 4.0 * roughness * drough};
+  }
+  [[gnu::always_inline]] static void Basis(const Geom& g, const Shape& s, double* b, double* db) {
+    const double d = g.cos_h2 * (s.r2 - 1.0) + 1.00001;
+    const double inv_d = 1.0 / d;
+    b[0] = 0.96 * kInvPi;
+    b[1] = s.k * inv_d * inv_d * g.inv_lo_h2;
+    if (db) {
+      db[0] = 0;
+      db[1] = b[1] * (s.d1 + s.d2 * g.cos_h2 * inv_d);
+    }
+  }
+  static bool OnSmoothPiece(const double*) { return true; }
+  static void Coefficients(const double* v, bool, double (*coef)[kBasis],
+                           double (*dcoef)[kBasis][kN]) {
+    UnityMetallicCoefficients<kBasis, kN>(v, coef, dcoef);
   }
 };
 
