@@ -261,7 +261,8 @@ AtlasManifest ParseAtlasManifest(std::string_view json_text, const std::string& 
                                                              prefix + "saturated_samples");
     if (list[i].contains("extrapolation")) {
       detail::JsonFields x(e.Object("extrapolation"), file, prefix + "extrapolation.");
-      entry.extrapolation = ExtrapolationInfo{x.Number("p"), x.Number("l"), x.Number("theta_b_deg")};
+      entry.extrapolation =
+          ExtrapolationInfo{x.Number("p"), x.Number("l"), x.Number("theta_b_deg")};
     }
     if (list[i].contains("fitted_models")) {
       const ordered_json& fitted = list[i]["fitted_models"];

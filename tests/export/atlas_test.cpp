@@ -142,7 +142,8 @@ TEST(Atlas, ManifestRecordsEachMaterialsExtrapolationAndFits) {
   Five five;
   five.materials[1].extrapolation = ExtrapolationInfo{0.25, 0.8, 75};
   five.materials[1].fitted_models_json = {R"({"kind":"extrapolation-auto","p":0.25,"l":0.8})"};
-  const AtlasManifest parsed = ParseAtlasManifest(AtlasManifestJson(BuildAtlas(five.materials), {}));
+  const AtlasManifest parsed =
+      ParseAtlasManifest(AtlasManifestJson(BuildAtlas(five.materials), {}));
   ASSERT_TRUE(parsed.materials[1].extrapolation.has_value());
   EXPECT_EQ(parsed.materials[1].extrapolation->p, 0.25);
   EXPECT_EQ(parsed.materials[1].extrapolation->l, 0.8);

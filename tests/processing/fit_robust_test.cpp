@@ -69,9 +69,11 @@ struct Case {
 };
 std::vector<Case> Cases() {
   return {
-      {"ggx", Material::Make(Model::kGgx, {{0.4, 0.2, 0.1}, {0.05, 0.05, 0.05}, {0.15, 0.15, 0.15}})},
-      {"unreal-defaultlit", Material::Make(Model::kUnrealDefaultLit,
-                                           {{0.8, 0.6, 0.3}, {0.5, 0, 0}, {0.5, 0, 0}, {0.3, 0, 0}})},
+      {"ggx",
+       Material::Make(Model::kGgx, {{0.4, 0.2, 0.1}, {0.05, 0.05, 0.05}, {0.15, 0.15, 0.15}})},
+      {"unreal-defaultlit",
+       Material::Make(Model::kUnrealDefaultLit,
+                      {{0.8, 0.6, 0.3}, {0.5, 0, 0}, {0.5, 0, 0}, {0.3, 0, 0}})},
   };
 }
 
@@ -109,9 +111,9 @@ TEST(FitRobust, OutliersPullThePlainFitAwayButNotTheRobustOne) {
     const double plain_error = WorstRelativeError(plain.material, c.truth, 0.05);
     EXPECT_GT(plain_error, 5 * robust_error)
         << "plain " << plain_error << ", robust " << robust_error;
-    RecordProperty(std::string(c.label) + "_worst_relative_error",
-                   "plain " + std::to_string(plain_error) + ", robust " +
-                       std::to_string(robust_error));
+    RecordProperty(
+        std::string(c.label) + "_worst_relative_error",
+        "plain " + std::to_string(plain_error) + ", robust " + std::to_string(robust_error));
   }
 }
 
@@ -151,7 +153,8 @@ TEST(FitRobust, CostScaleAndOptimumAgreeWithScipyCauchy) {
       const FitResult r = FitMaterial(meas, o);
       ASSERT_NE(r.report.status, "failed") << r.report.message;
 
-      const std::filesystem::path dir = tmp / (std::string(c.label) + "-" + std::string(FitLossName(loss)));
+      const std::filesystem::path dir =
+          tmp / (std::string(c.label) + "-" + std::string(FitLossName(loss)));
       std::filesystem::create_directories(dir);
       WriteFitData(dir / "fit_data.csv", PrepareFitData(meas, o));
       std::ofstream(dir / "start.json") << MaterialToJson(start);
@@ -167,7 +170,8 @@ TEST(FitRobust, CostScaleAndOptimumAgreeWithScipyCauchy) {
                               "/tests/python/robust_fit_oracle.py '" + dir.string() + "'";
       const brdf::test::CommandOutput oracle = brdf::test::RunCommand(cmd);
       ASSERT_EQ(oracle.status, 0) << cmd << " failed (needs /usr/bin/python3 with numpy and "
-                                  << "SciPy: tools/install-deps.sh)\n" << oracle.out;
+                                  << "SciPy: tools/install-deps.sh)\n"
+                                  << oracle.out;
       const nlohmann::json want = nlohmann::json::parse(oracle.out);
 
       // The plain fit's reported cost is numpy's ½·Σ r² at its parameters.

@@ -231,9 +231,9 @@ TEST(FitEngines, EngineFitsAreNeverWorseThanTheNaiveMappingOfTheGgxFit) {
     FitOptions o;
     o.model = Model::kGgx;
     const Material ggx = FitMaterial(meas, o).material;
-    for (Model engine : {Model::kUnrealDefaultLit, Model::kUnityHdrpLit,
-                         Model::kUnityHdrpLitSpecular, Model::kUnityUrpLit,
-                         Model::kUnityUrpLitSpecular}) {
+    for (Model engine :
+         {Model::kUnrealDefaultLit, Model::kUnityHdrpLit, Model::kUnityHdrpLitSpecular,
+          Model::kUnityUrpLit, Model::kUnityUrpLitSpecular}) {
       o.model = engine;
       const FitReport fit = FitMaterial(meas, o).report;
       const FitReport naive = EvaluateFit(meas, NaiveFromGgx(ggx, engine), o);

@@ -104,7 +104,7 @@ TEST_F(FitCommand, OptionsAreRecordedInTheReport) {
   EXPECT_EQ(fit["robust"], true);
   EXPECT_GT(fit["robust_scale"].get<double>(), 0);
   EXPECT_EQ(fit["starts"], 3);
-  EXPECT_EQ(fit["samples_used"].get<int>(), 4 * 61 * 360);             // θout 0…60
+  EXPECT_EQ(fit["samples_used"].get<int>(), 4 * 61 * 360);           // θout 0…60
   EXPECT_EQ(fit["excluded"]["theta_out"].get<int>(), 4 * 15 * 360);  // θout 61…75
   EXPECT_NEAR(Json::parse(ReadAll(dir_ / "o.json"))["alpha"][1].get<double>(), 0.2, 0.002);
 }

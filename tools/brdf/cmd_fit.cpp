@@ -92,7 +92,8 @@ std::optional<AutoExtrapolationChoice> AutoExtrapolationFor(const std::string& p
   const sources::PreparedMeasurement p = sources::PrepareMeasurement(path, kind, std::nullopt);
   // The input's own choice (a .extrapolate.json beside it, a material's "extrapolate") comes
   // before the command line's, so there is nothing to fit and nothing to record.
-  if (p.extrapolation.origin != sources::ExtrapolationChoice::Origin::kDefaults) return std::nullopt;
+  if (p.extrapolation.origin != sources::ExtrapolationChoice::Origin::kDefaults)
+    return std::nullopt;
   const processing::AutoExtrapolationResult r = processing::ChooseExtrapolationAuto(p.measurement);
   return AutoExtrapolationChoice{r.params, processing::AutoExtrapolationJson(r)};
 }
@@ -168,10 +169,10 @@ int RunFit(const FitCommandOptions& options) {
       std::string others;
       for (std::size_t o : same)
         if (o != i) others += (others.empty() ? "" : ", ") + inputs[o].path;
-      failures.push_back({inputs[i].path, "its results " +
-                                              (fs::path(options.out) / (inputs[i].name + ".*.json")).string() +
-                                              " would also be written for " + others +
-                                              "; rename one of them"});
+      failures.push_back(
+          {inputs[i].path, "its results " +
+                               (fs::path(options.out) / (inputs[i].name + ".*.json")).string() +
+                               " would also be written for " + others + "; rename one of them"});
     }
     inputs = std::move(kept);
   }
@@ -238,8 +239,8 @@ int RunFit(const FitCommandOptions& options) {
       [&](std::size_t i, const JobResult& job) {
         for (const std::string& w : job.warnings) progress.Message(w);
         if (!job.ok) {
-          progress.Message(inputs[i].path + ": FAILED: " +
-                           ReasonWithoutPath(inputs[i].path, job.error));
+          progress.Message(inputs[i].path +
+                           ": FAILED: " + ReasonWithoutPath(inputs[i].path, job.error));
           if (results[i].size() < models.size()) {
             progress.Advance(inputs[i].path, true);
             progress.Drop(models.size() - results[i].size() - 1);

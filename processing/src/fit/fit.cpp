@@ -154,8 +154,8 @@ class SummedCost : public ceres::CostFunction {
   // used) and g = Jᵀr in the material's values, with dvdx the slopes of the values in the
   // fitter's coordinates (0 for held values) and dvdx_all the slopes without holding.
   bool Compress(double cost, const Eigen::Matrix<double, kN, kN>& h,
-                const Eigen::Matrix<double, kN, 1>& g, const double* dvdx,
-                const double* dvdx_all, double* residuals, double* jo) const {
+                const Eigen::Matrix<double, kN, 1>& g, const double* dvdx, const double* dvdx_all,
+                double* residuals, double* jo) const {
     if (!std::isfinite(cost)) return false;
     if (jo == nullptr) {
       for (int i = 0; i < kN; ++i) residuals[i] = 0;
@@ -189,8 +189,7 @@ class SummedCost : public ceres::CostFunction {
   }
   // The values v of the fitter's coordinates x, their slopes dv/dx, and those without holding.
   static void Values(const double* x, const std::array<bool, kN>& log_scale,
-                     const std::array<bool, kN>* fixed, double* v, double* dvdx,
-                     double* dvdx_all) {
+                     const std::array<bool, kN>* fixed, double* v, double* dvdx, double* dvdx_all) {
     for (int i = 0; i < kN; ++i) {
       const bool log = log_scale[static_cast<std::size_t>(i)];
       v[i] = log ? std::exp(x[i]) : x[i];
@@ -345,8 +344,7 @@ class LinearCost final : public SummedCost<L::kN> {
           cost[c] += r * r;
         }
       }
-      return this->Compress(cost[0] + cost[1] + cost[2], h, g, dvdx, dvdx_all, residuals,
-                            nullptr);
+      return this->Compress(cost[0] + cost[1] + cost[2], h, g, dvdx, dvdx_all, residuals, nullptr);
     }
     double mom[kU][kU] = {}, wru[3][kU] = {};
     for (std::size_t k = begin_; k < end_; ++k) {
@@ -440,7 +438,8 @@ class BoundWatch final : public ceres::IterationCallback {
     const std::array<double, kN> g = gradient_();
     for (std::size_t i = 0; i < kN; ++i) {
       if (!fixed_[i] && check && Outward(i, g)) return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
-      if (fixed_[i] && release_early_ && !Outward(i, g)) return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
+      if (fixed_[i] && release_early_ && !Outward(i, g))
+        return ceres::SOLVER_TERMINATE_SUCCESSFULLY;
     }
     return ceres::SOLVER_CONTINUE;
   }
@@ -621,7 +620,7 @@ struct LinearOf {
   using type = K;  // none: LinearCost is not used
 };
 template <class K>
-  requires requires { typename K::Linear; }
+requires requires { typename K::Linear; }
 struct LinearOf<K> {
   using type = typename K::Linear;
 };
@@ -655,8 +654,7 @@ class KernelFit {
     for (const FitSample& s : data_.samples) {
       geom_.push_back(K::Prepare(s.g));
       LossSample l{s.sqrt_w, s.cos_in, {}};
-      for (std::size_t c = 0; c < 3; ++c)
-        l.target[c] = LossTarget(options_.loss, s.m[c], s.cos_in);
+      for (std::size_t c = 0; c < 3; ++c) l.target[c] = LossTarget(options_.loss, s.m[c], s.cos_in);
       loss_.push_back(l);
     }
   }
@@ -834,7 +832,8 @@ class KernelFit {
   void SetBlock(const Block& block, const std::vector<double>& x, Material* m) const {
     for (std::size_t i = 0; i < block.value_index.size(); ++i) {
       const ParameterInfo& p = ParameterOfValue(info_, block.value_index[i]);
-      m->values[static_cast<std::size_t>(block.value_index[i])] = p.log_scale ? std::exp(x[i]) : x[i];
+      m->values[static_cast<std::size_t>(block.value_index[i])] =
+          p.log_scale ? std::exp(x[i]) : x[i];
     }
   }
 
@@ -982,7 +981,8 @@ class KernelFit {
       // (Without the line search the Jacobian Ceres evaluated last is the current point's.)
       const std::array<double, kN> g = linear ? last_gradient() : gradient();
       for (std::size_t i = 0; i < kN; ++i)
-        if (fixed[i] && watch.release_early_ && !outward(i, g)) fixed[i] = false, released[i] = true;
+        if (fixed[i] && watch.release_early_ && !outward(i, g))
+          fixed[i] = false, released[i] = true;
         else if (!fixed[i] && watch.AtBound(i)) {
           if (outward(i, g))
             fixed[i] = true, released[i] = false;

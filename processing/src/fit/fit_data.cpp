@@ -142,7 +142,8 @@ FitData PrepareFitData(const Measurement& measurement, const FitOptions& options
       }
       for (int c = 0; c < 3; ++c) x.m[c] = s->rgb[c];
       x.cos_in = l.z;
-      if (cell_area < 0 || cell_key != kept_row[ki]) cell_key = kept_row[ki], cell_area = cell[cell_key];
+      if (cell_area < 0 || cell_key != kept_row[ki])
+        cell_key = kept_row[ki], cell_area = cell[cell_key];
       x.sqrt_w = cell_area;  // squared below, after normalising
       x.theta_h_deg = RadToDeg(std::acos(std::clamp(x.g.n_dot_h, -1.0, 1.0)));
       x.slice = static_cast<int>(si);

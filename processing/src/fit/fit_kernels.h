@@ -418,9 +418,12 @@ struct HdrpLinear {
   };
   static Geom Prepare(const ShadingGeometry& g) {
     const double n_dot_v = std::max(g.n_dot_v, 0.0001);
-    return {g.n_dot_h * g.n_dot_h,         g.n_dot_l,
-            n_dot_v,                       1.0 + g.l_dot_v,
-            models::Pow5(1.0 - g.n_dot_l), models::Pow5(1.0 - n_dot_v),
+    return {g.n_dot_h * g.n_dot_h,
+            g.n_dot_l,
+            n_dot_v,
+            1.0 + g.l_dot_v,
+            models::Pow5(1.0 - g.n_dot_l),
+            models::Pow5(1.0 - n_dot_v),
             models::Pow5(1.0 - g.v_dot_h)};
   }
   struct Shape {

@@ -57,8 +57,8 @@ struct Atlas {
   std::vector<double> theta_in_deg;
   std::vector<std::string> names, sources;
   std::vector<std::optional<std::vector<SaturatedCount>>> saturated_samples;  // per material
-  std::vector<std::optional<ExtrapolationInfo>> extrapolation;               // per material
-  std::vector<std::vector<std::string>> fitted_models_json;                  // per material
+  std::vector<std::optional<ExtrapolationInfo>> extrapolation;                // per material
+  std::vector<std::vector<std::string>> fitted_models_json;                   // per material
   PackedVolume volume;  // Cm·361 × Rm·181 × K, RGB9E5
 };
 
