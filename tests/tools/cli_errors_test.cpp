@@ -36,6 +36,8 @@ TEST_F(CliErrors, EveryParseErrorIsOneShortLineNamingOptionAndValue) {
       {"fit in --out o.json --model phong", {"--model", "phong", "blinn-phong"}},
       {"nonsense", {"brdf"}},
       {"eval x.json --in 30,0 --out 30,180 --bogus 1", {"brdf: eval: ", "'--bogus 1'"}},
+      {"fit x.json --out y.json --robust=3",
+       {"brdf: fit: --robust is a switch and takes no value"}},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.args);

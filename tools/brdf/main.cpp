@@ -97,6 +97,9 @@ std::string OneLineParseError(const CLI::App& app, const CLI::Error& e) {
     for (const std::string& a : app.remaining(true)) typed += (typed.empty() ? "" : " ") + a;
     if (!typed.empty()) what = "unexpected argument(s) '" + typed + "'";
   }
+  const std::size_t override_at = what.find(" was given a disallowed flag override");
+  if (override_at != std::string::npos)
+    what = "--" + what.substr(0, override_at) + " is a switch and takes no value";
   for (char& c : what)
     if (c == '\n') c = ' ';
   return where + what + " (see '" + command + " --help')";
@@ -108,6 +111,8 @@ int main(int argc, char** argv) {
   CLI::App app{"brdf: measured reflectance to engine-ready lookup textures"};
   app.set_version_flag("--version", std::string("brdf-toolchain ") + brdf::SoftwareVersion());
   app.require_subcommand(1);
+  // A switch takes no value: "--robust=3" is refused instead of being read as "on".
+  app.option_defaults()->disable_flag_override();
   // Errors reported through app.exit() (none today: main prints them) look the same.
   app.failure_message(
       [](const CLI::App* a, const CLI::Error& e) { return OneLineParseError(*a, e) + "\n"; });
