@@ -461,31 +461,16 @@ class BoundWatch final : public ceres::IterationCallback {
 // ----------------------------------------------------------------------------------------------
 // Costs in doubles.
 
-// ½ Σ r² over `samples` (every k-th with `stride`), without a robust loss.
+// ½ Σ r² over `samples`, or with robust_scale b > 0 the Cauchy cost ½ Σ b²·ln(1 + r²/b²).
 double Cost(const std::vector<FitSample>& samples, const Material& m, FitLoss loss,
-            std::size_t stride = 1) {
-  double sum = 0;
-  for (std::size_t k = 0; k < samples.size(); k += stride) {
-    const FitSample& s = samples[k];
-    const std::array<double, 3> f = models::EvaluateRgb(m.model, s.g, m.values.data());
-    for (int c = 0; c < 3; ++c) {
-      const double r = Residual(loss, f[c], s.m[c], s.cos_in, s.sqrt_w);
-      sum += r * r;
-    }
-  }
-  return 0.5 * sum;
-}
-
-// ½ Σ b²·ln(1 + r²/b²) over `samples`: the cost under the robust (Cauchy) loss of scale b.
-double RobustCost(const std::vector<FitSample>& samples, const Material& m, FitLoss loss,
-                  double scale) {
-  const double b2 = scale * scale;
+            double robust_scale = 0) {
+  const double b2 = robust_scale * robust_scale;
   double sum = 0;
   for (const FitSample& s : samples) {
     const std::array<double, 3> f = models::EvaluateRgb(m.model, s.g, m.values.data());
     for (int c = 0; c < 3; ++c) {
       const double r = Residual(loss, f[c], s.m[c], s.cos_in, s.sqrt_w);
-      sum += b2 * std::log1p(r * r / b2);
+      sum += robust_scale > 0 ? b2 * std::log1p(r * r / b2) : r * r;
     }
   }
   return 0.5 * sum;
@@ -1117,13 +1102,9 @@ FitReport EvaluateFit(const Measurement& measurement, const Material& material,
   report.loss = options.loss;
   report.robust = options.robust;
   report.status = "evaluated";
-  if (options.robust) {
-    report.robust_scale = RobustScale(data.samples, material, options);
-    report.final_cost = RobustCost(data.samples, material, options.loss, report.robust_scale);
-  } else {
-    report.final_cost = Cost(data.samples, material, options.loss);
-  }
-  report.initial_cost = report.final_cost;
+  report.robust_scale = options.robust ? RobustScale(data.samples, material, options) : 0.0;
+  report.final_cost = report.initial_cost =
+      Cost(data.samples, material, options.loss, report.robust_scale);
   FillErrors(data, material, &report);
   return report;
 }
