@@ -55,11 +55,9 @@ int RunAtlas(const AtlasOptions& options) {
     outputs.push_back(std::move(p));
   {
     std::set<std::string> inputs;
-    std::error_code ec;
-    for (const BatchInput& in : found.inputs)
-      inputs.insert(fs::weakly_canonical(in.path, ec).string());
+    for (const BatchInput& in : found.inputs) inputs.insert(Identity(in.path));
     for (const std::string& out : outputs)
-      if (inputs.count(fs::weakly_canonical(out, ec).string()))
+      if (inputs.count(Identity(out)))
         throw InvalidArgument("--out " + options.out + ": the atlas file " + out +
                               " would overwrite an input; choose another prefix");
   }

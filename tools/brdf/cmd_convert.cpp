@@ -44,19 +44,13 @@ std::vector<std::string> OutputPaths(const fs::path& dir, const std::string& nam
   return paths;
 }
 
-std::string Canonical(const std::string& p) {
-  std::error_code ec;
-  const fs::path c = fs::weakly_canonical(p, ec);
-  return ec ? fs::path(p).lexically_normal().string() : c.string();
-}
-
 // Refuses inputs whose outputs would collide with another input's outputs or overwrite an
 // input (a material "gold.json" converted into its own folder would be replaced by the sidecar
 // "gold.json"). Such inputs move from `inputs` to `failures`.
 void RefuseCollisions(const fs::path& out_dir, const exporter::LutExportFormats& formats,
                       std::vector<BatchInput>& inputs, std::vector<BatchFailure>& failures) {
   std::set<std::string> input_paths;
-  for (const BatchInput& in : inputs) input_paths.insert(Canonical(in.path));
+  for (const BatchInput& in : inputs) input_paths.insert(Identity(in.path));
   std::map<std::string, std::vector<std::size_t>> by_name;
   for (std::size_t i = 0; i < inputs.size(); ++i) by_name[inputs[i].name].push_back(i);
   std::vector<bool> refused(inputs.size(), false);
@@ -74,7 +68,7 @@ void RefuseCollisions(const fs::path& out_dir, const exporter::LutExportFormats&
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     if (reasons.count(i)) continue;
     for (const std::string& out : OutputPaths(out_dir, inputs[i].name, formats))
-      if (input_paths.count(Canonical(out))) {
+      if (input_paths.count(Identity(out))) {
         reasons[i] = "its output " + out + " would overwrite an input; choose another --out folder";
         break;
       }
