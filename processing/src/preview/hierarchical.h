@@ -55,8 +55,8 @@ class MapHierarchy {
 
 struct HierarchicalSettings {
   // A cell of solid angle Ω is split when the luminance of its estimate and of its children's
-  // sum differ by more than tolerance · scale · √(Ω/2π) (scale: Radiance()).
-  double tolerance = 0.02;
+  // sum differ by more than tolerance · scale · (Ω/2π)^0.1 (scale: Radiance()).
+  double tolerance = 0.002;
   // A cell whose estimate exceeds this fraction of the pixel's first (top-level) estimate is
   // split whatever its children say, so that no single cell carries a large share unchecked.
   double largest_share = 0.03;

@@ -204,7 +204,7 @@ struct PreviewOptions {
   // kHierarchical. Both tolerances are relative to the image's mean object luminance Ȳ
   // (estimated first from the coarsest level at about 1000 pixels), the scale the benchmark's
   // RMS error is measured against. A map cell of solid angle Ω is split when the luminance of
-  // its estimate and its four children's differ by more than hierarchical_tolerance·Ȳ·√(Ω/2π).
+  // its estimate and its four children's differ by more than hierarchical_tolerance·Ȳ·(Ω/2π)^0.1.
   // Image blocks of image_block × image_block pixels (a power of two) are filled by
   // biquadratic interpolation through the pixels computed at their corners, centre and edge
   // midpoints when those midpoints differ from the bilinear interpolation of the corners by at
@@ -213,7 +213,7 @@ struct PreviewOptions {
   // shrinks in smaller images, where a block spans a larger part of the object. With the
   // defaults the image is within about 0.1–0.6 % RMS of the brute-force kQuadrature
   // (docs/benchmarks.md).
-  double hierarchical_tolerance = 0.02;
+  double hierarchical_tolerance = 0.002;
   int image_block = 16;
   double image_tolerance = 0.1;
   // Kept for references at a subset of pixels: when non-empty, only these image pixels
