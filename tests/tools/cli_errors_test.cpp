@@ -38,6 +38,11 @@ TEST_F(CliErrors, EveryParseErrorIsOneShortLineNamingOptionAndValue) {
       {"eval x.json --in 30,0 --out 30,180 --bogus 1", {"brdf: eval: ", "'--bogus 1'"}},
       {"fit x.json --out y.json --robust=3",
        {"brdf: fit: --robust is a switch and takes no value"}},
+      // An option typed without its value, the next option taken for it by CLI11 before.
+      {"fit x.json --model --out y.json",
+       {"brdf: fit: --model needs a value", "the option '--out'"}},
+      {"preview x.json --env --out y.png", {"brdf: preview: --env needs a value", "'--out'"}},
+      {"preview x.json --size --help", {"--size needs a value", "'--help'"}},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.args);

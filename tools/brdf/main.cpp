@@ -105,6 +105,34 @@ std::string OneLineParseError(const CLI::App& app, const CLI::Error& e) {
   return where + what + " (see '" + command + " --help')";
 }
 
+// CLI11 takes the token after an option as its value even when it is another option, so
+// "--env --out a.png" would set the map to "--out" and then report --out missing. Said instead
+// as the user's mistake: the option typed without its value. Empty when there is none.
+std::string OptionWithoutValue(CLI::App& app, int argc, char** argv) {
+  if (argc < 2) return {};
+  CLI::App* sub = nullptr;
+  for (CLI::App* candidate : app.get_subcommands({}))
+    if (candidate->get_name() == argv[1]) sub = candidate;
+  if (sub == nullptr) return {};
+  auto option_named = [&](const std::string& token) -> const CLI::Option* {
+    if (token.size() < 3 || token.compare(0, 2, "--") != 0) return nullptr;
+    return sub->get_option_no_throw(token.substr(0, token.find('=')));
+  };
+  for (int i = 2; i + 1 < argc; ++i) {
+    const std::string token = argv[i], next = argv[i + 1];
+    if (token == "--") break;  // the rest are values
+    const CLI::Option* option = option_named(token);
+    if (option == nullptr || token.find('=') != std::string::npos ||
+        option->get_items_expected_min() == 0)
+      continue;
+    if (option_named(next) != nullptr || next == "--help")
+      return "brdf: " + sub->get_name() + ": " + token +
+             " needs a value, but the next argument is the option '" + next + "' (see 'brdf " +
+             sub->get_name() + " --help')";
+  }
+  return {};
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -576,6 +604,10 @@ int main(int argc, char** argv) {
     exit_code = brdf::cli::RunPreview(preview);
   });
 
+  if (const std::string missing = OptionWithoutValue(app, argc, argv); !missing.empty()) {
+    std::fprintf(stderr, "%s\n", missing.c_str());
+    return 2;
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
