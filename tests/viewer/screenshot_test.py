@@ -461,8 +461,30 @@ def case_compare_error(brdf_view, source_dir, tmp):
     print("compare error: " + lines[0])
 
 
+def case_small_window(brdf_view, source_dir, tmp):
+    # At 320 x 240 the overlay text must stay clear of the legend, which starts at 89 % of the
+    # width: no text-coloured pixels (bright, grey) in the columns just left of it, in the rows
+    # the overlay occupies; and the overlay must be there at all.
+    width, height = 320, 240
+    shot = os.path.join(tmp, "small.png")
+    gold = os.path.join(source_dir, "data-samples", "materials", "gold.json")
+    run_view(brdf_view, [gold, "--size", f"{width}x{height}", "--screenshot", shot], tmp)
+    img = read_png(shot, width, height)
+    text = (img.min(axis=2) > 150) & (img.max(axis=2) - img.min(axis=2) < 40)
+    rows = slice(0, height // 4)
+    overlay = text[rows, : int(0.3 * width)].sum()
+    if overlay < 50:
+        fail(f"the overlay text is missing ({overlay} text pixels at the top left)")
+    gap = text[rows, int(0.75 * width): int(0.88 * width)].sum()
+    if gap > 0:
+        fail(f"the overlay text runs into the legend: {gap} text pixels in columns "
+             f"{int(0.75 * width)}-{int(0.88 * width)} of the top rows")
+    print(f"small window: overlay {overlay} text pixels, none next to the legend")
+
+
 CASES = {
     "lobe_lambert": case_lobe_lambert,
+    "small_window": case_small_window,
     "lobe_glossy": case_lobe_glossy,
     "slices": case_slices,
     "preview": case_preview,

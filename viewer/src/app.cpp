@@ -222,6 +222,15 @@ vtkStandardNewMacro(ViewerStyle)
     renderer_->AddViewProp(prop);
     scene_.emplace_back(prop);
   }
+  // Text is sized for the default 960 × 720 window and shrinks with a smaller one (to half at
+  // most, 7 points at least), so that the overlay does not run into the legend in small
+  // screenshots.
+  double TextScale() const {
+    return std::clamp(std::min(options_.width / 960.0, options_.height / 720.0), 0.5, 1.0);
+  }
+  void Style(vtkTextProperty* p, int points, double r, double g, double b) const {
+    StyleText(p, std::max(7, static_cast<int>(std::lround(points * TextScale()))), r, g, b);
+  }
 
   Display* display_;  // owned by RunViewer, outlives every VTK object here
   ViewerOptions options_;
@@ -594,15 +603,15 @@ void App::BuildSlicesScene(bool reset_camera) {
       axis->GetProperty()->SetColor(0.85, 0.85, 0.85);
       axis->SetFontFactor(0.9);
       axis->SetLabelFactor(0.8);
-      StyleText(axis->GetTitleTextProperty(), 14, 0.9, 0.9, 0.9);
-      StyleText(axis->GetLabelTextProperty(), 12, 0.9, 0.9, 0.9);
+      Style(axis->GetTitleTextProperty(), 14, 0.9, 0.9, 0.9);
+      Style(axis->GetLabelTextProperty(), 12, 0.9, 0.9, 0.9);
       AddProp(axis);
     }
     vtkNew<vtkTextActor> title;
     title->SetInput(("θin = " + Fixed(img.theta_in_deg, 0) + "°").c_str());
     title->GetPositionCoordinate()->SetCoordinateSystemToWorld();
     title->GetPositionCoordinate()->SetValue(x0 + 150, y0 + 186, 0);
-    StyleText(title->GetTextProperty(), 16, 1, 1, 1);
+    Style(title->GetTextProperty(), 16, 1, 1, 1);
     AddProp(title);
   }
   legend_->SetLookupTable(colors_);
@@ -983,18 +992,18 @@ ViewerResult App::Run() {
   info_->GetPositionCoordinate()->SetCoordinateSystemToNormalizedDisplay();
   info_->GetPositionCoordinate()->SetValue(0.01, 0.99);
   info_->GetTextProperty()->SetVerticalJustificationToTop();
-  StyleText(info_->GetTextProperty(), 14, 0.95, 0.95, 0.95);
+  Style(info_->GetTextProperty(), 14, 0.95, 0.95, 0.95);
   info_->GetTextProperty()->SetVerticalJustificationToTop();
   help_->GetPositionCoordinate()->SetCoordinateSystemToNormalizedDisplay();
   help_->GetPositionCoordinate()->SetValue(0.01, 0.01);
-  StyleText(help_->GetTextProperty(), 13, 0.7, 0.8, 0.95);
+  Style(help_->GetTextProperty(), 13, 0.7, 0.8, 0.95);
   hover_->GetPositionCoordinate()->SetCoordinateSystemToNormalizedDisplay();
   hover_->GetPositionCoordinate()->SetValue(0.01, 0.90);
   hover_->GetTextProperty()->SetVerticalJustificationToTop();
-  StyleText(hover_->GetTextProperty(), 13, 1.0, 0.95, 0.6);
+  Style(hover_->GetTextProperty(), 13, 1.0, 0.95, 0.6);
   message_->GetPositionCoordinate()->SetCoordinateSystemToNormalizedDisplay();
   message_->GetPositionCoordinate()->SetValue(0.5, 0.5);
-  StyleText(message_->GetTextProperty(), 18, 1.0, 0.35, 0.3);
+  Style(message_->GetTextProperty(), 18, 1.0, 0.35, 0.3);
   message_->GetTextProperty()->SetJustificationToCentered();
   message_->GetTextProperty()->SetVerticalJustificationToCentered();
   for (vtkTextActor* t : {info_.Get(), help_.Get(), hover_.Get(), message_.Get()}) {
@@ -1002,13 +1011,14 @@ ViewerResult App::Run() {
   }
   legend_->SetNumberOfLabels(5);
   legend_->UnconstrainedFontSizeOn();
-  legend_->SetMaximumWidthInPixels(90);
+  legend_->SetMaximumWidthInPixels(static_cast<int>(90 * TextScale()));
+  legend_->SetVerticalTitleSeparation(static_cast<int>(std::lround(8 * TextScale())));
   legend_->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
   legend_->GetPositionCoordinate()->SetValue(0.89, 0.15);
   legend_->SetWidth(0.1);
   legend_->SetHeight(0.7);
-  StyleText(legend_->GetTitleTextProperty(), 13, 0.95, 0.95, 0.95);
-  StyleText(legend_->GetLabelTextProperty(), 12, 0.9, 0.9, 0.9);
+  Style(legend_->GetTitleTextProperty(), 13, 0.95, 0.95, 0.95);
+  Style(legend_->GetLabelTextProperty(), 12, 0.9, 0.9, 0.9);
   legend_->SetLabelFormat("%.3g");
   renderer_->AddViewProp(legend_);
 
@@ -1023,8 +1033,8 @@ ViewerResult App::Run() {
   slider_rep_->SetTubeWidth(0.006);
   slider_rep_->SetTitleHeight(0.025);
   slider_rep_->SetLabelHeight(0.022);
-  StyleText(slider_rep_->GetTitleProperty(), 14, 0.9, 0.9, 0.9);
-  StyleText(slider_rep_->GetLabelProperty(), 14, 0.9, 0.9, 0.9);
+  Style(slider_rep_->GetTitleProperty(), 14, 0.9, 0.9, 0.9);
+  Style(slider_rep_->GetLabelProperty(), 14, 0.9, 0.9, 0.9);
   if (Primary()) {
     theta_in_deg_ = std::clamp(theta_in_deg_, MinThetaIn(), MaxThetaIn());
     current_slice_ = NearestSlice();
