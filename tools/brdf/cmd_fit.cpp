@@ -106,7 +106,7 @@ int RunFit(const FitCommandOptions& options) {
     throw InvalidArgument("--starts: expected at least 1, got " + std::to_string(options.starts));
   if (options.max_theta_out_deg < 0 || options.max_theta_out_deg > 90)
     throw InvalidArgument("--max-theta-out: expected an angle in (0, 90] degrees, got " +
-                          std::to_string(options.max_theta_out_deg));
+                          NumberText(options.max_theta_out_deg));
   std::vector<Model> models;
   if (options.model == "all") {
     for (Model m : AllModels()) models.push_back(m);

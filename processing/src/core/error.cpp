@@ -2,6 +2,7 @@
 
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <utility>
@@ -34,6 +35,11 @@ FormatError::FormatError(std::string file, std::string position, std::string exp
 
 std::string BytePosition(std::uint64_t offset) { return "byte " + std::to_string(offset); }
 std::string LinePosition(std::uint64_t line) { return "line " + std::to_string(line); }
+std::string NumberText(double value) {
+  char text[32];
+  std::snprintf(text, sizeof text, "%.9g", value);
+  return text;
+}
 
 std::string TextPosition(std::string_view text, std::uint64_t offset) {
   std::uint64_t line = 1, column = 1;

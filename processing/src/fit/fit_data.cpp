@@ -79,7 +79,7 @@ FitData PrepareFitData(const Measurement& measurement, const FitOptions& options
   if (options.max_theta_out_deg &&
       !(*options.max_theta_out_deg > 0 && *options.max_theta_out_deg <= 90))
     throw InvalidArgument("fit: the largest θout must be in (0°, 90°], got " +
-                          std::to_string(*options.max_theta_out_deg));
+                          NumberText(*options.max_theta_out_deg));
   FitData data;
   data.samples.reserve(measurement.SampleCount());
   DirectionCache directions;

@@ -117,7 +117,7 @@ EnvironmentMap EnvironmentMap::Sky(double sun_theta_deg, double sun_phi_deg, int
   CheckSize(width, height);
   if (!(sun_theta_deg >= 0.0 && sun_theta_deg < 90.0) || !std::isfinite(sun_phi_deg))
     throw InvalidArgument("sky: the sun's polar angle must be in [0, 90) degrees, got " +
-                          std::to_string(sun_theta_deg));
+                          NumberText(sun_theta_deg));
   const Vec3 sun = SphericalDirectionDeg(sun_theta_deg, sun_phi_deg);
   const double sun_theta = DegToRad(sun_theta_deg);
   // CIE standard clear sky (ISO 15469 type 12): gradation φ(θ) = 1 − exp(−0.32 / cosθ),

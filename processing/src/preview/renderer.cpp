@@ -179,7 +179,7 @@ struct PreviewRenderer::Impl {
       fail("camera fill must be in (0, 1], got " + std::to_string(o.camera.fill));
     if (o.camera.projection == Camera::Projection::kPerspective &&
         !(o.camera.fov_deg > 0.0 && o.camera.fov_deg < 170.0))
-      fail("field of view must be in (0, 170) degrees, got " + std::to_string(o.camera.fov_deg));
+      fail("field of view must be in (0, 170) degrees, got " + NumberText(o.camera.fov_deg));
     if (!std::isfinite(o.camera.theta_deg) || !std::isfinite(o.camera.phi_deg) ||
         !std::isfinite(o.environment_rotation_deg))
       fail("camera angles and the map rotation must be finite");

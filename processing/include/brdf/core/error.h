@@ -119,5 +119,8 @@ class DeviceError : public Error {
 // "byte 1840" and "line 12": the two position spellings used by every reader.
 std::string BytePosition(std::uint64_t offset);
 std::string LinePosition(std::uint64_t line);
+// A number as a user typed it in messages: "-10", "0.25", "1e+30" (%g, 9 significant digits),
+// not std::to_string's "-10.000000".
+std::string NumberText(double value);
 
 }  // namespace brdf
