@@ -9,14 +9,6 @@
 namespace brdf::preview::detail {
 namespace {
 
-// ∫ ω dω over the patch θ ∈ [t0, t1], φ ∈ [p0, p1] (dω = sinθ dθ dφ).
-Vec3 PatchMoment(double t0, double t1, double p0, double p1) {
-  const double sin_sq = (0.5 * (t1 - t0) - 0.25 * (std::sin(2.0 * t1) - std::sin(2.0 * t0)));
-  const double sin_cos = 0.5 * (std::sin(t1) * std::sin(t1) - std::sin(t0) * std::sin(t0));
-  return {sin_sq * (std::sin(p1) - std::sin(p0)), sin_sq * (std::cos(p0) - std::cos(p1)),
-          sin_cos * (p1 - p0)};
-}
-
 void Store(float* out, const Vec3& v) {
   out[0] = static_cast<float>(v.x);
   out[1] = static_cast<float>(v.y);
@@ -24,25 +16,82 @@ void Store(float* out, const Vec3& v) {
 }
 Vec3 Load(const float* v) { return {v[0], v[1], v[2]}; }
 
-// The bounding cone of the cell θ ∈ [t0, t1], φ ∈ [p0, p1]: the distance from the centre
-// direction grows monotonically along each edge (small circles of constant θ, meridians), so a
-// corner is the farthest point; a small margin covers float rounding.
-void SetCone(double t0, double t1, double p0, double p1, MapHierarchy::Cell* cell) {
-  const Vec3 axis = SphericalDirection(0.5 * (t0 + t1), 0.5 * (p0 + p1));
-  double radius = 0.0;
-  for (double t : {t0, t1})
-    for (double p : {p0, p1})
-      radius =
-          std::max(radius, std::acos(std::clamp(Dot(axis, SphericalDirection(t, p)), -1.0, 1.0)));
-  radius = std::min(0.5 * kPi, radius * 1.01 + 1e-5);
-  Store(cell->axis, axis);
-  cell->sin_radius = static_cast<float>(std::sin(radius));
-  cell->cos_radius = static_cast<float>(std::cos(radius));
+// The trigonometry of the map's pixel edges along one axis: edge k lies at angle
+// k · range / pixels (θ: range π over the rows, φ: 2π over the columns). Every cell of every
+// level has its edges among them (a cell of level ℓ spans 2^ℓ pixels, clipped at the map's
+// edge), so sin/cos are taken once per edge instead of once per cell, corner and level.
+struct EdgeTrig {
+  std::vector<double> angle, sin, cos, sin_twice;  // sin_twice: sin(2·angle), θ edges only
+  EdgeTrig(int pixels, double range, bool twice) {
+    for (int k = 0; k <= pixels; ++k) {
+      const double a = k * range / pixels;
+      angle.push_back(a);
+      sin.push_back(std::sin(a));
+      cos.push_back(std::cos(a));
+      if (twice) sin_twice.push_back(std::sin(2.0 * a));
+    }
+  }
+};
+
+// The per-row (θ) or per-column (φ) terms of the cells of one level: the edge indices and the
+// direction of the centre angle.
+struct CellAxis {
+  int edge0, edge1;
+  double sin_centre, cos_centre;
+};
+std::vector<CellAxis> Axis(const EdgeTrig& edges, int cells, int span) {
+  const int pixels = static_cast<int>(edges.angle.size()) - 1;
+  std::vector<CellAxis> axis(static_cast<std::size_t>(cells));
+  for (int k = 0; k < cells; ++k) {
+    CellAxis& a = axis[k];
+    a.edge0 = std::min(k * span, pixels);
+    a.edge1 = std::min((k + 1) * span, pixels);
+    const double centre = 0.5 * (edges.angle[a.edge0] + edges.angle[a.edge1]);
+    a.sin_centre = std::sin(centre);
+    a.cos_centre = std::cos(centre);
+  }
+  return axis;
 }
+
+// The bounding cone of the cell between θ edges `row` and φ edges `column`: the distance from
+// the centre direction grows monotonically along each edge (small circles of constant θ,
+// meridians), so a corner is the farthest point (the smallest cosine); a small margin covers
+// float rounding. The cone of a row's cells is the same up to rounding in every column, so the
+// last cosine's sin/cos of the radius are kept in `cache` and reused when the cosine repeats
+// exactly (the same numbers as computing them again).
+struct ConeCache {
+  double min_dot = 2.0;  // no cosine is 2
+  float sin_radius = 0, cos_radius = 0;
+};
+void SetCone(const EdgeTrig& theta, const EdgeTrig& phi, const CellAxis& row,
+             const CellAxis& column, ConeCache* cache, MapHierarchy::Cell* cell) {
+  const Vec3 axis = {row.sin_centre * column.cos_centre, row.sin_centre * column.sin_centre,
+                     row.cos_centre};
+  double min_dot = 1.0;
+  for (int t : {row.edge0, row.edge1})
+    for (int p : {column.edge0, column.edge1}) {
+      const Vec3 corner = {theta.sin[t] * phi.cos[p], theta.sin[t] * phi.sin[p], theta.cos[t]};
+      min_dot = std::min(min_dot, std::clamp(Dot(axis, corner), -1.0, 1.0));
+    }
+  Store(cell->axis, axis);
+  if (min_dot != cache->min_dot) {
+    // acos falls monotonically, so the largest corner distance is the acos of the smallest
+    // cosine.
+    const double radius = std::min(0.5 * kPi, std::max(0.0, std::acos(min_dot)) * 1.01 + 1e-5);
+    cache->min_dot = min_dot;
+    cache->sin_radius = static_cast<float>(std::sin(radius));
+    cache->cos_radius = static_cast<float>(std::cos(radius));
+  }
+  cell->sin_radius = cache->sin_radius;
+  cell->cos_radius = cache->cos_radius;
+}
+
+// Rows are independent at every level, so they are built `jobs` at a time.
+constexpr std::size_t kRowsPerChunk = 4;
 
 }  // namespace
 
-MapHierarchy::MapHierarchy(const EnvironmentMap& map, int top_columns) {
+MapHierarchy::MapHierarchy(const EnvironmentMap& map, int top_columns, int jobs) {
   const int w0 = map.width(), h0 = map.height();
   width_.push_back(w0);
   height_.push_back(h0);
@@ -51,65 +100,91 @@ MapHierarchy::MapHierarchy(const EnvironmentMap& map, int top_columns) {
     height_.push_back((height_.back() + 1) / 2);
   }
   cells_.resize(width_.size());
-  // Level 0: the map's pixels, in double while summing.
+  const EdgeTrig theta(h0, kPi, true), phi(w0, 2.0 * kPi, false);
+  // Level 0: the map's pixels, in double while summing. The moment ∫ ω dω of the patch
+  // θ ∈ [t0, t1], φ ∈ [p0, p1] (dω = sinθ dθ dφ) is a θ factor times a φ factor per component:
+  //   (S · (sin p1 − sin p0), S · (cos p0 − cos p1), C · (p1 − p0)),
+  //   S = ∫ sin²θ dθ = (t1 − t0)/2 − (sin 2t1 − sin 2t0)/4,
+  //   C = ∫ sinθ cosθ dθ = (sin²t1 − sin²t0)/2.
   struct Sums {
     double e[3] = {0, 0, 0};
     Vec3 m{0, 0, 0};
     double y = 0, solid_angle = 0;
   };
-  std::vector<Sums> sums(static_cast<std::size_t>(w0) * h0);
+  std::vector<double> sin_sq(h0), sin_cos(h0), band(h0);
   for (int j = 0; j < h0; ++j) {
-    const double t0 = j * kPi / h0, t1 = (j + 1) * kPi / h0;
-    const double band = std::cos(t0) - std::cos(t1);
-    for (int i = 0; i < w0; ++i) {
-      const double p0 = i * 2.0 * kPi / w0, p1 = (i + 1) * 2.0 * kPi / w0;
-      const float* px = map.Pixel(i, j);
-      Sums& s = sums[static_cast<std::size_t>(j) * w0 + i];
-      s.solid_angle = band * (p1 - p0);
-      for (int c = 0; c < 3; ++c) s.e[c] = px[c] * s.solid_angle;
-      s.y = Luminance({px[0], px[1], px[2]}) * s.solid_angle;
-      s.m = PatchMoment(t0, t1, p0, p1) * Luminance({px[0], px[1], px[2]});
-    }
+    sin_sq[j] = 0.5 * (theta.angle[j + 1] - theta.angle[j]) -
+                0.25 * (theta.sin_twice[j + 1] - theta.sin_twice[j]);
+    sin_cos[j] = 0.5 * (theta.sin[j + 1] * theta.sin[j + 1] - theta.sin[j] * theta.sin[j]);
+    band[j] = theta.cos[j] - theta.cos[j + 1];
   }
+  std::vector<double> d_phi(w0), d_sin(w0), d_cos(w0);
+  for (int i = 0; i < w0; ++i) {
+    d_phi[i] = phi.angle[i + 1] - phi.angle[i];
+    d_sin[i] = phi.sin[i + 1] - phi.sin[i];
+    d_cos[i] = phi.cos[i] - phi.cos[i + 1];
+  }
+  std::vector<Sums> sums(static_cast<std::size_t>(w0) * h0);
+  ParallelChunks(
+      static_cast<std::size_t>(h0), kRowsPerChunk, jobs, nullptr,
+      [&](std::size_t b, std::size_t e) {
+        for (std::size_t j = b; j < e; ++j)
+          for (int i = 0; i < w0; ++i) {
+            const float* px = map.Pixel(i, static_cast<int>(j));
+            Sums& s = sums[j * w0 + i];
+            s.solid_angle = band[j] * d_phi[i];
+            for (int c = 0; c < 3; ++c) s.e[c] = px[c] * s.solid_angle;
+            const double y = Luminance({px[0], px[1], px[2]});
+            s.y = y * s.solid_angle;
+            s.m = Vec3{sin_sq[j] * d_sin[i], sin_sq[j] * d_cos[i], sin_cos[j] * d_phi[i]} * y;
+          }
+      });
   for (int level = 0; level < levels(); ++level) {
     const int w = width_[level], h = height_[level];
     if (level > 0) {
       std::vector<Sums> up(static_cast<std::size_t>(w) * h);
       const int wd = width_[level - 1], hd = height_[level - 1];
-      for (int j = 0; j < h; ++j)
-        for (int i = 0; i < w; ++i) {
-          Sums& s = up[static_cast<std::size_t>(j) * w + i];
-          for (int b = 2 * j; b < std::min(2 * j + 2, hd); ++b)
-            for (int a = 2 * i; a < std::min(2 * i + 2, wd); ++a) {
-              const Sums& d = sums[static_cast<std::size_t>(b) * wd + a];
-              for (int c = 0; c < 3; ++c) s.e[c] += d.e[c];
-              s.m = s.m + d.m;
-              s.y += d.y;
-              s.solid_angle += d.solid_angle;
-            }
-        }
+      ParallelChunks(static_cast<std::size_t>(h), kRowsPerChunk, jobs, nullptr,
+                     [&](std::size_t b0, std::size_t e0) {
+                       for (int j = static_cast<int>(b0); j < static_cast<int>(e0); ++j)
+                         for (int i = 0; i < w; ++i) {
+                           Sums& s = up[static_cast<std::size_t>(j) * w + i];
+                           for (int b = 2 * j; b < std::min(2 * j + 2, hd); ++b)
+                             for (int a = 2 * i; a < std::min(2 * i + 2, wd); ++a) {
+                               const Sums& d = sums[static_cast<std::size_t>(b) * wd + a];
+                               for (int c = 0; c < 3; ++c) s.e[c] += d.e[c];
+                               s.m = s.m + d.m;
+                               s.y += d.y;
+                               s.solid_angle += d.solid_angle;
+                             }
+                         }
+                     });
       sums = std::move(up);
     }
     // Cell (i, j) of this level covers map pixels [i·2^level, (i+1)·2^level) clipped.
     const int span = 1 << level;
+    const std::vector<CellAxis> rows = Axis(theta, h, span), columns = Axis(phi, w, span);
     std::vector<Cell>& cells = cells_[level];
     cells.resize(static_cast<std::size_t>(w) * h);
-    for (int j = 0; j < h; ++j)
-      for (int i = 0; i < w; ++i) {
-        const Sums& s = sums[static_cast<std::size_t>(j) * w + i];
-        Cell& cell = cells[static_cast<std::size_t>(j) * w + i];
-        for (int c = 0; c < 3; ++c) cell.radiance_solid_angle[c] = static_cast<float>(s.e[c]);
-        Store(cell.luminance_moment, s.m);
-        cell.luminance = static_cast<float>(s.y);
-        cell.solid_angle = static_cast<float>(s.solid_angle);
-        const double t0 = std::min(j * span, h0) * kPi / h0;
-        const double t1 = std::min((j + 1) * span, h0) * kPi / h0;
-        const double p0 = std::min(i * span, w0) * 2.0 * kPi / w0;
-        const double p1 = std::min((i + 1) * span, w0) * 2.0 * kPi / w0;
-        SetCone(t0, t1, p0, p1, &cell);
-        const double length = Length(s.m);
-        Store(cell.centroid, length > 0.0 ? s.m * (1.0 / length) : Load(cell.axis));
-      }
+    ParallelChunks(static_cast<std::size_t>(h), kRowsPerChunk, jobs, nullptr,
+                   [&](std::size_t b, std::size_t e) {
+                     for (std::size_t j = b; j < e; ++j) {
+                       ConeCache cache;
+                       for (int i = 0; i < w; ++i) {
+                         const Sums& s = sums[j * w + i];
+                         Cell& cell = cells[j * w + i];
+                         for (int c = 0; c < 3; ++c)
+                           cell.radiance_solid_angle[c] = static_cast<float>(s.e[c]);
+                         Store(cell.luminance_moment, s.m);
+                         cell.luminance = static_cast<float>(s.y);
+                         cell.solid_angle = static_cast<float>(s.solid_angle);
+                         SetCone(theta, phi, rows[j], columns[i], &cache, &cell);
+                         const double length = Length(s.m);
+                         Store(cell.centroid,
+                               length > 0.0 ? s.m * (1.0 / length) : Load(cell.axis));
+                       }
+                     }
+                   });
   }
 }
 

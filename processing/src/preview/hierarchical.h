@@ -38,8 +38,9 @@ class MapHierarchy {
     float solid_angle;              // sr
   };
 
-  // Levels are halved (rounding up) until the top level is at most `top_columns` wide.
-  MapHierarchy(const EnvironmentMap& map, int top_columns);
+  // Levels are halved (rounding up) until the top level is at most `top_columns` wide. Built on
+  // `jobs` threads (the cells do not depend on it).
+  MapHierarchy(const EnvironmentMap& map, int top_columns, int jobs = 1);
 
   int levels() const { return static_cast<int>(width_.size()); }
   int width(int level) const { return width_[level]; }

@@ -21,6 +21,7 @@ namespace {
 
 using detail::Frame;
 using detail::Luminance;
+using detail::ParallelChunks;
 
 std::uint64_t Mix(std::uint64_t x) {  // SplitMix64 finaliser
   x += 0x9e3779b97f4a7c15ull;
@@ -66,27 +67,6 @@ struct PixelSetup {
   Vec3 wo;      // towards the camera, local frame
   Rgb fixed{};  // background (misses) or the directional light's contribution (hits)
 };
-
-// `after_caller_chunk`, when set, runs on the calling thread after each chunk it completed
-// (progress reports come from there, so callbacks never run on a worker).
-template <class F>
-void ParallelChunks(std::size_t count, std::size_t chunk, int jobs, const std::atomic<bool>* cancel,
-                    F work, const std::function<void()>& after_caller_chunk = {}) {
-  std::atomic<std::size_t> next{0};
-  auto loop = [&](bool caller) {
-    for (std::size_t begin = next.fetch_add(chunk); begin < count; begin = next.fetch_add(chunk)) {
-      if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) return;
-      work(begin, std::min(count, begin + chunk));
-      if (caller && after_caller_chunk) after_caller_chunk();
-    }
-  };
-  const int threads =
-      std::max(1, std::min<int>(jobs, static_cast<int>((count + chunk - 1) / chunk)));
-  std::vector<std::thread> workers;
-  for (int t = 1; t < threads; ++t) workers.emplace_back(loop, false);
-  loop(true);
-  for (auto& w : workers) w.join();
-}
 
 // The fraction of a deterministic pass done, counted by the workers (one relaxed atomic add per
 // chunk, no lock) and reported to PreviewOptions::pass_progress from the calling thread.
@@ -450,7 +430,7 @@ struct PreviewRenderer::Impl {
   // The fast path (Estimator::kHierarchical, hierarchical.h): the adaptive map quadrature per
   // computed pixel, bilinear interpolation over image blocks that pass the midpoint checks.
   void Hierarchical() {
-    const detail::MapHierarchy hierarchy(environment, kHierarchyTopColumns);
+    const detail::MapHierarchy hierarchy(environment, kHierarchyTopColumns, jobs);
     detail::HierarchicalSettings settings;
     settings.tolerance = options.hierarchical_tolerance;
     const detail::HierarchicalIntegrator integrator(hierarchy, source, settings);
