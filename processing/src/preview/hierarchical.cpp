@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 #include "preview_internal.h"
 
@@ -107,9 +108,9 @@ MapHierarchy::MapHierarchy(const EnvironmentMap& map, int top_columns, int jobs)
   //   S = ∫ sin²θ dθ = (t1 − t0)/2 − (sin 2t1 − sin 2t0)/4,
   //   C = ∫ sinθ cosθ dθ = (sin²t1 − sin²t0)/2.
   struct Sums {
-    double e[3] = {0, 0, 0};
-    Vec3 m{0, 0, 0};
-    double y = 0, solid_angle = 0;
+    double e[3];
+    Vec3 m;
+    double y, solid_angle;
   };
   std::vector<double> sin_sq(h0), sin_cos(h0), band(h0);
   for (int j = 0; j < h0; ++j) {
@@ -124,34 +125,40 @@ MapHierarchy::MapHierarchy(const EnvironmentMap& map, int top_columns, int jobs)
     d_sin[i] = phi.sin[i + 1] - phi.sin[i];
     d_cos[i] = phi.cos[i] - phi.cos[i + 1];
   }
-  std::vector<Sums> sums(static_cast<std::size_t>(w0) * h0);
-  ParallelChunks(
-      static_cast<std::size_t>(h0), kRowsPerChunk, jobs, nullptr,
-      [&](std::size_t b, std::size_t e) {
-        for (std::size_t j = b; j < e; ++j)
-          for (int i = 0; i < w0; ++i) {
-            const float* px = map.Pixel(i, static_cast<int>(j));
-            Sums& s = sums[j * w0 + i];
-            s.solid_angle = band[j] * d_phi[i];
-            for (int c = 0; c < 3; ++c) s.e[c] = px[c] * s.solid_angle;
-            const double y = Luminance({px[0], px[1], px[2]});
-            s.y = y * s.solid_angle;
-            s.m = Vec3{sin_sq[j] * d_sin[i], sin_sq[j] * d_cos[i], sin_cos[j] * d_phi[i]} * y;
-          }
-      });
+  // The pixels' sums are a few products each, so they are made where they are needed (for the
+  // level-0 cells and again for level 1's) rather than kept: a stored copy would be as large as
+  // the level-0 cells twice over.
+  auto pixel_sums = [&](int i, int j) {
+    const float* px = map.Pixel(i, j);
+    Sums s;
+    s.solid_angle = band[j] * d_phi[i];
+    for (int c = 0; c < 3; ++c) s.e[c] = px[c] * s.solid_angle;
+    const double y = Luminance({px[0], px[1], px[2]});
+    s.y = y * s.solid_angle;
+    s.m = Vec3{sin_sq[j] * d_sin[i], sin_sq[j] * d_cos[i], sin_cos[j] * d_phi[i]} * y;
+    return s;
+  };
+  // The sums of the level below the one being built (from level 2 on; level 1 reads pixels).
+  std::unique_ptr<Sums[]> below, sums;
   for (int level = 0; level < levels(); ++level) {
     const int w = width_[level], h = height_[level];
+    const std::size_t count = static_cast<std::size_t>(w) * h;
     if (level > 0) {
-      std::vector<Sums> up(static_cast<std::size_t>(w) * h);
+      // Left uninitialised here and written by the threads, so that the pages are first
+      // touched (and cleared by the kernel) in parallel.
+      sums = std::make_unique_for_overwrite<Sums[]>(count);
       const int wd = width_[level - 1], hd = height_[level - 1];
       ParallelChunks(static_cast<std::size_t>(h), kRowsPerChunk, jobs, nullptr,
                      [&](std::size_t b0, std::size_t e0) {
                        for (int j = static_cast<int>(b0); j < static_cast<int>(e0); ++j)
                          for (int i = 0; i < w; ++i) {
-                           Sums& s = up[static_cast<std::size_t>(j) * w + i];
+                           Sums& s = sums[static_cast<std::size_t>(j) * w + i];
+                           s = {{0, 0, 0}, {0, 0, 0}, 0, 0};
                            for (int b = 2 * j; b < std::min(2 * j + 2, hd); ++b)
                              for (int a = 2 * i; a < std::min(2 * i + 2, wd); ++a) {
-                               const Sums& d = sums[static_cast<std::size_t>(b) * wd + a];
+                               const Sums d = level == 1
+                                                  ? pixel_sums(a, b)
+                                                  : below[static_cast<std::size_t>(b) * wd + a];
                                for (int c = 0; c < 3; ++c) s.e[c] += d.e[c];
                                s.m = s.m + d.m;
                                s.y += d.y;
@@ -159,32 +166,31 @@ MapHierarchy::MapHierarchy(const EnvironmentMap& map, int top_columns, int jobs)
                              }
                          }
                      });
-      sums = std::move(up);
     }
     // Cell (i, j) of this level covers map pixels [i·2^level, (i+1)·2^level) clipped.
     const int span = 1 << level;
     const std::vector<CellAxis> rows = Axis(theta, h, span), columns = Axis(phi, w, span);
-    std::vector<Cell>& cells = cells_[level];
-    cells.resize(static_cast<std::size_t>(w) * h);
-    ParallelChunks(static_cast<std::size_t>(h), kRowsPerChunk, jobs, nullptr,
-                   [&](std::size_t b, std::size_t e) {
-                     for (std::size_t j = b; j < e; ++j) {
-                       ConeCache cache;
-                       for (int i = 0; i < w; ++i) {
-                         const Sums& s = sums[j * w + i];
-                         Cell& cell = cells[j * w + i];
-                         for (int c = 0; c < 3; ++c)
-                           cell.radiance_solid_angle[c] = static_cast<float>(s.e[c]);
-                         Store(cell.luminance_moment, s.m);
-                         cell.luminance = static_cast<float>(s.y);
-                         cell.solid_angle = static_cast<float>(s.solid_angle);
-                         SetCone(theta, phi, rows[j], columns[i], &cache, &cell);
-                         const double length = Length(s.m);
-                         Store(cell.centroid,
-                               length > 0.0 ? s.m * (1.0 / length) : Load(cell.axis));
-                       }
-                     }
-                   });
+    cells_[level] = std::make_unique_for_overwrite<Cell[]>(count);
+    Cell* cells = cells_[level].get();
+    ParallelChunks(
+        static_cast<std::size_t>(h), kRowsPerChunk, jobs, nullptr,
+        [&](std::size_t b, std::size_t e) {
+          for (std::size_t j = b; j < e; ++j) {
+            ConeCache cache;
+            for (int i = 0; i < w; ++i) {
+              const Sums s = level == 0 ? pixel_sums(i, static_cast<int>(j)) : sums[j * w + i];
+              Cell& cell = cells[j * w + i];
+              for (int c = 0; c < 3; ++c) cell.radiance_solid_angle[c] = static_cast<float>(s.e[c]);
+              Store(cell.luminance_moment, s.m);
+              cell.luminance = static_cast<float>(s.y);
+              cell.solid_angle = static_cast<float>(s.solid_angle);
+              SetCone(theta, phi, rows[j], columns[i], &cache, &cell);
+              const double length = Length(s.m);
+              Store(cell.centroid, length > 0.0 ? s.m * (1.0 / length) : Load(cell.axis));
+            }
+          }
+        });
+    below = std::move(sums);
   }
 }
 

@@ -18,6 +18,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "brdf/core/brdf_source.h"
@@ -51,7 +52,7 @@ class MapHierarchy {
 
  private:
   std::vector<int> width_, height_;
-  std::vector<std::vector<Cell>> cells_;
+  std::vector<std::unique_ptr<Cell[]>> cells_;
 };
 
 struct HierarchicalSettings {
