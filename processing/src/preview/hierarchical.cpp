@@ -57,12 +57,34 @@ std::vector<CellAxis> Axis(const EdgeTrig& edges, int cells, int span) {
 // The bounding cone of the cell between θ edges `row` and φ edges `column`: the distance from
 // the centre direction grows monotonically along each edge (small circles of constant θ,
 // meridians), so a corner is the farthest point (the smallest cosine); a small margin covers
-// float rounding. The cone of a row's cells is the same up to rounding in every column, so the
-// last cosine's sin/cos of the radius are kept in `cache` and reused when the cosine repeats
-// exactly (the same numbers as computing them again).
-struct ConeCache {
-  double min_dot = 2.0;  // no cosine is 2
-  float sin_radius = 0, cos_radius = 0;
+// float rounding. The cone of a row's cells is the same in every column up to rounding, which
+// leaves a few distinct cosines per row, so the sin/cos of the radius of the last few are kept
+// in `cache` and reused when a cosine repeats exactly (the same numbers as computing them
+// again).
+class ConeCache {
+ public:
+  void Set(double min_dot, MapHierarchy::Cell* cell) {
+    int k = 0;
+    while (k < size_ && min_dot_[k] != min_dot) ++k;
+    if (k == size_) {
+      k = size_ < kEntries ? size_++ : next_;
+      next_ = (k + 1) % kEntries;
+      // acos falls monotonically, so the largest corner distance is the acos of the smallest
+      // cosine.
+      const double radius = std::min(0.5 * kPi, std::max(0.0, std::acos(min_dot)) * 1.01 + 1e-5);
+      min_dot_[k] = min_dot;
+      sin_radius_[k] = static_cast<float>(std::sin(radius));
+      cos_radius_[k] = static_cast<float>(std::cos(radius));
+    }
+    cell->sin_radius = sin_radius_[k];
+    cell->cos_radius = cos_radius_[k];
+  }
+
+ private:
+  static constexpr int kEntries = 8;
+  double min_dot_[kEntries];
+  float sin_radius_[kEntries], cos_radius_[kEntries];
+  int size_ = 0, next_ = 0;
 };
 void SetCone(const EdgeTrig& theta, const EdgeTrig& phi, const CellAxis& row,
              const CellAxis& column, ConeCache* cache, MapHierarchy::Cell* cell) {
@@ -75,16 +97,7 @@ void SetCone(const EdgeTrig& theta, const EdgeTrig& phi, const CellAxis& row,
       min_dot = std::min(min_dot, std::clamp(Dot(axis, corner), -1.0, 1.0));
     }
   Store(cell->axis, axis);
-  if (min_dot != cache->min_dot) {
-    // acos falls monotonically, so the largest corner distance is the acos of the smallest
-    // cosine.
-    const double radius = std::min(0.5 * kPi, std::max(0.0, std::acos(min_dot)) * 1.01 + 1e-5);
-    cache->min_dot = min_dot;
-    cache->sin_radius = static_cast<float>(std::sin(radius));
-    cache->cos_radius = static_cast<float>(std::cos(radius));
-  }
-  cell->sin_radius = cache->sin_radius;
-  cell->cos_radius = cache->cos_radius;
+  cache->Set(min_dot, cell);
 }
 
 // Rows are independent at every level, so they are built `jobs` at a time.
