@@ -2,6 +2,7 @@
 #include "hierarchical.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <memory>
 
@@ -207,11 +208,69 @@ MapHierarchy::MapHierarchy(const EnvironmentMap& map, int top_columns, int jobs)
   }
 }
 
+namespace {
+
+// Where the leaf contributions of the straddling cells Clip() has walked lie in the query's
+// leaf list: an open-addressed table from (level, i, j) to [begin, end), cleared per query by a
+// generation count. A cell that does not fit (the table is kept under half full) is walked
+// again when it is estimated, which gives the same numbers.
+class ClipRanges {
+ public:
+  void Clear() {
+    used_ = 0;
+    if (++generation_ == 0) {  // wrapped: forget every stamp
+      for (Slot& s : slots_) s.generation = 0;
+      generation_ = 1;
+    }
+  }
+  static std::uint64_t Key(int level, int i, int j) {
+    return (static_cast<std::uint64_t>(level) << 48) | (static_cast<std::uint64_t>(j) << 24) |
+           static_cast<std::uint64_t>(i);
+  }
+  bool Find(std::uint64_t key, std::size_t* begin, std::size_t* end) const {
+    for (std::size_t k = Hash(key);; k = (k + 1) & (kSlots - 1)) {
+      const Slot& s = slots_[k];
+      if (s.generation != generation_) return false;
+      if (s.key == key) {
+        *begin = s.begin;
+        *end = s.end;
+        return true;
+      }
+    }
+  }
+  void Insert(std::uint64_t key, std::size_t begin, std::size_t end) {
+    if (used_ >= kSlots / 2) return;
+    std::size_t k = Hash(key);
+    while (slots_[k].generation == generation_) k = (k + 1) & (kSlots - 1);
+    slots_[k] = {key, generation_, static_cast<std::uint32_t>(begin),
+                 static_cast<std::uint32_t>(end)};
+    ++used_;
+  }
+
+ private:
+  static constexpr std::size_t kSlots = 1024;
+  static std::size_t Hash(std::uint64_t key) {
+    return static_cast<std::size_t>((key * 0x9e3779b97f4a7c15ull) >> 54);  // 10 bits
+  }
+  struct Slot {
+    std::uint64_t key = 0;
+    std::uint32_t generation = 0, begin = 0, end = 0;
+  };
+  std::array<Slot, kSlots> slots_{};
+  std::uint32_t generation_ = 0;
+  std::size_t used_ = 0;
+};
+
+}  // namespace
+
 struct HierarchicalIntegrator::Query {
   Vec3 s, t, n, wo, mirror;
   double tolerance = 0.0;       // allowed |ΔY| of a cell of 2π sr (scaled by √(Ω/2π))
   double large_estimate = 0.0;  // cells estimated above this are always split
   mutable std::uint64_t evaluations = 0;  // counted for the benchmark figures
+  // Clip()'s record (per thread, reused across queries).
+  std::vector<CellSums>* leaves = nullptr;
+  ClipRanges* ranges = nullptr;
 };
 
 namespace {
@@ -233,17 +292,18 @@ bool ContainsMirror(const Vec3& r, const MapHierarchy::Cell& cell) {
 
 // The part of a cell above the horizon: the sums of its descendants that lie above it, down to
 // `level` `stop` (straddling cells there are taken whole; their signed n·M is nearly exact).
-void HierarchicalIntegrator::Clip(const Query& q, int level, int i, int j, int stop,
-                                  CellSums* out) const {
+void HierarchicalIntegrator::Clip(const Query& q, int level, int i, int j, int stop) const {
   const MapHierarchy::Cell& cell = map_.At(level, i, j);
   const Side side = SideOf(q.n, cell);
   if (side == Side::kBelow) return;
+  CellSums leaf;
   if (side == Side::kAbove) {
     for (int c = 0; c < 3; ++c) {
-      out->e[c] += cell.radiance_solid_angle[c];
-      out->m[c] += cell.luminance_moment[c];
+      leaf.e[c] = cell.radiance_solid_angle[c];
+      leaf.m[c] = cell.luminance_moment[c];
     }
-    out->y += cell.luminance;
+    leaf.y = cell.luminance;
+    q.leaves->push_back(leaf);
     return;
   }
   if (level <= stop) {
@@ -259,16 +319,40 @@ void HierarchicalIntegrator::Clip(const Query& q, int level, int i, int j, int s
     const double above = (d + rho) / (2.0 * rho);
     const double clipped_cos = cell.luminance * (d + rho) * (d + rho) / (4.0 * rho);
     const Vec3 m_above = m * above + q.n * (clipped_cos - above * Dot(q.n, m));
-    for (int c = 0; c < 3; ++c) out->e[c] += cell.radiance_solid_angle[c] * above;
-    out->m[0] += m_above.x;
-    out->m[1] += m_above.y;
-    out->m[2] += m_above.z;
-    out->y += cell.luminance * above;
+    for (int c = 0; c < 3; ++c) leaf.e[c] = cell.radiance_solid_angle[c] * above;
+    leaf.m[0] = m_above.x;
+    leaf.m[1] = m_above.y;
+    leaf.m[2] = m_above.z;
+    leaf.y = cell.luminance * above;
+    q.leaves->push_back(leaf);
     return;
   }
+  const std::size_t begin = q.leaves->size();
   const int wd = map_.width(level - 1), hd = map_.height(level - 1);
   for (int b = 2 * j; b < std::min(2 * j + 2, hd); ++b)
-    for (int a = 2 * i; a < std::min(2 * i + 2, wd); ++a) Clip(q, level - 1, a, b, stop, out);
+    for (int a = 2 * i; a < std::min(2 * i + 2, wd); ++a) Clip(q, level - 1, a, b, stop);
+  q.ranges->Insert(ClipRanges::Key(level, i, j), begin, q.leaves->size());
+}
+
+HierarchicalIntegrator::CellSums HierarchicalIntegrator::ClippedSums(const Query& q, int level,
+                                                                     int i, int j) const {
+  std::size_t begin = 0, end = 0;
+  if (level <= horizon_level_ || !q.ranges->Find(ClipRanges::Key(level, i, j), &begin, &end)) {
+    begin = q.leaves->size();
+    Clip(q, level, i, j, horizon_level_);
+    end = q.leaves->size();
+  }
+  // Summed from zero in the order Clip() visits the leaves, as a walk of the subtree would.
+  CellSums sums;
+  for (std::size_t k = begin; k < end; ++k) {
+    const CellSums& leaf = (*q.leaves)[k];
+    for (int c = 0; c < 3; ++c) {
+      sums.e[c] += leaf.e[c];
+      sums.m[c] += leaf.m[c];
+    }
+    sums.y += leaf.y;
+  }
+  return sums;
 }
 
 Rgb HierarchicalIntegrator::Estimate(const Query& q, int level, int i, int j,
@@ -278,7 +362,7 @@ Rgb HierarchicalIntegrator::Estimate(const Query& q, int level, int i, int j,
   CellSums sums;
   Vec3 centroid;
   if (straddles) {
-    Clip(q, level, i, j, horizon_level_, &sums);
+    sums = ClippedSums(q, level, i, j);
     const Vec3 m = {sums.m[0], sums.m[1], sums.m[2]};
     const double length = Length(m);
     if (!(length > 0.0)) return {0, 0, 0};
@@ -351,7 +435,14 @@ Rgb HierarchicalIntegrator::Refine(const Query& q, int level, int i, int j,
 Rgb HierarchicalIntegrator::Radiance(const Vec3& s, const Vec3& t, const Vec3& n, const Vec3& wo,
                                      double scale, bool top_only,
                                      std::uint64_t* evaluations) const {
+  // Clip()'s record, kept per thread so that a query allocates nothing once it has grown.
+  thread_local std::vector<CellSums> leaves;
+  thread_local ClipRanges ranges;
+  leaves.clear();
+  ranges.Clear();
   Query q;
+  q.leaves = &leaves;
+  q.ranges = &ranges;
   q.s = s;
   q.t = t;
   q.n = n;
@@ -363,8 +454,8 @@ Rgb HierarchicalIntegrator::Radiance(const Vec3& s, const Vec3& t, const Vec3& n
     int i, j;
     Rgb estimate;
   };
-  std::vector<Top> cells;
-  cells.reserve(static_cast<std::size_t>(w) * h);
+  thread_local std::vector<Top> cells;  // per thread, as Clip()'s record
+  cells.clear();
   Rgb sum = {0, 0, 0};
   for (int j = 0; j < h; ++j)
     for (int i = 0; i < w; ++i) {
