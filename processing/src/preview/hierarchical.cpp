@@ -329,6 +329,9 @@ void HierarchicalIntegrator::Clip(const Query& q, int level, int i, int j, int s
   }
   const std::size_t begin = q.leaves->size();
   const int wd = map_.width(level - 1), hd = map_.height(level - 1);
+  for (int b = 2 * j; b < std::min(2 * j + 2, hd); ++b)  // as in Refine()
+    for (int a = 2 * i; a < std::min(2 * i + 2, wd); ++a)
+      __builtin_prefetch(&map_.At(level - 1, a, b));
   for (int b = 2 * j; b < std::min(2 * j + 2, hd); ++b)
     for (int a = 2 * i; a < std::min(2 * i + 2, wd); ++a) Clip(q, level - 1, a, b, stop);
   q.ranges->Insert(ClipRanges::Key(level, i, j), begin, q.leaves->size());
@@ -397,6 +400,11 @@ Rgb HierarchicalIntegrator::Refine(const Query& q, int level, int i, int j,
   Child children[4];
   int count = 0;
   Rgb sum = {0, 0, 0};
+  // The children lie in two map rows far apart; asking for all four lines first overlaps their
+  // cache misses with each other and with the first child's BRDF evaluation.
+  for (int b = 2 * j; b < std::min(2 * j + 2, hd); ++b)
+    for (int a = 2 * i; a < std::min(2 * i + 2, wd); ++a)
+      __builtin_prefetch(&map_.At(child_level, a, b));
   for (int b = 2 * j; b < std::min(2 * j + 2, hd); ++b)
     for (int a = 2 * i; a < std::min(2 * i + 2, wd); ++a) {
       const MapHierarchy::Cell& cell = map_.At(child_level, a, b);
