@@ -1115,24 +1115,33 @@ TEST(PreviewProgressive, PassesAccumulateAndCancelStopsEarly) {
 // The one pass of the deterministic estimators reports the fraction of the object's pixels
 // finished, from the calling thread. With one thread every piece of work is the caller's, so the
 // reports of the hierarchical pass are known in advance from the sphere's geometry alone: its
-// 64 × 64 image has four rows of 16-pixel blocks, done even rows first (0, 2), then odd ones
-// (1, 3); after each block row the fraction is the share of the sphere's pixels in the rows done.
+// 64 × 64 image has 4 × 4 blocks of 16 pixels, done in four passes by the parity of their row
+// and column (even rows' even columns, even rows' odd columns, then the odd rows' likewise), each
+// pass row by row; after each block the fraction is the share of the sphere's pixels in the
+// blocks done.
 TEST(PreviewProgressive, DeterministicPassReportsTheFractionOfPixelsDoneFromTheCallingThread) {
   const AnalyticBrdf material(test::GgxAlpha03());
   const EnvironmentMap studio = EnvironmentMap::Studio(64, 32);
   const int size = 64;
   PreviewOptions o = SmallOptions(size, Estimator::kHierarchical);
-  std::vector<double> row_share(4, 0.0);
+  double block_share[4][4] = {};
   double all = 0.0;
   for (int y = 0; y < size; ++y)
     for (int x = 0; x < size; ++x)
       if (Vec3 n; SphereNormal(x, y, size, size, o.camera.fill, &n)) {
-        row_share[y / 16] += 1.0;
+        block_share[y / 16][x / 16] += 1.0;
         all += 1.0;
       }
-  for (double& share : row_share) share /= all;
-  const std::vector<double> expected = {row_share[0], row_share[0] + row_share[2],
-                                        row_share[0] + row_share[2] + row_share[1], 1.0, 1.0};
+  std::vector<double> expected;
+  double done = 0.0;
+  for (int pass = 0; pass < 4; ++pass)
+    for (int r = pass / 2; r < 4; r += 2)
+      for (int c = pass % 2; c < 4; c += 2) {
+        done += block_share[r][c];
+        expected.push_back(done / all);
+      }
+  expected.back() = 1.0;    // the same sum, in another order
+  expected.push_back(1.0);  // the end of the pass
   const PreviewImage silent = RenderPreview(material, studio, o);
   std::vector<double> fractions, seconds;
   std::vector<std::thread::id> threads;

@@ -15,17 +15,38 @@ namespace {
 
 using detail::Length;
 
-// Direction of the centre of pixel (i, j).
-Vec3 PixelCentre(int i, int j, int width, int height) {
-  return SphericalDirection((j + 0.5) * kPi / height, (i + 0.5) * 2.0 * kPi / width);
-}
+// Directions of the pixel centres, ω(θ_j, φ_i) with θ_j = (j + ½)·π/height and
+// φ_i = (i + ½)·2π/width: sin/cos are taken once per row and once per column.
+class PixelCentres {
+ public:
+  PixelCentres(int width, int height) {
+    for (int j = 0; j < height; ++j) {
+      const double theta = (j + 0.5) * kPi / height;
+      sin_theta_.push_back(std::sin(theta));
+      cos_theta_.push_back(std::cos(theta));
+    }
+    for (int i = 0; i < width; ++i) {
+      const double phi = (i + 0.5) * 2.0 * kPi / width;
+      sin_phi_.push_back(std::sin(phi));
+      cos_phi_.push_back(std::cos(phi));
+    }
+  }
+  // The same numbers as SphericalDirection(θ_j, φ_i).
+  Vec3 At(int i, int j) const {
+    return {sin_theta_[j] * cos_phi_[i], sin_theta_[j] * sin_phi_[i], cos_theta_[j]};
+  }
+
+ private:
+  std::vector<double> sin_theta_, cos_theta_, sin_phi_, cos_phi_;
+};
 
 template <class F>
 std::vector<float> Tabulate(int width, int height, F radiance) {
+  const PixelCentres centres(width, height);
   std::vector<float> rgb(static_cast<std::size_t>(width) * height * 3);
   for (int j = 0; j < height; ++j)
     for (int i = 0; i < width; ++i) {
-      const Rgb c = radiance(PixelCentre(i, j, width, height));
+      const Rgb c = radiance(centres.At(i, j));
       float* p = &rgb[(static_cast<std::size_t>(j) * width + i) * 3];
       for (int k = 0; k < 3; ++k) p[k] = static_cast<float>(c[k]);
     }
@@ -39,23 +60,54 @@ double SmoothStep(double edge0, double edge1, double x) {
 
 // A soft box: a rectangle on the sphere centred on direction (θc, φc), `half_width_deg` across
 // and `half_height_deg` up and down in the box's own tangent frame, edges softened over
-// `soft_deg`. Returns the coverage in [0, 1].
-struct SoftBox {
-  double theta_deg, phi_deg, half_width_deg, half_height_deg, soft_deg;
-  Rgb radiance;
-  double Coverage(const Vec3& w) const {
-    const Vec3 c = SphericalDirectionDeg(theta_deg, phi_deg);
-    const double cos_angle = Dot(w, c);
-    if (cos_angle <= 0.0) return 0.0;
-    // Gnomonic coordinates on the plane tangent at c: right is horizontal, up towards +z.
-    Vec3 right = detail::Cross(c, Vec3{0, 0, 1});
-    right = right * (1.0 / Length(right));
-    const Vec3 up = detail::Cross(right, c);
-    const double x = RadToDeg(std::atan(Dot(w, right) / cos_angle));
-    const double y = RadToDeg(std::atan(Dot(w, up) / cos_angle));
-    return (1.0 - SmoothStep(half_width_deg - soft_deg, half_width_deg, std::fabs(x))) *
-           (1.0 - SmoothStep(half_height_deg - soft_deg, half_height_deg, std::fabs(y)));
+// `soft_deg`.
+class SoftBox {
+ public:
+  SoftBox(double theta_deg, double phi_deg, double half_width_deg, double half_height_deg,
+          double soft_deg, Rgb radiance)
+      : radiance_(radiance),
+        across_(half_width_deg, soft_deg),
+        upward_(half_height_deg, soft_deg),
+        centre_(SphericalDirectionDeg(theta_deg, phi_deg)) {
+    // Gnomonic coordinates on the plane tangent at the centre: right is horizontal, up towards
+    // +z.
+    right_ = detail::Cross(centre_, Vec3{0, 0, 1});
+    right_ = right_ * (1.0 / Length(right_));
+    up_ = detail::Cross(right_, centre_);
   }
+  // The coverage of direction w, in [0, 1].
+  double Coverage(const Vec3& w) const {
+    const double cos_angle = Dot(w, centre_);
+    if (cos_angle <= 0.0) return 0.0;
+    const double x = across_.Inside(Dot(w, right_) / cos_angle);
+    if (x == 0.0) return 0.0;
+    return x * upward_.Inside(Dot(w, up_) / cos_angle);
+  }
+  const Rgb& radiance() const { return radiance_; }
+
+ private:
+  // One axis of the box: 1 − smoothstep(half − soft, half, |angle|) of the gnomonic coordinate
+  // `tan_angle` = tan(angle). Outside the soft band the answer is exactly 1 or 0 whatever the
+  // angle, so atan is only taken inside it; the band's limits on tan(angle) are widened by a
+  // relative 1e-6, far more than atan's rounding, so that a direction is never classed on the
+  // wrong side of them.
+  struct Edge {
+    double inner_deg, outer_deg, tan_inner, tan_outer;
+    Edge(double half_deg, double soft_deg)
+        : inner_deg(half_deg - soft_deg),
+          outer_deg(half_deg),
+          tan_inner(std::tan(DegToRad(half_deg - soft_deg)) * (1.0 - 1e-6)),
+          tan_outer(std::tan(DegToRad(half_deg)) * (1.0 + 1e-6)) {}
+    double Inside(double tan_angle) const {
+      const double t = std::fabs(tan_angle);
+      if (t >= tan_outer) return 0.0;
+      if (t <= tan_inner) return 1.0;
+      return 1.0 - SmoothStep(inner_deg, outer_deg, std::fabs(RadToDeg(std::atan(tan_angle))));
+    }
+  };
+  Rgb radiance_;
+  Edge across_, upward_;
+  Vec3 centre_, right_{}, up_{};
 };
 
 void CheckSize(int width, int height) {
@@ -105,7 +157,7 @@ EnvironmentMap EnvironmentMap::Studio(int width, int height) {
     Rgb c = {g, g, g * 1.05};
     for (const SoftBox& box : boxes) {
       const double k = box.Coverage(w);
-      for (int ch = 0; ch < 3; ++ch) c[ch] = c[ch] * (1.0 - k) + box.radiance[ch] * k;
+      for (int ch = 0; ch < 3; ++ch) c[ch] = c[ch] * (1.0 - k) + box.radiance()[ch] * k;
     }
     return c;
   });
@@ -129,16 +181,22 @@ EnvironmentMap EnvironmentMap::Sky(double sun_theta_deg, double sun_phi_deg, int
   };
   const double zenith_norm = indicatrix(sun_theta) * gradation(1.0);
   const Rgb sky_tint = {0.55, 0.72, 1.0};
-  auto sky = [&](const Vec3& w) {
-    const double cos_theta = std::max(w.z, 0.02);  // keeps the horizon finite
-    const double gamma = std::acos(std::clamp(Dot(w, sun), -1.0, 1.0));
-    return indicatrix(gamma) * gradation(cos_theta) / zenith_norm;
-  };
-  std::vector<float> rgb = Tabulate(width, height, [&](const Vec3& w) {
-    if (w.z <= 0.0) return Rgb{0, 0, 0};
-    const double l = sky(w);
-    return Rgb{l * sky_tint[0], l * sky_tint[1], l * sky_tint[2]};
-  });
+  // The gradation depends on the row alone (w.z = cosθ of the row's centre), so it is taken
+  // once per row.
+  const PixelCentres centres(width, height);
+  std::vector<double> row_gradation(static_cast<std::size_t>(height));
+  for (int j = 0; j < height; ++j)
+    row_gradation[j] = gradation(std::max(centres.At(0, j).z, 0.02));  // keeps the horizon finite
+  std::vector<float> rgb(static_cast<std::size_t>(width) * height * 3, 0.0f);
+  for (int j = 0; j < height; ++j)
+    for (int i = 0; i < width; ++i) {
+      const Vec3 w = centres.At(i, j);
+      if (w.z <= 0.0) continue;
+      const double gamma = std::acos(std::clamp(Dot(w, sun), -1.0, 1.0));
+      const double l = indicatrix(gamma) * row_gradation[j] / zenith_norm;
+      float* p = &rgb[(static_cast<std::size_t>(j) * width + i) * 3];
+      for (int k = 0; k < 3; ++k) p[k] = static_cast<float>(l * sky_tint[k]);
+    }
   // The sun: irradiance kSunIrradiance on a surface facing it, spread over the pixels whose
   // centres lie within max(0.265°, one pixel) of the sun's direction, so even a coarse map
   // carries exactly that irradiance.
@@ -148,13 +206,14 @@ EnvironmentMap EnvironmentMap::Sky(double sun_theta_deg, double sun_phi_deg, int
   const double radius = std::max(DegToRad(0.265), 0.75 * pixel_rad);
   std::vector<std::size_t> disc;
   double disc_solid_angle = 0.0;
+  const double cos_radius = std::cos(radius);
   for (int j = 0; j < height; ++j) {
     const double cos0 = std::cos(j * kPi / height), cos1 = std::cos((j + 1) * kPi / height);
     const double pixel_solid_angle = (cos0 - cos1) * 2.0 * kPi / width;
     for (int i = 0; i < width; ++i)
-      if (Dot(PixelCentre(i, j, width, height), sun) >= std::cos(radius)) {
+      if (const double cos_sun = Dot(centres.At(i, j), sun); cos_sun >= cos_radius) {
         disc.push_back(static_cast<std::size_t>(j) * width + i);
-        disc_solid_angle += pixel_solid_angle * Dot(PixelCentre(i, j, width, height), sun);
+        disc_solid_angle += pixel_solid_angle * cos_sun;
       }
   }
   if (disc.empty()) {  // the disc fell between centres: take the sun's own pixel

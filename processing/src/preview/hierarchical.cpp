@@ -2,20 +2,14 @@
 #include "hierarchical.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <memory>
 
 #include "preview_internal.h"
 
 namespace brdf::preview::detail {
 namespace {
-
-// ∫ ω dω over the patch θ ∈ [t0, t1], φ ∈ [p0, p1] (dω = sinθ dθ dφ).
-Vec3 PatchMoment(double t0, double t1, double p0, double p1) {
-  const double sin_sq = (0.5 * (t1 - t0) - 0.25 * (std::sin(2.0 * t1) - std::sin(2.0 * t0)));
-  const double sin_cos = 0.5 * (std::sin(t1) * std::sin(t1) - std::sin(t0) * std::sin(t0));
-  return {sin_sq * (std::sin(p1) - std::sin(p0)), sin_sq * (std::cos(p0) - std::cos(p1)),
-          sin_cos * (p1 - p0)};
-}
 
 void Store(float* out, const Vec3& v) {
   out[0] = static_cast<float>(v.x);
@@ -24,25 +18,95 @@ void Store(float* out, const Vec3& v) {
 }
 Vec3 Load(const float* v) { return {v[0], v[1], v[2]}; }
 
-// The bounding cone of the cell θ ∈ [t0, t1], φ ∈ [p0, p1]: the distance from the centre
-// direction grows monotonically along each edge (small circles of constant θ, meridians), so a
-// corner is the farthest point; a small margin covers float rounding.
-void SetCone(double t0, double t1, double p0, double p1, MapHierarchy::Cell* cell) {
-  const Vec3 axis = SphericalDirection(0.5 * (t0 + t1), 0.5 * (p0 + p1));
-  double radius = 0.0;
-  for (double t : {t0, t1})
-    for (double p : {p0, p1})
-      radius =
-          std::max(radius, std::acos(std::clamp(Dot(axis, SphericalDirection(t, p)), -1.0, 1.0)));
-  radius = std::min(0.5 * kPi, radius * 1.01 + 1e-5);
-  Store(cell->axis, axis);
-  cell->sin_radius = static_cast<float>(std::sin(radius));
-  cell->cos_radius = static_cast<float>(std::cos(radius));
+// The trigonometry of the map's pixel edges along one axis: edge k lies at angle
+// k · range / pixels (θ: range π over the rows, φ: 2π over the columns). Every cell of every
+// level has its edges among them (a cell of level ℓ spans 2^ℓ pixels, clipped at the map's
+// edge), so sin/cos are taken once per edge instead of once per cell, corner and level.
+struct EdgeTrig {
+  std::vector<double> angle, sin, cos, sin_twice;  // sin_twice: sin(2·angle), θ edges only
+  EdgeTrig(int pixels, double range, bool twice) {
+    for (int k = 0; k <= pixels; ++k) {
+      const double a = k * range / pixels;
+      angle.push_back(a);
+      sin.push_back(std::sin(a));
+      cos.push_back(std::cos(a));
+      if (twice) sin_twice.push_back(std::sin(2.0 * a));
+    }
+  }
+};
+
+// The per-row (θ) or per-column (φ) terms of the cells of one level: the edge indices and the
+// direction of the centre angle.
+struct CellAxis {
+  int edge0, edge1;
+  double sin_centre, cos_centre;
+};
+std::vector<CellAxis> Axis(const EdgeTrig& edges, int cells, int span) {
+  const int pixels = static_cast<int>(edges.angle.size()) - 1;
+  std::vector<CellAxis> axis(static_cast<std::size_t>(cells));
+  for (int k = 0; k < cells; ++k) {
+    CellAxis& a = axis[k];
+    a.edge0 = std::min(k * span, pixels);
+    a.edge1 = std::min((k + 1) * span, pixels);
+    const double centre = 0.5 * (edges.angle[a.edge0] + edges.angle[a.edge1]);
+    a.sin_centre = std::sin(centre);
+    a.cos_centre = std::cos(centre);
+  }
+  return axis;
 }
+
+// The bounding cone of the cell between θ edges `row` and φ edges `column`: the distance from
+// the centre direction grows monotonically along each edge (small circles of constant θ,
+// meridians), so a corner is the farthest point (the smallest cosine); a small margin covers
+// float rounding. The cone of a row's cells is the same in every column up to rounding, which
+// leaves a few distinct cosines per row, so the sin/cos of the radius of the last few are kept
+// in `cache` and reused when a cosine repeats exactly (the same numbers as computing them
+// again).
+class ConeCache {
+ public:
+  void Set(double min_dot, MapHierarchy::Cell* cell) {
+    int k = 0;
+    while (k < size_ && min_dot_[k] != min_dot) ++k;
+    if (k == size_) {
+      k = size_ < kEntries ? size_++ : next_;
+      next_ = (k + 1) % kEntries;
+      // acos falls monotonically, so the largest corner distance is the acos of the smallest
+      // cosine.
+      const double radius = std::min(0.5 * kPi, std::max(0.0, std::acos(min_dot)) * 1.01 + 1e-5);
+      min_dot_[k] = min_dot;
+      sin_radius_[k] = static_cast<float>(std::sin(radius));
+      cos_radius_[k] = static_cast<float>(std::cos(radius));
+    }
+    cell->sin_radius = sin_radius_[k];
+    cell->cos_radius = cos_radius_[k];
+  }
+
+ private:
+  static constexpr int kEntries = 8;
+  double min_dot_[kEntries];
+  float sin_radius_[kEntries], cos_radius_[kEntries];
+  int size_ = 0, next_ = 0;
+};
+void SetCone(const EdgeTrig& theta, const EdgeTrig& phi, const CellAxis& row,
+             const CellAxis& column, ConeCache* cache, MapHierarchy::Cell* cell) {
+  const Vec3 axis = {row.sin_centre * column.cos_centre, row.sin_centre * column.sin_centre,
+                     row.cos_centre};
+  double min_dot = 1.0;
+  for (int t : {row.edge0, row.edge1})
+    for (int p : {column.edge0, column.edge1}) {
+      const Vec3 corner = {theta.sin[t] * phi.cos[p], theta.sin[t] * phi.sin[p], theta.cos[t]};
+      min_dot = std::min(min_dot, std::clamp(Dot(axis, corner), -1.0, 1.0));
+    }
+  Store(cell->axis, axis);
+  cache->Set(min_dot, cell);
+}
+
+// Rows are independent at every level, so they are built `jobs` at a time.
+constexpr std::size_t kRowsPerChunk = 4;
 
 }  // namespace
 
-MapHierarchy::MapHierarchy(const EnvironmentMap& map, int top_columns) {
+MapHierarchy::MapHierarchy(const EnvironmentMap& map, int top_columns, int jobs) {
   const int w0 = map.width(), h0 = map.height();
   width_.push_back(w0);
   height_.push_back(h0);
@@ -51,73 +115,162 @@ MapHierarchy::MapHierarchy(const EnvironmentMap& map, int top_columns) {
     height_.push_back((height_.back() + 1) / 2);
   }
   cells_.resize(width_.size());
-  // Level 0: the map's pixels, in double while summing.
+  const EdgeTrig theta(h0, kPi, true), phi(w0, 2.0 * kPi, false);
+  // Level 0: the map's pixels, in double while summing. The moment ∫ ω dω of the patch
+  // θ ∈ [t0, t1], φ ∈ [p0, p1] (dω = sinθ dθ dφ) is a θ factor times a φ factor per component:
+  //   (S · (sin p1 − sin p0), S · (cos p0 − cos p1), C · (p1 − p0)),
+  //   S = ∫ sin²θ dθ = (t1 − t0)/2 − (sin 2t1 − sin 2t0)/4,
+  //   C = ∫ sinθ cosθ dθ = (sin²t1 − sin²t0)/2.
   struct Sums {
-    double e[3] = {0, 0, 0};
-    Vec3 m{0, 0, 0};
-    double y = 0, solid_angle = 0;
+    double e[3];
+    Vec3 m;
+    double y, solid_angle;
   };
-  std::vector<Sums> sums(static_cast<std::size_t>(w0) * h0);
+  std::vector<double> sin_sq(h0), sin_cos(h0), band(h0);
   for (int j = 0; j < h0; ++j) {
-    const double t0 = j * kPi / h0, t1 = (j + 1) * kPi / h0;
-    const double band = std::cos(t0) - std::cos(t1);
-    for (int i = 0; i < w0; ++i) {
-      const double p0 = i * 2.0 * kPi / w0, p1 = (i + 1) * 2.0 * kPi / w0;
-      const float* px = map.Pixel(i, j);
-      Sums& s = sums[static_cast<std::size_t>(j) * w0 + i];
-      s.solid_angle = band * (p1 - p0);
-      for (int c = 0; c < 3; ++c) s.e[c] = px[c] * s.solid_angle;
-      s.y = Luminance({px[0], px[1], px[2]}) * s.solid_angle;
-      s.m = PatchMoment(t0, t1, p0, p1) * Luminance({px[0], px[1], px[2]});
-    }
+    sin_sq[j] = 0.5 * (theta.angle[j + 1] - theta.angle[j]) -
+                0.25 * (theta.sin_twice[j + 1] - theta.sin_twice[j]);
+    sin_cos[j] = 0.5 * (theta.sin[j + 1] * theta.sin[j + 1] - theta.sin[j] * theta.sin[j]);
+    band[j] = theta.cos[j] - theta.cos[j + 1];
   }
+  std::vector<double> d_phi(w0), d_sin(w0), d_cos(w0);
+  for (int i = 0; i < w0; ++i) {
+    d_phi[i] = phi.angle[i + 1] - phi.angle[i];
+    d_sin[i] = phi.sin[i + 1] - phi.sin[i];
+    d_cos[i] = phi.cos[i] - phi.cos[i + 1];
+  }
+  // The pixels' sums are a few products each, so they are made where they are needed (for the
+  // level-0 cells and again for level 1's) rather than kept: a stored copy would be as large as
+  // the level-0 cells twice over.
+  auto pixel_sums = [&](int i, int j) {
+    const float* px = map.Pixel(i, j);
+    Sums s;
+    s.solid_angle = band[j] * d_phi[i];
+    for (int c = 0; c < 3; ++c) s.e[c] = px[c] * s.solid_angle;
+    const double y = Luminance({px[0], px[1], px[2]});
+    s.y = y * s.solid_angle;
+    s.m = Vec3{sin_sq[j] * d_sin[i], sin_sq[j] * d_cos[i], sin_cos[j] * d_phi[i]} * y;
+    return s;
+  };
+  // The sums of the level below the one being built (from level 2 on; level 1 reads pixels).
+  std::unique_ptr<Sums[]> below, sums;
   for (int level = 0; level < levels(); ++level) {
     const int w = width_[level], h = height_[level];
+    const std::size_t count = static_cast<std::size_t>(w) * h;
     if (level > 0) {
-      std::vector<Sums> up(static_cast<std::size_t>(w) * h);
+      // Left uninitialised here and written by the threads, so that the pages are first
+      // touched (and cleared by the kernel) in parallel.
+      sums = std::make_unique_for_overwrite<Sums[]>(count);
       const int wd = width_[level - 1], hd = height_[level - 1];
-      for (int j = 0; j < h; ++j)
-        for (int i = 0; i < w; ++i) {
-          Sums& s = up[static_cast<std::size_t>(j) * w + i];
-          for (int b = 2 * j; b < std::min(2 * j + 2, hd); ++b)
-            for (int a = 2 * i; a < std::min(2 * i + 2, wd); ++a) {
-              const Sums& d = sums[static_cast<std::size_t>(b) * wd + a];
-              for (int c = 0; c < 3; ++c) s.e[c] += d.e[c];
-              s.m = s.m + d.m;
-              s.y += d.y;
-              s.solid_angle += d.solid_angle;
-            }
-        }
-      sums = std::move(up);
+      ParallelChunks(static_cast<std::size_t>(h), kRowsPerChunk, jobs, nullptr,
+                     [&](std::size_t b0, std::size_t e0) {
+                       for (int j = static_cast<int>(b0); j < static_cast<int>(e0); ++j)
+                         for (int i = 0; i < w; ++i) {
+                           Sums& s = sums[static_cast<std::size_t>(j) * w + i];
+                           s = {{0, 0, 0}, {0, 0, 0}, 0, 0};
+                           for (int b = 2 * j; b < std::min(2 * j + 2, hd); ++b)
+                             for (int a = 2 * i; a < std::min(2 * i + 2, wd); ++a) {
+                               const Sums d = level == 1
+                                                  ? pixel_sums(a, b)
+                                                  : below[static_cast<std::size_t>(b) * wd + a];
+                               for (int c = 0; c < 3; ++c) s.e[c] += d.e[c];
+                               s.m = s.m + d.m;
+                               s.y += d.y;
+                               s.solid_angle += d.solid_angle;
+                             }
+                         }
+                     });
     }
     // Cell (i, j) of this level covers map pixels [i·2^level, (i+1)·2^level) clipped.
     const int span = 1 << level;
-    std::vector<Cell>& cells = cells_[level];
-    cells.resize(static_cast<std::size_t>(w) * h);
-    for (int j = 0; j < h; ++j)
-      for (int i = 0; i < w; ++i) {
-        const Sums& s = sums[static_cast<std::size_t>(j) * w + i];
-        Cell& cell = cells[static_cast<std::size_t>(j) * w + i];
-        for (int c = 0; c < 3; ++c) cell.radiance_solid_angle[c] = static_cast<float>(s.e[c]);
-        Store(cell.luminance_moment, s.m);
-        cell.luminance = static_cast<float>(s.y);
-        cell.solid_angle = static_cast<float>(s.solid_angle);
-        const double t0 = std::min(j * span, h0) * kPi / h0;
-        const double t1 = std::min((j + 1) * span, h0) * kPi / h0;
-        const double p0 = std::min(i * span, w0) * 2.0 * kPi / w0;
-        const double p1 = std::min((i + 1) * span, w0) * 2.0 * kPi / w0;
-        SetCone(t0, t1, p0, p1, &cell);
-        const double length = Length(s.m);
-        Store(cell.centroid, length > 0.0 ? s.m * (1.0 / length) : Load(cell.axis));
-      }
+    const std::vector<CellAxis> rows = Axis(theta, h, span), columns = Axis(phi, w, span);
+    cells_[level] = std::make_unique_for_overwrite<Cell[]>(count);
+    Cell* cells = cells_[level].get();
+    ParallelChunks(
+        static_cast<std::size_t>(h), kRowsPerChunk, jobs, nullptr,
+        [&](std::size_t b, std::size_t e) {
+          for (std::size_t j = b; j < e; ++j) {
+            ConeCache cache;
+            for (int i = 0; i < w; ++i) {
+              const Sums s = level == 0 ? pixel_sums(i, static_cast<int>(j)) : sums[j * w + i];
+              Cell& cell = cells[j * w + i];
+              for (int c = 0; c < 3; ++c) cell.radiance_solid_angle[c] = static_cast<float>(s.e[c]);
+              Store(cell.luminance_moment, s.m);
+              cell.luminance = static_cast<float>(s.y);
+              cell.solid_angle = static_cast<float>(s.solid_angle);
+              SetCone(theta, phi, rows[j], columns[i], &cache, &cell);
+              const double length = Length(s.m);
+              Store(cell.centroid, length > 0.0 ? s.m * (1.0 / length) : Load(cell.axis));
+            }
+          }
+        });
+    below = std::move(sums);
   }
 }
+
+namespace {
+
+// Where the leaf contributions of the straddling cells Clip() has walked lie in the query's
+// leaf list: an open-addressed table from (level, i, j) to [begin, end), cleared per query by a
+// generation count. A cell that does not fit (the table is kept under half full) is walked
+// again when it is estimated, which gives the same numbers.
+class ClipRanges {
+ public:
+  void Clear() {
+    used_ = 0;
+    if (++generation_ == 0) {  // wrapped: forget every stamp
+      for (Slot& s : slots_) s.generation = 0;
+      generation_ = 1;
+    }
+  }
+  static std::uint64_t Key(int level, int i, int j) {
+    return (static_cast<std::uint64_t>(level) << 48) | (static_cast<std::uint64_t>(j) << 24) |
+           static_cast<std::uint64_t>(i);
+  }
+  bool Find(std::uint64_t key, std::size_t* begin, std::size_t* end) const {
+    for (std::size_t k = Hash(key);; k = (k + 1) & (kSlots - 1)) {
+      const Slot& s = slots_[k];
+      if (s.generation != generation_) return false;
+      if (s.key == key) {
+        *begin = s.begin;
+        *end = s.end;
+        return true;
+      }
+    }
+  }
+  void Insert(std::uint64_t key, std::size_t begin, std::size_t end) {
+    if (used_ >= kSlots / 2) return;
+    std::size_t k = Hash(key);
+    while (slots_[k].generation == generation_) k = (k + 1) & (kSlots - 1);
+    slots_[k] = {key, generation_, static_cast<std::uint32_t>(begin),
+                 static_cast<std::uint32_t>(end)};
+    ++used_;
+  }
+
+ private:
+  static constexpr std::size_t kSlots = 1024;
+  static std::size_t Hash(std::uint64_t key) {
+    return static_cast<std::size_t>((key * 0x9e3779b97f4a7c15ull) >> 54);  // 10 bits
+  }
+  struct Slot {
+    std::uint64_t key = 0;
+    std::uint32_t generation = 0, begin = 0, end = 0;
+  };
+  std::array<Slot, kSlots> slots_{};
+  std::uint32_t generation_ = 0;
+  std::size_t used_ = 0;
+};
+
+}  // namespace
 
 struct HierarchicalIntegrator::Query {
   Vec3 s, t, n, wo, mirror;
   double tolerance = 0.0;       // allowed |ΔY| of a cell of 2π sr (scaled by √(Ω/2π))
   double large_estimate = 0.0;  // cells estimated above this are always split
   mutable std::uint64_t evaluations = 0;  // counted for the benchmark figures
+  // Clip()'s record (per thread, reused across queries).
+  std::vector<CellSums>* leaves = nullptr;
+  ClipRanges* ranges = nullptr;
 };
 
 namespace {
@@ -149,17 +302,18 @@ bool ContainsMirror(const Vec3& r, const MapHierarchy::Cell& cell) {
 
 // The part of a cell above the horizon: the sums of its descendants that lie above it, down to
 // `level` `stop` (straddling cells there are taken whole; their signed n·M is nearly exact).
-void HierarchicalIntegrator::Clip(const Query& q, int level, int i, int j, int stop,
-                                  CellSums* out) const {
+void HierarchicalIntegrator::Clip(const Query& q, int level, int i, int j, int stop) const {
   const MapHierarchy::Cell& cell = map_.At(level, i, j);
   const Side side = SideOf(q.n, cell);
   if (side == Side::kBelow) return;
+  CellSums leaf;
   if (side == Side::kAbove) {
     for (int c = 0; c < 3; ++c) {
-      out->e[c] += cell.radiance_solid_angle[c];
-      out->m[c] += cell.luminance_moment[c];
+      leaf.e[c] = cell.radiance_solid_angle[c];
+      leaf.m[c] = cell.luminance_moment[c];
     }
-    out->y += cell.luminance;
+    leaf.y = cell.luminance;
+    q.leaves->push_back(leaf);
     return;
   }
   if (level <= stop) {
@@ -175,16 +329,43 @@ void HierarchicalIntegrator::Clip(const Query& q, int level, int i, int j, int s
     const double above = (d + rho) / (2.0 * rho);
     const double clipped_cos = cell.luminance * (d + rho) * (d + rho) / (4.0 * rho);
     const Vec3 m_above = m * above + q.n * (clipped_cos - above * Dot(q.n, m));
-    for (int c = 0; c < 3; ++c) out->e[c] += cell.radiance_solid_angle[c] * above;
-    out->m[0] += m_above.x;
-    out->m[1] += m_above.y;
-    out->m[2] += m_above.z;
-    out->y += cell.luminance * above;
+    for (int c = 0; c < 3; ++c) leaf.e[c] = cell.radiance_solid_angle[c] * above;
+    leaf.m[0] = m_above.x;
+    leaf.m[1] = m_above.y;
+    leaf.m[2] = m_above.z;
+    leaf.y = cell.luminance * above;
+    q.leaves->push_back(leaf);
     return;
   }
+  const std::size_t begin = q.leaves->size();
   const int wd = map_.width(level - 1), hd = map_.height(level - 1);
+  for (int b = 2 * j; b < std::min(2 * j + 2, hd); ++b)  // as in Refine()
+    for (int a = 2 * i; a < std::min(2 * i + 2, wd); ++a)
+      __builtin_prefetch(&map_.At(level - 1, a, b));
   for (int b = 2 * j; b < std::min(2 * j + 2, hd); ++b)
-    for (int a = 2 * i; a < std::min(2 * i + 2, wd); ++a) Clip(q, level - 1, a, b, stop, out);
+    for (int a = 2 * i; a < std::min(2 * i + 2, wd); ++a) Clip(q, level - 1, a, b, stop);
+  q.ranges->Insert(ClipRanges::Key(level, i, j), begin, q.leaves->size());
+}
+
+HierarchicalIntegrator::CellSums HierarchicalIntegrator::ClippedSums(const Query& q, int level,
+                                                                     int i, int j) const {
+  std::size_t begin = 0, end = 0;
+  if (level <= horizon_level_ || !q.ranges->Find(ClipRanges::Key(level, i, j), &begin, &end)) {
+    begin = q.leaves->size();
+    Clip(q, level, i, j, horizon_level_);
+    end = q.leaves->size();
+  }
+  // Summed from zero in the order Clip() visits the leaves, as a walk of the subtree would.
+  CellSums sums;
+  for (std::size_t k = begin; k < end; ++k) {
+    const CellSums& leaf = (*q.leaves)[k];
+    for (int c = 0; c < 3; ++c) {
+      sums.e[c] += leaf.e[c];
+      sums.m[c] += leaf.m[c];
+    }
+    sums.y += leaf.y;
+  }
+  return sums;
 }
 
 Rgb HierarchicalIntegrator::Estimate(const Query& q, int level, int i, int j,
@@ -194,7 +375,7 @@ Rgb HierarchicalIntegrator::Estimate(const Query& q, int level, int i, int j,
   CellSums sums;
   Vec3 centroid;
   if (straddles) {
-    Clip(q, level, i, j, horizon_level_, &sums);
+    sums = ClippedSums(q, level, i, j);
     const Vec3 m = {sums.m[0], sums.m[1], sums.m[2]};
     const double length = Length(m);
     if (!(length > 0.0)) return {0, 0, 0};
@@ -229,6 +410,11 @@ Rgb HierarchicalIntegrator::Refine(const Query& q, int level, int i, int j,
   Child children[4];
   int count = 0;
   Rgb sum = {0, 0, 0};
+  // The children lie in two map rows far apart; asking for all four lines first overlaps their
+  // cache misses with each other and with the first child's BRDF evaluation.
+  for (int b = 2 * j; b < std::min(2 * j + 2, hd); ++b)
+    for (int a = 2 * i; a < std::min(2 * i + 2, wd); ++a)
+      __builtin_prefetch(&map_.At(child_level, a, b));
   for (int b = 2 * j; b < std::min(2 * j + 2, hd); ++b)
     for (int a = 2 * i; a < std::min(2 * i + 2, wd); ++a) {
       const MapHierarchy::Cell& cell = map_.At(child_level, a, b);
@@ -263,7 +449,14 @@ Rgb HierarchicalIntegrator::Refine(const Query& q, int level, int i, int j,
 Rgb HierarchicalIntegrator::Radiance(const Vec3& s, const Vec3& t, const Vec3& n, const Vec3& wo,
                                      double scale, bool top_only,
                                      std::uint64_t* evaluations) const {
+  // Clip()'s record, kept per thread so that a query allocates nothing once it has grown.
+  thread_local std::vector<CellSums> leaves;
+  thread_local ClipRanges ranges;
+  leaves.clear();
+  ranges.Clear();
   Query q;
+  q.leaves = &leaves;
+  q.ranges = &ranges;
   q.s = s;
   q.t = t;
   q.n = n;
@@ -275,8 +468,8 @@ Rgb HierarchicalIntegrator::Radiance(const Vec3& s, const Vec3& t, const Vec3& n
     int i, j;
     Rgb estimate;
   };
-  std::vector<Top> cells;
-  cells.reserve(static_cast<std::size_t>(w) * h);
+  thread_local std::vector<Top> cells;  // per thread, as Clip()'s record
+  cells.clear();
   Rgb sum = {0, 0, 0};
   for (int j = 0; j < h; ++j)
     for (int i = 0; i < w; ++i) {

@@ -18,6 +18,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <memory>
 #include <vector>
 
 #include "brdf/core/brdf_source.h"
@@ -28,7 +29,8 @@ namespace brdf::preview::detail {
 
 class MapHierarchy {
  public:
-  struct Cell {
+  // One cache line, aligned to one, so that reading a cell costs one line.
+  struct alignas(64) Cell {
     float radiance_solid_angle[3];  // E: ∫ L dω over the cell, RGB
     float luminance_moment[3];      // M: ∫ Y(ω) ω dω, map frame
     float centroid[3];              // M/|M| (the geometric centre for a black cell)
@@ -38,8 +40,9 @@ class MapHierarchy {
     float solid_angle;              // sr
   };
 
-  // Levels are halved (rounding up) until the top level is at most `top_columns` wide.
-  MapHierarchy(const EnvironmentMap& map, int top_columns);
+  // Levels are halved (rounding up) until the top level is at most `top_columns` wide. Built on
+  // `jobs` threads (the cells do not depend on it).
+  MapHierarchy(const EnvironmentMap& map, int top_columns, int jobs = 1);
 
   int levels() const { return static_cast<int>(width_.size()); }
   int width(int level) const { return width_[level]; }
@@ -50,7 +53,7 @@ class MapHierarchy {
 
  private:
   std::vector<int> width_, height_;
-  std::vector<std::vector<Cell>> cells_;
+  std::vector<std::unique_ptr<Cell[]>> cells_;
 };
 
 struct HierarchicalSettings {
@@ -95,7 +98,13 @@ class HierarchicalIntegrator {
   struct CellSums {
     double e[3] = {0, 0, 0}, m[3] = {0, 0, 0}, y = 0;
   };
-  void Clip(const Query& q, int level, int i, int j, int stop, CellSums* out) const;
+  // Appends to the query's leaf list the contributions (CellSums) of the part of cell
+  // (level, i, j) above the horizon, in a fixed order, and notes where each straddling
+  // descendant's own contributions lie in it, so that estimating that descendant later sums the
+  // same numbers in the same order without walking its subtree again.
+  void Clip(const Query& q, int level, int i, int j, int stop) const;
+  // The CellSums of the part of straddling cell (level, i, j) above the horizon.
+  CellSums ClippedSums(const Query& q, int level, int i, int j) const;
   Rgb Estimate(const Query& q, int level, int i, int j, bool straddles) const;
   Rgb Refine(const Query& q, int level, int i, int j, const Rgb& estimate) const;
 

@@ -21,6 +21,7 @@ namespace {
 
 using detail::Frame;
 using detail::Luminance;
+using detail::ParallelChunks;
 
 std::uint64_t Mix(std::uint64_t x) {  // SplitMix64 finaliser
   x += 0x9e3779b97f4a7c15ull;
@@ -66,27 +67,6 @@ struct PixelSetup {
   Vec3 wo;      // towards the camera, local frame
   Rgb fixed{};  // background (misses) or the directional light's contribution (hits)
 };
-
-// `after_caller_chunk`, when set, runs on the calling thread after each chunk it completed
-// (progress reports come from there, so callbacks never run on a worker).
-template <class F>
-void ParallelChunks(std::size_t count, std::size_t chunk, int jobs, const std::atomic<bool>* cancel,
-                    F work, const std::function<void()>& after_caller_chunk = {}) {
-  std::atomic<std::size_t> next{0};
-  auto loop = [&](bool caller) {
-    for (std::size_t begin = next.fetch_add(chunk); begin < count; begin = next.fetch_add(chunk)) {
-      if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) return;
-      work(begin, std::min(count, begin + chunk));
-      if (caller && after_caller_chunk) after_caller_chunk();
-    }
-  };
-  const int threads =
-      std::max(1, std::min<int>(jobs, static_cast<int>((count + chunk - 1) / chunk)));
-  std::vector<std::thread> workers;
-  for (int t = 1; t < threads; ++t) workers.emplace_back(loop, false);
-  loop(true);
-  for (auto& w : workers) w.join();
-}
 
 // The fraction of a deterministic pass done, counted by the workers (one relaxed atomic add per
 // chunk, no lock) and reported to PreviewOptions::pass_progress from the calling thread.
@@ -237,7 +217,9 @@ struct PreviewRenderer::Impl {
     const std::size_t pixels = static_cast<std::size_t>(o.width) * o.height;
     object.assign(pixels, 0);
     fixed.assign(pixels, Rgb{0, 0, 0});
-    std::vector<PixelSetup> all(pixels);
+    // The hits of each image row, in order of x (a per-pixel array would be cleared and copied
+    // serially, most of it for misses).
+    std::vector<std::vector<PixelSetup>> row_hits(static_cast<std::size_t>(o.height));
     std::vector<std::uint8_t> wanted;
     if (!o.pixel_subset.empty()) {
       wanted.assign(pixels, 0);
@@ -266,7 +248,7 @@ struct PreviewRenderer::Impl {
                 continue;
               }
               object[p] = 1;
-              PixelSetup& s = all[p];
+              PixelSetup& s = row_hits[y].emplace_back();
               s.position = hit.position;
               s.geometric_normal = hit.geometric_normal;
               s.frame = Frame::FromNormal(hit.normal);
@@ -280,11 +262,13 @@ struct PreviewRenderer::Impl {
               }
             }
         });
+    std::size_t hits = 0;
+    for (const auto& row : row_hits) hits += row.size();
+    object_index.reserve(hits);
+    setup.reserve(hits);
     for (std::size_t p = 0; p < pixels; ++p)
-      if (object[p]) {
-        object_index.push_back(static_cast<std::uint32_t>(p));
-        setup.push_back(all[p]);
-      }
+      if (object[p]) object_index.push_back(static_cast<std::uint32_t>(p));
+    for (const auto& row : row_hits) setup.insert(setup.end(), row.begin(), row.end());
     sum.assign(setup.size() * 3, 0.0);
     sum_sq.assign(setup.size(), 0.0);
   }
@@ -450,7 +434,7 @@ struct PreviewRenderer::Impl {
   // The fast path (Estimator::kHierarchical, hierarchical.h): the adaptive map quadrature per
   // computed pixel, bilinear interpolation over image blocks that pass the midpoint checks.
   void Hierarchical() {
-    const detail::MapHierarchy hierarchy(environment, kHierarchyTopColumns);
+    const detail::MapHierarchy hierarchy(environment, kHierarchyTopColumns, jobs);
     detail::HierarchicalSettings settings;
     settings.tolerance = options.hierarchical_tolerance;
     const detail::HierarchicalIntegrator integrator(hierarchy, source, settings);
@@ -525,12 +509,17 @@ struct PreviewRenderer::Impl {
                              std::min(options.width, options.height) / kImageToleranceSize;
     // Phase 2: each block owns its pixels [x0, x0 + block) × [y0, y0 + block) and reads its
     // far edges too. A pixel integrated by one block is integrated once: `integrated` keeps it for
-    // the neighbours sharing that edge. Block rows run in two passes, even rows then odd ones,
-    // each row by one thread from left to right, so two blocks that run at the same time never
-    // share a pixel.
+    // the neighbours sharing that edge. Blocks run in four passes by the parity of their row and
+    // column, each block by one thread, so two blocks that run at the same time never share a
+    // pixel, and the threads end a pass within about one block of each other (with whole block
+    // rows as the unit, a few of which carry most of the work, one thread sat idle at the end of
+    // each pass). The order does not change the result: a pixel's integral is the same whichever
+    // block computes it, and a block decides from its own pixels' values alone.
     const int block_columns = (width + block - 1) / block;
-    std::vector<std::size_t> row_pixels(static_cast<std::size_t>(lattice_rows), 0);
-    for (std::uint32_t p : object_index) ++row_pixels[p / width / block];
+    std::vector<std::size_t> block_pixels(static_cast<std::size_t>(lattice_rows) * block_columns,
+                                          0);
+    for (std::uint32_t p : object_index)
+      ++block_pixels[p / width / block * block_columns + p % width / block];
     std::vector<Rgb> integrated(object.size(), Rgb{0, 0, 0});
     std::vector<std::uint8_t> has_integral(object.size(), 0);
     for (int c = 0; c < block_columns; ++c)
@@ -540,17 +529,19 @@ struct PreviewRenderer::Impl {
           integrated[g] = value[g];
           has_integral[g] = 1;
         }
-    for (int parity : {0, 1})
+    for (int pass = 0; pass < 4; ++pass) {
+      const int row_parity = pass / 2, column_parity = pass % 2;
+      const std::size_t pass_columns = (block_columns + 1 - column_parity) / 2;
       ParallelChunks(
-          static_cast<std::size_t>((lattice_rows + 1 - parity) / 2), 1, jobs, options.cancel,
+          (lattice_rows + 1 - row_parity) / 2 * pass_columns, 1, jobs, options.cancel,
           [&](std::size_t b, std::size_t e) {
             std::uint64_t count = 0;
             const int side = block + 1;
             std::vector<Rgb> local(static_cast<std::size_t>(side) * side);
             std::vector<std::uint8_t> known(local.size());
-            for (std::size_t pair = b; pair < e; ++pair)
-              for (int c = 0; c < block_columns; ++c) {
-                const std::size_t r = 2 * pair + static_cast<std::size_t>(parity);
+            for (std::size_t task = b; task < e; ++task)
+              for (const int c : {2 * static_cast<int>(task % pass_columns) + column_parity}) {
+                const std::size_t r = 2 * (task / pass_columns) + row_parity;
                 const int x0 = c * block, y0 = static_cast<int>(r) * block;
                 auto inside = [&](int dx, int dy) {
                   return x0 + dx < width && y0 + dy < height && object_at(x0 + dx, y0 + dy) >= 0;
@@ -667,10 +658,12 @@ struct PreviewRenderer::Impl {
                   }
               }
             counted += count;
-            for (std::size_t pair = b; pair < e; ++pair)
-              progress.Add(row_pixels[2 * pair + static_cast<std::size_t>(parity)]);
+            for (std::size_t task = b; task < e; ++task)
+              progress.Add(block_pixels[(2 * (task / pass_columns) + row_parity) * block_columns +
+                                        2 * (task % pass_columns) + column_parity]);
           },
           progress.Reporter());
+    }
     progress.Finish();
     for (std::size_t k = 0; k < object_index.size(); ++k) store(k, value[object_index[k]]);
     evaluations = counted;
