@@ -19,9 +19,11 @@
 // size of the reference's own rounding. With double tables the two agree to ~1e-11.
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstddef>
 #include <filesystem>
+#include <thread>
 #include <utility>
 
 #if defined(__SSE2__)
@@ -195,6 +197,46 @@ inline void ThetaAndU(double rho2_a, double z_a, double rho2_b, double z_b, doub
 #endif
 }
 
+// Where a direction pair lands in the file's parameterisation (rgl.h, step 1): the incidence
+// elevation θi and u(θi), the incidence azimuth φi (left 0 when only φm − φi is needed) and the
+// half vector's unit-square position u_m. False (and nothing set) when either direction is at
+// or below the horizon or not finite.
+struct PairCoordinates {
+  double theta_i_rad, u_i, phi_i_rad, um_x, um_y;
+};
+inline bool Coordinates(const Vec3& wi, const Vec3& wo, bool relative_phi_only, bool isotropic,
+                        PairCoordinates& out) {
+  if (!(wi.z > 0.0) || !(wo.z > 0.0)) return false;
+  if (!std::isfinite(wi.x + wi.y + wi.z + wo.x + wo.y + wo.z)) return false;
+  // θ and φ of ωi and of the half vector, all from atan2: both are invariant to the length
+  // of their arguments, so h = ωi + ωo needs no normalisation, and atan2(ρ, z) is the acos
+  // of a unit vector's z (better conditioned near the pole).
+  const Vec3 h = wi + wo;
+  double theta[2], u[2];  // ωi, h
+  ThetaAndU(wi.x * wi.x + wi.y * wi.y, wi.z, h.x * h.x + h.y * h.y, h.z, theta, u);
+  // The reference takes atan2 of each vector (atan2(0, ±0) = 0 or π at the pole); the
+  // relative angle of the general case is the same number from one atan2 of the cross and
+  // dot products of the projections.
+  double phi_i_rad = 0.0, phi;
+  if (relative_phi_only && (wi.x != 0.0 || wi.y != 0.0) && (h.x != 0.0 || h.y != 0.0)) {
+    phi = FastAtan2(wi.x * h.y - wi.y * h.x, wi.x * h.x + wi.y * h.y);
+  } else {
+    phi_i_rad = FastAtan2(wi.y, wi.x);
+    const double phi_m = FastAtan2(h.y, h.x);
+    phi = isotropic ? phi_m - phi_i_rad : phi_m;
+  }
+  double um_y = PhiToU(phi);
+  // Wrap into [0, 1) as u − floor(u) does (φ − φi spans two turns, so u ∈ [−½, 3/2)),
+  // without floor: baseline x86-64 has no rounding instruction and calls a function.
+  if (um_y < 0.0) {
+    um_y += 1.0;
+  } else if (um_y >= 1.0) {
+    um_y -= 1.0;
+  }
+  out = {theta[0], u[0], phi_i_rad, u[1], um_y};
+  return true;
+}
+
 }  // namespace
 
 struct RglBrdf::Tables {
@@ -291,41 +333,15 @@ struct RglBrdf::Tables {
   // f_r·cosθo, divided by cosθo when `divide_by_cos` (then f_r): one division serves both
   // that and the 1/(4σ) of the jacobian.
   Rgb EvalCosine(const Vec3& wi, const Vec3& wo, bool divide_by_cos) const {
-    if (!(wi.z > 0.0) || !(wo.z > 0.0)) return {0.0, 0.0, 0.0};
-    if (!std::isfinite(wi.x + wi.y + wi.z + wo.x + wo.y + wo.z)) return {0.0, 0.0, 0.0};
-    // θ and φ of ωi and of the half vector, all from atan2: both are invariant to the length
-    // of their arguments, so h = ωi + ωo needs no normalisation, and atan2(ρ, z) is the acos
-    // of a unit vector's z (better conditioned near the pole).
-    const Vec3 h = wi + wo;
-    double theta[2], u[2];  // ωi, h
-    ThetaAndU(wi.x * wi.x + wi.y * wi.y, wi.z, h.x * h.x + h.y * h.y, h.z, theta, u);
-    const double theta_i_rad = theta[0];
-    // The reference takes atan2 of each vector (atan2(0, ±0) = 0 or π at the pole); the
-    // relative angle of the general case is the same number from one atan2 of the cross and
-    // dot products of the projections.
-    double phi_i_rad = 0.0, phi;
-    if (relative_phi_only && (wi.x != 0.0 || wi.y != 0.0) && (h.x != 0.0 || h.y != 0.0)) {
-      phi = FastAtan2(wi.x * h.y - wi.y * h.x, wi.x * h.x + wi.y * h.y);
-    } else {
-      phi_i_rad = FastAtan2(wi.y, wi.x);
-      const double phi_m = FastAtan2(h.y, h.x);
-      phi = info.isotropic ? phi_m - phi_i_rad : phi_m;
-    }
-    const double um_x = u[1];
-    double um_y = PhiToU(phi);
-    // Wrap into [0, 1) as u − floor(u) does (φ − φi spans two turns, so u ∈ [−½, 3/2)),
-    // without floor: baseline x86-64 has no rounding instruction and calls a function.
-    if (um_y < 0.0) {
-      um_y += 1.0;
-    } else if (um_y >= 1.0) {
-      um_y -= 1.0;
-    }
-    const Corners c = SlicesFor(phi_i_rad, theta_i_rad);
+    PairCoordinates p;
+    if (!Coordinates(wi, wo, relative_phi_only, info.isotropic, p)) return {0.0, 0.0, 0.0};
+    const double phi_i_rad = p.phi_i_rad, um_x = p.um_x, um_y = p.um_y;
+    const Corners c = SlicesFor(phi_i_rad, p.theta_i_rad);
     double sx, sy;
     InvertWarp(um_x, um_y, c, sx, sy);
     Rgb f = InterpolateRgb(sx, sy, c);
     if (info.jacobian) {
-      const double area = 4.0 * sigma.Eval(u[0], PhiToU(phi_i_rad));
+      const double area = 4.0 * sigma.Eval(p.u_i, PhiToU(phi_i_rad));
       const double scale = ndf.Eval(um_x, um_y) / (divide_by_cos ? area * wo.z : area);
       for (double& v : f) v *= scale;
     } else if (divide_by_cos) {
@@ -606,6 +622,289 @@ RglBrdf RglBrdf::FromTensorFile(const TensorFile& tf, std::string name) {
   info.vndf_theta_res = t->vx;
   info.vndf_phi_res = t->vy;
   return RglBrdf(std::move(t), std::move(name));
+}
+
+// The tabulated form (rgl.h, RglTabulatedBrdf).
+//
+// Incidence: interval j of theta_i holds K_j slots at weights m/K_j (m = 0 … K_j − 1) of the way
+// from theta_i[j] to theta_i[j + 1], starting at slot first_slot[j]; the last node is the final
+// slot. So the slots blend as RglBrdf's slices do and every node is a slot.
+// u(θm): VNDF cell k (between vertices k and k + 1) holds cells[k] table cells of equal width,
+// starting at table vertex offset[k]; u(φm): the VNDF grid's vertices.
+// Storage: vertex (x, y) of slot s holds R, G, B (and a 0 pad) as 16-bit fractions of the slot's
+// per-channel maximum `scale[4 s + ch]`, at texel ((s·ny + y)·nx + x), 8 bytes each: a lookup's
+// two x-neighbours are 16 contiguous bytes, and a real file's table stays within a few MB.
+struct RglTabulatedBrdf::Table {
+  std::vector<double> theta_i, theta_i_inv_step;
+  std::vector<int> first_slot, samples;  // per incidence interval
+  std::vector<double> offset, cells;     // per VNDF cell along u(θm)
+  int slots = 1, vx = 0, nx = 0, ny = 0;
+  std::vector<std::uint16_t> texels;
+  std::vector<float> scale;
+  Interpolant2 ndf;
+  bool ndf_same_for_all_phi = false;  // then its first row alone is looked up
+  bool jacobian = true;
+
+  Rgb EvalCosine(const Vec3& wi, const Vec3& wo, bool divide_by_cos) const {
+    PairCoordinates p;
+    if (!Coordinates(wi, wo, true, true, p)) return {0.0, 0.0, 0.0};
+    int interval;
+    double w;
+    Interval(theta_i, theta_i_inv_step, p.theta_i_rad, interval, w);
+    const int k_samples = samples[interval];
+    const double position = w * k_samples;
+    const int m = std::min(static_cast<int>(position), k_samples - 1);
+    const int s0 = first_slot[interval] + m, s1 = std::min(s0 + 1, slots - 1);
+    const double ft = position - m;
+    const Cell ck = Locate(p.um_x, vx);
+    const double tx = offset[ck.i] + cells[ck.i] * ck.f;
+    const int ix = std::min(static_cast<int>(tx), nx - 2);
+    const double fx = tx - ix;
+    const Cell cy = Locate(p.um_y, ny);
+    const std::size_t row = 4 * static_cast<std::size_t>(nx);
+    const std::size_t at = row * static_cast<std::size_t>(cy.i) + 4 * static_cast<std::size_t>(ix);
+    const std::uint16_t* t0 = texels.data() + row * ny * static_cast<std::size_t>(s0) + at;
+    const std::uint16_t* t1 = texels.data() + row * ny * static_cast<std::size_t>(s1) + at;
+    const float w00 = static_cast<float>((1 - fx) * (1 - cy.f)),
+                w10 = static_cast<float>(fx * (1 - cy.f)), w01 = static_cast<float>((1 - fx) * cy.f),
+                w11 = static_cast<float>(fx * cy.f);
+    Rgb f;
+#if defined(__SSE2__)
+    // Four 16-bit channels per vertex: one 8-byte load each, widened to float lane by lane.
+    const __m128i zero = _mm_setzero_si128();
+    auto texel = [&](const std::uint16_t* q) {
+      return _mm_cvtepi32_ps(
+          _mm_unpacklo_epi16(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(q)), zero));
+    };
+    auto corners = [&](const std::uint16_t* q, int slot, double weight) {
+      __m128 a = _mm_mul_ps(texel(q), _mm_set1_ps(w00));
+      a = _mm_add_ps(a, _mm_mul_ps(texel(q + 4), _mm_set1_ps(w10)));
+      a = _mm_add_ps(a, _mm_mul_ps(texel(q + row), _mm_set1_ps(w01)));
+      a = _mm_add_ps(a, _mm_mul_ps(texel(q + row + 4), _mm_set1_ps(w11)));
+      return _mm_mul_ps(a, _mm_mul_ps(_mm_loadu_ps(scale.data() + 4 * slot),
+                                      _mm_set1_ps(static_cast<float>(weight))));
+    };
+    alignas(16) float out[4];
+    _mm_store_ps(out, _mm_add_ps(corners(t0, s0, 1 - ft), corners(t1, s1, ft)));
+    for (int ch = 0; ch < 3; ++ch) f[ch] = out[ch];
+#else
+    for (int ch = 0; ch < 3; ++ch) {
+      auto corners = [&](const std::uint16_t* q, int slot) {
+        return (w00 * q[ch] + w10 * q[4 + ch] + w01 * q[row + ch] + w11 * q[row + 4 + ch]) *
+               static_cast<double>(scale[4 * slot + ch]);
+      };
+      f[ch] = (1 - ft) * corners(t0, s0) + ft * corners(t1, s1);
+    }
+#endif
+    // The slot scales hold 1 / 4σ; what is left of rgl.h's step 3 is ndf(u_m) [/ cosθo].
+    double factor = 1.0;
+    if (jacobian) {
+      if (ndf_same_for_all_phi) {
+        const Cell cn = Locate(p.um_x, ndf.nx);
+        factor = (1 - cn.f) * ndf.v[cn.i] + cn.f * ndf.v[cn.i + 1];
+      } else {
+        factor = ndf.Eval(p.um_x, p.um_y);
+      }
+    }
+    if (divide_by_cos) factor /= wo.z;
+    for (double& v : f) v *= factor;
+    return f;
+  }
+};
+
+RglTabulatedBrdf::RglTabulatedBrdf(std::unique_ptr<Table> table, std::string name)
+    : table_(std::move(table)), name_(std::move(name)) {}
+RglTabulatedBrdf::RglTabulatedBrdf(RglTabulatedBrdf&&) noexcept = default;
+RglTabulatedBrdf& RglTabulatedBrdf::operator=(RglTabulatedBrdf&&) noexcept = default;
+RglTabulatedBrdf::~RglTabulatedBrdf() = default;
+
+Rgb RglTabulatedBrdf::Eval(const Vec3& wi, const Vec3& wo) const {
+  return table_->EvalCosine(wi, wo, true);
+}
+Rgb RglTabulatedBrdf::EvalCosine(const Vec3& wi, const Vec3& wo) const {
+  return table_->EvalCosine(wi, wo, false);
+}
+std::size_t RglTabulatedBrdf::table_bytes() const {
+  return table_->texels.size() * sizeof(std::uint16_t) + table_->scale.size() * sizeof(float);
+}
+int RglTabulatedBrdf::incidence_samples() const { return table_->slots; }
+int RglTabulatedBrdf::vertices_theta() const { return table_->nx; }
+int RglTabulatedBrdf::vertices_phi() const { return table_->ny; }
+
+std::unique_ptr<RglTabulatedBrdf> RglBrdf::Tabulate(const RglTabulationSettings& settings) const {
+  const RglTabulationSettings& o = settings;
+  if (!(o.incidence_tolerance > 0.0) || !(o.cells_per_rgb_cell > 0.0) ||
+      !std::isfinite(o.incidence_tolerance + o.cells_per_rgb_cell) ||
+      o.max_samples_per_interval < 1 || o.max_samples_per_interval > 64 ||
+      o.max_cells_per_vndf_cell < 1 || o.max_cells_per_vndf_cell > 64 || o.phi_vertices < 0 ||
+      o.phi_vertices == 1 || o.phi_vertices > 4096)
+    throw InvalidArgument(
+        "RGL tabulation: the incidence tolerance and cells per RGB cell must be finite and > 0, "
+        "the largest samples per interval and cells per VNDF cell between 1 and 64, the φ "
+        "vertices 0 (the file's) or between 2 and 4096");
+  const Tables& e = *tables_;
+  if (!e.relative_phi_only) return nullptr;
+  auto t = std::make_unique<RglTabulatedBrdf::Table>();
+  t->theta_i = e.theta_i;
+  t->theta_i_inv_step = e.theta_i_inv_step;
+  t->ndf = e.ndf;
+  t->ndf_same_for_all_phi = true;
+  for (int y = 1; y < e.ndf.ny; ++y)
+    for (int x = 0; x < e.ndf.nx; ++x)
+      t->ndf_same_for_all_phi &=
+          e.ndf.v[static_cast<std::size_t>(y) * e.ndf.nx + x] == e.ndf.v[x];
+  t->jacobian = e.info.jacobian;
+  t->vx = e.vx;
+  t->ny = o.phi_vertices > 0 ? o.phi_vertices : e.vy;
+  // Cells along u(θm): X, the conditional CDF the RGB table is indexed by, changes by
+  // density / row total per VNDF cell (the warp tables are normalised over the index domain);
+  // enough cells that no table cell spans more than 1 / cells_per_rgb_cell of an RGB cell, in
+  // any slice or row.
+  const std::size_t vx = e.vx, vy = e.vy, slices = e.theta_i.size();
+  double cell_total = 0.0;
+  for (std::size_t k = 0; k + 1 < vx; ++k) {
+    double rate = 0.0;
+    for (std::size_t sl = 0; sl < slices; ++sl)
+      for (std::size_t y = 0; y < vy; ++y) {
+        const double total = e.rows[2 * (sl * vy + y)];
+        if (!(total > 0.0)) continue;
+        const double* d = e.warp.data() + 2 * ((sl * vy + y) * vx + k);
+        rate = std::max(rate, std::max(d[0], d[2]) / total);
+      }
+    const double wanted = std::ceil(rate * (e.rx - 1) * o.cells_per_rgb_cell - 1e-9);
+    const double n = std::clamp(wanted, 1.0, static_cast<double>(o.max_cells_per_vndf_cell));
+    t->offset.push_back(cell_total);
+    t->cells.push_back(n);
+    cell_total += n;
+  }
+  t->nx = static_cast<int>(cell_total) + 1;
+  const std::size_t nx = t->nx, ny = t->ny, plane = nx * ny;
+  std::vector<double> ux(nx);
+  for (std::size_t k = 0; k + 1 < vx; ++k)
+    for (int i = 0; i <= static_cast<int>(t->cells[k]); ++i)
+      ux[static_cast<std::size_t>(t->offset[k]) + i] =
+          (static_cast<double>(k) + i / t->cells[k]) / static_cast<double>(vx - 1);
+  // Weights of the incidence test: f_r·cosθo at a vertex is g · ndf / 4σ and the vertex stands
+  // for a solid angle of half vectors ∝ sinθm · u(θm) (θm = u² π/2), so an error in g there
+  // counts with ndf² · sinθm · u in the RMS of f over directions.
+  std::vector<double> weight(plane);
+  for (std::size_t y = 0; y < ny; ++y)
+    for (std::size_t x = 0; x < nx; ++x) {
+      const double uy = static_cast<double>(y) / (ny - 1);
+      const double n = e.info.jacobian ? e.ndf.Eval(ux[x], uy) : 1.0;
+      weight[y * nx + x] = n * n * std::sin(ux[x] * ux[x] * 0.5 * kPi) * ux[x];
+    }
+  // g at weight w of interval j (RGB per vertex, double).
+  auto sample = [&](int j, double w) {
+    Corners c;
+    const bool single = slices == 1;
+    c.n = single ? 1 : 2;
+    c.slice = {static_cast<std::size_t>(j), static_cast<std::size_t>(single ? j : j + 1), 0, 0};
+    c.w = {1.0 - w, w, 0.0, 0.0};
+    std::vector<double> g(3 * plane);
+    for (std::size_t y = 0; y < ny; ++y)
+      for (std::size_t x = 0; x < nx; ++x) {
+        double sx, sy;
+        e.InvertWarp(ux[x], static_cast<double>(y) / (ny - 1), c, sx, sy);
+        const Rgb v = e.InterpolateRgb(sx, sy, c);
+        for (int ch = 0; ch < 3; ++ch) g[3 * (y * nx + x) + ch] = v[ch];
+      }
+    return g;
+  };
+  // Incidence samples per interval: doubled until linear interpolation between the samples
+  // predicts every new midpoint within incidence_tolerance (weighted RMS relative to the
+  // midpoint's own weighted RMS). Intervals are independent: built on `jobs` threads, each
+  // holding its slots from w = 0 to w = 1 (the shared nodes are computed twice).
+  const int intervals = static_cast<int>(slices) - 1;
+  std::vector<std::vector<std::vector<double>>> runs(std::max(1, intervals));
+  auto build_interval = [&](int j) {
+    std::vector<std::vector<double>> run = {sample(j, 0.0)};
+    if (intervals == 0) {
+      runs[0] = std::move(run);
+      return;
+    }
+    run.push_back(sample(j, 1.0));  // run[m] at w = m / k_samples
+    int k_samples = 1;
+    while (k_samples < o.max_samples_per_interval) {
+      std::vector<std::vector<double>> refined;
+      double err = 0.0, norm = 0.0;
+      for (int m = 0; m < k_samples; ++m) {
+        std::vector<double> mid = sample(j, (m + 0.5) / k_samples);
+        for (std::size_t v = 0; v < plane; ++v)
+          for (int ch = 0; ch < 3; ++ch) {
+            const std::size_t i = 3 * v + static_cast<std::size_t>(ch);
+            const double d = mid[i] - 0.5 * (run[m][i] + run[m + 1][i]);
+            err += weight[v] * d * d;
+            norm += weight[v] * mid[i] * mid[i];
+          }
+        refined.push_back(std::move(run[m]));
+        refined.push_back(std::move(mid));
+      }
+      refined.push_back(std::move(run[k_samples]));
+      run = std::move(refined);
+      k_samples *= 2;
+      if (!(err > o.incidence_tolerance * o.incidence_tolerance * norm)) break;
+    }
+    runs[j] = std::move(run);
+  };
+  {
+    std::atomic<int> next{0};
+    auto worker = [&] {
+      for (int j = next++; j < static_cast<int>(runs.size()); j = next++) build_interval(j);
+    };
+    const int threads = std::clamp(o.jobs > 0 ? o.jobs : static_cast<int>(std::thread::hardware_concurrency()),
+                                   1, static_cast<int>(runs.size()));
+    std::vector<std::thread> pool;
+    for (int k = 1; k < threads; ++k) pool.emplace_back(worker);
+    worker();
+    for (std::thread& th : pool) th.join();
+  }
+  // Slots in order, each interval's w = 1 end dropped in favour of the next one's w = 0 (the
+  // same node; the last node kept).
+  std::vector<const std::vector<double>*> slot_values;
+  std::vector<double> slot_theta;
+  for (int j = 0; j < static_cast<int>(runs.size()); ++j) {
+    const int k_samples = std::max(1, static_cast<int>(runs[j].size()) - 1);
+    t->first_slot.push_back(static_cast<int>(slot_values.size()));
+    t->samples.push_back(k_samples);
+    const bool last = j + 1 == static_cast<int>(runs.size());
+    for (std::size_t m = 0; m < runs[j].size(); ++m) {
+      if (intervals > 0 && m + 1 == runs[j].size() && !last) break;
+      slot_values.push_back(&runs[j][m]);
+      slot_theta.push_back(intervals == 0 ? e.theta_i[0]
+                                          : e.theta_i[j] + (e.theta_i[j + 1] - e.theta_i[j]) *
+                                                               static_cast<double>(m) / k_samples);
+    }
+  }
+  t->slots = static_cast<int>(slot_values.size());
+  // 16-bit fractions of each slot's per-channel maximum (values are ≥ 0: RglBrdf clips). With
+  // the jacobian, the slot's 1 / (4σ(θi)) is folded into its scale: σ is smooth in θi (the
+  // projected area of the microsurface), so interpolating g / 4σ between slots instead of g
+  // and σ separately changes f by far less than the tabulation of g itself.
+  t->texels.assign(4 * plane * slot_values.size(), 0);
+  t->scale.assign(4 * slot_values.size(), 0.0f);
+  for (std::size_t sl = 0; sl < slot_values.size(); ++sl) {
+    const std::vector<double>& g = *slot_values[sl];
+    const double factor =
+        e.info.jacobian
+            ? 1.0 / (4.0 * e.sigma.Eval(std::sqrt(slot_theta[sl] * (2.0 / kPi)), PhiToU(0.0)))
+            : 1.0;
+    for (int ch = 0; ch < 3; ++ch) {
+      double peak = 0.0;
+      for (std::size_t v = 0; v < plane; ++v) peak = std::max(peak, g[3 * v + ch]);
+      const double step = peak > 0.0 ? peak / 65535.0 : 1.0;
+      t->scale[4 * sl + ch] = static_cast<float>(step * factor);
+      for (std::size_t v = 0; v < plane; ++v)
+        t->texels[4 * (sl * plane + v) + ch] =
+            static_cast<std::uint16_t>(std::min(65535.0, std::rint(g[3 * v + ch] / step)));
+    }
+  }
+  return std::unique_ptr<RglTabulatedBrdf>(
+      new RglTabulatedBrdf(std::move(t), name_ + " (tabulated)"));
+}
+
+std::unique_ptr<BrdfSource> RglBrdf::QuadratureApproximation() const {
+  return Tabulate(RglTabulationSettings{});
 }
 
 }  // namespace brdf
