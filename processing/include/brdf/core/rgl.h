@@ -142,12 +142,11 @@ struct RglTabulationSettings {
   // max_samples_per_interval.
   double incidence_tolerance = 0.002;
   int max_samples_per_interval = 8;
-  // Table cells per VNDF cell along u(θm): enough that one table cell spans at most
-  // 1 / cells_per_rgb_cell of an RGB cell in warped space, from 1 to max_cells_per_vndf_cell.
+  // Table cells per VNDF cell along u(θm) and along u(φm − φi): enough that one table cell
+  // spans at most 1 / cells_per_rgb_cell of an RGB cell in warped space (in every slice), from
+  // 1 to max_cells_per_vndf_cell.
   double cells_per_rgb_cell = 1.0;
   int max_cells_per_vndf_cell = 8;
-  // Vertices along u(φm − φi), evenly spaced over [0, 1]; 0: the VNDF grid's.
-  int phi_vertices = 0;
   // Threads building the table; 0: one per core.
   int jobs = 0;
 };

@@ -629,16 +629,60 @@ RglBrdf RglBrdf::FromTensorFile(const TensorFile& tf, std::string name) {
 // Incidence: interval j of theta_i holds K_j slots at weights m/K_j (m = 0 … K_j − 1) of the way
 // from theta_i[j] to theta_i[j + 1], starting at slot first_slot[j]; the last node is the final
 // slot. So the slots blend as RglBrdf's slices do and every node is a slot.
-// u(θm): VNDF cell k (between vertices k and k + 1) holds cells[k] table cells of equal width,
-// starting at table vertex offset[k]; u(φm): the VNDF grid's vertices.
+// u(θm) and u(φm − φi): VNDF cell k (between vertices k and k + 1) holds cells[k] table cells of
+// equal width, starting at table vertex offset[k] (TableAxis), more where the warp is steep.
 // Storage: vertex (x, y) of slot s holds R, G, B (and a 0 pad) as 16-bit fractions of the slot's
 // per-channel maximum `scale[4 s + ch]`, at texel ((s·ny + y)·nx + x), 8 bytes each: a lookup's
 // two x-neighbours are 16 contiguous bytes, and a real file's table stays within a few MB.
+namespace {
+
+// One axis of the table: the VNDF grid's `n` even vertices over [0, 1], cell k split into
+// cells[k] equal table cells starting at table vertex offset[k].
+struct TableAxis {
+  int n = 0, vertices = 0;
+  std::vector<double> offset, cells;
+
+  // Table cells per VNDF cell from `rate` (how many RGB cells the warped coordinate crosses in
+  // each VNDF cell), as RglTabulationSettings says.
+  static TableAxis FromRates(const std::vector<double>& rate, double cells_per_rgb_cell,
+                             int max_cells) {
+    TableAxis a;
+    a.n = static_cast<int>(rate.size()) + 1;
+    double total = 0.0;
+    for (const double r : rate) {
+      const double wanted = std::ceil(r * cells_per_rgb_cell - 1e-9);
+      const double c = std::clamp(wanted, 1.0, static_cast<double>(max_cells));
+      a.offset.push_back(total);
+      a.cells.push_back(c);
+      total += c;
+    }
+    a.vertices = static_cast<int>(total) + 1;
+    return a;
+  }
+  // The unit-square coordinate of every table vertex.
+  std::vector<double> Positions() const {
+    std::vector<double> u(static_cast<std::size_t>(vertices));
+    for (std::size_t k = 0; k < cells.size(); ++k)
+      for (int i = 0; i <= static_cast<int>(cells[k]); ++i)
+        u[static_cast<std::size_t>(offset[k]) + i] =
+            (static_cast<double>(k) + i / cells[k]) / static_cast<double>(n - 1);
+    return u;
+  }
+  Cell Map(double u) const {
+    const Cell c = Locate(u, n);
+    const double t = offset[c.i] + cells[c.i] * c.f;
+    const int i = std::min(static_cast<int>(t), vertices - 2);
+    return {i, t - i};
+  }
+};
+
+}  // namespace
+
 struct RglTabulatedBrdf::Table {
   std::vector<double> theta_i, theta_i_inv_step;
   std::vector<int> first_slot, samples;  // per incidence interval
-  std::vector<double> offset, cells;     // per VNDF cell along u(θm)
-  int slots = 1, vx = 0, nx = 0, ny = 0;
+  TableAxis ax, ay;                      // along u(θm) and u(φm − φi)
+  int slots = 1, nx = 0, ny = 0;
   std::vector<std::uint16_t> texels;
   std::vector<float> scale;
   Interpolant2 ndf;
@@ -656,13 +700,10 @@ struct RglTabulatedBrdf::Table {
     const int m = std::min(static_cast<int>(position), k_samples - 1);
     const int s0 = first_slot[interval] + m, s1 = std::min(s0 + 1, slots - 1);
     const double ft = position - m;
-    const Cell ck = Locate(p.um_x, vx);
-    const double tx = offset[ck.i] + cells[ck.i] * ck.f;
-    const int ix = std::min(static_cast<int>(tx), nx - 2);
-    const double fx = tx - ix;
-    const Cell cy = Locate(p.um_y, ny);
+    const Cell cx = ax.Map(p.um_x), cy = ay.Map(p.um_y);
+    const double fx = cx.f;
     const std::size_t row = 4 * static_cast<std::size_t>(nx);
-    const std::size_t at = row * static_cast<std::size_t>(cy.i) + 4 * static_cast<std::size_t>(ix);
+    const std::size_t at = row * static_cast<std::size_t>(cy.i) + 4 * static_cast<std::size_t>(cx.i);
     const std::uint16_t* t0 = texels.data() + row * ny * static_cast<std::size_t>(s0) + at;
     const std::uint16_t* t1 = texels.data() + row * ny * static_cast<std::size_t>(s1) + at;
     const float w00 = static_cast<float>((1 - fx) * (1 - cy.f)),
@@ -736,12 +777,10 @@ std::unique_ptr<RglTabulatedBrdf> RglBrdf::Tabulate(const RglTabulationSettings&
   if (!(o.incidence_tolerance > 0.0) || !(o.cells_per_rgb_cell > 0.0) ||
       !std::isfinite(o.incidence_tolerance + o.cells_per_rgb_cell) ||
       o.max_samples_per_interval < 1 || o.max_samples_per_interval > 64 ||
-      o.max_cells_per_vndf_cell < 1 || o.max_cells_per_vndf_cell > 64 || o.phi_vertices < 0 ||
-      o.phi_vertices == 1 || o.phi_vertices > 4096)
+      o.max_cells_per_vndf_cell < 1 || o.max_cells_per_vndf_cell > 64)
     throw InvalidArgument(
         "RGL tabulation: the incidence tolerance and cells per RGB cell must be finite and > 0, "
-        "the largest samples per interval and cells per VNDF cell between 1 and 64, the φ "
-        "vertices 0 (the file's) or between 2 and 4096");
+        "the largest samples per interval and cells per VNDF cell between 1 and 64");
   const Tables& e = *tables_;
   if (!e.relative_phi_only) return nullptr;
   auto t = std::make_unique<RglTabulatedBrdf::Table>();
@@ -754,44 +793,45 @@ std::unique_ptr<RglTabulatedBrdf> RglBrdf::Tabulate(const RglTabulationSettings&
       t->ndf_same_for_all_phi &=
           e.ndf.v[static_cast<std::size_t>(y) * e.ndf.nx + x] == e.ndf.v[x];
   t->jacobian = e.info.jacobian;
-  t->vx = e.vx;
-  t->ny = o.phi_vertices > 0 ? o.phi_vertices : e.vy;
-  // Cells along u(θm): X, the conditional CDF the RGB table is indexed by, changes by
-  // density / row total per VNDF cell (the warp tables are normalised over the index domain);
-  // enough cells that no table cell spans more than 1 / cells_per_rgb_cell of an RGB cell, in
-  // any slice or row.
+  // Table cells per VNDF cell. Along u(θm): X, the conditional CDF the RGB table is indexed
+  // by, changes by density / row total per VNDF cell (the warp tables are normalised over the
+  // index domain). Along u(φm): Y, the marginal CDF, changes by the row total, and X at a
+  // given u(θm) by the difference of the two rows' conditional CDFs (large between rows of
+  // little mass, e.g. half vectors facing away from a grazing ωi). Each rate is the largest
+  // over slices (and rows or columns), in RGB cells.
   const std::size_t vx = e.vx, vy = e.vy, slices = e.theta_i.size();
-  double cell_total = 0.0;
-  for (std::size_t k = 0; k + 1 < vx; ++k) {
-    double rate = 0.0;
-    for (std::size_t sl = 0; sl < slices; ++sl)
-      for (std::size_t y = 0; y < vy; ++y) {
-        const double total = e.rows[2 * (sl * vy + y)];
-        if (!(total > 0.0)) continue;
+  std::vector<double> rate_x(vx - 1, 0.0), rate_y(vy - 1, 0.0);
+  for (std::size_t sl = 0; sl < slices; ++sl)
+    for (std::size_t y = 0; y < vy; ++y) {
+      const double total = e.rows[2 * (sl * vy + y)];
+      if (y + 1 < vy)
+        rate_y[y] = std::max(rate_y[y], std::max(total, e.rows[2 * (sl * vy + y + 1)]) * (e.ry - 1));
+      if (!(total > 0.0)) continue;
+      for (std::size_t k = 0; k + 1 < vx; ++k) {
         const double* d = e.warp.data() + 2 * ((sl * vy + y) * vx + k);
-        rate = std::max(rate, std::max(d[0], d[2]) / total);
+        rate_x[k] = std::max(rate_x[k], std::max(d[0], d[2]) / total * (e.rx - 1));
       }
-    const double wanted = std::ceil(rate * (e.rx - 1) * o.cells_per_rgb_cell - 1e-9);
-    const double n = std::clamp(wanted, 1.0, static_cast<double>(o.max_cells_per_vndf_cell));
-    t->offset.push_back(cell_total);
-    t->cells.push_back(n);
-    cell_total += n;
-  }
-  t->nx = static_cast<int>(cell_total) + 1;
+      const double next = y + 1 < vy ? e.rows[2 * (sl * vy + y + 1)] : 0.0;
+      if (!(next > 0.0)) continue;
+      for (std::size_t k = 0; k < vx; ++k) {
+        const double* d = e.warp.data() + 2 * ((sl * vy + y) * vx + k);
+        const double change = std::abs(d[2 * vx + 1] / next - d[1] / total);
+        rate_y[y] = std::max(rate_y[y], change * (e.rx - 1));
+      }
+    }
+  t->ax = TableAxis::FromRates(rate_x, o.cells_per_rgb_cell, o.max_cells_per_vndf_cell);
+  t->ay = TableAxis::FromRates(rate_y, o.cells_per_rgb_cell, o.max_cells_per_vndf_cell);
+  t->nx = t->ax.vertices;
+  t->ny = t->ay.vertices;
   const std::size_t nx = t->nx, ny = t->ny, plane = nx * ny;
-  std::vector<double> ux(nx);
-  for (std::size_t k = 0; k + 1 < vx; ++k)
-    for (int i = 0; i <= static_cast<int>(t->cells[k]); ++i)
-      ux[static_cast<std::size_t>(t->offset[k]) + i] =
-          (static_cast<double>(k) + i / t->cells[k]) / static_cast<double>(vx - 1);
+  const std::vector<double> ux = t->ax.Positions(), uy = t->ay.Positions();
   // Weights of the incidence test: f_r·cosθo at a vertex is g · ndf / 4σ and the vertex stands
   // for a solid angle of half vectors ∝ sinθm · u(θm) (θm = u² π/2), so an error in g there
   // counts with ndf² · sinθm · u in the RMS of f over directions.
   std::vector<double> weight(plane);
   for (std::size_t y = 0; y < ny; ++y)
     for (std::size_t x = 0; x < nx; ++x) {
-      const double uy = static_cast<double>(y) / (ny - 1);
-      const double n = e.info.jacobian ? e.ndf.Eval(ux[x], uy) : 1.0;
+      const double n = e.info.jacobian ? e.ndf.Eval(ux[x], uy[y]) : 1.0;
       weight[y * nx + x] = n * n * std::sin(ux[x] * ux[x] * 0.5 * kPi) * ux[x];
     }
   // g at weight w of interval j (RGB per vertex, double).
@@ -805,7 +845,7 @@ std::unique_ptr<RglTabulatedBrdf> RglBrdf::Tabulate(const RglTabulationSettings&
     for (std::size_t y = 0; y < ny; ++y)
       for (std::size_t x = 0; x < nx; ++x) {
         double sx, sy;
-        e.InvertWarp(ux[x], static_cast<double>(y) / (ny - 1), c, sx, sy);
+        e.InvertWarp(ux[x], uy[y], c, sx, sy);
         const Rgb v = e.InterpolateRgb(sx, sy, c);
         for (int ch = 0; ch < 3; ++ch) g[3 * (y * nx + x) + ch] = v[ch];
       }
