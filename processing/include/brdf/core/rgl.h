@@ -147,6 +147,9 @@ struct RglTabulationSettings {
   // 1 to max_cells_per_vndf_cell.
   double cells_per_rgb_cell = 1.0;
   int max_cells_per_vndf_cell = 8;
+  // Largest table (bytes, at the most incidence samples the refinement may make): cells per
+  // RGB cell are reduced by steps of 0.8 until it fits, down to one cell per VNDF cell.
+  std::size_t max_table_bytes = 10u << 20;
   // Threads building the table; 0: one per core.
   int jobs = 0;
 };
