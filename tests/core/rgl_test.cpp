@@ -577,6 +577,20 @@ TEST(RglTabulated, IsNoneForAnAnisotropicFileAndZeroWhereTheExactOneIs) {
   EXPECT_EQ(brdf->Eval({INFINITY, 0.0, 0.9}, up), (Rgb{0, 0, 0}));
 }
 
+TEST(RglTabulated, QuadratureApproximationDeclinesATableThatFailsItsSelfCheck) {
+  // cc_ibiza_sunset's table checks well within the limit; chm_mint's does not (creases of its
+  // RGB table at grazing incidence: the NumPy oracle puts its 99th percentile at ~13 %,
+  // rgl_tabulated_check.py --files chm_mint_rgb.bsdf), so the preview keeps the exact evaluator.
+  const RglBrdf ibiza = RglBrdf::Load(RglDir() + "cc_ibiza_sunset_rgb.bsdf");
+  const std::unique_ptr<RglTabulatedBrdf> good = ibiza.Tabulate(RglTabulationSettings{});
+  EXPECT_LT(good->self_check_p99_error(), 0.02);
+  EXPECT_NE(ibiza.QuadratureApproximation(), nullptr);
+  const RglBrdf mint = RglBrdf::Load(RglDir() + "chm_mint_rgb.bsdf");
+  const std::unique_ptr<RglTabulatedBrdf> bad = mint.Tabulate(RglTabulationSettings{});
+  EXPECT_GT(bad->self_check_p99_error(), kRglApproximationMaxP99Error);
+  EXPECT_EQ(mint.QuadratureApproximation(), nullptr);
+}
+
 TEST(RglTabulated, RefusesSettingsOutOfRange) {
   const RglBrdf paper = RglBrdf::Load(RglDir() + "paper_white_rgb.bsdf");
   for (auto change : {+[](RglTabulationSettings& o) { o.incidence_tolerance = 0.0; },

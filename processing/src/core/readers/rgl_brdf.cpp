@@ -25,6 +25,7 @@
 #include <filesystem>
 #include <thread>
 #include <utility>
+#include <vector>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -626,8 +627,8 @@ RglBrdf RglBrdf::FromTensorFile(const TensorFile& tf, std::string name) {
 
 // The tabulated form (rgl.h, RglTabulatedBrdf).
 //
-// Incidence: interval j of theta_i holds K_j slots at weights m/K_j (m = 0 … K_j − 1) of the way
-// from theta_i[j] to theta_i[j + 1], starting at slot first_slot[j]; the last node is the final
+// Incidence: interval j of theta_i holds K_j slots (incidence samples) at weights m/K_j
+// (m = 0 … K_j − 1) of the way from theta_i[j] to theta_i[j + 1]; the last node is the final
 // slot. So the slots blend as RglBrdf's slices do and every node is a slot.
 // u(θm) and u(φm − φi): VNDF cell k (between vertices k and k + 1) holds cells[k] table cells of
 // equal width, starting at table vertex offset[k] (TableAxis), more where the warp is steep.
@@ -679,27 +680,33 @@ struct TableAxis {
 }  // namespace
 
 struct RglTabulatedBrdf::Table {
-  std::vector<double> theta_i, theta_i_inv_step;
-  std::vector<int> first_slot, samples;  // per incidence interval
+  // Per incidence sample: θi (rad) and 1 / (distance to the next; 0 for the last). bin_slot[b]:
+  // the last sample at or below slot_theta[0] + b / bins_per_rad.
+  std::vector<double> slot_theta, slot_inv_step;
+  std::vector<std::uint16_t> bin_slot;
+  double bins_per_rad = 0.0;
   TableAxis ax, ay;                      // along u(θm) and u(φm − φi)
   int slots = 1, nx = 0, ny = 0;
   std::vector<std::uint16_t> texels;
   std::vector<float> scale;
   Interpolant2 ndf;
   bool ndf_same_for_all_phi = false;  // then its first row alone is looked up
+  double self_check_p99 = 0.0;
   bool jacobian = true;
 
   Rgb EvalCosine(const Vec3& wi, const Vec3& wo, bool divide_by_cos) const {
     PairCoordinates p;
     if (!Coordinates(wi, wo, true, true, p)) return {0.0, 0.0, 0.0};
-    int interval;
-    double w;
-    Interval(theta_i, theta_i_inv_step, p.theta_i_rad, interval, w);
-    const int k_samples = samples[interval];
-    const double position = w * k_samples;
-    const int m = std::min(static_cast<int>(position), k_samples - 1);
-    const int s0 = first_slot[interval] + m, s1 = std::min(s0 + 1, slots - 1);
-    const double ft = position - m;
+    // The incidence sample at or below θi: from the bin of θi, then at most a step or two up
+    // (bins are no wider than the closest two samples, so usually none).
+    const double theta = p.theta_i_rad;
+    const double bin_position = (theta - slot_theta[0]) * bins_per_rad;
+    const int bin = std::clamp(static_cast<int>(bin_position), 0, static_cast<int>(bin_slot.size()) - 1);
+    int s0 = bin_slot[static_cast<std::size_t>(bin)];
+    while (s0 + 2 < slots && theta >= slot_theta[static_cast<std::size_t>(s0) + 1]) ++s0;
+    const int s1 = std::min(s0 + 1, slots - 1);
+    const double ft = Clamp01((theta - slot_theta[static_cast<std::size_t>(s0)]) *
+                              slot_inv_step[static_cast<std::size_t>(s0)]);
     const Cell cx = ax.Map(p.um_x), cy = ay.Map(p.um_y);
     const double fx = cx.f;
     const std::size_t row = 3 * static_cast<std::size_t>(nx);
@@ -772,6 +779,53 @@ std::size_t RglTabulatedBrdf::table_bytes() const {
 int RglTabulatedBrdf::incidence_samples() const { return table_->slots; }
 int RglTabulatedBrdf::vertices_theta() const { return table_->nx; }
 int RglTabulatedBrdf::vertices_phi() const { return table_->ny; }
+double RglTabulatedBrdf::self_check_p99_error() const { return table_->self_check_p99; }
+
+namespace {
+
+// RglTabulatedBrdf::self_check_p99_error: the table against the exact evaluator at fixed
+// pseudo-random pairs (SplitMix64, so every build checks the same pairs).
+double SelfCheckP99(const RglBrdf& exact, const RglTabulatedBrdf& table) {
+  std::uint64_t state = 0x5eed5eed12345678ull;
+  auto next = [&] {
+    std::uint64_t z = (state += 0x9e3779b97f4a7c15ull);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    return static_cast<double>((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
+  };
+  auto direction = [](double theta, double phi) {
+    return Vec3{std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)};
+  };
+  constexpr int kPairs = 16384;
+  std::vector<std::array<double, 6>> values;  // exact, tabulated per channel
+  values.reserve(kPairs);
+  std::array<double, 3> peak{0, 0, 0};
+  for (int k = 0; k < kPairs; ++k) {
+    const double theta_i = std::acos(std::sqrt(1.0 - next())), phi_i = 2 * kPi * next();
+    const Vec3 wi = direction(theta_i, phi_i);
+    Vec3 wo;
+    if (k % 2 == 0) {
+      wo = direction(std::acos(std::sqrt(1.0 - next())), 2 * kPi * next());
+    } else {  // within ±4° (uniform) of the mirror direction in θ and φ
+      const double spread = 4.0 * kPi / 180.0;
+      const double theta_o = std::abs(theta_i + spread * (2 * next() - 1));
+      wo = direction(std::min(theta_o, 0.5 * kPi - 1e-3), phi_i + kPi + spread * (2 * next() - 1));
+    }
+    const Rgb a = exact.EvalCosine(wi, wo), b = table.EvalCosine(wi, wo);
+    values.push_back({a[0], a[1], a[2], b[0], b[1], b[2]});
+    for (int ch = 0; ch < 3; ++ch) peak[ch] = std::max(peak[ch], a[ch]);
+  }
+  std::vector<double> rel;
+  for (const auto& v : values)
+    for (int ch = 0; ch < 3; ++ch)
+      if (v[ch] > 0.0 && v[ch] >= 0.01 * peak[ch]) rel.push_back(std::abs(v[3 + ch] - v[ch]) / v[ch]);
+  if (rel.empty()) return 0.0;
+  const std::size_t at = rel.size() * 99 / 100;
+  std::nth_element(rel.begin(), rel.begin() + static_cast<std::ptrdiff_t>(at), rel.end());
+  return rel[at];
+}
+
+}  // namespace
 
 std::unique_ptr<RglTabulatedBrdf> RglBrdf::Tabulate(const RglTabulationSettings& settings) const {
   const RglTabulationSettings& o = settings;
@@ -785,8 +839,6 @@ std::unique_ptr<RglTabulatedBrdf> RglBrdf::Tabulate(const RglTabulationSettings&
   const Tables& e = *tables_;
   if (!e.relative_phi_only) return nullptr;
   auto t = std::make_unique<RglTabulatedBrdf::Table>();
-  t->theta_i = e.theta_i;
-  t->theta_i_inv_step = e.theta_i_inv_step;
   t->ndf = e.ndf;
   t->ndf_same_for_all_phi = true;
   for (int y = 1; y < e.ndf.ny; ++y)
@@ -917,8 +969,6 @@ std::unique_ptr<RglTabulatedBrdf> RglBrdf::Tabulate(const RglTabulationSettings&
   std::vector<double> slot_theta;
   for (int j = 0; j < static_cast<int>(runs.size()); ++j) {
     const int k_samples = std::max(1, static_cast<int>(runs[j].size()) - 1);
-    t->first_slot.push_back(static_cast<int>(slot_values.size()));
-    t->samples.push_back(k_samples);
     const bool last = j + 1 == static_cast<int>(runs.size());
     for (std::size_t m = 0; m < runs[j].size(); ++m) {
       if (intervals > 0 && m + 1 == runs[j].size() && !last) break;
@@ -929,6 +979,23 @@ std::unique_ptr<RglTabulatedBrdf> RglBrdf::Tabulate(const RglTabulationSettings&
     }
   }
   t->slots = static_cast<int>(slot_values.size());
+  t->slot_theta = slot_theta;
+  t->slot_inv_step.assign(slot_theta.size(), 0.0);
+  double closest = kPi;
+  for (std::size_t k = 0; k + 1 < slot_theta.size(); ++k) {
+    t->slot_inv_step[k] = 1.0 / (slot_theta[k + 1] - slot_theta[k]);
+    closest = std::min(closest, slot_theta[k + 1] - slot_theta[k]);
+  }
+  const double span = slot_theta.back() - slot_theta.front();
+  const std::size_t bins =
+      std::clamp<std::size_t>(static_cast<std::size_t>(std::ceil(span / closest)) + 1, 1, 1u << 14);
+  t->bins_per_rad = span > 0.0 ? static_cast<double>(bins) / span : 0.0;
+  t->bin_slot.resize(bins);
+  for (std::size_t b = 0, k = 0; b < bins; ++b) {
+    const double start = slot_theta.front() + static_cast<double>(b) / t->bins_per_rad;
+    while (k + 1 < slot_theta.size() && slot_theta[k + 1] <= start) ++k;
+    t->bin_slot[b] = static_cast<std::uint16_t>(std::min<std::size_t>(k, slot_theta.size() > 1 ? slot_theta.size() - 2 : 0));
+  }
   // 16-bit fractions of each slot's per-channel maximum (values are ≥ 0: RglBrdf clips). With
   // the jacobian, the slot's 1 / (4σ(θi)) is folded into its scale: σ is smooth in θi (the
   // projected area of the microsurface), so interpolating g / 4σ between slots instead of g
@@ -951,12 +1018,17 @@ std::unique_ptr<RglTabulatedBrdf> RglBrdf::Tabulate(const RglTabulationSettings&
             static_cast<std::uint16_t>(std::min(65535.0, std::rint(g[3 * v + ch] / step)));
     }
   }
-  return std::unique_ptr<RglTabulatedBrdf>(
-      new RglTabulatedBrdf(std::move(t), name_ + " (tabulated)"));
+  RglTabulatedBrdf::Table* raw = t.get();
+  std::unique_ptr<RglTabulatedBrdf> out(new RglTabulatedBrdf(std::move(t), name_ + " (tabulated)"));
+  raw->self_check_p99 = SelfCheckP99(*this, *out);
+  return out;
 }
 
 std::unique_ptr<BrdfSource> RglBrdf::QuadratureApproximation() const {
-  return Tabulate(RglTabulationSettings{});
+  std::unique_ptr<RglTabulatedBrdf> table = Tabulate(RglTabulationSettings{});
+  if (table == nullptr || table->self_check_p99_error() > kRglApproximationMaxP99Error)
+    return nullptr;
+  return table;
 }
 
 }  // namespace brdf
