@@ -77,9 +77,7 @@ BENCHMARK_CAPTURE(BM_RglEval, cc_ibiza_sunset, std::string("cc_ibiza_sunset_rgb.
 // The exact evaluator and its tabulated form (RglTabulatedBrdf, what `brdf preview` integrates)
 // on the same random pairs, side by side:
 //   build/bench/bench_rgl --benchmark_filter='RglEvalExact|RglEvalTabulated'
-void BM_RglEvalExact(benchmark::State& state, const std::string& file) {
-  BM_RglEval(state, file);
-}
+void BM_RglEvalExact(benchmark::State& state, const std::string& file) { BM_RglEval(state, file); }
 void BM_RglEvalTabulated(benchmark::State& state, const std::string& file) {
   const RglBrdf exact = RglBrdf::Load(kRglDir + file);
   const std::unique_ptr<RglTabulatedBrdf> brdf = exact.Tabulate(RglTabulationSettings{});

@@ -523,10 +523,12 @@ TEST(RglTabulated, ReproducesAnEvaluatorThatIsLinearInThetaIAndConstantOverTheSq
     for (const Vec3& wo : CosineDirections(5, 85, 12)) {
       const double theta = std::acos(wi.z);
       const int j = theta < static_cast<double>(s.theta_i[1]) ? 0 : 1;
-      const double w = std::clamp((theta - s.theta_i[j]) / (s.theta_i[j + 1] - s.theta_i[j]), 0.0, 1.0);
+      const double w =
+          std::clamp((theta - s.theta_i[j]) / (s.theta_i[j + 1] - s.theta_i[j]), 0.0, 1.0);
       const Rgb f = table->EvalCosine(wi, wo);
       for (int ch = 0; ch < 3; ++ch) {
-        const double want = (1 - w) * static_cast<float>(c[j][ch]) + w * static_cast<float>(c[j + 1][ch]);
+        const double want =
+            (1 - w) * static_cast<float>(c[j][ch]) + w * static_cast<float>(c[j + 1][ch]);
         EXPECT_NEAR(f[ch], want, 2e-5) << "theta_i " << theta << " channel " << ch;
       }
       const Rgb g = table->Eval(wi, wo);

@@ -685,7 +685,7 @@ struct RglTabulatedBrdf::Table {
   std::vector<double> slot_theta, slot_inv_step;
   std::vector<std::uint16_t> bin_slot;
   double bins_per_rad = 0.0;
-  TableAxis ax, ay;                      // along u(θm) and u(φm − φi)
+  TableAxis ax, ay;  // along u(θm) and u(φm − φi)
   int slots = 1, nx = 0, ny = 0;
   std::vector<std::uint16_t> texels;
   std::vector<float> scale;
@@ -701,7 +701,8 @@ struct RglTabulatedBrdf::Table {
     // (bins are no wider than the closest two samples, so usually none).
     const double theta = p.theta_i_rad;
     const double bin_position = (theta - slot_theta[0]) * bins_per_rad;
-    const int bin = std::clamp(static_cast<int>(bin_position), 0, static_cast<int>(bin_slot.size()) - 1);
+    const int bin =
+        std::clamp(static_cast<int>(bin_position), 0, static_cast<int>(bin_slot.size()) - 1);
     int s0 = bin_slot[static_cast<std::size_t>(bin)];
     while (s0 + 2 < slots && theta >= slot_theta[static_cast<std::size_t>(s0) + 1]) ++s0;
     const int s1 = std::min(s0 + 1, slots - 1);
@@ -710,12 +711,13 @@ struct RglTabulatedBrdf::Table {
     const Cell cx = ax.Map(p.um_x), cy = ay.Map(p.um_y);
     const double fx = cx.f;
     const std::size_t row = 3 * static_cast<std::size_t>(nx);
-    const std::size_t at = row * static_cast<std::size_t>(cy.i) + 3 * static_cast<std::size_t>(cx.i);
+    const std::size_t at =
+        row * static_cast<std::size_t>(cy.i) + 3 * static_cast<std::size_t>(cx.i);
     const std::uint16_t* t0 = texels.data() + row * ny * static_cast<std::size_t>(s0) + at;
     const std::uint16_t* t1 = texels.data() + row * ny * static_cast<std::size_t>(s1) + at;
     const float w00 = static_cast<float>((1 - fx) * (1 - cy.f)),
-                w10 = static_cast<float>(fx * (1 - cy.f)), w01 = static_cast<float>((1 - fx) * cy.f),
-                w11 = static_cast<float>(fx * cy.f);
+                w10 = static_cast<float>(fx * (1 - cy.f)),
+                w01 = static_cast<float>((1 - fx) * cy.f), w11 = static_cast<float>(fx * cy.f);
     Rgb f;
 #if defined(__SSE2__)
     // Three 16-bit channels per vertex: one 8-byte load each (its fourth lane, the next
@@ -818,7 +820,8 @@ double SelfCheckP99(const RglBrdf& exact, const RglTabulatedBrdf& table) {
   std::vector<double> rel;
   for (const auto& v : values)
     for (int ch = 0; ch < 3; ++ch)
-      if (v[ch] > 0.0 && v[ch] >= 0.01 * peak[ch]) rel.push_back(std::abs(v[3 + ch] - v[ch]) / v[ch]);
+      if (v[ch] > 0.0 && v[ch] >= 0.01 * peak[ch])
+        rel.push_back(std::abs(v[3 + ch] - v[ch]) / v[ch]);
   if (rel.empty()) return 0.0;
   const std::size_t at = rel.size() * 99 / 100;
   std::nth_element(rel.begin(), rel.begin() + static_cast<std::ptrdiff_t>(at), rel.end());
@@ -843,8 +846,7 @@ std::unique_ptr<RglTabulatedBrdf> RglBrdf::Tabulate(const RglTabulationSettings&
   t->ndf_same_for_all_phi = true;
   for (int y = 1; y < e.ndf.ny; ++y)
     for (int x = 0; x < e.ndf.nx; ++x)
-      t->ndf_same_for_all_phi &=
-          e.ndf.v[static_cast<std::size_t>(y) * e.ndf.nx + x] == e.ndf.v[x];
+      t->ndf_same_for_all_phi &= e.ndf.v[static_cast<std::size_t>(y) * e.ndf.nx + x] == e.ndf.v[x];
   t->jacobian = e.info.jacobian;
   // Table cells per VNDF cell. Along u(θm): X, the conditional CDF the RGB table is indexed
   // by, changes by density / row total per VNDF cell (the warp tables are normalised over the
@@ -859,7 +861,8 @@ std::unique_ptr<RglTabulatedBrdf> RglBrdf::Tabulate(const RglTabulationSettings&
     for (std::size_t y = 0; y < vy; ++y) {
       const double total = e.rows[2 * (sl * vy + y)];
       if (y + 1 < vy)
-        rate_y[y] = std::max(rate_y[y], std::max(total, e.rows[2 * (sl * vy + y + 1)]) * (e.ry - 1));
+        rate_y[y] =
+            std::max(rate_y[y], std::max(total, e.rows[2 * (sl * vy + y + 1)]) * (e.ry - 1));
       if (!(total > 0.0)) continue;
       for (std::size_t k = 0; k + 1 < vx; ++k) {
         const double* d = e.warp.data() + 2 * ((sl * vy + y) * vx + k);
@@ -956,8 +959,9 @@ std::unique_ptr<RglTabulatedBrdf> RglBrdf::Tabulate(const RglTabulationSettings&
     auto worker = [&] {
       for (int j = next++; j < static_cast<int>(runs.size()); j = next++) build_interval(j);
     };
-    const int threads = std::clamp(o.jobs > 0 ? o.jobs : static_cast<int>(std::thread::hardware_concurrency()),
-                                   1, static_cast<int>(runs.size()));
+    const int threads =
+        std::clamp(o.jobs > 0 ? o.jobs : static_cast<int>(std::thread::hardware_concurrency()), 1,
+                   static_cast<int>(runs.size()));
     std::vector<std::thread> pool;
     for (int k = 1; k < threads; ++k) pool.emplace_back(worker);
     worker();
@@ -994,7 +998,8 @@ std::unique_ptr<RglTabulatedBrdf> RglBrdf::Tabulate(const RglTabulationSettings&
   for (std::size_t b = 0, k = 0; b < bins; ++b) {
     const double start = slot_theta.front() + static_cast<double>(b) / t->bins_per_rad;
     while (k + 1 < slot_theta.size() && slot_theta[k + 1] <= start) ++k;
-    t->bin_slot[b] = static_cast<std::uint16_t>(std::min<std::size_t>(k, slot_theta.size() > 1 ? slot_theta.size() - 2 : 0));
+    t->bin_slot[b] = static_cast<std::uint16_t>(
+        std::min<std::size_t>(k, slot_theta.size() > 1 ? slot_theta.size() - 2 : 0));
   }
   // 16-bit fractions of each slot's per-channel maximum (values are ≥ 0: RglBrdf clips). With
   // the jacobian, the slot's 1 / (4σ(θi)) is folded into its scale: σ is smooth in θi (the
