@@ -219,9 +219,9 @@ class RglBrdf final : public BrdfSource {
 //   fractions of each sample's per-channel maximum (6 bytes per vertex): 4.8–9.7 MB, built in
 //   35–50 ms of CPU on 2 threads (the self-check included).
 // What is exact. ndf(u_m) (a 1-D table in θm for the isotropic files) is looked up exactly:
-// it carries the sharp part of the lobe, which the warp has already divided out of g (g is
-// what is left once the RGB table's resolution follows the lobe), so interpolating ndf would
-// cost accuracy at the mirror direction while saving almost nothing. 1/(4σ(θi)) is folded
+// it carries the sharp part of the lobe (the file's RGB holds the reflectance with that
+// factor divided out, so g is the smooth remainder), so interpolating ndf too would cost
+// accuracy at the mirror direction while saving one 1-D lookup. 1/(4σ(θi)) is folded
 // into each incidence sample's scale: σ (the projected microsurface area) is smooth in θi.
 // Files with jacobian = 0 tabulate g the same way without the ndf/σ factor.
 //
@@ -235,7 +235,7 @@ class RglBrdf final : public BrdfSource {
 // values differs; chm_mint is the worst file (p99 13 %, at grazing incidence). Directional
 // albedos (over ωo at fixed ωi and over ωi at fixed ωo) agree within 0.4 % on every file
 // tested. The preview of cc_ibiza_sunset at 512² moves from 0.525 to 0.572 % RMS from the
-// brute-force reference, chm_light_blue from 0.594 to 0.560 %. Speed: 1.8–2.0 × fewer ns per
+// brute-force reference, chm_light_blue from 0.594 to 0.560 %. Speed: 1.75–2.1 × fewer ns per
 // call than RglBrdf on random pairs (the half-vector coordinates are computed in single
 // precision here; the rest is mostly the texel loads of a table larger than the L2 cache), and
 // 1.45 × less CPU for the whole preview of cc_ibiza_sunset on one thread.
