@@ -10,6 +10,7 @@
 #include <vector>
 
 #include <filesystem>
+#include <memory>
 
 #include "brdf/core/brdf_source.h"
 #include "brdf/core/file_util.h"
@@ -72,6 +73,41 @@ BENCHMARK_CAPTURE(BM_RglEval, chm_mint, std::string("chm_mint_rgb.bsdf"));
 BENCHMARK_CAPTURE(BM_RglEval, cg_sunflower_64, std::string("cg_sunflower_rgb.bsdf"));
 // The material of issue 10's preview benchmark.
 BENCHMARK_CAPTURE(BM_RglEval, cc_ibiza_sunset, std::string("cc_ibiza_sunset_rgb.bsdf"));
+
+// The exact evaluator and its tabulated form (RglTabulatedBrdf, what `brdf preview` integrates)
+// on the same random pairs, side by side:
+//   build/bench/bench_rgl --benchmark_filter='RglEvalExact|RglEvalTabulated'
+void BM_RglEvalExact(benchmark::State& state, const std::string& file) { BM_RglEval(state, file); }
+void BM_RglEvalTabulated(benchmark::State& state, const std::string& file) {
+  const RglBrdf exact = RglBrdf::Load(kRglDir + file);
+  const std::unique_ptr<RglTabulatedBrdf> brdf = exact.Tabulate(RglTabulationSettings{});
+  const std::vector<Pair> pairs = RandomPairs(1 << 14);
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const Pair& p = pairs[i++ & (pairs.size() - 1)];
+    benchmark::DoNotOptimize(brdf->Eval(p.wi, p.wo));
+  }
+  state.SetItemsProcessed(state.iterations());
+  state.SetLabel(file + ", " + std::to_string(brdf->table_bytes() >> 10) + " KiB table");
+}
+// Building the table (QuadratureApproximation's cost, paid once per preview).
+void BM_RglTabulate(benchmark::State& state, const std::string& file) {
+  const RglBrdf exact = RglBrdf::Load(kRglDir + file);
+  for (auto _ : state) benchmark::DoNotOptimize(exact.Tabulate(RglTabulationSettings{}));
+  state.SetLabel(file);
+}
+BENCHMARK_CAPTURE(BM_RglEvalExact, cc_ibiza_sunset, std::string("cc_ibiza_sunset_rgb.bsdf"));
+BENCHMARK_CAPTURE(BM_RglEvalTabulated, cc_ibiza_sunset, std::string("cc_ibiza_sunset_rgb.bsdf"));
+BENCHMARK_CAPTURE(BM_RglEvalExact, chm_light_blue, std::string("chm_light_blue_rgb.bsdf"));
+BENCHMARK_CAPTURE(BM_RglEvalTabulated, chm_light_blue, std::string("chm_light_blue_rgb.bsdf"));
+BENCHMARK_CAPTURE(BM_RglEvalExact, paper_white, std::string("paper_white_rgb.bsdf"));
+BENCHMARK_CAPTURE(BM_RglEvalTabulated, paper_white, std::string("paper_white_rgb.bsdf"));
+BENCHMARK_CAPTURE(BM_RglTabulate, cc_ibiza_sunset, std::string("cc_ibiza_sunset_rgb.bsdf"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK_CAPTURE(BM_RglTabulate, chm_light_blue, std::string("chm_light_blue_rgb.bsdf"))
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 // A virtual capture at the reference instrument's geometry (docs/design.md §1): θin ∈ {0, 20, 40,
 // 60}°, θout 0…75° and φout 0…359° at 1° steps: 4 × 76 × 360 = 109,440 evaluations.

@@ -1,10 +1,13 @@
 // Test driver for tests/python/rgl_oracle.py: evaluates an RGL file with brdf::RglBrdf at
 // direction pairs read from a file and writes f_r, so the NumPy oracle can compare.
-//   rgl_eval_points FILE.bsdf PAIRS OUT
+//   rgl_eval_points FILE.bsdf PAIRS OUT [--tabulated]
+// --tabulated: the file's tabulated form at its default settings (RglTabulatedBrdf, what the
+// preview's quadrature evaluates) instead of the exact evaluator.
 // PAIRS: n × 6 little-endian float64 (wi.xyz, wo.xyz); OUT: n × 3 float64 (f_r RGB, 1/sr).
 #include <bit>
 #include <cstdio>
 #include <exception>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -12,12 +15,22 @@
 #include "brdf/core/rgl.h"
 
 int main(int argc, char** argv) {
-  if (argc != 4) {
-    std::fprintf(stderr, "usage: %s FILE.bsdf PAIRS OUT\n", argv[0]);
+  const bool tabulated = argc == 5 && std::string(argv[4]) == "--tabulated";
+  if (argc != 4 && !tabulated) {
+    std::fprintf(stderr, "usage: %s FILE.bsdf PAIRS OUT [--tabulated]\n", argv[0]);
     return 2;
   }
   try {
-    const brdf::RglBrdf brdf = brdf::RglBrdf::Load(argv[1]);
+    const brdf::RglBrdf exact = brdf::RglBrdf::Load(argv[1]);
+    std::unique_ptr<brdf::RglTabulatedBrdf> table;
+    if (tabulated) {
+      table = exact.Tabulate(brdf::RglTabulationSettings{});
+      if (!table) {
+        std::fprintf(stderr, "%s: no tabulated form (more than one phi_i)\n", argv[1]);
+        return 1;
+      }
+    }
+    const brdf::BrdfSource& brdf = table ? static_cast<const brdf::BrdfSource&>(*table) : exact;
     const std::vector<std::uint8_t> in = brdf::ReadFileBytes(argv[2], 1u << 30);
     brdf::ByteReader r(in.data(), in.size(), argv[2]);
     std::string out;

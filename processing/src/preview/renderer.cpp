@@ -437,7 +437,11 @@ struct PreviewRenderer::Impl {
     const detail::MapHierarchy hierarchy(environment, kHierarchyTopColumns, jobs);
     detail::HierarchicalSettings settings;
     settings.tolerance = options.hierarchical_tolerance;
-    const detail::HierarchicalIntegrator integrator(hierarchy, source, settings);
+    // The source's faster approximation when it has one (an RGL file's tabulated form,
+    // brdf/core/rgl.h RglTabulatedBrdf: docs/preview.md states its deviation).
+    const std::unique_ptr<BrdfSource> approximation = source.QuadratureApproximation();
+    const detail::HierarchicalIntegrator integrator(
+        hierarchy, approximation ? *approximation : source, settings);
     std::atomic<std::uint64_t> counted{0}, computed_pixels{0};
     auto radiance = [&](std::size_t k, double scale, bool top_only, std::uint64_t* count) {
       const PixelSetup& s = setup[k];

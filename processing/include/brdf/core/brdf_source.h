@@ -29,6 +29,12 @@ class BrdfSource {
     (void)wo;
     return true;
   }
+
+  // A faster approximation of this source for integrators that evaluate it millions of times
+  // (the preview's hierarchical quadrature), or null when the source has none (then use the
+  // source itself). The overriding class documents what is approximated and the measured
+  // error. Building one may cost up to ~0.1 s (an RGL table), so ask once per render.
+  virtual std::unique_ptr<BrdfSource> QuadratureApproximation() const { return nullptr; }
 };
 
 class AnalyticBrdf final : public BrdfSource {
