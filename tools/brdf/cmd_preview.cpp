@@ -139,11 +139,13 @@ class PassProgress {
     if (deterministic) {
       std::size_t object = 0;
       for (std::uint8_t o : image.object) object += o;
+      const std::string of =
+          image.evaluated_as.empty() ? std::string() : " of " + image.evaluated_as;
       std::fprintf(stderr,
-                   "%s%s: %s quadrature, %llu BRDF evaluations, %llu of %zu object pixels "
+                   "%s%s: %s quadrature, %llu BRDF evaluations%s, %llu of %zu object pixels "
                    "integrated (the rest interpolated), %s\n",
                    tty_ ? "\r\033[K" : "", label_.c_str(), EstimatorName(image.estimator),
-                   static_cast<unsigned long long>(image.brdf_evaluations),
+                   static_cast<unsigned long long>(image.brdf_evaluations), of.c_str(),
                    static_cast<unsigned long long>(image.computed_pixels), object,
                    Progress::FormatDuration(image.seconds).c_str());
       return;

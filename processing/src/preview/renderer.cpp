@@ -136,6 +136,7 @@ struct PreviewRenderer::Impl {
   double seconds = 0.0;
   std::uint64_t evaluations = 0;     // f_r evaluations of the deterministic estimators
   std::uint64_t computed_count = 0;  // kHierarchical: object pixels integrated (not interpolated)
+  std::string evaluated_as;          // kHierarchical: the approximation's name, when one was used
   std::chrono::steady_clock::time_point pass_start;  // of the running RenderPasses call
 
   Impl(const BrdfSource& s, const EnvironmentMap& e, PreviewOptions o,
@@ -440,6 +441,7 @@ struct PreviewRenderer::Impl {
     // The source's faster approximation when it has one (an RGL file's tabulated form,
     // brdf/core/rgl.h RglTabulatedBrdf: docs/preview.md states its deviation).
     const std::unique_ptr<BrdfSource> approximation = source.QuadratureApproximation();
+    if (approximation) evaluated_as = approximation->Name();
     const detail::HierarchicalIntegrator integrator(
         hierarchy, approximation ? *approximation : source, settings);
     std::atomic<std::uint64_t> counted{0}, computed_pixels{0};
@@ -707,6 +709,7 @@ struct PreviewRenderer::Impl {
     image.estimator = options.estimator;
     image.brdf_evaluations = evaluations;
     image.computed_pixels = exact ? (computed_count > 0 ? computed_count : setup.size()) : 0;
+    image.evaluated_as = evaluated_as;
     image.relative_rms_estimate = RelativeRms();
     image.seconds = seconds;
     return image;

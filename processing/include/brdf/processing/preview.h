@@ -242,6 +242,10 @@ struct PreviewImage {
   std::uint64_t brdf_evaluations = 0;     // kHierarchical and kQuadrature: f_r evaluations
   std::uint64_t computed_pixels = 0;      // deterministic estimators: pixels integrated, the
                                           // rest interpolated (kHierarchical)
+  // kHierarchical: the name of what was evaluated instead of the source, when the source
+  // offered a faster approximation (BrdfSource::QuadratureApproximation: an RGL file's
+  // tabulated form); empty when the source itself was evaluated.
+  std::string evaluated_as;
   int samples_per_pixel = 0;              // passes accumulated
   double relative_rms_estimate = 0.0;     // EstimatedRelativeRms() when the image was taken
   double seconds = 0.0;
