@@ -211,7 +211,7 @@ struct PreviewOptions {
   // most image_tolerance·Ȳ·min(width, height)/512 in every channel, else split in four down to
   // single pixels; 1: every pixel computed. The tolerance is stated for 512 pixels across and
   // shrinks in smaller images, where a block spans a larger part of the object. With the
-  // defaults the image is within about 0.1–0.6 % RMS of the brute-force kQuadrature
+  // defaults the image is within about 0.04–0.75 % RMS of the brute-force kQuadrature
   // (docs/benchmarks.md).
   double hierarchical_tolerance = 0.002;
   int image_block = 16;
