@@ -27,8 +27,7 @@ namespace {
 void CheckPolar(double theta_deg, const char* which) {
   if (!(theta_deg >= 0.0 && theta_deg <= 90.0))
     throw InvalidArgument(std::string("--") + which +
-                          ": polar angle must be in [0, 90] degrees, got " +
-                          NumberText(theta_deg));
+                          ": polar angle must be in [0, 90] degrees, got " + NumberText(theta_deg));
 }
 
 struct Pair {

@@ -290,9 +290,7 @@ Side SideOf(const Vec3& n, const MapHierarchy::Cell& cell) {
 // "Split threshold"), the nearly flat one gives the same or a lower image error for 20-30 % fewer
 // BRDF evaluations on glossy materials and the same on matte ones. The sharp features that
 // need small cells are few per pixel, and their errors are what the image error is made of.
-double SizeFactor(double solid_angle_sr) {
-  return std::pow(solid_angle_sr / (2.0 * kPi), 0.1);
-}
+double SizeFactor(double solid_angle_sr) { return std::pow(solid_angle_sr / (2.0 * kPi), 0.1); }
 
 bool ContainsMirror(const Vec3& r, const MapHierarchy::Cell& cell) {
   return r.x * cell.axis[0] + r.y * cell.axis[1] + r.z * cell.axis[2] >= cell.cos_radius;

@@ -246,8 +246,8 @@ struct PreviewImage {
   // offered a faster approximation (BrdfSource::QuadratureApproximation: an RGL file's
   // tabulated form); empty when the source itself was evaluated.
   std::string evaluated_as;
-  int samples_per_pixel = 0;              // passes accumulated
-  double relative_rms_estimate = 0.0;     // EstimatedRelativeRms() when the image was taken
+  int samples_per_pixel = 0;           // passes accumulated
+  double relative_rms_estimate = 0.0;  // EstimatedRelativeRms() when the image was taken
   double seconds = 0.0;
   const float* Pixel(int x, int y) const {
     return &rgb[(static_cast<std::size_t>(y) * width + x) * 3];
