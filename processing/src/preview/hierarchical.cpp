@@ -396,6 +396,18 @@ Rgb HierarchicalIntegrator::Estimate(const Query& q, int level, int i, int j,
   return {f[0] * sums.e[0] * mean_cos, f[1] * sums.e[1] * mean_cos, f[2] * sums.e[2] * mean_cos};
 }
 
+std::vector<HierarchicalIntegrator::RowFactors> HierarchicalIntegrator::SizeFactors(
+    const MapHierarchy& map) {
+  std::vector<RowFactors> factors(static_cast<std::size_t>(map.levels()));
+  for (int level = 0; level < map.levels(); ++level) {
+    const int w = map.width(level);
+    for (int j = 0; j < map.height(level); ++j)
+      factors[level].push_back({SizeFactor(map.At(level, 0, j).solid_angle),
+                                SizeFactor(map.At(level, w - 1, j).solid_angle)});
+  }
+  return factors;
+}
+
 Rgb HierarchicalIntegrator::Refine(const Query& q, int level, int i, int j,
                                    const Rgb& estimate) const {
   const int child_level = level - 1;
@@ -428,7 +440,7 @@ Rgb HierarchicalIntegrator::Refine(const Query& q, int level, int i, int j,
     }
   if (child_level == 0) return sum;
   const double difference = std::fabs(Luminance(sum) - Luminance(estimate));
-  const bool split_all = difference > q.tolerance * SizeFactor(map_.At(level, i, j).solid_angle);
+  const bool split_all = difference > q.tolerance * SizeFactorOf(level, i, j);
   Rgb total = {0, 0, 0};
   if (!split_all) {
     // Accepted: the midpoint-type rule's error falls as h², so the parent's error is about four
