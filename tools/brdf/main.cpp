@@ -566,7 +566,7 @@ int main(int argc, char** argv) {
   preview_cmd
       ->add_option("--estimator", preview.estimator,
                    "auto (default): the sphere by the deterministic hierarchical quadrature "
-                   "(one pass, within about 0.05-0.75 % RMS of the converged image; "
+                   "(one pass, at 512 px typically within 1 % RMS of the converged image; "
                    "docs/preview.md), planes and meshes by mis; with --spp or --rms, mis. "
                    "Or: hierarchical (sphere, plane), mis (Monte Carlo, map and BRDF samples "
                    "combined), env, brdf, quadrature (brute force over every map pixel, the slow "

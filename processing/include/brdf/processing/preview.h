@@ -211,8 +211,9 @@ struct PreviewOptions {
   // most image_tolerance·Ȳ·min(width, height)/512 in every channel, else split in four down to
   // single pixels; 1: every pixel computed. The tolerance is stated for 512 pixels across and
   // shrinks in smaller images, where a block spans a larger part of the object. With the
-  // defaults the image is within about 0.04–0.75 % RMS of the brute-force kQuadrature
-  // (docs/benchmarks.md).
+  // defaults the image is within about 0.04–0.8 % RMS of the brute-force kQuadrature at 512²
+  // for the benchmark's materials, up to 1.4 % for some RGL files and more in smaller images
+  // (docs/preview.md, docs/benchmarks.md).
   double hierarchical_tolerance = 0.002;
   int image_block = 16;
   double image_tolerance = 0.1;
