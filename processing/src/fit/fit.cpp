@@ -8,7 +8,6 @@
 
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -16,11 +15,10 @@
 #include <limits>
 #include <map>
 #include <memory>
-#include <mutex>
 #include <nlohmann/json.hpp>
-#include <thread>
 
 #include "brdf/core/error.h"
+#include "brdf/core/parallel.h"
 #include "fit_data.h"
 #include "fit_kernels.h"
 
@@ -685,23 +683,9 @@ class KernelFit {
     // Independent blocks run on their own threads when there are threads to spare.
     const int parallel = std::min<int>(options_.threads, static_cast<int>(blocks.size()));
     if (parallel > 1) {
-      std::vector<std::thread> workers;
-      std::atomic<std::size_t> next{0};
-      std::exception_ptr error;
-      std::mutex error_mutex;
-      for (int t = 0; t < parallel; ++t)
-        workers.emplace_back([&] {
-          for (std::size_t b; (b = next++) < blocks.size();) {
-            try {
-              outcomes[b] = Solve(start, blocks[b], robust_scale, 1);
-            } catch (...) {
-              const std::lock_guard<std::mutex> lock(error_mutex);
-              error = std::current_exception();
-            }
-          }
-        });
-      for (std::thread& w : workers) w.join();
-      if (error) std::rethrow_exception(error);
+      ParallelChunks(blocks.size(), 1, parallel, nullptr, [&](std::size_t b, std::size_t e) {
+        for (std::size_t k = b; k < e; ++k) outcomes[k] = Solve(start, blocks[k], robust_scale, 1);
+      });
     } else {
       for (std::size_t b = 0; b < blocks.size(); ++b)
         outcomes[b] = Solve(start, blocks[b], robust_scale, options_.threads);

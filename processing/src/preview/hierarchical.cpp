@@ -265,7 +265,7 @@ class ClipRanges {
 
 struct HierarchicalIntegrator::Query {
   Vec3 s, t, n, wo, mirror;
-  double tolerance = 0.0;       // allowed |ΔY| of a cell of 2π sr (scaled by √(Ω/2π))
+  double tolerance = 0.0;       // allowed |ΔY| of a cell of 2π sr (scaled by SizeFactor)
   double large_estimate = 0.0;  // cells estimated above this are always split
   mutable std::uint64_t evaluations = 0;  // counted for the benchmark figures
   // Clip()'s record (per thread, reused across queries).

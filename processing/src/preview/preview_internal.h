@@ -12,6 +12,7 @@
 
 #include "brdf/core/geometry.h"
 #include "brdf/core/models.h"
+#include "brdf/core/parallel.h"
 #include "brdf/processing/preview.h"
 
 namespace brdf::preview::detail {
@@ -51,29 +52,8 @@ inline void MapPixelOf(const EnvironmentMap& map, const Vec3& w, int* i, int* j)
   *j = std::min(map.height() - 1, std::max(0, static_cast<int>(v * map.height())));
 }
 
-// Runs work(begin, end) over [0, count) in chunks of `chunk` on `jobs` threads (the calling
-// thread one of them), handing out chunks in order from one atomic counter. Stops handing out
-// chunks once `cancel` (if given) becomes true. `after_caller_chunk`, when set, runs on the
-// calling thread after each chunk it completed (progress reports come from there, so callbacks
-// never run on a worker).
-template <class F>
-void ParallelChunks(std::size_t count, std::size_t chunk, int jobs, const std::atomic<bool>* cancel,
-                    F work, const std::function<void()>& after_caller_chunk = {}) {
-  std::atomic<std::size_t> next{0};
-  auto loop = [&](bool caller) {
-    for (std::size_t begin = next.fetch_add(chunk); begin < count; begin = next.fetch_add(chunk)) {
-      if (cancel != nullptr && cancel->load(std::memory_order_relaxed)) return;
-      work(begin, std::min(count, begin + chunk));
-      if (caller && after_caller_chunk) after_caller_chunk();
-    }
-  };
-  const int threads =
-      std::max(1, std::min<int>(jobs, static_cast<int>((count + chunk - 1) / chunk)));
-  std::vector<std::thread> workers;
-  for (int t = 1; t < threads; ++t) workers.emplace_back(loop, false);
-  loop(true);
-  for (auto& w : workers) w.join();
-}
+// The work-sharing loop (brdf/core/parallel.h).
+using brdf::ParallelChunks;
 
 // The pixels of an .exr or .hdr file (RGB floats, row 0 at the top). The one place that reads
 // image files, so the reader can change without touching the map code.

@@ -98,13 +98,9 @@ class TabulatedSampler final : public BrdfSampler {
   static constexpr double kDefensive = 0.1;
 
   TabulatedSampler(const BrdfSource& source, int jobs) : tables_(kSlices) {
-    std::vector<std::thread> workers;
-    std::atomic<int> next{0};
-    auto work = [&] {
-      for (int k = next++; k < kSlices; k = next++) tables_[k] = BuildSlice(source, k);
-    };
-    for (int t = 0; t < jobs; ++t) workers.emplace_back(work);
-    for (auto& w : workers) w.join();
+    ParallelChunks(kSlices, 1, jobs, nullptr, [&](std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k) tables_[k] = BuildSlice(source, static_cast<int>(k));
+    });
   }
 
   bool Sample(const Vec3& wo, double u1, double u2, double u3, Vec3* wi,

@@ -19,7 +19,6 @@
 // size of the reference's own rounding. With double tables the two agree to ~1e-11.
 #include <algorithm>
 #include <array>
-#include <atomic>
 #include <cmath>
 #include <cstddef>
 #include <filesystem>
@@ -32,6 +31,7 @@
 #endif
 
 #include "brdf/core/error.h"
+#include "brdf/core/parallel.h"
 #include "brdf/core/rgl.h"
 #include "readers/rgl_internal.h"
 
@@ -198,6 +198,16 @@ inline void ThetaAndU(double rho2_a, double z_a, double rho2_b, double z_b, doub
 #endif
 }
 
+// u(φ) of a half-vector azimuth that may span two turns (φm − φi ∈ [−2π, 2π), so PhiToU gives
+// [−½, 3/2)), wrapped into [0, 1) as u − floor(u) does, without floor: baseline x86-64 has no
+// rounding instruction and calls a function.
+inline double RelativePhiToU(double phi) {
+  const double u = PhiToU(phi);
+  if (u < 0.0) return u + 1.0;
+  if (u >= 1.0) return u - 1.0;
+  return u;
+}
+
 // Where a direction pair lands in the file's parameterisation (rgl.h, step 1): the incidence
 // elevation θi and u(θi), the incidence azimuth φi (left 0 when only φm − φi is needed) and the
 // half vector's unit-square position u_m. False (and nothing set) when either direction is at
@@ -226,15 +236,7 @@ inline bool Coordinates(const Vec3& wi, const Vec3& wo, bool relative_phi_only, 
     const double phi_m = FastAtan2(h.y, h.x);
     phi = isotropic ? phi_m - phi_i_rad : phi_m;
   }
-  double um_y = PhiToU(phi);
-  // Wrap into [0, 1) as u − floor(u) does (φ − φi spans two turns, so u ∈ [−½, 3/2)),
-  // without floor: baseline x86-64 has no rounding instruction and calls a function.
-  if (um_y < 0.0) {
-    um_y += 1.0;
-  } else if (um_y >= 1.0) {
-    um_y -= 1.0;
-  }
-  out = {theta[0], u[0], phi_i_rad, u[1], um_y};
+  out = {theta[0], u[0], phi_i_rad, u[1], RelativePhiToU(phi)};
   return true;
 }
 
@@ -285,13 +287,7 @@ inline bool CoordinatesSingle(const Vec3& wi, const Vec3& wo, PairCoordinates& o
   _mm_store_ps(angle, r);
   _mm_store_ps(unit, u);
   const double phi = cross < 0.0 ? -static_cast<double>(angle[2]) : angle[2];
-  double um_y = PhiToU(phi);
-  if (um_y < 0.0) {
-    um_y += 1.0;
-  } else if (um_y >= 1.0) {
-    um_y -= 1.0;
-  }
-  out = {angle[0], unit[0], 0.0, unit[1], um_y};
+  out = {angle[0], unit[0], 0.0, unit[1], RelativePhiToU(phi)};
   return true;
 #endif
 }
@@ -853,23 +849,21 @@ double SelfCheckP99(const RglBrdf& exact, const RglTabulatedBrdf& table) {
     z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
     return static_cast<double>((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
   };
-  auto direction = [](double theta, double phi) {
-    return Vec3{std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta)};
-  };
   constexpr int kPairs = 16384;
   std::vector<std::array<double, 6>> values;  // exact, tabulated per channel
   values.reserve(kPairs);
   std::array<double, 3> peak{0, 0, 0};
   for (int k = 0; k < kPairs; ++k) {
     const double theta_i = std::acos(std::sqrt(1.0 - next())), phi_i = 2 * kPi * next();
-    const Vec3 wi = direction(theta_i, phi_i);
+    const Vec3 wi = SphericalDirection(theta_i, phi_i);
     Vec3 wo;
     if (k % 2 == 0) {
-      wo = direction(std::acos(std::sqrt(1.0 - next())), 2 * kPi * next());
+      wo = SphericalDirection(std::acos(std::sqrt(1.0 - next())), 2 * kPi * next());
     } else {  // within ±4° (uniform) of the mirror direction in θ and φ
       const double spread = 4.0 * kPi / 180.0;
       const double theta_o = std::abs(theta_i + spread * (2 * next() - 1));
-      wo = direction(std::min(theta_o, 0.5 * kPi - 1e-3), phi_i + kPi + spread * (2 * next() - 1));
+      wo = SphericalDirection(std::min(theta_o, 0.5 * kPi - 1e-3),
+                              phi_i + kPi + spread * (2 * next() - 1));
     }
     const Rgb a = exact.EvalCosine(wi, wo), b = table.EvalCosine(wi, wo);
     values.push_back({a[0], a[1], a[2], b[0], b[1], b[2]});
@@ -1012,19 +1006,11 @@ std::unique_ptr<RglTabulatedBrdf> RglBrdf::Tabulate(const RglTabulationSettings&
     }
     runs[j] = std::move(run);
   };
-  {
-    std::atomic<int> next{0};
-    auto worker = [&] {
-      for (int j = next++; j < static_cast<int>(runs.size()); j = next++) build_interval(j);
-    };
-    const int threads =
-        std::clamp(o.jobs > 0 ? o.jobs : static_cast<int>(std::thread::hardware_concurrency()), 1,
-                   static_cast<int>(runs.size()));
-    std::vector<std::thread> pool;
-    for (int k = 1; k < threads; ++k) pool.emplace_back(worker);
-    worker();
-    for (std::thread& th : pool) th.join();
-  }
+  ParallelChunks(runs.size(), 1,
+                 o.jobs > 0 ? o.jobs : static_cast<int>(std::thread::hardware_concurrency()),
+                 nullptr, [&](std::size_t begin, std::size_t end) {
+                   for (std::size_t j = begin; j < end; ++j) build_interval(static_cast<int>(j));
+                 });
   // Slots in order, each interval's w = 1 end dropped in favour of the next one's w = 0 (the
   // same node; the last node kept).
   std::vector<const std::vector<double>*> slot_values;
