@@ -545,124 +545,122 @@ struct PreviewRenderer::Impl {
             const int side = block + 1;
             std::vector<Rgb> local(static_cast<std::size_t>(side) * side);
             std::vector<std::uint8_t> known(local.size());
-            for (std::size_t task = b; task < e; ++task)
-              for (const int c : {2 * static_cast<int>(task % pass_columns) + column_parity}) {
-                const std::size_t r = 2 * (task / pass_columns) + row_parity;
-                const int x0 = c * block, y0 = static_cast<int>(r) * block;
-                auto inside = [&](int dx, int dy) {
-                  return x0 + dx < width && y0 + dy < height && object_at(x0 + dx, y0 + dy) >= 0;
-                };
-                auto at = [&](int dx, int dy) -> Rgb& { return local[dy * side + dx]; };
-                // known: 0 nothing, 1 computed (exact), 2 interpolated.
-                std::fill(known.begin(), known.end(), 0);
-                for (int dy : {0, block})
-                  for (int dx : {0, block})
-                    if (inside(dx, dy)) {
-                      at(dx, dy) = value[static_cast<std::size_t>(y0 + dy) * width + x0 + dx];
-                      known[dy * side + dx] = 1;
-                    }
-                // The integral at (dx, dy), from `integrated` when another block or an earlier step
-                // integrated it.
-                auto integral = [&](int dx, int dy) -> const Rgb& {
-                  const std::size_t g = static_cast<std::size_t>(y0 + dy) * width + x0 + dx;
-                  if (!has_integral[g]) {
-                    integrated[g] = compute(object_at(x0 + dx, y0 + dy), &count);
-                    has_integral[g] = 1;
-                  }
-                  return integrated[g];
-                };
-                auto computed = [&](int dx, int dy) -> const Rgb& {
-                  if (known[dy * side + dx] != 1) {
-                    at(dx, dy) = integral(dx, dy);
+            for (std::size_t task = b; task < e; ++task) {
+              const int c = 2 * static_cast<int>(task % pass_columns) + column_parity;
+              const std::size_t r = 2 * (task / pass_columns) + row_parity;
+              const int x0 = c * block, y0 = static_cast<int>(r) * block;
+              auto inside = [&](int dx, int dy) {
+                return x0 + dx < width && y0 + dy < height && object_at(x0 + dx, y0 + dy) >= 0;
+              };
+              auto at = [&](int dx, int dy) -> Rgb& { return local[dy * side + dx]; };
+              // known: 0 nothing, 1 computed (exact), 2 interpolated.
+              std::fill(known.begin(), known.end(), 0);
+              for (int dy : {0, block})
+                for (int dx : {0, block})
+                  if (inside(dx, dy)) {
+                    at(dx, dy) = value[static_cast<std::size_t>(y0 + dy) * width + x0 + dx];
                     known[dy * side + dx] = 1;
                   }
-                  return at(dx, dy);
+              // The integral at (dx, dy), from `integrated` when another block or an earlier step
+              // integrated it.
+              auto integral = [&](int dx, int dy) -> const Rgb& {
+                const std::size_t g = static_cast<std::size_t>(y0 + dy) * width + x0 + dx;
+                if (!has_integral[g]) {
+                  integrated[g] = compute(object_at(x0 + dx, y0 + dy), &count);
+                  has_integral[g] = 1;
+                }
+                return integrated[g];
+              };
+              auto computed = [&](int dx, int dy) -> const Rgb& {
+                if (known[dy * side + dx] != 1) {
+                  at(dx, dy) = integral(dx, dy);
+                  known[dy * side + dx] = 1;
+                }
+                return at(dx, dy);
+              };
+              auto close = [&](const Rgb& got, const Rgb& a, const Rgb& b2) {
+                for (int ch = 0; ch < 3; ++ch)
+                  if (std::fabs(got[ch] - 0.5 * (a[ch] + b2[ch])) > tolerance) return false;
+                return true;
+              };
+              // The square at (dx, dy) of `size`, all of it on the object, corners computed:
+              // interpolated when its centre and edge midpoints pass, else split in four.
+              auto refine = [&](auto&& self, int dx, int dy, int size) -> void {
+                if (size <= 1) return;
+                const int h = size / 2;
+                const Rgb c00 = at(dx, dy), c10 = at(dx + size, dy), c01 = at(dx, dy + size),
+                          c11 = at(dx + size, dy + size);
+                const Rgb diagonal = {0.5 * (c00[0] + c11[0]), 0.5 * (c00[1] + c11[1]),
+                                      0.5 * (c00[2] + c11[2])};
+                const Rgb other = {0.5 * (c10[0] + c01[0]), 0.5 * (c10[1] + c01[1]),
+                                   0.5 * (c10[2] + c01[2])};
+                bool ok = close(computed(dx + h, dy), c00, c10);
+                ok = close(computed(dx, dy + h), c00, c01) && ok;
+                ok = close(computed(dx + size, dy + h), c10, c11) && ok;
+                ok = close(computed(dx + h, dy + size), c01, c11) && ok;
+                ok = close(computed(dx + h, dy + h), diagonal, other) && ok;
+                if (!ok || h == 1) {
+                  for (int qy : {dy, dy + h})
+                    for (int qx : {dx, dx + h}) self(self, qx, qy, h);
+                  return;
+                }
+                // Biquadratic through the nine computed points over the whole square: they
+                // passed the check, so the image is smooth here, and the quadratic's error is of
+                // third order in the square's size where the bilinear's is of second order
+                // (at the default tolerance, half the interpolation error for the same pixels;
+                // docs/benchmarks.md).
+                Rgb node[3][3];
+                for (int row = 0; row < 3; ++row)
+                  for (int col = 0; col < 3; ++col) node[row][col] = at(dx + col * h, dy + row * h);
+                // The Lagrange basis of the nodes 0, ½, 1.
+                auto basis = [](double u, double* l) {
+                  l[0] = 2.0 * (u - 0.5) * (u - 1.0);
+                  l[1] = -4.0 * u * (u - 1.0);
+                  l[2] = 2.0 * u * (u - 0.5);
                 };
-                auto close = [&](const Rgb& got, const Rgb& a, const Rgb& b2) {
-                  for (int ch = 0; ch < 3; ++ch)
-                    if (std::fabs(got[ch] - 0.5 * (a[ch] + b2[ch])) > tolerance) return false;
-                  return true;
-                };
-                // The square at (dx, dy) of `size`, all of it on the object, corners computed:
-                // interpolated when its centre and edge midpoints pass, else split in four.
-                auto refine = [&](auto&& self, int dx, int dy, int size) -> void {
-                  if (size <= 1) return;
-                  const int h = size / 2;
-                  const Rgb c00 = at(dx, dy), c10 = at(dx + size, dy), c01 = at(dx, dy + size),
-                            c11 = at(dx + size, dy + size);
-                  const Rgb diagonal = {0.5 * (c00[0] + c11[0]), 0.5 * (c00[1] + c11[1]),
-                                        0.5 * (c00[2] + c11[2])};
-                  const Rgb other = {0.5 * (c10[0] + c01[0]), 0.5 * (c10[1] + c01[1]),
-                                     0.5 * (c10[2] + c01[2])};
-                  bool ok = close(computed(dx + h, dy), c00, c10);
-                  ok = close(computed(dx, dy + h), c00, c01) && ok;
-                  ok = close(computed(dx + size, dy + h), c10, c11) && ok;
-                  ok = close(computed(dx + h, dy + size), c01, c11) && ok;
-                  ok = close(computed(dx + h, dy + h), diagonal, other) && ok;
-                  if (!ok || h == 1) {
-                    for (int qy : {dy, dy + h})
-                      for (int qx : {dx, dx + h}) self(self, qx, qy, h);
-                    return;
-                  }
-                  // Biquadratic through the nine computed points over the whole square: they
-                  // passed the check, so the image is smooth here, and the quadratic's error is of
-                  // third order in the square's size where the bilinear's is of second order
-                  // (at the default tolerance, half the interpolation error for the same pixels;
-                  // docs/benchmarks.md).
-                  Rgb node[3][3];
-                  for (int row = 0; row < 3; ++row)
-                    for (int col = 0; col < 3; ++col)
-                      node[row][col] = at(dx + col * h, dy + row * h);
-                  // The Lagrange basis of the nodes 0, ½, 1.
-                  auto basis = [](double u, double* l) {
-                    l[0] = 2.0 * (u - 0.5) * (u - 1.0);
-                    l[1] = -4.0 * u * (u - 1.0);
-                    l[2] = 2.0 * u * (u - 0.5);
-                  };
-                  for (int y = 0; y <= size; ++y) {
-                    double lv[3];
-                    basis(static_cast<double>(y) / size, lv);
-                    for (int x = 0; x <= size; ++x) {
-                      if (known[(dy + y) * side + dx + x]) continue;
-                      double lu[3];
-                      basis(static_cast<double>(x) / size, lu);
-                      Rgb& out = at(dx + x, dy + y);
-                      for (int ch = 0; ch < 3; ++ch) {
-                        double v = 0.0;
-                        for (int row = 0; row < 3; ++row)
-                          for (int col = 0; col < 3; ++col)
-                            v += lv[row] * lu[col] * node[row][col][ch];
-                        out[ch] = v;
-                      }
-                      known[(dy + y) * side + dx + x] = 2;
+                for (int y = 0; y <= size; ++y) {
+                  double lv[3];
+                  basis(static_cast<double>(y) / size, lv);
+                  for (int x = 0; x <= size; ++x) {
+                    if (known[(dy + y) * side + dx + x]) continue;
+                    double lu[3];
+                    basis(static_cast<double>(x) / size, lu);
+                    Rgb& out = at(dx + x, dy + y);
+                    for (int ch = 0; ch < 3; ++ch) {
+                      double v = 0.0;
+                      for (int row = 0; row < 3; ++row)
+                        for (int col = 0; col < 3; ++col)
+                          v += lv[row] * lu[col] * node[row][col][ch];
+                      out[ch] = v;
                     }
+                    known[(dy + y) * side + dx + x] = 2;
                   }
-                };
-                // The rim and the image edges: the largest squares wholly on the object are refined
-                // as above; what is left is computed pixel by pixel below.
-                auto cover = [&](auto&& self, int dx, int dy, int size) -> void {
-                  bool whole = true;
-                  for (int y = dy; whole && y <= dy + size; ++y)
-                    for (int x = dx; whole && x <= dx + size; ++x) whole = inside(x, y);
-                  if (whole) {
-                    for (int qy : {dy, dy + size})
-                      for (int qx : {dx, dx + size}) computed(qx, qy);
-                    refine(refine, dx, dy, size);
-                  } else if (size > 2) {
-                    const int h = size / 2;
-                    for (int qy : {dy, dy + h})
-                      for (int qx : {dx, dx + h}) self(self, qx, qy, h);
-                  }
-                };
-                cover(cover, 0, 0, block);
-                for (int dy = 0; dy < block; ++dy)
-                  for (int dx = 0; dx < block; ++dx) {
-                    if ((dx == 0 && dy == 0) || !inside(dx, dy))
-                      continue;  // lattice corner, or off
-                    const Rgb v = known[dy * side + dx] ? at(dx, dy) : integral(dx, dy);
-                    value[static_cast<std::size_t>(y0 + dy) * width + x0 + dx] = v;
-                  }
-              }
+                }
+              };
+              // The rim and the image edges: the largest squares wholly on the object are refined
+              // as above; what is left is computed pixel by pixel below.
+              auto cover = [&](auto&& self, int dx, int dy, int size) -> void {
+                bool whole = true;
+                for (int y = dy; whole && y <= dy + size; ++y)
+                  for (int x = dx; whole && x <= dx + size; ++x) whole = inside(x, y);
+                if (whole) {
+                  for (int qy : {dy, dy + size})
+                    for (int qx : {dx, dx + size}) computed(qx, qy);
+                  refine(refine, dx, dy, size);
+                } else if (size > 2) {
+                  const int h = size / 2;
+                  for (int qy : {dy, dy + h})
+                    for (int qx : {dx, dx + h}) self(self, qx, qy, h);
+                }
+              };
+              cover(cover, 0, 0, block);
+              for (int dy = 0; dy < block; ++dy)
+                for (int dx = 0; dx < block; ++dx) {
+                  if ((dx == 0 && dy == 0) || !inside(dx, dy)) continue;  // lattice corner, or off
+                  const Rgb v = known[dy * side + dx] ? at(dx, dy) : integral(dx, dy);
+                  value[static_cast<std::size_t>(y0 + dy) * width + x0 + dx] = v;
+                }
+            }
             counted += count;
             for (std::size_t task = b; task < e; ++task)
               progress.Add(block_pixels[(2 * (task / pass_columns) + row_parity) * block_columns +
