@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "brdf/core/error.h"
 #include "brdf/core/geometry.h"
@@ -184,6 +185,34 @@ TEST(LightTools, MissingChannelBlockIsReportedWithItsLine) {
   } catch (const FormatError& e) {
     EXPECT_EQ(std::string(e.what()),
               "rgb.bsdf: line 6: expected a G block for AOI 10, POI 0, got none");
+  }
+}
+
+// Found by the fuzzer: a file whose data section is empty used to be accepted only when
+// enough bytes (here, trailing blanks) followed DataBegin to "hold" its 3 × 3 grid, so the
+// writer's compact copy of it was refused.
+TEST(LightTools, FileWithoutBlocksReadsTheSameWithOrWithoutPadding) {
+  const std::string header =
+      "SpectralContent Monochrome\nScatterAzimuth 3 0 90 180\nScatterRadial 3 0 30 60\n"
+      "DataBegin\nDataEnd\n";
+  for (const std::string& text : {header, header + std::string(40, ' ') + "\n"}) {
+    const LightToolsBsdf lt = ParseLightToolsBsdf(text, "empty.bsdf");
+    EXPECT_TRUE(lt.blocks.empty());
+    EXPECT_EQ(lt.scatter_azimuth_deg, (std::vector<double>{0, 90, 180}));
+    EXPECT_EQ(lt.scatter_radial_deg, (std::vector<double>{0, 30, 60}));
+    const LightToolsBsdf again = ParseLightToolsBsdf(FormatLightToolsBsdf(lt), "rewritten.bsdf");
+    EXPECT_TRUE(again.blocks.empty());
+    EXPECT_EQ(again.scatter_azimuth_deg, lt.scatter_azimuth_deg);
+  }
+  // A block still has to find its 9 values in the file.
+  try {
+    ParseLightToolsBsdf(
+        "SpectralContent Monochrome\nScatterAzimuth 3 0 90 180\n"
+        "ScatterRadial 3 0 30 60\nDataBegin\nAOI 0 TIS 1\n1 2 3\nDataEnd\n",
+        "short.bsdf");
+    FAIL();
+  } catch (const FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find("short.bsdf: line 5"), std::string::npos) << e.what();
   }
 }
 

@@ -118,10 +118,9 @@ LightToolsBsdf ParseLightToolsBsdf(std::string_view text_in, const std::string& 
   if (!have_azimuth) ts.FailAt(begin_line, "a ScatterAzimuth line before DataBegin", "DataBegin");
   if (!have_radial) ts.FailAt(begin_line, "a ScatterRadial line before DataBegin", "DataBegin");
   if (!have_spectral) ts.FailAt(begin_line, "a SpectralContent line before DataBegin", "DataBegin");
-  if (lt.scatter_azimuth_deg.size() > (ts.remaining_bytes() / 2 + 1) / lt.scatter_radial_deg.size())
-    ts.FailAt(begin_line, "ScatterAzimuth × ScatterRadial values that the file can hold",
-              std::to_string(lt.scatter_azimuth_deg.size()) + " × " +
-                  std::to_string(lt.scatter_radial_deg.size()));
+  // A file may end its data at once (DataBegin DataEnd), so the grid's size is checked
+  // against the rest of the file only where a block asks for its values, below; both counts
+  // are at most 100,000, so their product fits.
   const std::size_t per_block = lt.scatter_azimuth_deg.size() * lt.scatter_radial_deg.size();
 
   while (true) {
