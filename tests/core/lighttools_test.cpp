@@ -203,6 +203,14 @@ TEST(LightTools, FileWithoutBlocksReadsTheSameWithOrWithoutPadding) {
     const LightToolsBsdf again = ParseLightToolsBsdf(FormatLightToolsBsdf(lt), "rewritten.bsdf");
     EXPECT_TRUE(again.blocks.empty());
     EXPECT_EQ(again.scatter_azimuth_deg, lt.scatter_azimuth_deg);
+    try {
+      LightToolsToMeasurement(lt, "empty.bsdf");
+      FAIL();
+    } catch (const FormatError& e) {
+      EXPECT_EQ(std::string(e.what()),
+                "empty.bsdf: line 1: expected a front-side BRDF block, got no blocks between "
+                "DataBegin and DataEnd");
+    }
   }
   // A block still has to find its 9 values in the file.
   try {

@@ -280,8 +280,9 @@ Measurement LightToolsToMeasurement(const LightToolsBsdf& lt, const std::string&
   if (brdf_front == 0 && !use_btdf) {
     throw FormatError(file, LinePosition(lt.blocks.empty() ? 1 : lt.blocks.front().line),
                       "a front-side BRDF block",
-                      std::to_string(btdf_front) + " front-side BTDF and " + std::to_string(back) +
-                          " back-side blocks",
+                      lt.blocks.empty() ? std::string("no blocks between DataBegin and DataEnd")
+                                        : std::to_string(btdf_front) + " front-side BTDF and " +
+                                              std::to_string(back) + " back-side blocks",
                       btdf_front > 0 ? "transmission data, stored mirrored into the reflection "
                                        "hemisphere only on request"
                                      : "",
