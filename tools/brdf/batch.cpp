@@ -12,6 +12,7 @@
 
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
+#include "brdf/core/parallel.h"
 #include "cli_support.h"
 
 namespace brdf::cli {
@@ -101,10 +102,7 @@ DiscoveredInputs DiscoverInputs(const std::vector<std::string>& arguments,
   return out;
 }
 
-int DefaultJobs() {
-  const unsigned n = std::thread::hardware_concurrency();
-  return n == 0 ? 1 : static_cast<int>(n);
-}
+int DefaultJobs() { return ResolveJobs(0); }
 
 std::vector<JobResult> RunJobs(std::size_t count, int jobs,
                                const std::function<void(std::size_t, JobResult&)>& job,

@@ -3,11 +3,8 @@
 #pragma once
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
-#include <functional>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "brdf/core/geometry.h"
@@ -51,9 +48,6 @@ inline void MapPixelOf(const EnvironmentMap& map, const Vec3& w, int* i, int* j)
   *i = std::min(map.width() - 1, std::max(0, static_cast<int>(u * map.width())));
   *j = std::min(map.height() - 1, std::max(0, static_cast<int>(v * map.height())));
 }
-
-// The work-sharing loop (brdf/core/parallel.h).
-using brdf::ParallelChunks;
 
 // The pixels of an .exr or .hdr file (RGB floats, row 0 at the top). The one place that reads
 // image files, so the reader can change without touching the map code.

@@ -7,7 +7,6 @@
 #include <functional>
 #include <limits>
 #include <memory>
-#include <thread>
 #include <vector>
 
 #include "brdf/core/error.h"
@@ -21,7 +20,6 @@ namespace {
 
 using detail::Frame;
 using detail::Luminance;
-using detail::ParallelChunks;
 
 std::uint64_t Mix(std::uint64_t x) {  // SplitMix64 finaliser
   x += 0x9e3779b97f4a7c15ull;
@@ -53,11 +51,6 @@ struct Kronecker {
 constexpr int kHierarchyTopColumns = 16;
 // The image size PreviewOptions::image_tolerance is stated for.
 constexpr double kImageToleranceSize = 512.0;
-
-int ResolveJobs(int jobs) {
-  if (jobs > 0) return jobs;
-  return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-}
 
 // What a camera ray through a pixel found, computed once per renderer.
 struct PixelSetup {
@@ -538,6 +531,11 @@ struct PreviewRenderer::Impl {
     for (int pass = 0; pass < 4; ++pass) {
       const int row_parity = pass / 2, column_parity = pass % 2;
       const std::size_t pass_columns = (block_columns + 1 - column_parity) / 2;
+      // Task k of the pass: the block at this column and row of the block lattice.
+      auto column_of = [&](std::size_t task) {
+        return 2 * static_cast<int>(task % pass_columns) + column_parity;
+      };
+      auto row_of = [&](std::size_t task) { return 2 * (task / pass_columns) + row_parity; };
       ParallelChunks(
           (lattice_rows + 1 - row_parity) / 2 * pass_columns, 1, jobs, options.cancel,
           [&](std::size_t b, std::size_t e) {
@@ -546,8 +544,8 @@ struct PreviewRenderer::Impl {
             std::vector<Rgb> local(static_cast<std::size_t>(side) * side);
             std::vector<std::uint8_t> known(local.size());
             for (std::size_t task = b; task < e; ++task) {
-              const int c = 2 * static_cast<int>(task % pass_columns) + column_parity;
-              const std::size_t r = 2 * (task / pass_columns) + row_parity;
+              const int c = column_of(task);
+              const std::size_t r = row_of(task);
               const int x0 = c * block, y0 = static_cast<int>(r) * block;
               auto inside = [&](int dx, int dy) {
                 return x0 + dx < width && y0 + dy < height && object_at(x0 + dx, y0 + dy) >= 0;
@@ -663,8 +661,7 @@ struct PreviewRenderer::Impl {
             }
             counted += count;
             for (std::size_t task = b; task < e; ++task)
-              progress.Add(block_pixels[(2 * (task / pass_columns) + row_parity) * block_columns +
-                                        2 * (task % pass_columns) + column_parity]);
+              progress.Add(block_pixels[row_of(task) * block_columns + column_of(task)]);
           },
           progress.Reporter());
     }

@@ -6,7 +6,6 @@
 #include <cmath>
 #include <memory>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "brdf/core/error.h"
@@ -207,11 +206,6 @@ class TabulatedSampler final : public BrdfSampler {
 
   std::vector<Distribution2D> tables_;
 };
-
-int ResolveJobs(int jobs) {
-  if (jobs > 0) return jobs;
-  return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
-}
 
 }  // namespace
 

@@ -14,6 +14,13 @@
 
 namespace brdf {
 
+// The number of threads a `jobs` setting asks for: itself when positive, else one per core
+// (std::thread::hardware_concurrency(), at least 1).
+inline int ResolveJobs(int jobs) {
+  if (jobs > 0) return jobs;
+  return std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+}
+
 // Runs work(begin, end) over [0, count) in chunks of `chunk` on `jobs` threads (the calling
 // thread one of them; never more threads than chunks, at least one), handing out chunks in
 // order from one atomic counter. Stops handing out chunks once `cancel` (if given) becomes

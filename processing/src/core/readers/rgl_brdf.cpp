@@ -22,7 +22,6 @@
 #include <cmath>
 #include <cstddef>
 #include <filesystem>
-#include <thread>
 #include <utility>
 #include <vector>
 
@@ -1006,9 +1005,8 @@ std::unique_ptr<RglTabulatedBrdf> RglBrdf::Tabulate(const RglTabulationSettings&
     }
     runs[j] = std::move(run);
   };
-  ParallelChunks(runs.size(), 1,
-                 o.jobs > 0 ? o.jobs : static_cast<int>(std::thread::hardware_concurrency()),
-                 nullptr, [&](std::size_t begin, std::size_t end) {
+  ParallelChunks(runs.size(), 1, ResolveJobs(o.jobs), nullptr,
+                 [&](std::size_t begin, std::size_t end) {
                    for (std::size_t j = begin; j < end; ++j) build_interval(static_cast<int>(j));
                  });
   // Slots in order, each interval's w = 1 end dropped in favour of the next one's w = 0 (the
