@@ -15,7 +15,7 @@
 
 #include "brdf/core/bpc.h"
 #include "brdf/core/models.h"
-#include "brdf/processing/fit.h"
+#include "brdf/fit/fit.h"
 #include "fit_data.h"  // private to brdf_fit: the exact samples and weights the fit uses
 
 using namespace brdf;

@@ -30,7 +30,7 @@
 #include "brdf/core/lut_brdf.h"
 #include "brdf/core/rgl.h"
 #include "brdf/processing/measurement_brdf.h"
-#include "brdf/processing/preview.h"
+#include "brdf/preview/preview.h"
 
 namespace {
 

@@ -16,7 +16,7 @@
 
 #include "brdf/core/bpc.h"
 #include "brdf/device/capture_session.h"
-#include "brdf/device/emulated_usb.h"
+#include "brdf/device_emulation/emulated_usb.h"
 #include "brdf/device/usb_transport.h"
 #include "device_test_support.h"
 

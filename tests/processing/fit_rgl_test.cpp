@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "brdf/core/rgl.h"
-#include "brdf/processing/fit.h"
+#include "brdf/fit/fit.h"
 
 namespace brdf::processing {
 namespace {

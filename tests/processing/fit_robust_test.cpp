@@ -22,7 +22,7 @@
 #include <string>
 
 #include "../device/device_test_support.h"
-#include "brdf/processing/fit.h"
+#include "brdf/fit/fit.h"
 #include "fit_data.h"  // private to brdf_fit: the exact samples and weights a fit uses
 #include "synthetic_capture.h"
 #include "test_support.h"

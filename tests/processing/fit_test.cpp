@@ -5,7 +5,7 @@
 // material evaluated at every sample; with noise: the simulated instrument at its reference
 // noise level through the real driver), and for the extrapolation the analytic GGX values
 // between 75° and 90°.
-#include "brdf/processing/fit.h"
+#include "brdf/fit/fit.h"
 
 #include <gtest/gtest.h>
 

@@ -9,7 +9,7 @@ the fit started) and fitted.json (what it returned). The models and the residual
 come from bench/fit/scipy_baseline.py (transcribed from the published formulas, not from the
 C++). Prints one JSON object:
   auto_scale        1.4826 × the median |r| at the start (the scale the docs promise when
-                    none is given: brdf/processing/fit.h)
+                    none is given: brdf/fit/fit.h)
   cost_at_fitted    ½·Σ b²·ln(1 + r²/b²) at the fitted parameters with b = job "scale"
   cost_at_start, plain_cost_at_start   the same at the start, and ½·Σ r² there
   scipy_cost        SciPy's least_squares(loss="cauchy", f_scale=b) final cost from the start

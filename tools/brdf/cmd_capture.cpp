@@ -18,7 +18,7 @@
 #include "brdf/core/error.h"
 #include "brdf/device/capture_session.h"
 #include "brdf/device/driver.h"
-#include "brdf/device/emulated_usb.h"
+#include "brdf/device_emulation/emulated_usb.h"
 #include "brdf/device/simulator.h"
 #include "brdf/device/transport.h"
 #include "brdf/device/usb_models.h"

@@ -18,7 +18,7 @@
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
 #include "brdf/core/importers.h"
-#include "brdf/processing/fit.h"
+#include "brdf/fit/fit.h"
 #include "brdf/sources/detect.h"
 #include "brdf/sources/open.h"
 #include "cli_support.h"

@@ -15,7 +15,7 @@
 
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
-#include "brdf/processing/preview.h"
+#include "brdf/preview/preview.h"
 #include "brdf/sources/open.h"
 #include "cli_support.h"
 #include "commands.h"

@@ -135,7 +135,7 @@ struct RepairOptions {
 };
 int RunRepair(const RepairOptions& options);
 // `brdf fit`: analytic materials fitted to captures, material files or measured BRDFs
-// (brdf/processing/fit.h). One input and one model: --out is the material file to write;
+// (brdf/fit/fit.h). One input and one model: --out is the material file to write;
 // otherwise --out is a folder receiving <input>.<model>.json for every input and model.
 struct FitCommandOptions {
   std::vector<std::string> inputs;  // files and folders
@@ -155,7 +155,7 @@ struct DevicesOptions {
   bool json = false;
 };
 int RunDevices(const DevicesOptions& options);
-// `brdf preview`: an environment-lit render of any source (brdf/processing/preview.h), to a
+// `brdf preview`: an environment-lit render of any source (brdf/preview/preview.h), to a
 // linear EXR or a tone-mapped PNG; with `compare`, both renders and their signed difference.
 struct PreviewCommandOptions {
   std::string file;

@@ -1,4 +1,4 @@
-// The preview panel on top of brdf::preview (processing/include/brdf/processing/preview.h):
+// The preview panel on top of brdf::preview (preview/include/brdf/preview/preview.h):
 // a sphere under the built-in studio map, refined one pass per idle tick. Built only when the
 // brdf::preview target exists (viewer/CMakeLists.txt); preview_panel.cpp is the fallback.
 #include <algorithm>
@@ -6,7 +6,7 @@
 #include <string>
 
 #include "brdf/core/error.h"
-#include "brdf/processing/preview.h"
+#include "brdf/preview/preview.h"
 #include "preview_panel.h"
 
 namespace brdf::viewer {

@@ -7,7 +7,7 @@
 // clang-format off
 #include <linux/usbdevice_fs.h>
 // clang-format on
-#include "brdf/device/emulated_usb.h"
+#include "brdf/device_emulation/emulated_usb.h"
 
 #include <umockdev.h>
 

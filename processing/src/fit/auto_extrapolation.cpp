@@ -1,5 +1,5 @@
 // --extrapolate auto: the docs/design.md §6 Bézier parameters that follow a fitted model's
-// fall-off beyond the last measured θout (brdf/processing/fit.h).
+// fall-off beyond the last measured θout (brdf/fit/fit.h).
 #include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
@@ -8,7 +8,7 @@
 #include "brdf/core/error.h"
 #include "brdf/core/geometry.h"
 #include "brdf/processing/extrapolation.h"
-#include "brdf/processing/fit.h"
+#include "brdf/fit/fit.h"
 
 namespace brdf::processing {
 

@@ -1,6 +1,6 @@
 // FitMaterial: data preparation, the deterministic multi-start sweep, the Ceres refinement and
-// the report (brdf/processing/fit.h explains the method).
-#include "brdf/processing/fit.h"
+// the report (brdf/fit/fit.h explains the method).
+#include "brdf/fit/fit.h"
 
 #include <ceres/ceres.h>
 

@@ -7,7 +7,7 @@
 
 #include "brdf/core/measurement.h"
 #include "brdf/core/models.h"
-#include "brdf/processing/fit.h"
+#include "brdf/fit/fit.h"
 
 namespace brdf::processing {
 
@@ -26,7 +26,7 @@ struct FitData {
   std::size_t excluded_invalid = 0, excluded_saturated = 0, excluded_theta_out = 0;
 };
 
-// Selects and weighs the samples (brdf/processing/fit.h). Throws FormatError when none is
+// Selects and weighs the samples (brdf/fit/fit.h). Throws FormatError when none is
 // usable, InvalidArgument for a bad max_theta_out_deg.
 FitData PrepareFitData(const Measurement& measurement, const FitOptions& options);
 

@@ -7,7 +7,7 @@
 #include "brdf/core/error.h"
 #include "brdf/core/measurement.h"
 #include "brdf/image_io/image_io.h"
-#include "brdf/processing/preview.h"
+#include "brdf/preview/preview.h"
 #include "preview_internal.h"
 
 namespace brdf::preview {

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "brdf/core/geometry.h"
-#include "brdf/processing/preview.h"
+#include "brdf/preview/preview.h"
 
 namespace brdf::preview::detail {
 

@@ -10,7 +10,7 @@
 #include "brdf/core/geometry.h"
 #include "brdf/core/models.h"
 #include "brdf/core/parallel.h"
-#include "brdf/processing/preview.h"
+#include "brdf/preview/preview.h"
 
 namespace brdf::preview::detail {
 

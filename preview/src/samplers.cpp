@@ -1,5 +1,5 @@
 // Importance sampling of the environment map and of BRDFs (preview.h). Every Sample() has a
-// Pdf() that returns exactly the density of what it draws; tests/processing/preview_test.cpp
+// Pdf() that returns exactly the density of what it draws; tests/preview/preview_test.cpp
 // checks each pair with a χ² test.
 #include <algorithm>
 #include <atomic>
@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "brdf/core/error.h"
-#include "brdf/processing/preview.h"
+#include "brdf/preview/preview.h"
 #include "distribution.h"
 #include "preview_internal.h"
 

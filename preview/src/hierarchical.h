@@ -24,7 +24,7 @@
 
 #include "brdf/core/brdf_source.h"
 #include "brdf/core/geometry.h"
-#include "brdf/processing/preview.h"
+#include "brdf/preview/preview.h"
 
 namespace brdf::preview::detail {
 

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "brdf/core/error.h"
-#include "brdf/processing/preview.h"
+#include "brdf/preview/preview.h"
 #include "hierarchical.h"
 #include "preview_internal.h"
 #include "scene.h"

@@ -1,8 +1,8 @@
-// Physics of the environment-lit preview (brdf/processing/preview.h). Every expected value comes
+// Physics of the environment-lit preview (brdf/preview/preview.h). Every expected value comes
 // from outside the renderer: closed forms (furnace, linear-gradient irradiance, mirror
 // geometry), NumPy quadrature of the docs/design.md §9 formulas (tests/python/preview_oracle.py),
 // or another estimator whose error bars are known.
-#include "brdf/processing/preview.h"
+#include "brdf/preview/preview.h"
 
 #include <gtest/gtest.h>
 

@@ -8,7 +8,7 @@
 
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
-#include "brdf/processing/preview.h"
+#include "brdf/preview/preview.h"
 #include "preview_internal.h"
 
 namespace brdf::preview {

@@ -1,4 +1,4 @@
-// The environment-map hierarchy of the hierarchical preview (processing/src/preview/
+// The environment-map hierarchy of the hierarchical preview (preview/src/
 // hierarchical.h, private to brdf_preview). The cells' integrals are checked against a direct
 // numerical quadrature written here (midpoint rule over θ and φ, not the closed forms the
 // hierarchy uses), their bounding cones against directions sampled over each cell, and the
@@ -13,7 +13,7 @@
 #include <vector>
 
 #include "brdf/core/geometry.h"
-#include "brdf/processing/preview.h"
+#include "brdf/preview/preview.h"
 
 namespace brdf::preview::detail {
 namespace {

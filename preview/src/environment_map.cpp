@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "brdf/core/error.h"
-#include "brdf/processing/preview.h"
+#include "brdf/preview/preview.h"
 #include "preview_internal.h"
 
 namespace brdf::preview {
