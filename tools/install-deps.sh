@@ -7,6 +7,7 @@ set -euo pipefail
 
 packages=(
   build-essential cmake ninja-build pkg-config git
+  ccache  # shares compiled objects between build trees (the emulation-off and fuzz sub-builds)
   libceres-dev libeigen3-dev
   libopenimageio-dev openimageio-tools libopenexr-dev
   libimath-dev libpng-dev zlib1g-dev python3-openimageio  # brdf::image_io and its oracle
