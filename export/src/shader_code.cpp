@@ -48,8 +48,9 @@ FLOAT3 MeasuredBrdfCoords(float sin_in, float cos_in, FLOAT3 v_local, FLOAT2 cel
   float theta_d_deg = ATAN2(in_plane, w_d.z) * MEASURED_BRDF_DEG_PER_RAD;
   // phi_d from the upper half-plane: atan2 of abs(y), then y's sign. A view in the plane of
   // incidence (the normal, the horizon at phi 0 or 180 deg, any mirror-plane view) has
-  // w_d.y = -0.0, and GPUs need not honour a zero's sign: SwiftShader's atan(-0.0, x) is 0 for
-  // x < 0 and pi for x > 0, which read phi_d 180 deg as 0 and 0 as 180. abs() gives +0.0.
+  // w_d.y = -v_local.y = a negated zero, and GPUs need not get atan right there: SwiftShader
+  // returns 0 instead of pi for x < 0 and pi instead of 0 for x > 0, i.e. read phi_d 180 deg as
+  // 0 and 0 as 180 (the browser test's exact directions). With abs() it returns 0 and pi.
   float phi_d_deg = 0.0;
   if (in_plane > 0.0) {
     phi_d_deg = ATAN2(abs(w_d.y), w_d.x) * MEASURED_BRDF_DEG_PER_RAD;
