@@ -1,5 +1,5 @@
 // .bpc write and read throughput for one full reference capture: 4 θin slices × 76 θout ×
-// 360 φout = 109,440 samples with σ (about 4.8 MB). Target (issue 2): well under 10 ms per read.
+// 360 φout = 109,440 samples with σ (about 4.8 MB). Target: well under 10 ms per read.
 #include <benchmark/benchmark.h>
 #include <unistd.h>
 

@@ -1,6 +1,6 @@
 // Resampling + grazing extrapolation of one capture of the reference instrument's size
 // (4 θin × 76 θout × 360 φout = 109,440 samples) into the 4 × 361 × 181 LUT of docs/design.md §5.
-// Target (issue 3): under 20 ms per capture on one core.
+// Target: under 20 ms per capture on one core.
 //   build/bench/bench_processing --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include <benchmark/benchmark.h>
 

@@ -1,4 +1,4 @@
-// Read time per text format for a typical file (issue 4 benchmark):
+// Read time per text format for a typical file:
 //   Zemax BSDF    the shared Imaging Sphere file (13 incidences × 19 × 11)
 //   CSV           a capture of the reference instrument's size: 4 θin × 76 θout × 360 φout
 //                 = 109,440 rows, written once from an analytic GGX material

@@ -1,6 +1,6 @@
 // RGL and MERL readers: load time per file and evaluation throughput.
 //   build/bench/bench_rgl --benchmark_filter=Rgl   (or Merl, Sha256)
-// Evaluation target (issue 4): at least 5 M RGL evaluations per second per core.
+// Evaluation target: at least 5 M RGL evaluations per second per core.
 #include <benchmark/benchmark.h>
 
 #include <cmath>
@@ -71,7 +71,7 @@ void BM_RglEval(benchmark::State& state, const std::string& file) {
 BENCHMARK_CAPTURE(BM_RglEval, paper_white, std::string("paper_white_rgb.bsdf"));
 BENCHMARK_CAPTURE(BM_RglEval, chm_mint, std::string("chm_mint_rgb.bsdf"));
 BENCHMARK_CAPTURE(BM_RglEval, cg_sunflower_64, std::string("cg_sunflower_rgb.bsdf"));
-// The material of issue 10's preview benchmark.
+// The material of the preview benchmark (bench/preview/).
 BENCHMARK_CAPTURE(BM_RglEval, cc_ibiza_sunset, std::string("cc_ibiza_sunset_rgb.bsdf"));
 
 // The exact evaluator and its tabulated form (RglTabulatedBrdf, what `brdf preview` integrates)

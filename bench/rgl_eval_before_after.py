@@ -6,7 +6,7 @@
 Each round runs BEFORE then AFTER (Google Benchmark, --benchmark_min_time=0.3, JSON output);
 prints the load average before and after and, per benchmark present in both builds, the median
 CPU time per item over the rounds and the ratio before / after (docs/benchmarks.md, "RGL
-evaluation speed-up (rgl2, session 4)"). The data folder is $BRDF_DATA_DIR when set.
+and MERL evaluation"). The data folder is $BRDF_DATA_DIR when set.
 """
 import json
 import os

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Start-up cost of `brdf` commands (issue 7): median wall time (hyperfine, no shell) and median
+# Start-up cost of `brdf` commands: median wall time (hyperfine, no shell) and median
 # peak RSS (GNU time %M over 5 runs), for one build or two side by side.
 #
 #   bench/startup.sh NEW_BRDF [BASELINE_BRDF] [RUNS]

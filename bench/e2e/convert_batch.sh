@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# End-to-end batch benchmark of `brdf convert` (issue 3): 216 simulated captures (the size of
+# End-to-end batch benchmark of `brdf convert`: 216 simulated captures (the size of
 # the reference paper's dataset) to every format (KTX2, DDS, EXR, PNG, JSON sidecar), compared
 # with the I/O floor: reading the same inputs and writing the same number of files of the same
 # sizes, doing nothing else (bench/e2e/io_floor.cpp), once plainly and once with the exporters'

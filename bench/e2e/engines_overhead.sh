@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Time `brdf convert --engine all` adds to a 216-capture batch (issue 11: target under 25 %):
+# Time `brdf convert --engine all` adds to a 216-capture batch (target: under 25 %):
 # the same captures converted with the default formats, alternately without and with
 # --engine all, REPETITIONS times each, into fresh folders; medians of wall and CPU
 # (user + system) time from /usr/bin/time -v. Alternating keeps both configurations under the

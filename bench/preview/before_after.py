@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """The default `brdf preview` (hierarchical quadrature) of two builds side by side: time, error
-and BRDF evaluations, interleaved rounds (docs/benchmarks.md, "RGL preview (rglfast)").
+and BRDF evaluations, interleaved rounds (docs/benchmarks.md, "Environment-lit preview").
 
   before_after.py BEFORE_TOOL AFTER_TOOL OUT_DIR SOURCE... [--runs 5] [--ref-pixels 1500]
                   [--jobs 2] [--keep-reference]

@@ -1,5 +1,5 @@
 #!/bin/bash
-# (Issue 10, docs/benchmarks.md "Progress of the deterministic pass".)
+# (docs/benchmarks.md, "Progress of the deterministic pass".)
 # Progress reporting of the hierarchical pass: brdf preview with progress (stderr to a pipe, plain
 # lines) and with --quiet (no callback), interleaved, N pairs; prints wall, user, sys per run.
 # usage: progress_overhead.sh BRDF SOURCE [PAIRS]

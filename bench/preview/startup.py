@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Two builds of `brdf preview` side by side: the fixed cost of a preview (the map, its hierarchy,
-opening the source) and whether the image changed (docs/benchmarks.md, "Preview overheads
-(integ)").
+opening the source) and whether the image changed (docs/benchmarks.md,
+"Environment-lit preview").
 
   startup.py BEFORE_TOOL AFTER_TOOL OUT_DIR SOURCE... [--runs 5] [--jobs 2]
 

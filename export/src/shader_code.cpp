@@ -46,12 +46,17 @@ FLOAT3 MeasuredBrdfCoords(float sin_in, float cos_in, FLOAT3 v_local, FLOAT2 cel
   float in_plane = length(w_d.xy);
   // atan2 of the in-plane length and z, not acos(z): exact near the pole at any precision.
   float theta_d_deg = ATAN2(in_plane, w_d.z) * MEASURED_BRDF_DEG_PER_RAD;
+  // phi_d from the upper half-plane: atan2 of abs(y), then y's sign. A view in the plane of
+  // incidence (the normal, the horizon at phi 0 or 180 deg, any mirror-plane view) has
+  // w_d.y = -v_local.y = a negated zero, and GPUs need not get atan right there: SwiftShader
+  // returns 0 instead of pi for x < 0 and pi instead of 0 for x > 0, i.e. read phi_d 180 deg as
+  // 0 and 0 as 180 (the browser test's exact directions). With abs() it returns 0 and pi.
   float phi_d_deg = 0.0;
   if (in_plane > 0.0) {
-    phi_d_deg = ATAN2(w_d.y, w_d.x) * MEASURED_BRDF_DEG_PER_RAD;
+    phi_d_deg = ATAN2(abs(w_d.y), w_d.x) * MEASURED_BRDF_DEG_PER_RAD;
   }
-  if (phi_d_deg < 0.0) {
-    phi_d_deg = phi_d_deg + 360.0;
+  if (w_d.y < 0.0) {
+    phi_d_deg = 360.0 - phi_d_deg;
   }
   float theta_in_deg = ATAN2(sin_in, cos_in) * MEASURED_BRDF_DEG_PER_RAD;
   float tex_u = clamp(cell_texels.x + phi_d_deg + 0.5, cell_texels.x + 0.5,

@@ -141,7 +141,7 @@ TEST_F(CaptureCli, InterruptedCaptureRecordsItsPlanSoConvertNamesTheMissingSlice
     ASSERT_EQ(ReadBpc(out).measurement.slices.size(), 2u);
 
     const ToolRun info = Run("info --json " + out);
-    // Missing planned slices: convert refuses it, so info reports it and exits 1 (issue 7).
+    // Missing planned slices: convert refuses it, so info reports it and exits 1.
     ASSERT_EQ(info.exit_code, 1) << info.err;
     EXPECT_NE(info.out.find("\"theta_in_deg\": \"" + c.key + "\""), std::string::npos) << info.out;
 

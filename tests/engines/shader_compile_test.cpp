@@ -113,7 +113,7 @@ TEST_F(ShaderCompile, Glsl450LinksToSpirvWithAMain) {
       "GLSL 4.50 to SPIR-V");
 }
 
-// docs/design.md §5 / issue: the sidecar's "glsl" snippet compiles as it ships (ES 3.00 needs a
+// docs/design.md §5: the sidecar's "glsl" snippet compiles as it ships (ES 3.00 needs a
 // precision for sampler3D, which the earlier snippet lacked) and equals the shipped files' body.
 TEST_F(ShaderCompile, SidecarSnippetIsTheShippedGlslAndCompiles) {
   exporter::PackedVolume v{361, 181, 4, std::vector<std::uint32_t>(361 * 181 * 4, 0)};

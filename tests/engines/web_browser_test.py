@@ -1,19 +1,26 @@
 """The web hand-off in a real browser, end to end (ctest label: browser).
 
-A GGX material is captured noise-free and converted by `brdf convert --engine web,unity`; the
+A GGX material is captured noise-free and converted by `brdf convert --engine all`; the
 exported web folder is served to headless Chromium (WebGL 2 on SwiftShader), which loads the
 KTX2 with three.js's KTX2Loader and renders a sphere with the shipped ShaderMaterial
 (tests/node/render_web.mjs). tests/python/web_render_check.py then compares, independently of
 the code under test:
   - the float image with a numpy reference from the analytic material (RMS and max error),
   - the manifest's probe texels with the KTX2 file and with what the GPU fetched,
-  - the shipped GLSL and the shipped Unity HLSL (glslangValidator -D → SPIR-V → spirv-cross →
-    GLSL ES, executed by the same WebGL context) with `brdf eval` of the LUT for 300 pairs.
+  - every shipped shader with `brdf eval` of the LUT, for 300 random direction pairs and for
+    the exact directions where angle math meets a pole or the horizon (views exactly along the
+    normal, at the horizon, in the mirror direction; lights exactly along the normal): the
+    three.js module's GLSL (MeasuredBrdfCell, MeasuredBrdfTangent), the sidecar's
+    texel_convention.glsl, and, executed by the same WebGL context as GLSL ES, the Unity HLSL
+    and the Unreal .ush (glslangValidator -D → SPIR-V → spirv-cross), the GLSL 4.50 file
+    (glslangValidator -V → SPIR-V → spirv-cross) and the Godot shader (its GLSL ES dialect
+    with Godot's additions replaced).
 Usage: web_browser_test.py BRDF_TOOL SOURCE_DIR [CHROMIUM]   (Debian /usr/bin/python3; fails when a tool
 is missing: install it with tools/install-deps.sh and tools/install-npm-deps.sh)
 """
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -21,9 +28,9 @@ import tempfile
 
 MATERIAL = {"model": "ggx", "kd": [0.10, 0.20, 0.35], "f0": [0.04, 0.04, 0.04], "alpha": 0.35}
 
-HARNESS = """// glslang stand-in for Unity's Core RP texture struct (Texture.hlsl)
-struct UnityTexture3D { Texture3D tex; SamplerState samplerstate; };
-#include "MeasuredBrdf.hlsl"
+# The HLSL harnesses: a function Evaluate(Lut, LutSampler, N, L, V) calling the shipped code as
+# the engine does, and this main() evaluating it for each column of the pairs texture.
+HLSL_PAIRS_MAIN = """
 Texture3D lut : register(t0);
 SamplerState lut_sampler : register(s0);
 Texture2D<float4> pairs : register(t1);
@@ -32,12 +39,70 @@ float4 main(float4 pos : SV_Position) : SV_Target {
   float3 n = pairs.Load(int3(x, 0, 0)).xyz;
   float3 l = pairs.Load(int3(x, 1, 0)).xyz;
   float3 v = pairs.Load(int3(x, 2, 0)).xyz;
+  return float4(Evaluate(lut, lut_sampler, n, l, v), 1.0);
+}
+"""
+
+# Unity: the Shader Graph entry point, with a glslang stand-in for Core RP's texture struct
+# (Texture.hlsl).
+UNITY_HARNESS = """struct UnityTexture3D { Texture3D tex; SamplerState samplerstate; };
+#include "@INCLUDE@"
+float3 Evaluate(Texture3D Lut, SamplerState LutSampler, float3 N, float3 L, float3 V) {
   UnityTexture3D t;
-  t.tex = lut;
-  t.samplerstate = lut_sampler;
+  t.tex = Lut;
+  t.samplerstate = LutSampler;
   float3 f;
-  MeasuredBrdf_float(t, n, l, v, f);
-  return float4(f, 1.0);
+  MeasuredBrdf_float(t, N, L, V, f);
+  return f;
+}
+""" + HLSL_PAIRS_MAIN
+
+# Unreal wraps a Custom node's code in a function of its inputs (MaterialTemplate.ush
+# CustomExpressionN; a TextureObject input "Lut" arrives as Lut and LutSampler). @CODE@ is the
+# code line the .ush tells the artist to type.
+UNREAL_HARNESS = """#include "@USH@"
+float3 Evaluate(Texture3D Lut, SamplerState LutSampler, float3 N, float3 L, float3 V) {
+  @CODE@
+}
+""" + HLSL_PAIRS_MAIN
+
+# Appended to the shipped GLSL 4.50 file for glslangValidator -V (Vulkan GLSL needs bindings).
+GL450_MAIN = """
+layout(binding = 0) uniform sampler3D lut;
+layout(binding = 1) uniform sampler2D pairs;
+layout(location = 0) out vec4 color;
+void main() {
+  int x = int(gl_FragCoord.x);
+  vec3 n = texelFetch(pairs, ivec2(x, 0), 0).xyz;
+  vec3 l = texelFetch(pairs, ivec2(x, 1), 0).xyz;
+  vec3 v = texelFetch(pairs, ivec2(x, 2), 0).xyz;
+  color = vec4(MeasuredBrdf(lut, n, l, v), 1.0);
+}
+"""
+
+# Godot's shading language is GLSL ES 3.0 plus a header, uniform hints and built-ins
+# (tests/engines/shader_compile_test.cpp does the same translation to compile it): the built-ins
+# become globals that main() fills from the pairs texture, with a white light of unit energy,
+# and DIFFUSE_LIGHT, what light() accumulates, is the output.
+GODOT_BUILTINS = """precision highp float;
+vec3 ALBEDO; float METALLIC; float SPECULAR; float ROUGHNESS;
+vec3 NORMAL; vec3 LIGHT; vec3 VIEW; vec3 LIGHT_COLOR; float ATTENUATION;
+vec3 DIFFUSE_LIGHT; vec3 SPECULAR_LIGHT;
+"""
+GODOT_MAIN = """
+uniform highp sampler2D pairs;
+layout(location = 0) out highp vec4 fragColor;
+void main() {
+  int x = int(gl_FragCoord.x);
+  NORMAL = texelFetch(pairs, ivec2(x, 0), 0).xyz;
+  LIGHT = texelFetch(pairs, ivec2(x, 1), 0).xyz;
+  VIEW = texelFetch(pairs, ivec2(x, 2), 0).xyz;
+  LIGHT_COLOR = vec3(1.0);
+  ATTENUATION = 1.0;
+  DIFFUSE_LIGHT = vec3(0.0);
+  godot_fragment();
+  godot_light();
+  fragColor = vec4(DIFFUSE_LIGHT, 1.0);
 }
 """
 
@@ -48,6 +113,70 @@ def run(cmd, **kw):
         print(f"FAILED ({r.returncode}): {' '.join(cmd)}\n{r.stdout}\n{r.stderr[-4000:]}")
         sys.exit(1)
     return r.stdout
+
+
+def es_harnesses(out, work):
+    """GLSL ES 3.00 sources, each with a main() that evaluates one shipped shader for the pairs
+    texture: the Unity HLSL, the Unreal .ush (glslangValidator -D → SPIR-V → spirv-cross), the
+    GLSL 4.50 file (glslangValidator -V → SPIR-V → spirv-cross) and the Godot shader
+    (translated). Returns {name: path}."""
+    def cross(name, src_path, hlsl):
+        spv = os.path.join(work, name + ".spv")
+        run(["glslangValidator"] + (["-D"] if hlsl else []) +
+            ["-V", "-e", "main", "-S", "frag", src_path, "-o", spv])
+        es = os.path.join(work, name + "_es.glsl")
+        run(["spirv-cross", spv, "--es", "--version", "300", "--output", es])
+        return es
+
+    def only(folder, suffix):
+        found = sorted(f for f in os.listdir(folder) if f.endswith(suffix))
+        if len(found) != 1:
+            print(f"FAILED: expected one *{suffix} in {folder}, found {found}")
+            sys.exit(1)
+        return found[0]
+
+    result = {}
+    unity = os.path.join(out, "unity")
+    include = only(unity, ".hlsl")
+    with open(os.path.join(unity, "harness.hlsl"), "w") as f:
+        f.write(UNITY_HARNESS.replace("@INCLUDE@", include))
+    result["hlsl"] = cross("unity", os.path.join(unity, "harness.hlsl"), True)
+
+    unreal = os.path.join(out, "unreal")
+    ush = only(unreal, ".ush")
+    with open(os.path.join(unreal, ush)) as f:
+        code = re.search(r"// Code:\s+(return [^\n]+;)", f.read())
+    if code is None:
+        print(f"FAILED: {ush} names no Custom node code line ('// Code: return ...;')")
+        sys.exit(1)
+    with open(os.path.join(unreal, "harness.hlsl"), "w") as f:
+        f.write(UNREAL_HARNESS.replace("@USH@", ush).replace("@CODE@", code.group(1)))
+    result["unreal"] = cross("unreal", os.path.join(unreal, "harness.hlsl"), True)
+
+    web = os.path.join(out, "web")
+    with open(os.path.join(web, only(web, ".450.glsl"))) as f:
+        gl450 = f.read()
+    gl450_path = os.path.join(work, "gl450.frag")
+    with open(gl450_path, "w") as f:
+        f.write(gl450 + GL450_MAIN)
+    result["gl450"] = cross("gl450", gl450_path, False)
+
+    godot = os.path.join(out, "godot")
+    with open(os.path.join(godot, only(godot, ".gdshader"))) as f:
+        src = f.read()
+    for pattern, repl in ((r"shader_type spatial;", ""),
+                          (r"uniform sampler3D (\w+) : [^;]+;", r"uniform highp sampler3D \1;"),
+                          (r"void fragment\(\)", "void godot_fragment()"),
+                          (r"void light\(\)", "void godot_light()")):
+        src, n = re.subn(pattern, repl, src)
+        if n != 1:
+            print(f"FAILED: the Godot shader has {n} matches of {pattern!r}, expected 1")
+            sys.exit(1)
+    godot_path = os.path.join(work, "godot_es.glsl")
+    with open(godot_path, "w") as f:
+        f.write(GODOT_BUILTINS + src + GODOT_MAIN)
+    result["godot"] = godot_path
+    return result
 
 
 def main():
@@ -63,30 +192,58 @@ def main():
     with open(mat, "w") as f:
         json.dump(MATERIAL, f)
     out = os.path.join(work, "out")
-    run([tool, "convert", mat, "--out", out, "--engine", "web,unity", "--quiet",
+    run([tool, "convert", mat, "--out", out, "--engine", "all", "--quiet",
          "--formats", "ktx2,json"])
     web = os.path.join(out, "web")
+    ktx2 = os.path.join(out, "ggx_blue.ktx2")
     angles, nlv = os.path.join(work, "angles.txt"), os.path.join(work, "nlv.txt")
     run([sys.executable, check, "gen-pairs", "300", "11", angles, nlv])
-    with open(os.path.join(work, "eval.txt"), "w") as f:
-        f.write(run([tool, "eval", os.path.join(out, "ggx_blue.ktx2"), "--pairs", angles]))
-    harness = os.path.join(out, "unity", "harness.hlsl")
-    with open(harness, "w") as f:
-        f.write(HARNESS)
-    spv = os.path.join(work, "harness.spv")
-    run(["glslangValidator", "-D", "-V", "-e", "main", "-S", "frag", harness, "-o", spv])
-    es = os.path.join(work, "harness_es.glsl")
-    run(["spirv-cross", spv, "--es", "--version", "300", "--output", es])
+    exact_angles = os.path.join(work, "exact_angles.txt")
+    exact_nlv = os.path.join(work, "exact_nlv.txt")
+    run([sys.executable, check, "gen-exact", exact_angles, exact_nlv])
+    for a, e in ((angles, "eval.txt"), (exact_angles, "exact_eval.txt")):
+        with open(os.path.join(work, e), "w") as f:
+            f.write(run([tool, "eval", ktx2, "--pairs", a]))
+    harnesses = es_harnesses(out, work)
     result = os.path.join(work, "result")
     os.makedirs(result)
     run(["node", os.path.join(source, "tests/node/render_web.mjs"), "--web", web,
          "--material", "ggx_blue", "--out", result, "--size", "256", "--pairs", nlv,
-         "--hlsl-glsl", es, "--chromium", chromium])
+         "--exact", exact_nlv, "--sidecar", os.path.join(out, "ggx_blue.json"),
+         "--es-harness", ",".join(f"{k}={v}" for k, v in harnesses.items()),
+         "--chromium", chromium])
+    langs = ["glsl", "tangent", "sidecar"] + list(harnesses)
     r = subprocess.run([sys.executable, check, "check", "--material", mat, "--result", result,
                         "--ktx2", os.path.join(web, "ggx_blue.ktx2"), "--manifest",
-                        os.path.join(web, "ggx_blue.manifest.json"), "--eval",
-                        os.path.join(work, "eval.txt"), "--hlsl"], capture_output=True, text=True)
+                        os.path.join(web, "ggx_blue.manifest.json"), "--langs", ",".join(langs),
+                        "--eval", os.path.join(work, "eval.txt"), "--angles", angles,
+                        "--exact-eval", os.path.join(work, "exact_eval.txt"),
+                        "--exact-angles", exact_angles], capture_output=True, text=True)
     print(r.stdout + r.stderr, end="")
+    # A real capture's LUT (data-samples/captures/gold.bpc, measured noise and the extrapolated
+    # band): its slices are not exactly symmetric, so a lookup at the wrong azimuth or θin
+    # shows. The exact directions through every shader against `brdf eval` of its KTX2.
+    cap = os.path.join(work, "capture")
+    run([tool, "convert", os.path.join(source, "data-samples/captures/gold.bpc"), "--out", cap,
+         "--engine", "web", "--quiet", "--formats", "ktx2,json"])
+    with open(os.path.join(work, "gold_exact_eval.txt"), "w") as f:
+        f.write(run([tool, "eval", os.path.join(cap, "gold.ktx2"), "--pairs", exact_angles]))
+    cap_result = os.path.join(work, "capture_result")
+    os.makedirs(cap_result)
+    run(["node", os.path.join(source, "tests/node/render_web.mjs"), "--web",
+         os.path.join(cap, "web"), "--material", "gold", "--out", cap_result, "--size", "64",
+         "--exact", exact_nlv, "--sidecar", os.path.join(cap, "gold.json"),
+         "--es-harness", ",".join(f"{k}={v}" for k, v in harnesses.items()),
+         "--chromium", chromium])
+    c = subprocess.run([sys.executable, check, "check", "--result", cap_result, "--ktx2",
+                        os.path.join(cap, "web", "gold.ktx2"), "--manifest",
+                        os.path.join(cap, "web", "gold.manifest.json"), "--langs",
+                        ",".join(langs), "--exact-eval",
+                        os.path.join(work, "gold_exact_eval.txt"), "--exact-angles",
+                        exact_angles], capture_output=True, text=True)
+    print("capture gold.bpc: " + (c.stdout + c.stderr).strip().replace("\n", "\ncapture: "))
+    if c.returncode != 0:
+        r = c
     # An atlas: the second material's cell (a Lambertian) through the viewer's ?cell= path.
     lam = os.path.join(work, "lambert_orange.json")
     with open(lam, "w") as f:

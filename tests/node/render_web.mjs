@@ -6,14 +6,18 @@
 //   probes.json     the manifest's probe texels read back with texelFetch and with a filtered
 //                   fetch at the texel centre
 //   pairs_glsl.txt  MeasuredBrdfCell (the shipped GLSL) for each line "nx ny nz lx ly lz vx vy vz"
-//                   of --pairs, one "r g b" line each
-//   pairs_hlsl.txt  the same through the shipped Unity HLSL cross-compiled to GLSL ES
-//                   (--hlsl-glsl, made by glslangValidator -D and spirv-cross)
+//                   of --pairs, one "r g b" line each; pairs_tangent.txt MeasuredBrdfTangent;
+//                   pairs_sidecar.txt the sidecar's texel_convention.glsl (--sidecar FILE.json)
+//   pairs_NAME.txt  the same through each GLSL ES harness of --es-harness NAME=FILE,...
+//                   (the Unity and Unreal HLSL and the GLSL 4.50 file cross-compiled by
+//                   glslangValidator and spirv-cross, the Godot shader translated)
+//   exact_*.txt     the same for the exact directions of --exact
 //   screenshot.png  the viewer as a person sees it (sRGB canvas), light moved once
 //   bench.json      with --bench: frame times of a 1024² canvas, the measured material and
 //                   three's MeshStandardMaterial (the baseline) alternating
 // Usage: node render_web.mjs --web DIR --material NAME --out DIR [--size N] [--pairs FILE]
-//        [--hlsl-glsl FILE] [--cell NAME (an atlas material)] [--bench] [--chromium PATH]
+//        [--exact FILE] [--sidecar FILE.json] [--es-harness NAME=FILE,...]
+//        [--cell NAME (an atlas material)] [--bench] [--chromium PATH]
 import { spawn } from 'node:child_process';
 import { createServer } from 'node:http';
 import { mkdtempSync, readFileSync, writeFileSync, existsSync, rmSync, statSync } from 'node:fs';
@@ -244,15 +248,14 @@ try {
     texel_fetch: Array.from(fetched.subarray(i * 4, i * 4 + 3)),
     filtered_at_centre: Array.from(filtered.subarray(i * 4, i * 4 + 3)) })), null, 1));
 
-  // Direction pairs through the shipped GLSL (and the HLSL cross-compiled to GLSL ES).
-  if (args.pairs) {
-    const rows = readFileSync(args.pairs, 'utf8').split('\n').map((l) => l.trim())
-      .filter((l) => l && !l.startsWith('#')).map((l) => l.split(/\s+/).map(Number));
-    const count = rows.length;
-    const data = new Float32Array(count * 3 * 4);
-    rows.forEach((r, i) => {
-      for (let k = 0; k < 3; k++) data.set([r[3 * k], r[3 * k + 1], r[3 * k + 2], 0], (k * count + i) * 4);
-    });
+  // Direction pairs through every shipped shader: the GLSL of the three.js module (as
+  // MeasuredBrdfCell and as MeasuredBrdfTangent), the sidecar's texel_convention.glsl, and the
+  // GLSL ES sources made from the other shaders (--es-harness), for the random pairs (--pairs)
+  // and the exact ones (--exact).
+  const readRows = (file) => readFileSync(file, 'utf8').split('\n').map((l) => l.trim())
+    .filter((l) => l && !l.startsWith('#')).map((l) => l.split(/\s+/).map(Number));
+  const pairSets = [['pairs', args.pairs], ['exact', args.exact]].filter(([, f]) => f);
+  if (pairSets.length) {
     const glslMain = `
       uniform highp sampler3D lut; uniform highp sampler2D pairs;
       layout(location = 0) out highp vec4 fragColor;
@@ -262,31 +265,51 @@ try {
              v = texelFetch(pairs, ivec2(x, 2), 0).xyz;
         fragColor = vec4(MeasuredBrdfCell(lut, vec2(0.0), n, l, v), 1.0);
       }`;
-    const runPairs = async (source, lutName, pairsName) => fromBase64(await page.eval(`(async () => {
-        const M = window.measuredBrdf;
-        const mod = await import('${base}/web/${manifest.engines.web.files.shader}');
-        const source = ${JSON.stringify(source)}.replace('@MEASURED_BRDF_GLSL@', mod.MEASURED_BRDF_GLSL);
-        const t = M.dataTexture(new Float32Array(${JSON.stringify(Array.from(data))}), ${count}, 3);
-        return M.toBase64(M.runFragment(source, { ${lutName}: { value: M.texture }, ${pairsName}: { value: t } }, ${count}, 1)); })()`));
-    const format = (out) => Array.from({ length: count }, (_, i) =>
-      `${out[i * 4]} ${out[i * 4 + 1]} ${out[i * 4 + 2]}`).join('\n') + '\n';
-    writeFileSync(join(outDir, 'pairs_glsl.txt'), format(await runPairs('@MEASURED_BRDF_GLSL@' + glslMain, 'lut', 'pairs')));
-    // The tangent-space entry point, with l and v expressed in an arbitrary tangent basis of n
-    // (not the light's): MeasuredBrdfTangent must find the light's frame itself.
-    const tangentMain = glslMain.replace('fragColor = vec4(MeasuredBrdfCell(lut, vec2(0.0), n, l, v), 1.0);', `
-        vec3 t = normalize(abs(n.z) < 0.9 ? cross(n, vec3(0.0, 0.0, 1.0)) : cross(n, vec3(1.0, 0.0, 0.0)));
+    // The tangent-space entry point, with l and v expressed in a tangent basis of n other than
+    // the light's: MeasuredBrdfTangent must find the light's frame itself. For the random pairs
+    // an arbitrary basis; for the exact ones the basis MeasuredBrdfCell falls back to (the
+    // world x axis projected, y when |n.x| > 0.7), which is the exact frames' own x axis, so a
+    // light on the normal keeps the azimuth reference `brdf eval` uses.
+    const tangentMain = (exact) => glslMain.replace('fragColor = vec4(MeasuredBrdfCell(lut, vec2(0.0), n, l, v), 1.0);', `
+        ${exact ? 'vec3 t = normalize((abs(n.x) > 0.7 ? vec3(0.0, 1.0, 0.0) : vec3(1.0, 0.0, 0.0)) - n * (abs(n.x) > 0.7 ? n.y : n.x));'
+                : 'vec3 t = normalize(abs(n.z) < 0.9 ? cross(n, vec3(0.0, 0.0, 1.0)) : cross(n, vec3(1.0, 0.0, 0.0)));'}
         vec3 b = cross(n, t);
         vec3 l_ts = vec3(dot(l, t), dot(l, b), dot(l, n)), v_ts = vec3(dot(v, t), dot(v, b), dot(v, n));
         fragColor = vec4(MeasuredBrdfTangent(lut, vec2(0.0), l_ts, v_ts), 1.0);`);
-    writeFileSync(join(outDir, 'pairs_tangent.txt'), format(await runPairs('@MEASURED_BRDF_GLSL@' + tangentMain, 'lut', 'pairs')));
-    if (args['hlsl-glsl']) {
-      // spirv-cross output: drop its #version line (three writes its own); find the combined
-      // sampler names it made for lut/lut_sampler and for the pairs texture.
-      let src = readFileSync(args['hlsl-glsl'], 'utf8').replace(/^#version.*\n/, '');
+    // GLSL ES sources with their own main (spirv-cross output, the translated Godot shader):
+    // drop a #version line (three writes its own); the first sampler3D is the LUT, the first
+    // sampler2D the pairs.
+    const harnesses = (args['es-harness'] || '').split(',').filter((x) => x).map((item) => {
+      const [name, file] = item.split('=');
+      const src = readFileSync(file, 'utf8').replace(/^#version.*\n/, '');
       const s3 = src.match(/uniform\s+(?:highp\s+)?sampler3D\s+(\w+);/);
       const s2 = src.match(/uniform\s+(?:highp\s+)?sampler2D\s+(\w+);/);
-      if (!s3 || !s2) throw new Error('cross-compiled HLSL has no sampler3D/sampler2D uniforms:\n' + src);
-      writeFileSync(join(outDir, 'pairs_hlsl.txt'), format(await runPairs(src, s3[1], s2[1])));
+      if (!s3 || !s2) throw new Error(`${file}: no sampler3D/sampler2D uniforms:\n` + src);
+      return [name, src, s3[1], s2[1]];
+    });
+    const sidecar = args.sidecar ? JSON.parse(readFileSync(args.sidecar, 'utf8')).texel_convention.glsl : null;
+    for (const [prefix, file] of pairSets) {
+      const rows = readRows(file);
+      const count = rows.length;
+      const data = new Float32Array(count * 3 * 4);
+      rows.forEach((r, i) => {
+        for (let k = 0; k < 3; k++) data.set([r[3 * k], r[3 * k + 1], r[3 * k + 2], 0], (k * count + i) * 4);
+      });
+      const runPairs = async (source, lutName, pairsName) => fromBase64(await page.eval(`(async () => {
+          const M = window.measuredBrdf;
+          const mod = await import('${base}/web/${manifest.engines.web.files.shader}');
+          const source = ${JSON.stringify(source)}.replace('@MEASURED_BRDF_GLSL@', mod.MEASURED_BRDF_GLSL);
+          const t = M.dataTexture(new Float32Array(${JSON.stringify(Array.from(data))}), ${count}, 3);
+          return M.toBase64(M.runFragment(source, { ${lutName}: { value: M.texture }, ${pairsName}: { value: t } }, ${count}, 1)); })()`));
+      const format = (out) => Array.from({ length: count }, (_, i) =>
+        `${out[i * 4]} ${out[i * 4 + 1]} ${out[i * 4 + 2]}`).join('\n') + '\n';
+      const write = async (lang, source, lutName, pairsName) =>
+        writeFileSync(join(outDir, `${prefix}_${lang}.txt`), format(await runPairs(source, lutName, pairsName)));
+      await write('glsl', '@MEASURED_BRDF_GLSL@' + glslMain, 'lut', 'pairs');
+      await write('tangent', '@MEASURED_BRDF_GLSL@' + tangentMain(prefix === 'exact'), 'lut', 'pairs');
+      // The sidecar's snippet starts with its precision statements, as it ships.
+      if (sidecar) await write('sidecar', sidecar + glslMain, 'lut', 'pairs');
+      for (const [name, src, s3, s2] of harnesses) await write(name, src, s3, s2);
     }
   }
 

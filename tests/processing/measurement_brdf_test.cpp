@@ -95,8 +95,8 @@ void ExpectMatchesOracle(const std::vector<double>& theta_in,
 
 // Between measured θin the capture interpolates in the specular frame, as the LUT does: in the
 // mirror direction of θin = 30° it reads the 20° and 40° slices at their mirror directions (the
-// peak), not at the fixed 30° view where both slices are off their peaks (issue 7's gold at
-// 30°: 2.62 against 4.52 from the material).
+// peak), not at the fixed 30° view where both slices are off their peaks (reading a gold
+// capture that way gave 2.62 at 30° against 4.52 from the material).
 TEST(MeasurementAsBrdf, InterpolatesBetweenSlicesInTheSpecularFrameLikeTheNumpyLut) {
   ExpectMatchesOracle({0, 20, 40, 60}, {{30, 30, 180},
                                         {10, 10, 180},

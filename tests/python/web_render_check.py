@@ -12,13 +12,20 @@ under test. Run with Debian's /usr/bin/python3 (numpy).
           precision and the capture-to-LUT resampling of a 1° capture.
   probes  Every manifest probe equals the RGB9E5 word of the KTX2 file at that index, decoded
           here from EXT_texture_shared_exponent, and what the GPU's texelFetch returned.
-  pairs   MeasuredBrdfCell on the GPU (GLSL, and the HLSL cross-compiled) and
-          MeasuredBrdfTangent (GLSL, an arbitrary tangent basis) against `brdf eval` of the
-          same LUT for the same direction pairs.
+  pairs   Every shipped shader the browser ran (--langs: the GLSL of the three.js module as
+          MeasuredBrdfCell and as MeasuredBrdfTangent, the sidecar's texel_convention.glsl,
+          the GLSL 4.50 file, the Unity and Unreal HLSL and the Godot shader, the last four
+          cross-compiled or translated to GLSL ES) against `brdf eval` of the same LUT for the
+          same direction pairs: random ones (gen-pairs) and exact ones (gen-exact: views
+          exactly along the normal, at the horizon and in the mirror direction, lights exactly
+          along the normal), where a shader's angle math meets a pole.
 
 Usage: web_render_check.py gen-pairs COUNT SEED ANGLES_OUT NLV_OUT
-       web_render_check.py check --material M.json --result DIR --ktx2 F.ktx2
-                                  --manifest F.manifest.json [--eval EVAL_OUT] [--hlsl]
+       web_render_check.py gen-exact ANGLES_OUT NLV_OUT
+       web_render_check.py check [--material M.json] --result DIR --ktx2 F.ktx2
+                                  --manifest F.manifest.json [--langs L1,L2,...]
+                                  [--eval EVAL_OUT --angles ANGLES]
+                                  [--exact-eval EVAL_OUT --exact-angles ANGLES]
 Prints one line per check with the figures; exits 1 when a check fails.
 """
 import json
@@ -162,12 +169,100 @@ def gen_pairs(count, seed, angles_out, nlv_out):
             b.write(" ".join(f"{x:.9f}" for x in (*n, *l, *v)) + "\n")
 
 
+# Exact frames for gen-exact: signed permutations (entries 0 and ±1), so the zero components of
+# n, l and v stay exactly zero in the file and on the GPU. Each is (x, y, z) of the surface frame
+# in world space, right-handed (y = z × x), with x the axis `brdf eval` measures azimuths from.
+# x is also the tangent the shaders fall back to for a light on the normal (the world x axis
+# projected, or the world y axis when |n.x| > 0.7), so for such a light eval and the GPU read
+# the θin = 0 slice at the same azimuth even where RGB9E5 rounding breaks its symmetry.
+EXACT_FRAMES = [
+    ((1, 0, 0), (0, 1, 0), (0, 0, 1)),
+    ((1, 0, 0), (0, 0, 1), (0, -1, 0)),
+    ((0, 1, 0), (0, 0, 1), (1, 0, 0)),
+]
+
+
+def exact_angles():
+    """(θin, φin, θout, φout) in degrees: the directions where a shader's angle math meets a pole
+    or the horizon: the view exactly along the normal, exactly at the horizon (four relative
+    azimuths), exactly in the mirror direction, for lights inside, on the edge of and beyond the
+    measured θin range, and the light exactly along the normal."""
+    out = []
+    for phi_in in (0.0, 90.0):
+        for t_in in (10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0, 80.0, 90.0):
+            out.append((t_in, phi_in, 0.0, 0.0))  # view along the normal
+            for rel in (0.0, 90.0, 180.0, 270.0):  # view at the horizon
+                out.append((t_in, phi_in, 90.0, phi_in + rel))
+            if t_in < 90.0:
+                out.append((t_in, phi_in, t_in, phi_in + 180.0))  # mirror direction
+        # Light along the normal (its azimuth is meaningless; eval and the shaders measure the
+        # view's azimuth from the frame's x axis).
+        for t_out, p_out in ((0.0, 0.0), (30.0, 0.0), (30.0, 90.0), (45.0, 45.0), (75.0, 200.0),
+                             (90.0, 0.0), (90.0, 90.0), (90.0, 180.0), (90.0, 270.0)):
+            out.append((0.0, phi_in, t_out, p_out))
+    return out
+
+
+def exact_category(t_in, p_in, t_out, p_out):
+    if t_in == 0.0:
+        return "light on the normal"
+    if t_out == 0.0:
+        return "view on the normal"
+    if t_out == 90.0:
+        return "view at the horizon"
+    return "mirror view"
+
+
+def gen_exact(angles_out, nlv_out):
+    with open(angles_out, "w") as a, open(nlv_out, "w") as b:
+        for frame in EXACT_FRAMES:
+            q = np.array(frame, dtype=float).T  # columns: the frame's x, y, z in world space
+            for t_i, p_i, t_o, p_o in exact_angles():
+                n = q @ np.array([0.0, 0.0, 1.0])
+                l = q @ spherical(t_i * DEG, p_i * DEG)
+                v = q @ spherical(t_o * DEG, p_o * DEG)
+                a.write(f"{t_i:.9f} {p_i:.9f} {t_o:.9f} {p_o:.9f}\n")
+                # %.9f writes cos 90° (6e-17) as 0: the components on a pole or the horizon are
+                # exactly 0 on the GPU.
+                b.write(" ".join(f"{x:.9f}" for x in (*n, *l, *v)) + "\n")
+
+
+def compare_pairs(name, cpu, gpu, angles, by_category):
+    """Prints the max and median relative difference of gpu against cpu; False when above 1e-4."""
+    if gpu.shape != cpu.shape:
+        print(f"FAIL {name}: {gpu.shape} values, brdf eval gave {cpu.shape}")
+        return False
+    rel = np.abs(gpu - cpu) / np.maximum(np.abs(cpu), 1e-6)
+    worst_per_pair = np.max(rel, axis=1)
+    line = (f"{name}: {len(cpu)} direction pairs vs brdf eval of the LUT: max rel diff "
+            f"{rel.max():.3g}, median {np.median(rel):.3g}")
+    if by_category:
+        cats = [exact_category(*a) for a in angles]
+        parts = []
+        for c in dict.fromkeys(cats):
+            sel = np.array([x == c for x in cats])
+            parts.append(f"{c} {worst_per_pair[sel].max():.3g}")
+        line += " (max by case: " + ", ".join(parts) + ")"
+    print(line)
+    # Same texels, same coordinates: only float32 angle math and the GPU's filter weights differ
+    # from the double-precision CPU lookup (measured: up to 4.6e-6, the HLSL paths).
+    if rel.max() <= 1e-4:
+        return True
+    bad = np.nonzero(worst_per_pair > 1e-4)[0]
+    for i in bad[:6]:
+        print(f"FAIL {name}: pair {i + 1} (θin {angles[i][0]:g}, φin {angles[i][1]:g}, θout "
+              f"{angles[i][2]:g}, φout {angles[i][3]:g}): GPU {gpu[i]} vs eval {cpu[i]}")
+    if len(bad) > 6:
+        print(f"FAIL {name}: {len(bad) - 6} more pairs differ by more than 1e-4")
+    return False
+
+
 def check(argv):
     opts = {}
     it = iter(argv)
     for a in it:
-        opts[a.lstrip("-")] = True if a == "--hlsl" else next(it)
-    mat = json.load(open(opts["material"]))
+        opts[a.lstrip("-")] = next(it)
+    mat = json.load(open(opts["material"])) if "material" in opts else None
     manifest = json.load(open(opts["manifest"]))
     res = opts["result"]
     meta = json.load(open(f"{res}/image.json"))
@@ -195,89 +290,93 @@ def check(argv):
         print("FAIL probes: GPU values differ from the manifest")
         ok = False
 
-    # Image.
-    size = meta["width"]
-    img = np.fromfile(f"{res}/image.f32", dtype="<f4").reshape(size, size, 4)[..., :3].astype(float)
-    cam = np.asarray(meta["camera"]["position"], float)
-    tan_half = math.tan(meta["camera"]["fov_y_deg"] * DEG / 2)
-    py, px = np.meshgrid(np.arange(size), np.arange(size), indexing="ij")
-    ndc_x = (px + 0.5) / size * 2 - 1
-    ndc_y = 1 - (py + 0.5) / size * 2
-    d = np.stack([ndc_x * tan_half, ndc_y * tan_half, -np.ones_like(ndc_x)], axis=-1)
-    d /= np.linalg.norm(d, axis=-1, keepdims=True)
-    b = np.sum(d * cam, -1)
-    disc = b * b - (np.dot(cam, cam) - 1.0)
-    hit = disc > 0
-    t = -b - np.sqrt(np.maximum(disc, 0))
-    p = cam + d * t[..., None]
-    n = p / np.linalg.norm(p, axis=-1, keepdims=True)
-    v = cam - p
-    v /= np.linalg.norm(v, axis=-1, keepdims=True)
-    light = np.asarray(meta["light_direction"], float)
-    light /= np.linalg.norm(light)
-    l = np.broadcast_to(light, n.shape)
-    cos_l = np.sum(n * l, -1)
-    # Away from the silhouette (the GPU sphere is a 128 × 64 mesh, the reference exact).
-    mask = hit & (np.sum(n * v, -1) > 0.2) & (cos_l > 0.0)
-    lut = numpy_lut(mat, theta)
-    u, vv, w = lut_coords(n[mask], l[mask], v[mask], theta0, delta, k)
-    # An atlas cell samples the same texels as the material's own LUT (the cell is clamped to
-    # its outer texel centres), so the single-LUT reference applies; the cell offset is what
-    # the GPU must get right.
-    ref = np.zeros_like(img)
-    ref[mask] = trilinear(lut, u, vv, w) * cos_l[mask][:, None]
-    peak = float(np.max(ref[mask]))
-    diff = img[mask] - ref[mask]
-    rms = float(np.sqrt(np.mean(diff ** 2)))
-    mx = float(np.max(np.abs(diff)))
-    rel = np.abs(diff) / np.maximum(np.abs(ref[mask]), 1e-3 * peak)
-    # Direct analytic shading (no LUT) for scale: includes the θin interpolation between slices.
-    analytic = np.zeros_like(img)
-    nm, lm, vm = n[mask], l[mask], v[mask]
-    lt = lm - nm * cos_l[mask][:, None]
-    x = lt / np.linalg.norm(lt, axis=-1, keepdims=True)
-    y = np.cross(nm, x)
-    frame = lambda a: np.stack([np.sum(a * x, -1), np.sum(a * y, -1), np.sum(a * nm, -1)], -1)
-    analytic[mask] = material_f(mat, frame(lm), frame(vm)) * cos_l[mask][:, None]
-    a_rms = float(np.sqrt(np.mean((img[mask] - analytic[mask]) ** 2)))
-    print(f"image: {int(mask.sum())} sphere pixels of {size}x{size}; peak radiance {peak:.4g}; "
-          f"vs LUT-scheme reference: RMS {rms:.3g} ({rms / peak:.3%} of peak), max {mx:.3g} "
-          f"({mx / peak:.3%} of peak), 99th percentile relative {np.percentile(rel, 99):.3%}; "
-          f"vs direct analytic shading: RMS {a_rms / peak:.3%} of peak")
-    # RGB9E5 rounds each texel by at most 2^-9 of its largest channel (0.2 %, RMS about a third
-    # of that); the 1° capture's resampling and the GPU's filter weights add less (measured with
-    # SwiftShader: RMS 0.034 % / 0.049 %, max 0.19 % / 0.22 % of peak for the GGX LUT and a
-    # Lambertian atlas cell). Allow 0.07 % RMS and 0.35 % max: a lookup half a texel off in θd
-    # alone gives 0.09 % and 0.45 %.
-    if not (rms <= 0.0007 * peak and mx <= 0.0035 * peak):
-        print("FAIL image: the rendered sphere differs from the reference")
-        ok = False
-    np.save(f"{res}/reference.npy", ref)
+    # Image (with --material: the analytic material the LUT was made from).
+    if mat is not None:
+        size = meta["width"]
+        img = np.fromfile(f"{res}/image.f32", dtype="<f4").reshape(size, size, 4)[..., :3]
+        img = img.astype(float)
+        cam = np.asarray(meta["camera"]["position"], float)
+        tan_half = math.tan(meta["camera"]["fov_y_deg"] * DEG / 2)
+        py, px = np.meshgrid(np.arange(size), np.arange(size), indexing="ij")
+        ndc_x = (px + 0.5) / size * 2 - 1
+        ndc_y = 1 - (py + 0.5) / size * 2
+        d = np.stack([ndc_x * tan_half, ndc_y * tan_half, -np.ones_like(ndc_x)], axis=-1)
+        d /= np.linalg.norm(d, axis=-1, keepdims=True)
+        b = np.sum(d * cam, -1)
+        disc = b * b - (np.dot(cam, cam) - 1.0)
+        hit = disc > 0
+        t = -b - np.sqrt(np.maximum(disc, 0))
+        p = cam + d * t[..., None]
+        n = p / np.linalg.norm(p, axis=-1, keepdims=True)
+        v = cam - p
+        v /= np.linalg.norm(v, axis=-1, keepdims=True)
+        light = np.asarray(meta["light_direction"], float)
+        light /= np.linalg.norm(light)
+        l = np.broadcast_to(light, n.shape)
+        cos_l = np.sum(n * l, -1)
+        # Away from the silhouette (the GPU sphere is a 128 × 64 mesh, the reference exact).
+        mask = hit & (np.sum(n * v, -1) > 0.2) & (cos_l > 0.0)
+        lut = numpy_lut(mat, theta)
+        u, vv, w = lut_coords(n[mask], l[mask], v[mask], theta0, delta, k)
+        # An atlas cell samples the same texels as the material's own LUT (the cell is clamped to
+        # its outer texel centres), so the single-LUT reference applies; the cell offset is what
+        # the GPU must get right.
+        ref = np.zeros_like(img)
+        ref[mask] = trilinear(lut, u, vv, w) * cos_l[mask][:, None]
+        peak = float(np.max(ref[mask]))
+        diff = img[mask] - ref[mask]
+        rms = float(np.sqrt(np.mean(diff ** 2)))
+        mx = float(np.max(np.abs(diff)))
+        rel = np.abs(diff) / np.maximum(np.abs(ref[mask]), 1e-3 * peak)
+        # Direct analytic shading (no LUT) for scale: includes the θin interpolation between
+        # slices.
+        analytic = np.zeros_like(img)
+        nm, lm, vm = n[mask], l[mask], v[mask]
+        lt = lm - nm * cos_l[mask][:, None]
+        x = lt / np.linalg.norm(lt, axis=-1, keepdims=True)
+        y = np.cross(nm, x)
+        frame = lambda a: np.stack([np.sum(a * x, -1), np.sum(a * y, -1), np.sum(a * nm, -1)], -1)
+        analytic[mask] = material_f(mat, frame(lm), frame(vm)) * cos_l[mask][:, None]
+        a_rms = float(np.sqrt(np.mean((img[mask] - analytic[mask]) ** 2)))
+        print(f"image: {int(mask.sum())} sphere pixels of {size}x{size}; peak radiance {peak:.4g}; "
+              f"vs LUT-scheme reference: RMS {rms:.3g} ({rms / peak:.3%} of peak), max {mx:.3g} "
+              f"({mx / peak:.3%} of peak), 99th percentile relative {np.percentile(rel, 99):.3%}; "
+              f"vs direct analytic shading: RMS {a_rms / peak:.3%} of peak")
+        # RGB9E5 rounds each texel by at most 2^-9 of its largest channel (0.2 %, RMS about a
+        # third of that); the 1° capture's resampling and the GPU's filter weights add less
+        # (measured with SwiftShader: RMS 0.034 % / 0.049 %, max 0.19 % / 0.22 % of peak for the
+        # GGX LUT and a Lambertian atlas cell). Allow 0.07 % RMS and 0.35 % max: a lookup half a
+        # texel off in θd alone gives 0.09 % and 0.45 %.
+        if not (rms <= 0.0007 * peak and mx <= 0.0035 * peak):
+            print("FAIL image: the rendered sphere differs from the reference")
+            ok = False
+        np.save(f"{res}/reference.npy", ref)
 
-    # Direction pairs.
-    if "eval" in opts:
-        cpu = np.loadtxt(opts["eval"], ndmin=2)
-        for lang in ["glsl", "tangent"] + (["hlsl"] if "hlsl" in opts else []):
-            gpu = np.loadtxt(f"{res}/pairs_{lang}.txt", ndmin=2)
-            if gpu.shape != cpu.shape:
-                print(f"FAIL pairs {lang}: {gpu.shape} values, brdf eval gave {cpu.shape}")
-                ok = False
-                continue
-            rel = np.abs(gpu - cpu) / np.maximum(np.abs(cpu), 1e-6)
-            print(f"pairs ({lang}): {len(cpu)} direction pairs vs brdf eval of the LUT: max rel "
-                  f"diff {rel.max():.3g}, median {np.median(rel):.3g}")
-            # Same texels, same coordinates: only float32 angle math and the GPU's filter
-            # weights differ from the double-precision CPU lookup (measured 2.5e-6).
-            if rel.max() > 1e-4:
-                worst = int(np.argmax(np.max(rel, axis=1)))
-                print(f"FAIL pairs {lang}: pair {worst + 1}: GPU {gpu[worst]} vs eval {cpu[worst]}")
-                ok = False
+    # Direction pairs: random ones (pairs_<lang>.txt) and exact ones (exact_<lang>.txt), every
+    # shader path the browser ran (--langs), against `brdf eval` of the same LUT. Godot's light()
+    # returns radiance, f_r · max(n·l, 0) with a white light, so eval is multiplied by cos θin.
+    langs = opts["langs"].split(",") if "langs" in opts else []
+    for prefix, eval_key, angles_key in (("pairs", "eval", "angles"),
+                                         ("exact", "exact-eval", "exact-angles")):
+        if eval_key not in opts:
+            continue
+        cpu = np.loadtxt(opts[eval_key], ndmin=2)
+        angles = np.loadtxt(opts[angles_key], ndmin=2)
+        cos_in = np.maximum(np.cos(angles[:, 0] * DEG), 0.0)[:, None]
+        for lang in langs:
+            gpu = np.loadtxt(f"{res}/{prefix}_{lang}.txt", ndmin=2)
+            expect = cpu * cos_in if lang == "godot" else cpu
+            ok = compare_pairs(f"{prefix} ({lang})", expect, gpu, angles.tolist(),
+                               prefix == "exact") and ok
     return 0 if ok else 1
 
 
 def main():
     if len(sys.argv) >= 2 and sys.argv[1] == "gen-pairs":
         gen_pairs(int(sys.argv[2]), int(sys.argv[3]), sys.argv[4], sys.argv[5])
+        return 0
+    if len(sys.argv) >= 2 and sys.argv[1] == "gen-exact":
+        gen_exact(sys.argv[2], sys.argv[3])
         return 0
     if len(sys.argv) >= 2 and sys.argv[1] == "check":
         return check(sys.argv[2:])

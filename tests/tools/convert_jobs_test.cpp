@@ -1,4 +1,4 @@
-// `brdf convert` run in parallel (issue 7): `--jobs 2` writes the same bytes as `--jobs 1` for
+// `brdf convert` run in parallel: `--jobs 2` writes the same bytes as `--jobs 1` for
 // every output file of a folder of captures and a material file, and two concurrent
 // `convert --force` runs into one folder leave only intact files. The expected files are those of
 // a single `--jobs 1` run; "intact" is read from the containers' own specifications (KTX2

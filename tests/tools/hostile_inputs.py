@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""The second pass over hostile inputs of issue 7: every `brdf` command that reads a file, run on
+"""Hostile inputs, second pass: every `brdf` command that reads a file, run on
 damaged copies of valid files of every supported format, must neither crash, hang, misreport,
 nor disagree with another command about the same file.
 

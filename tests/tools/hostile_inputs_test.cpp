@@ -31,7 +31,7 @@ class HostileInputs : public ToolTest {
   }
 };
 
-// Defect 1: a .json input whose text does not parse was refused by `info`, `eval` and `convert`
+// A .json input whose text does not parse was refused by `info`, `eval` and `convert`
 // with "JSON text: expected valid JSON ..., got text that does not parse as JSON": no line, no
 // column, nothing to look for. NaN is not JSON; the 'N' is on line 3, column 10.
 TEST_F(HostileInputs, JsonSyntaxErrorNamesLineAndColumn) {
@@ -48,7 +48,7 @@ TEST_F(HostileInputs, JsonSyntaxErrorNamesLineAndColumn) {
   }
 }
 
-// Defect 2: a number literal beyond double's range (1e309) is valid JSON text but an infinite
+// A number literal beyond double's range (1e309) is valid JSON text but an infinite
 // value; it was reported without a position. The literal starts on line 2, column 10.
 TEST_F(HostileInputs, JsonNumberBeyondDoubleNamesItsPosition) {
   const fs::path mat = dir_ / "huge.json";
@@ -59,7 +59,7 @@ TEST_F(HostileInputs, JsonNumberBeyondDoubleNamesItsPosition) {
       << err;
 }
 
-// Defect 3: a DDS texture saved under a .json name (recognised by its magic, as every file is)
+// A DDS texture saved under a .json name (recognised by its magic, as every file is)
 // was read with "<stem>.json" beside it as its sidecar, i.e. with itself: the refusal quoted the
 // JSON library ("[json.exception.parse_error.101] ... last read: 'D'") and called the file an
 // "embedded sidecar", which a DDS cannot have. It is a DDS without a sidecar: its θin list is
@@ -80,7 +80,7 @@ TEST_F(HostileInputs, DdsUnderAJsonNameIsNotItsOwnSidecar) {
   EXPECT_EQ(Run("eval " + Quote(wrong) + " --in 30,0 --out 30,180").exit_code, 0);
 }
 
-// Defect 3b: a sidecar beside a DDS that does not parse was reported as the DDS's "(embedded
+// A sidecar beside a DDS that does not parse was reported as the DDS's "(embedded
 // sidecar)" with the parser's text. The error names the sidecar file and where it breaks: the
 // text is cut after `{"kind": ` (line 1, column 10, the end of the text).
 TEST_F(HostileInputs, BrokenSidecarBesideADdsIsNamed) {
@@ -98,7 +98,7 @@ TEST_F(HostileInputs, BrokenSidecarBesideADdsIsNamed) {
   EXPECT_EQ(err.find("embedded"), std::string::npos) << err;
 }
 
-// Defect 4: a per-material "<name>.extrapolate.json" that did not parse leaked the parser's
+// A per-material "<name>.extrapolate.json" that did not parse leaked the parser's
 // message too. The stray comma before '}' is at line 1, column 31.
 TEST_F(HostileInputs, UnparsableExtrapolationFileNamesLineAndColumn) {
   const fs::path mat = dir_ / "gold.json";
@@ -114,7 +114,7 @@ TEST_F(HostileInputs, UnparsableExtrapolationFileNamesLineAndColumn) {
       << r.err;
 }
 
-// Defect 5: `info` on a third-party table said "usable: yes ('brdf convert' and 'brdf eval'
+// `info` on a third-party table said "usable: yes ('brdf convert' and 'brdf eval'
 // accept it)" although convert refuses every table ("not an input": tables are imported
 // first). What info claims must hold: eval accepts the table, convert is not claimed.
 TEST_F(HostileInputs, InfoOnATableClaimsOnlyWhatTheCommandsDo) {
@@ -131,7 +131,7 @@ TEST_F(HostileInputs, InfoOnATableClaimsOnlyWhatTheCommandsDo) {
   EXPECT_NE(Run("convert " + Quote(csv) + " --quiet --out " + Quote(dir_ / "o")).exit_code, 0);
 }
 
-// Defect 6: `atlas` and `fit` given a folder without inputs said "... found in the inputs"
+// `atlas` and `fit` given a folder without inputs said "... found in the inputs"
 // without naming the folder (convert named it).
 TEST_F(HostileInputs, EmptyFolderIsNamedByEveryBatchCommand) {
   const fs::path empty = dir_ / "empty";
@@ -236,7 +236,7 @@ class HostileCaptures : public HostileInputs {
   std::uint64_t samples_ = 0;
 };
 
-// Defect 7: export-csv read captures with its own strict rule and refused what convert, eval
+// `export-csv` read captures with its own strict rule and refused what convert, eval
 // and info accept with a warning: bytes after the end chunk (e.g. a capture at the start of a
 // larger, zero-filled file) and an end chunk cut short. It now follows the capture rule of
 // every command: the same warning, and every sample the file holds exported.
@@ -257,7 +257,7 @@ TEST_F(HostileCaptures, ExportCsvAcceptsWhatConvertAcceptsWithAWarning) {
   }
 }
 
-// Defect 8: an end chunk whose counts lie (CRC-valid, sample_count one short) and two slice
+// An end chunk whose counts lie (CRC-valid, sample_count one short) and two slice
 // chunks with one index were refused by info, convert and eval with "run 'brdf repair'", but
 // export-csv exported them silently and repair said "an intact, finished capture; nothing to
 // repair", so the advice led nowhere. Now export-csv refuses them as info does, and repair
@@ -291,7 +291,7 @@ TEST_F(HostileCaptures, InconsistentChunksAreRefusedAlikeAndRepaired) {
   }
 }
 
-// Defect 9: export-csv went by the file name: a capture saved as "cap.dat" was refused, and a
+// `export-csv` went by the file name: a capture saved as "cap.dat" was refused, and a
 // KTX2 texture saved as "x.bpc" (which info describes as a texture) was read as a capture with a
 // damaged magic. It recognises files by content like every other command.
 TEST_F(HostileCaptures, ExportCsvRecognisesCapturesByContent) {
@@ -309,7 +309,7 @@ TEST_F(HostileCaptures, ExportCsvRecognisesCapturesByContent) {
   EXPECT_NE(err.find(texture.string() + ": a KTX2 texture"), std::string::npos) << err;
 }
 
-// Defect 10: export-csv of a capture without slices (cut right after its header) blamed the
+// `export-csv` of a capture without slices (cut right after its header) blamed the
 // output it had not written ("h.csv: line 39: expected at least one data row after the
 // header"). It names the capture, the byte where its slices should start and how to continue.
 TEST_F(HostileCaptures, ExportCsvOfAnEmptyCaptureNamesTheCapture) {
@@ -323,10 +323,10 @@ TEST_F(HostileCaptures, ExportCsvOfAnEmptyCaptureNamesTheCapture) {
   EXPECT_NE(err.find("--resume"), std::string::npos) << err;
 }
 
-// Defect 11: a damaged .exr environment map was refused with OpenEXR's sentence that repeats
+// A damaged .exr environment map was refused with OpenEXR's sentence that repeats
 // the file name ("x.exr: EXR content: expected a readable OpenEXR image, got Cannot read image
-// file "x.exr". Early end of file: ..."). The line names the file once, and (issue 10) where
-// the file breaks: a 1-byte file holds no OpenEXR signature.
+// file "x.exr". Early end of file: ..."). The line names the file once, and where the file
+// breaks: a 1-byte file holds no OpenEXR signature.
 TEST_F(HostileInputs, DamagedExrNamesTheFileOnce) {
   ASSERT_EQ(
       Run("convert " + Quote(kGoldMaterial) + " --quiet --formats exr --out " + Quote(dir_ / "lut"))

@@ -113,7 +113,7 @@ TEST_F(Overwrite, AnOutputThatIsAFolderIsRefusedEvenWithForce) {
   EXPECT_FALSE(fs::exists(dir_ / "luts" / "gold.dds")) << "nothing may be written";
 }
 
-// `--engine` outputs follow the same rule (issue 7): a run whose regular outputs are all new but
+// `--engine` outputs follow the same rule: a run whose regular outputs are all new but
 // whose engine files exist is refused before it writes anything, with one line naming the engine
 // file and --force; --force rewrites it. The expected state is the first run's files.
 TEST_F(Overwrite, ConvertRefusesExistingEngineOutputsWithoutForce) {

@@ -1,4 +1,4 @@
-// Issue 4: every RGL material in the shared data folder, captured on the simulated instrument
+// Every RGL material in the shared data folder, captured on the simulated instrument
 // (default noise), converts to a LUT whose values agree with the RGL file's own f_r. The
 // reference values come from the RGL files (`brdf eval FILE.bsdf`); the texel directions come
 // from the specular frame of docs/design.md §5 written out in tool_test_util.h; the payload size
@@ -117,7 +117,7 @@ TEST_F(RglCapture, EveryRglMaterialCapturedOnTheSimulatorConvertsToAMatchingLut)
             clipped[k] = true;
       }
     for (bool is_clipped : clipped) clipped_count += is_clipped ? 1 : 0;
-    // The instrument's ND filter stage (issue 9) reads the sharpest peaks without clipping, so
+    // The instrument's ND filter stage reads the sharpest peaks without clipping, so
     // they are in the capture now; but a peak a few degrees wide cannot be resampled on the 1°
     // lattice to 5 %. Directions within 2° of the mirror direction are left out as well.
     for (std::size_t k = 0; k < count; ++k) {

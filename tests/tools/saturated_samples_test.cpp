@@ -1,4 +1,4 @@
-// Issue 7: `brdf convert` and `brdf atlas` report the samples a capture flagged saturated, per
+// `brdf convert` and `brdf atlas` report the samples a capture flagged saturated, per
 // slice, on stderr and in the sidecar / atlas manifest. The capture is written here with flags
 // set on chosen samples, so the expected counts are the ones this test put in.
 #include <nlohmann/json.hpp>

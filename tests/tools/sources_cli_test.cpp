@@ -1,4 +1,4 @@
-// Issue 7 through the built tool and the brdf::sources library: one evaluation path for
+// Through the built tool and the brdf::sources library: one evaluation path for
 // captures and LUTs, one rule beyond the measured θin range, `brdf repair` followed by
 // `brdf capture --resume`, and `brdf info` reporting every problem `convert` and `eval` refuse.
 // Expected values come from the analytic formulas of tool_test_util.h (written from
@@ -48,8 +48,8 @@ void FixChunkCrcs(std::string& b, std::size_t at) {
   StoreU32(b, at + 20, ZlibCrc(b, at, 20));
 }
 
-// Issue 7: gold at θin = 30°, mirror direction, gave 2.62 from the capture against 4.80 from
-// the LUT. Between measured θin both now interpolate linearly at the same specular-frame
+// Gold at θin = 30°, mirror direction, once gave 2.62 from the capture against 4.80 from the
+// LUT. Between measured θin both now interpolate linearly at the same specular-frame
 // coordinates: in the mirror direction θd = 0 in both neighbouring slices, so the value is the
 // mean of the two slices' mirror values, f(20°→20°) and f(40°→40°), exactly (texel centres on
 // capture nodes; 1e-6 covers the float32 storage).

@@ -9,7 +9,7 @@ libraries only they bring: OpenVDB, GDAL). Ceres is linked directly: measured, i
 control: a program that reads an image through brdf::image_io must show OpenImageIO.
 
 Peak RSS (GNU time's %M, the child's ru_maxrss) of each non-image command must stay
-under 30 MiB (issue 7: "under 50 ms and 30 MB"; time is measured by bench/startup.sh, since a
+under 30 MiB (the start-up target is "under 50 ms and 30 MB"; time is measured by bench/startup.sh, since a
 timing assertion on a shared machine would fail for reasons that are not the program's).
 
 usage: startup_libraries.py BRDF IMAGE_PROBE SAMPLES_DIR

@@ -8,7 +8,7 @@
 // incidence slices, and three bilinear lookups.
 //
 // Tried and measured slower or no faster (bench_rgl and `brdf preview`, docs/benchmarks.md,
-// "RGL evaluation speed-up (rgl2, session 4)"): a per-cell warp layout (one 32-byte block per
+// "RGL and MERL evaluation", "Tried and not kept"): a per-cell warp layout (one 32-byte block per
 // cell and slice: one cache line instead of two, but twice the table), 12-byte packed
 // vertices (float density, double CDF), and a 32-bit fixed-point CDF (half the table, but the
 // oracle then differs by 1e-5: X needs double).
