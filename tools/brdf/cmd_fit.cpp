@@ -19,6 +19,7 @@
 #include "brdf/core/file_util.h"
 #include "brdf/core/importers.h"
 #include "brdf/fit/fit.h"
+#include "brdf/fit/result_files.h"
 #include "brdf/sources/detect.h"
 #include "brdf/sources/open.h"
 #include "cli_support.h"
@@ -177,38 +178,32 @@ int RunFit(const FitCommandOptions& options) {
     inputs = std::move(kept);
   }
 
-  // Output names: one input and one model write --out itself.
-  const bool single = inputs.size() == 1 && failures.empty() && models.size() == 1;
-  auto output_of = [&](const FitInput& in, Model m) {
-    if (single) return options.out;
-    if (inputs.size() == 1 && LowerExtension(options.out) == ".json") {
-      const fs::path p(options.out);
-      return (p.parent_path() / (p.stem().string() + "." + std::string(ModelName(m)) + ".json"))
-          .string();
+  // Output names (brdf/fit/result_files.h): one input and one model write --out itself.
+  const processing::FitResultFiles files{
+      options.out, inputs.size() == 1 && failures.empty() && models.size() == 1,
+      inputs.size() == 1};
+  auto output_of = [&](const FitInput& in, Model m) { return files.PathOf(in.name, m); };
+  // The overwrite rule of every writing command, on exactly the files the fits will write,
+  // before any fit runs.
+  {
+    std::vector<std::string> names;
+    for (const FitInput& in : inputs) names.push_back(in.name);
+    const std::vector<std::string> outputs = files.Paths(names, models);
+    if (files.single) {
+      CheckOutputPath(options.out, inputs.front().path, ".json", options.force);
+    } else {
+      std::set<std::string> input_paths;
+      for (const FitInput& in : inputs) input_paths.insert(Identity(in.path));
+      for (const FitInput& in : inputs)
+        for (Model m : models)
+          if (input_paths.count(Identity(output_of(in, m))))
+            throw InvalidArgument(output_of(in, m) + ": the result of " + in.path +
+                                  " would overwrite an input; choose another --out");
+      ReportRemovedTemporaries(CheckWritableOutputs(outputs, options.force));
     }
-    return (fs::path(options.out) / (in.name + "." + std::string(ModelName(m)) + ".json")).string();
-  };
-  // The folder the results go to exists before any fit runs (the parent of a .json --out).
-  if (single) {
-    CheckOutputPath(options.out, inputs.front().path, ".json", options.force);
-    CreateOutputFolder(fs::path(options.out).parent_path().string());
-  } else if (inputs.size() == 1 && LowerExtension(options.out) == ".json") {
-    CreateOutputFolder(fs::path(options.out).parent_path().string());
-  } else {
-    CreateOutputFolder(options.out);
   }
-  std::set<std::string> input_paths;
-  for (const FitInput& in : inputs) input_paths.insert(Identity(in.path));
-  for (const FitInput& in : inputs)
-    for (Model m : models) {
-      const std::string out = output_of(in, m);
-      if (input_paths.count(Identity(out)))
-        throw InvalidArgument(out + ": the result of " + in.path +
-                              " would overwrite an input; choose another --out");
-      std::error_code ec;
-      if (!options.force && fs::exists(out, ec))
-        throw InvalidArgument(out + ": already exists; pass --force to overwrite it");
-    }
+  // The folder the results go to exists before any fit runs (the parent of a .json --out).
+  CreateOutputFolder(files.Folder());
 
   for (const BatchFailure& f : failures)
     std::fprintf(stderr, "%s: FAILED: %s\n", f.path.c_str(), f.reason.c_str());
