@@ -16,6 +16,9 @@
 #include "brdf/core/merl.h"
 #include "brdf/core/models.h"
 #include "brdf/core/rgl.h"
+#include "brdf/exporter/atlas.h"
+#include "brdf/exporter/lut_export.h"
+#include "brdf/processing/resample.h"
 #include "test_support.h"
 #include "tools/tool_test_util.h"
 
@@ -144,6 +147,66 @@ TEST_F(Open, ForTheViewerAMaterialKeepsItsFormulaAndShowsItsReferenceCapture) {
   EXPECT_EQ(x.theta_out_deg, 30.0f);
   EXPECT_EQ(x.phi_out_deg, 180.0f);
   EXPECT_LT(Relative(x.rgb[0], tooltest::Ggx03().FAngles(40, 30, 180)[0]), 1e-6);
+}
+
+// A table measured at θin 10, 30, 50° (not k·Δin): opened for the viewer at its own θin, from
+// its own samples, resampled once, as `brdf eval` evaluates it.
+TEST_F(Open, ForTheViewerATableKeepsItsOwnIncidenceAngles) {
+  std::string csv = "theta_in,phi_in,theta_out,phi_out,r,g,b\n";
+  const Analytic m = tooltest::Lambertian();
+  for (int ti : {10, 30, 50})
+    for (int to = 0; to <= 70; to += 10)
+      for (int po = 0; po < 360; po += 30) {
+        const std::array<double, 3> f = m.FAngles(ti, to, po);
+        csv += std::to_string(ti) + ",0," + std::to_string(to) + "," + std::to_string(po) + "," +
+               std::to_string(f[0]) + "," + std::to_string(f[1]) + "," + std::to_string(f[2]) +
+               "\n";
+      }
+  const fs::path table = dir_ / "table.csv";
+  WriteText(table, csv);
+  const OpenedForView view = OpenForView(table.string());
+  EXPECT_EQ(view.kind, FileKind::kCsv);
+  EXPECT_EQ(view.evaluation, Evaluation::kResampledLut);
+  EXPECT_EQ(view.lut.theta_in_deg, (std::vector<double>{10, 30, 50}));
+  ASSERT_TRUE(view.measurement.has_value());
+  EXPECT_EQ(view.measurement->slices.size(), 3u);
+  EXPECT_DOUBLE_EQ(view.theta_b_deg, 70.0);
+  // std::to_string keeps six decimals: ρ/π to within 1e-6 absolute.
+  const Rgb f = view.brdf->Eval(SphericalDirectionDeg(20, 0), SphericalDirectionDeg(35, 140));
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(f[c], m.kd[c] / tooltest::kPi, 2e-6) << c;
+  // And OpenBrdf evaluates the very same LUT.
+  const OpenedSource opened = OpenBrdf(table.string());
+  EXPECT_EQ(dynamic_cast<const LutBrdf&>(*opened.brdf).lut().texels, view.lut.texels);
+}
+
+// An exported LUT is shown as stored: no measurement, θb from its sidecar; an atlas is refused
+// with the remedy of evaluating one material's own LUT.
+TEST_F(Open, ForTheViewerAnExportedLutIsAsStoredAndAnAtlasIsRefused) {
+  const Lut lut = processing::BuildLut(CaptureOf(tooltest::Lambertian(), {0, 20, 40}, 70, 5, 10));
+  exporter::TextureMetadata meta;
+  meta.name = "matte";
+  meta.extrapolation = exporter::ExtrapolationInfo{1.0, 0.5, 70.0};
+  exporter::ExportLut(dir_.string(), lut, meta, {exporter::ParseExportFormats("ktx2,json"), {}});
+  const OpenedForView view = OpenForView((dir_ / "matte.ktx2").string());
+  EXPECT_EQ(view.evaluation, Evaluation::kExportedLut);
+  EXPECT_FALSE(view.measurement.has_value());
+  EXPECT_DOUBLE_EQ(view.theta_b_deg, 70.0);
+  EXPECT_EQ(view.lut.theta_in_deg, (std::vector<double>{0, 20, 40}));
+  // RGB9E5: 9 mantissa bits under the exponent the largest channel sets, so every channel is
+  // within half a step, at most max/512, of ρ/π.
+  const Rgb f = view.brdf->Eval(SphericalDirectionDeg(20, 0), SphericalDirectionDeg(35, 140));
+  const double largest = tooltest::Lambertian().kd[0] / tooltest::kPi;
+  for (int c = 0; c < 3; ++c)
+    EXPECT_NEAR(f[c], tooltest::Lambertian().kd[c] / tooltest::kPi, largest / 512) << c;
+
+  exporter::WriteAtlas((dir_ / "lib").string(), {{"a", &lut, ""}, {"b", &lut, ""}});
+  try {
+    OpenForView((dir_ / "lib.ktx2").string());
+    ADD_FAILURE() << "an atlas opened for the viewer";
+  } catch (const InvalidArgument& e) {
+    EXPECT_EQ(e.remedy().kind, RemedyKind::kEvaluateSingleLut) << e.what();
+    EXPECT_NE(std::string(e.what()).find("holds many materials"), std::string::npos) << e.what();
+  }
 }
 
 TEST_F(Open, FilesThatAreNotBrdfsAreRefusedNamingWhatTheyAre) {

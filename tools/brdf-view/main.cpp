@@ -172,7 +172,8 @@ int main(int argc, char** argv) {
   double theta_in_deg = 0;
   app.add_option("source", source,
                  "File to view (.bpc, material .json, .ktx2/.dds/sidecar, RGL .bsdf, MERL "
-                 ".binary, Zemax/LightTools/CSV table) or a library material name")
+                 ".binary, Zemax/LightTools/CSV table) or a library material name ('brdf "
+                 "materials' lists them; a file of the same name wins)")
       ->required();
   app.add_option("--compare", compare,
                  "Second source drawn over the first (e.g. a fit over its measurement)");
