@@ -38,33 +38,32 @@ struct FitInput {
   std::string name;
 };
 
-bool IsEvaluableFile(const std::string& path) {
-  const std::string ext = LowerExtension(path);
-  return ext == ".bsdf" || ext == ".binary";
+// The kind of `path` by content (sources::DetectFileKind), kUnknown when it cannot be read or
+// classified (the convert rules then report it).
+sources::FileKind KindOf(const std::string& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return sources::FileKind::kUnknown;
+  try {
+    return sources::DetectFileKind(path);
+  } catch (const Error&) {
+    return sources::FileKind::kUnknown;
+  }
+}
+
+// Measured BRDF files a folder contributes besides its captures and material files.
+bool IsMeasuredBrdf(sources::FileKind kind) {
+  using sources::FileKind;
+  return kind == FileKind::kRgl || kind == FileKind::kMerl || kind == FileKind::kZemax ||
+         kind == FileKind::kLightTools;
 }
 
 // A file named on the command line that is fitted as it is, not through the convert rules:
 // measured databases, imported tables and exported LUTs (sources::PrepareMeasurement).
 bool IsDirectInput(const std::string& path) {
-  if (IsEvaluableFile(path)) return true;
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) return false;
-  try {
-    switch (sources::DetectFileKind(path)) {
-      case sources::FileKind::kZemax:
-      case sources::FileKind::kLightTools:
-      case sources::FileKind::kCsv:
-      case sources::FileKind::kGonio:
-      case sources::FileKind::kKtx2:
-      case sources::FileKind::kDds:
-      case sources::FileKind::kSidecar:
-        return true;
-      default:
-        return false;
-    }
-  } catch (const Error&) {
-    return false;  // the convert rules report it
-  }
+  using sources::FileKind;
+  const FileKind kind = KindOf(path);
+  return IsMeasuredBrdf(kind) || kind == FileKind::kCsv || kind == FileKind::kGonio ||
+         kind == FileKind::kKtx2 || kind == FileKind::kDds || kind == FileKind::kSidecar;
 }
 
 Measurement OpenForFit(const std::string& path, std::vector<std::string>* warnings) {
@@ -120,8 +119,9 @@ int RunFit(const FitCommandOptions& options) {
   if (options.max_theta_out_deg > 0) fit.max_theta_out_deg = options.max_theta_out_deg;
   fit.starts = options.starts;
 
-  // Inputs: measured BRDF files (.bsdf, .binary) directly or from folders, everything else
-  // through the convert rules (captures and material files).
+  // Inputs: measured BRDF files (RGL, MERL, Zemax, LightTools; by content) directly or from
+  // folders, tables and exported LUTs directly, everything else through the convert rules
+  // (captures and material files).
   std::vector<FitInput> inputs;
   std::vector<BatchFailure> failures;
   std::vector<std::string> rest;
@@ -130,7 +130,7 @@ int RunFit(const FitCommandOptions& options) {
     if (fs::is_directory(arg, ec)) {
       std::vector<std::string> evaluable;
       for (const auto& e : fs::directory_iterator(arg, ec))
-        if (e.is_regular_file() && IsEvaluableFile(e.path().string()))
+        if (e.is_regular_file() && IsMeasuredBrdf(KindOf(e.path().string())))
           evaluable.push_back(e.path().string());
       std::sort(evaluable.begin(), evaluable.end());
       for (const std::string& f : evaluable) inputs.push_back({f, sources::OutputNameOf(f)});

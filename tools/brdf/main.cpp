@@ -489,7 +489,8 @@ int main(int argc, char** argv) {
                    "Captures (.bpc), material files (.json), RGL .bsdf or MERL .binary files, "
                    "third-party tables (Zemax, LightTools, CSV, goniometer), exported LUTs "
                    "(.ktx2, .dds, sidecar .json), or folders of captures, material files and "
-                   ".bsdf/.binary files, or library material names" +
+                   "measured BRDF files (RGL, MERL, Zemax, LightTools; recognised by content), "
+                   "or library material names" +
                        std::string(kLibraryNames))
       ->required();
   fit_cmd
