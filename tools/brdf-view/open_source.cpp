@@ -7,6 +7,17 @@
 
 namespace brdf::view_tool {
 
+std::string RemedyText(const Remedy& remedy) {
+  switch (remedy.kind) {
+    case RemedyKind::kEvaluateSingleLut:
+      return "; open one material's LUT";
+    case RemedyKind::kForceOverwrite:  // an empty file: several outputs exist
+      return std::string("; use --force to overwrite ") + (remedy.file.empty() ? "them" : "it");
+    default:
+      return {};
+  }
+}
+
 viewer::LoadedSource OpenViewSource(const std::string& path_or_name) {
   viewer::LoadedSource out;
   out.path = path_or_name;
@@ -24,8 +35,7 @@ viewer::LoadedSource OpenViewSource(const std::string& path_or_name) {
     out.view.reset();
     out.brdf.reset();
     out.error = e.what();
-    // The remedies a viewer's source can carry, in brdf-view's words.
-    if (e.remedy().kind == RemedyKind::kEvaluateSingleLut) out.error += "; open one material's LUT";
+    out.error += RemedyText(e.remedy());
   } catch (const std::exception& e) {
     out.view.reset();
     out.brdf.reset();

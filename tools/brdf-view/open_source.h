@@ -5,6 +5,7 @@
 
 #include <string>
 
+#include "brdf/core/error.h"
 #include "brdf/viewer/app.h"
 
 namespace brdf::view_tool {
@@ -13,5 +14,9 @@ namespace brdf::view_tool {
 // of that name wins). Never throws: a failure comes back as LoadedSource::error (one line,
 // naming the file).
 viewer::LoadedSource OpenViewSource(const std::string& path_or_name);
+
+// What the user can do about an error, in brdf-view's words ("; use --force to overwrite it"),
+// for the remedies its sources and outputs carry; empty for any other.
+std::string RemedyText(const Remedy& remedy);
 
 }  // namespace brdf::view_tool
