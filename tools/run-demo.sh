@@ -55,9 +55,9 @@ mkdir -p "$out/pictures"
 echo "== lobe pictures -> $out/pictures"
 for material in gold plastic_glossy_red wood_oak paper_white; do
   "$tools/brdf-view" "$out/captures/$material.bpc" --mode lobe --theta-in 40 \
-    --size 960x720 --screenshot "$out/pictures/$material-lobe.png"
+    --size 960x720 --force --screenshot "$out/pictures/$material-lobe.png"
 done
 "$tools/brdf-view" "$out/captures/gold.bpc" --mode slices --theta-in 40 \
-  --size 960x600 --screenshot "$out/pictures/gold-slices.png"
+  --size 960x600 --force --screenshot "$out/pictures/gold-slices.png"
 echo "== done: $(ls "$out/captures" | wc -l) captures in $out/captures, LUTs in $out/luts, atlas in $out/atlas, previews in $out/previews, pictures in $out/pictures"
 "$brdf" info "$out/luts/gold.ktx2"

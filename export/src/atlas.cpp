@@ -200,6 +200,10 @@ std::string AtlasManifestJson(const Atlas& atlas, const std::vector<std::string>
   return j.dump(2) + "\n";
 }
 
+std::vector<std::string> AtlasOutputPaths(const std::string& prefix) {
+  return {prefix + ".ktx2", prefix + ".dds", prefix + ".exr", prefix + ".json"};
+}
+
 std::vector<std::string> WriteAtlas(const std::string& prefix,
                                     const std::vector<AtlasMaterial>& materials,
                                     const ExrOptions& exr_options) {

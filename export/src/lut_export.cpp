@@ -1,6 +1,7 @@
 #include "brdf/exporter/lut_export.h"
 
 #include <filesystem>
+#include <utility>
 
 #include "brdf/core/error.h"
 #include "brdf/exporter/dds.h"
@@ -35,6 +36,17 @@ LutExportFormats ParseExportFormats(std::string_view list) {
   }
   if (!any) throw InvalidArgument("no output format given (known: ktx2, dds, exr, png, json)");
   return f;
+}
+
+std::vector<std::string> LutExportPaths(const std::string& out_dir, const std::string& name,
+                                        const LutExportFormats& formats) {
+  std::vector<std::string> paths;
+  const std::filesystem::path dir(out_dir);
+  for (const auto& [on, ext] : {std::pair{formats.ktx2, ".ktx2"}, std::pair{formats.dds, ".dds"},
+                                std::pair{formats.exr, ".exr"}, std::pair{formats.png, ".png"},
+                                std::pair{formats.json, ".json"}})
+    if (on) paths.push_back((dir / (name + ext)).string());
+  return paths;
 }
 
 LutExportResult ExportLut(const std::string& out_dir, const Lut& lut, TextureMetadata metadata,

@@ -247,8 +247,7 @@ RepairReport RepairCapture(const std::string& input, const std::string& output, 
   if (fs::exists(output, ec) && fs::equivalent(input, output, ec))
     throw InvalidArgument(output + ": the repaired capture must go to a new file, not over " +
                           input);
-  if (fs::exists(output, ec) && !overwrite)
-    throw InvalidArgument(output + ": already exists", Remedy{RemedyKind::kForceOverwrite, output});
+  CheckWritableOutput(output, overwrite);  // the overwrite rule of every writer
   CaptureAssessment a = AssessCapture(input);
   const BpcReadResult& r = a.read;
   // Damage, an incomplete slice, or CRC-valid chunks that contradict each other (slice

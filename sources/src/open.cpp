@@ -92,25 +92,34 @@ ExtrapolationChoice ChooseExtrapolation(
   return {processing::ExtrapolationParams{}, ExtrapolationChoice::Origin::kDefaults, {}};
 }
 
-PreparedMeasurement PrepareMeasurement(
-    const std::string& path, FileKind kind,
-    const std::optional<processing::ExtrapolationParams>& command_line, bool allow_btdf) {
+namespace {
+
+// PrepareMeasurement; for a file evaluable by itself (material, RGL, MERL) that is captured
+// virtually, also the source it captured, in `*evaluable` when not null (so one read serves
+// both the evaluation and the capture).
+PreparedMeasurement Prepare(const std::string& path, FileKind kind,
+                            const std::optional<processing::ExtrapolationParams>& command_line,
+                            bool allow_btdf, std::shared_ptr<const BrdfSource>* evaluable) {
   PreparedMeasurement out;
+  std::shared_ptr<const BrdfSource> source;
   switch (kind) {
     case FileKind::kCapture:
       out.measurement = LoadCaptureForLut(path, &out.warnings);
       break;
     case FileKind::kMaterial: {
-      const Material material = LoadMaterialFile(path);
-      out.measurement = CaptureFile(AnalyticBrdf(material), path, kind);
-      out.measurement.metadata.extra["model"] = std::string(ModelName(material.model));
+      auto material = std::make_shared<AnalyticBrdf>(LoadMaterialFile(path));
+      out.measurement = CaptureFile(*material, path, kind);
+      out.measurement.metadata.extra["model"] = std::string(ModelName(material->material().model));
+      source = std::move(material);
       break;
     }
     case FileKind::kRgl:
-      out.measurement = CaptureFile(RglBrdf::Load(path), path, kind);
+      source = std::make_shared<RglBrdf>(RglBrdf::Load(path));
+      out.measurement = CaptureFile(*source, path, kind);
       break;
     case FileKind::kMerl:
-      out.measurement = CaptureFile(MerlBrdf::Load(path), path, kind);
+      source = std::make_shared<MerlBrdf>(MerlBrdf::Load(path));
+      out.measurement = CaptureFile(*source, path, kind);
       break;
     case FileKind::kKtx2:
     case FileKind::kDds:
@@ -142,7 +151,16 @@ PreparedMeasurement PrepareMeasurement(
                             std::string(FileKindName(kind)));
   }
   out.extrapolation = ChooseExtrapolation(path, kind, command_line, &out.warnings);
+  if (evaluable) *evaluable = std::move(source);
   return out;
+}
+
+}  // namespace
+
+PreparedMeasurement PrepareMeasurement(
+    const std::string& path, FileKind kind,
+    const std::optional<processing::ExtrapolationParams>& command_line, bool allow_btdf) {
+  return Prepare(path, kind, command_line, allow_btdf, nullptr);
 }
 
 OpenedTexture OpenExportedTexture(const std::string& path) {
@@ -268,7 +286,33 @@ std::optional<std::string> OpenedSource::SphereCoverageNote(const std::string& p
          "° slice's values, not measured ones (docs/preview.md, \"Captures\")";
 }
 
-OpenedSource OpenBrdf(const std::string& path, const OpenOptions& options) {
+namespace {
+
+// An exported texture opened for evaluation: OpenExportedTexture, an atlas refused.
+OpenedTexture OpenTextureToEvaluate(const std::string& path, const OpenOptions& options,
+                                    std::vector<std::string>* warnings) {
+  OpenedTexture t = OpenExportedTexture(path);
+  for (std::string& w : t.warnings) warnings->push_back(std::move(w));
+  if (!t.texture.IsSingleLut())
+    throw InvalidArgument(path + ": an atlas (" + std::to_string(t.texture.volume.width) + " × " +
+                              std::to_string(t.texture.volume.height) +
+                              " texels) holds many materials",
+                          Remedy{RemedyKind::kEvaluateSingleLut, path});
+  if (options.extrapolation) warnings->push_back(ExtrapolationIgnored(path));
+  return t;
+}
+
+[[noreturn]] void RefuseUnevaluable(const std::string& path, FileKind kind) {
+  throw InvalidArgument(path + ": cannot evaluate a " + std::string(FileKindName(kind)) +
+                        " (evaluable: material .json, .bpc capture, .ktx2 / .dds LUT, LUT "
+                        "sidecar .json, RGL .bsdf, MERL .binary, Zemax or LightTools BSDF "
+                        "table, CSV point cloud, goniometer table)");
+}
+
+}  // namespace
+
+OpenedSource OpenBrdf(const std::string& path_or_name, const OpenOptions& options) {
+  const std::string path = ResolveSource(path_or_name);
   OpenedSource out;
   out.kind = DetectFileKind(path);
   switch (out.kind) {
@@ -304,25 +348,65 @@ OpenedSource OpenBrdf(const std::string& path, const OpenOptions& options) {
     case FileKind::kDds:
     case FileKind::kSidecar:
     case FileKind::kAtlasManifest: {
-      OpenedTexture t = OpenExportedTexture(path);
-      out.warnings = std::move(t.warnings);
-      if (!t.texture.IsSingleLut())
-        throw InvalidArgument(path + ": an atlas (" + std::to_string(t.texture.volume.width) +
-                                  " × " + std::to_string(t.texture.volume.height) +
-                                  " texels) holds many materials",
-                              Remedy{RemedyKind::kEvaluateSingleLut, path});
-      if (options.extrapolation) out.warnings.push_back(ExtrapolationIgnored(path));
+      OpenedTexture t = OpenTextureToEvaluate(path, options, &out.warnings);
       out.measured_theta_in_deg = t.texture.lut.theta_in_deg;
       out.evaluation = Evaluation::kExportedLut;
       out.brdf = std::make_unique<LutBrdf>(std::move(t.texture.lut), OutputNameOf(path));
       return out;
     }
     default:
-      throw InvalidArgument(path + ": cannot evaluate a " + std::string(FileKindName(out.kind)) +
-                            " (evaluable: material .json, .bpc capture, .ktx2 / .dds LUT, LUT "
-                            "sidecar .json, RGL .bsdf, MERL .binary, Zemax or LightTools BSDF "
-                            "table, CSV point cloud, goniometer table)");
+      RefuseUnevaluable(path, out.kind);
   }
+}
+
+OpenedForView OpenForView(const std::string& path_or_name, const OpenOptions& options) {
+  OpenedForView out;
+  out.path = ResolveSource(path_or_name);
+  const std::string& path = out.path;
+  const std::string name = OutputNameOf(path);
+  out.kind = DetectFileKind(path);
+  if (IsExportedLut(out.kind)) {
+    OpenedTexture t = OpenTextureToEvaluate(path, options, &out.warnings);
+    if (t.sidecar && t.sidecar->extrapolation)
+      out.theta_b_deg = t.sidecar->extrapolation->theta_b_deg;
+    out.lut = std::move(t.texture.lut);
+    out.evaluation = Evaluation::kExportedLut;
+    out.brdf = std::make_shared<LutBrdf>(out.lut, name);
+    return out;
+  }
+  switch (out.kind) {
+    case FileKind::kMaterial:
+      out.evaluation = Evaluation::kAnalytic;
+      break;
+    case FileKind::kRgl:
+    case FileKind::kMerl:
+      out.evaluation = Evaluation::kMeasuredDatabase;
+      break;
+    case FileKind::kCapture:
+    case FileKind::kZemax:
+    case FileKind::kLightTools:
+    case FileKind::kCsv:
+    case FileKind::kGonio:
+      out.evaluation = Evaluation::kResampledLut;
+      break;
+    default:
+      RefuseUnevaluable(path, out.kind);
+  }
+  std::shared_ptr<const BrdfSource> evaluable;
+  PreparedMeasurement p =
+      Prepare(path, out.kind, options.extrapolation, /*allow_btdf=*/true, &evaluable);
+  // Any distinct θin, as OpenBrdf evaluates them (processing::MeasurementAsBrdf).
+  processing::ResampleOptions resample = options.resample;
+  resample.require_uniform_theta_in = false;
+  processing::ResampleReport report;
+  out.lut = processing::BuildLut(p.measurement, p.extrapolation.params, resample, &report);
+  out.theta_b_deg = report.theta_b_deg;
+  out.brdf = evaluable ? std::move(evaluable) : std::make_shared<LutBrdf>(out.lut, name);
+  out.measurement = std::move(p.measurement);
+  out.resample_report = std::move(report);
+  out.extrapolation = p.extrapolation;
+  out.warnings = std::move(p.warnings);
+  return out;
 }
 
 InputLut LutFromInput(const std::string& path, FileKind kind,

@@ -485,14 +485,6 @@ TEST(RglFiles, GlossyFilmsPeakAtTheMirrorDirection) {
   }
 }
 
-TEST(RglFiles, OpenBrdfSourceDispatchesOnTheBsdfExtension) {
-  const std::unique_ptr<BrdfSource> source = OpenBrdfSource(RglDir() + "chm_orange_rgb.bsdf");
-  const RglBrdf direct = RglBrdf::Load(RglDir() + "chm_orange_rgb.bsdf");
-  EXPECT_EQ(source->Name(), "chm_orange_rgb.bsdf");
-  const Vec3 wi = SphericalDirectionDeg(35, 10), wo = SphericalDirectionDeg(33, 188);
-  EXPECT_EQ(source->Eval(wi, wo), direct.Eval(wi, wo));
-}
-
 // ---------------------------------------------------------------------------------------
 // Bad input
 

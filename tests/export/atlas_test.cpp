@@ -54,6 +54,8 @@ TEST(Atlas, EachCellOfEveryContainerEqualsItsOwnLut) {
   const std::string dir = test::TestDir("atlas_cells");
   const std::vector<std::string> written = WriteAtlas(dir + "/five", five.materials);
   EXPECT_EQ(written.size(), 4u);
+  // The list a caller's overwrite check covers is exactly what was written.
+  EXPECT_EQ(AtlasOutputPaths(dir + "/five"), written);
   const LoadedTexture ktx2 = ReadKtx2(dir + "/five.ktx2");
   const LoadedTexture dds = ReadTextureFile(dir + "/five.dds");
   const ExrFile exr = ReadExr(dir + "/five.exr");

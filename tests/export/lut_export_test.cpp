@@ -54,6 +54,25 @@ TEST(ExportLut, WritesOnlyTheSelectedFormats) {
   EXPECT_EQ(ReadSidecar(dir + "/p.json").files, std::vector<std::string>{"p.dds"});
 }
 
+// The list a caller's overwrite check covers is exactly what ExportLut writes, in its order.
+TEST(ExportLut, ListsTheFilesItWillWriteBeforeWritingThem) {
+  const Lut lut = test::PatternLut({0, 20}, 9);
+  for (const char* formats : {"ktx2,dds,exr,png,json", "dds,json", "png", "json,ktx2"}) {
+    const std::string dir = test::TestDir(std::string("export_list_") + formats[0] + formats[1]);
+    TextureMetadata meta;
+    meta.name = "p";
+    const LutExportFormats f = ParseExportFormats(formats);
+    const std::vector<std::string> planned = LutExportPaths(dir, "p", f);
+    EXPECT_TRUE(Listing(dir).empty());
+    const LutExportResult r = ExportLut(dir, lut, meta, {f, {}});
+    EXPECT_EQ(planned, r.written) << formats;
+    std::vector<std::string> names;
+    for (const std::string& p : planned) names.push_back(std::filesystem::path(p).filename());
+    std::sort(names.begin(), names.end());
+    EXPECT_EQ(names, Listing(dir)) << formats;
+  }
+}
+
 TEST(ExportLut, ParsesFormatListsAndNamesUnknownOnes) {
   const LutExportFormats f = ParseExportFormats("ktx2,png");
   EXPECT_TRUE(f.ktx2);

@@ -1,7 +1,8 @@
-// The one overwrite rule of every writing command (brdf::CheckWritableOutputs; README "Writing
-// files"): an existing output is refused with one line naming it and --force, nothing is
-// changed, and --force replaces it; an output path that is a folder is refused even with
-// --force. The expected bytes come from the first run's files, compared before and after.
+// The one overwrite rule of every writing command (convert, atlas, capture, import, export-csv,
+// preview, repair, fit; brdf::CheckWritableOutputs, README "Writing files"): an existing output
+// is refused before any work with one line naming it and --force, nothing is changed, and
+// --force replaces it; an output path that is a folder is refused even with --force. The
+// expected bytes come from the first run's files, compared before and after.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -94,21 +95,83 @@ TEST_F(Overwrite, CaptureRefusesAnExistingFileWithoutForce) {
   EXPECT_EQ(capture.ErrLines()[0], expected);
 }
 
+// A capture whose end chunk is cut: every slice intact, so `brdf repair` rewrites it.
+fs::path WriteUnfinishedCapture(const fs::path& dir) {
+  const fs::path cut = dir / "cut.bpc";
+  std::string b = ReadAll(kGoldCapture);
+  const std::vector<ChunkSpan> chunks = BpcChunks(kGoldCapture);
+  b.resize(chunks.back().offset + 3);
+  WriteText(cut, b);
+  return cut;
+}
+
+TEST_F(Overwrite, RepairRefusesAnExistingFileWithoutForce) {
+  const fs::path cut = WriteUnfinishedCapture(dir_);
+  ExpectRefusedThenForced("repair " + Quote(cut) + " --out " + Quote(dir_ / "fixed.bpc"),
+                          dir_ / "fixed.bpc");
+}
+
+TEST_F(Overwrite, FitRefusesAnExistingResultWithoutForce) {
+  ExpectRefusedThenForced("fit gold --model lambert --quiet --out " + Quote(dir_ / "gold.fit.json"),
+                          dir_ / "gold.fit.json");
+}
+
+// Several results into a folder: one of them existing stops the whole run before any fit, so
+// the result that did not exist is not written either.
+TEST_F(Overwrite, FitChecksEveryResultBeforeAnyFit) {
+  const std::string args = "fit gold paper_white --model lambert --quiet --out " + Quote(dir_);
+  const ToolRun first = Run(args);
+  ASSERT_EQ(first.exit_code, 0) << first.err;
+  const fs::path gold = dir_ / "gold.lambert.json", paper = dir_ / "paper_white.lambert.json";
+  ASSERT_TRUE(fs::exists(gold) && fs::exists(paper));
+  fs::remove(paper);
+  const std::string before = ReadAll(gold);
+  const ToolRun second = Run(args);
+  EXPECT_EQ(second.exit_code, 1) << second.err;
+  const std::vector<std::string> lines = second.ErrLines();
+  ASSERT_EQ(lines.size(), 1u) << second.err;
+  EXPECT_EQ(lines[0],
+            "brdf: error: " + gold.string() + ": already exists; use --force to overwrite it");
+  EXPECT_FALSE(fs::exists(paper)) << "a fit ran before the check";
+  EXPECT_EQ(ReadAll(gold), before);
+  const ToolRun forced = Run(args + " --force");
+  EXPECT_EQ(forced.exit_code, 0) << forced.err;
+  EXPECT_TRUE(fs::exists(paper));
+}
+
 TEST_F(Overwrite, AnOutputThatIsAFolderIsRefusedEvenWithForce) {
   fs::create_directories(dir_ / "luts" / "gold.ktx2");
   fs::create_directories(dir_ / "lib.json");
   fs::create_directories(dir_ / "c.bpc");
+  fs::create_directories(dir_ / "f.json");
+  fs::create_directories(dir_ / "folder_out" / "gold.lambert.json");
+  fs::create_directories(dir_ / "g.csv");
+  fs::create_directories(dir_ / "p.png");
+  const fs::path cut = WriteUnfinishedCapture(dir_);
+  const fs::path csv = dir_ / "in.csv";
+  WriteText(csv, "theta_in,phi_in,theta_out,phi_out,r,g,b\n20,0,30,180,0.1,0.2,0.3\n");
   for (const std::string& args :
        {"convert " + Quote(kGoldCapture) + " --quiet --force --out " + Quote(dir_ / "luts"),
         "atlas " + Quote(kGoldCapture) + " --quiet --force --out " + Quote(dir_ / "lib"),
         kSmallCapture + " --force --out " + Quote(dir_ / "c.bpc"),
-        kSmallCapture + " --resume --out " + Quote(dir_ / "c.bpc")}) {
+        kSmallCapture + " --resume --out " + Quote(dir_ / "c.bpc"),
+        "repair " + Quote(cut) + " --force --out " + Quote(dir_ / "c.bpc"),
+        "import " + Quote(csv) + " --force --out " + Quote(dir_ / "c.bpc"),
+        "export-csv " + Quote(kGoldCapture) + " --force --out " + Quote(dir_ / "g.csv"),
+        "preview gold --size 16 --spp 1 --quiet --force --out " + Quote(dir_ / "p.png"),
+        "fit gold --model lambert --quiet --force --out " + Quote(dir_ / "f.json"),
+        "fit gold paper_white --model lambert --quiet --force --out " +
+            Quote(dir_ / "folder_out")}) {
     const ToolRun r = Run(args);
     EXPECT_EQ(r.exit_code, 1) << args;
     const std::vector<std::string> lines = r.ErrLines();
     ASSERT_EQ(lines.size(), 1u) << r.err;
-    EXPECT_NE(lines[0].find("is a folder, not a file"), std::string::npos) << lines[0];
+    EXPECT_NE(lines[0].find("is a folder, not a file"), std::string::npos) << args << lines[0];
   }
+  for (const char* folder : {"c.bpc", "f.json", "g.csv", "p.png"})
+    EXPECT_TRUE(fs::is_directory(dir_ / folder)) << folder;
+  EXPECT_FALSE(fs::exists(dir_ / "folder_out" / "paper_white.lambert.json"))
+      << "a fit ran before the check";
   EXPECT_TRUE(fs::is_directory(dir_ / "luts" / "gold.ktx2"));
   EXPECT_FALSE(fs::exists(dir_ / "luts" / "gold.dds")) << "nothing may be written";
 }

@@ -77,6 +77,46 @@ TEST_F(SourcesCli, CaptureBetweenSlicesInterpolatesInTheSpecularFrameLikeTheLut)
   }
 }
 
+// Every command that reads a source takes a library material name (README "Library names"):
+// `eval gold` is gold.json's GGX formula (its own numbers: kd 0, f0 (0.962585, 0.786916,
+// 0.40822), α 0.15); info, convert and import answer about that file; a file named `gold` in the
+// current folder wins; an unknown bare name is one line listing the library.
+TEST_F(SourcesCli, EveryCommandThatReadsASourceAcceptsALibraryName) {
+  const Analytic gold{"ggx", {0, 0, 0}, {0.962585, 0.786916, 0.40822}, 0.15};
+  const auto got = Eval("gold", "30,0", "30,180");
+  const auto want = gold.FAngles(30, 30, 180);
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], want[c], 1e-7 * want[c]) << c;
+  const std::string library_file =
+      (fs::path(BRDF_SOURCE_DIR) / "data-samples" / "materials" / "gold.json").string();
+  const ToolRun info = Run("info gold");
+  EXPECT_EQ(info.exit_code, 0) << info.err;
+  EXPECT_NE(info.out.find(library_file), std::string::npos) << info.out;
+  const ToolRun convert = Run("convert gold --formats ktx2 --quiet --out " + Quote(dir_ / "luts"));
+  EXPECT_EQ(convert.exit_code, 0) << convert.err;
+  EXPECT_TRUE(fs::exists(dir_ / "luts" / "gold.ktx2"));
+  const ToolRun import = Run("import gold --out " + Quote(dir_ / "g.bpc"));
+  EXPECT_EQ(import.exit_code, 1);
+  EXPECT_NE(import.err.find(library_file + ": file content: expected a third-party measurement"),
+            std::string::npos)
+      << import.err;
+  // ./gold, a Lambertian material, is read instead of the library's gold: ρ/π.
+  WriteText(dir_ / "gold", Lambertian().Json());
+  const std::string here_out = (dir_ / "here.txt").string();
+  ASSERT_EQ(std::system(("cd " + Quote(dir_) + " && " + BRDF_TOOL +
+                         " eval gold --in 30,0 --out 30,180 >'" + here_out + "'")
+                            .c_str()),
+            0);
+  const auto here = ParseTriple(ReadAll(here_out));
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(here[c], Lambertian().kd[c] / kPi, 1e-8) << c;
+  const ToolRun unknown = Run("eval velvet --in 30,0 --out 30,180");
+  EXPECT_EQ(unknown.exit_code, 1);
+  ASSERT_EQ(unknown.ErrLines().size(), 1u) << unknown.err;
+  EXPECT_NE(unknown.err.find("velvet: no such file, and no library material of that name"),
+            std::string::npos)
+      << unknown.err;
+  EXPECT_NE(unknown.err.find("gold, paper_white"), std::string::npos) << unknown.err;
+}
+
 // The library form of the same guarantee: OpenBrdf of a capture and the float LUT that
 // BuildLut makes of it (what `brdf convert` encodes) agree to the last bit.
 TEST_F(SourcesCli, OpenBrdfOfACaptureIsTheFloatLutSampledAsAGpuDoes) {

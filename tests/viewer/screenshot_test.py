@@ -432,8 +432,9 @@ def case_startup_timing_inner(brdf_view, source_dir, tmp):
     found = parse_timing(run.stderr)
     check_milestones(found, MILESTONES + ["screenshot"], (t1 - t0) * 1000, "screenshot")
     check_not_blank(read_png(shot, 640, 480), 0.01)
-    # Without the variable the program prints nothing about timing.
-    run = subprocess.run([brdf_view, gold, "--size", "640x480", "--screenshot", shot], cwd=tmp,
+    # Without the variable the program prints nothing about timing (the same picture again).
+    run = subprocess.run([brdf_view, gold, "--size", "640x480", "--screenshot", shot, "--force"],
+                         cwd=tmp,
                          capture_output=True, text=True, timeout=120,
                          env={k: v for k, v in os.environ.items() if k != "BRDF_VIEW_TIMING"})
     if run.returncode != 0 or "timing" in run.stderr:
@@ -482,7 +483,38 @@ def case_small_window(brdf_view, source_dir, tmp):
     print(f"small window: overlay {overlay} text pixels, none next to the legend")
 
 
+def case_overwrite(brdf_view, source_dir, tmp):
+    """The overwrite rule of every writing command: an existing screenshot is refused before
+    any work with one line naming it and --force, and left as it was; --force replaces it; a
+    folder in its place is refused even with --force."""
+    gold = os.path.join(source_dir, "data-samples", "materials", "gold.json")
+    shot = os.path.join(tmp, "again.png")
+    args = [gold, "--size", "320x240", "--screenshot", shot]
+    run_view(brdf_view, args, tmp)
+    with open(shot, "rb") as f:
+        before = f.read()
+    os.utime(shot, (1_000_000_000, 1_000_000_000))
+    proc = run_view(brdf_view, args, tmp, expect_rc=1)
+    lines = [l for l in proc.stderr.splitlines() if l.strip()]
+    if (len(lines) != 1 or shot not in lines[0] or "already exists" not in lines[0]
+            or "--force" not in lines[0]):
+        fail(f"expected one line naming {shot} and --force, got: {proc.stderr!r}")
+    with open(shot, "rb") as f:
+        if f.read() != before or os.stat(shot).st_mtime != 1_000_000_000:
+            fail("the refused run touched the existing screenshot")
+    run_view(brdf_view, args + ["--force"], tmp)
+    if os.stat(shot).st_mtime == 1_000_000_000:
+        fail("--force did not rewrite the screenshot")
+    folder = os.path.join(tmp, "folder.png")
+    os.mkdir(folder)
+    proc = run_view(brdf_view, [gold, "--screenshot", folder, "--force"], tmp, expect_rc=1)
+    if "is a folder, not a file" not in proc.stderr or not os.path.isdir(folder):
+        fail(f"a folder in the screenshot's place: {proc.stderr!r}")
+    print("overwrite: " + lines[0])
+
+
 CASES = {
+    "overwrite": case_overwrite,
     "lobe_lambert": case_lobe_lambert,
     "small_window": case_small_window,
     "lobe_glossy": case_lobe_glossy,

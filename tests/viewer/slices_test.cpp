@@ -5,21 +5,25 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <vector>
 
 #include "brdf/core/brdf_source.h"
 #include "brdf/core/error.h"
 #include "brdf/core/models.h"
+#include "brdf/processing/resample.h"
 
 namespace brdf::viewer {
 namespace {
 
 // A reference-geometry capture (θin 0/20/40/60°, θout 0–75°, φout 0–359° at 1°) of a
 // Lambertian ρ = (0.3, 0.6, 0.9), written here sample by sample, with the samples in
-// θout 30–34°, φout 100–110° of the θin = 20° slice flagged invalid (a blind spot).
-Measurement CaptureWithBlindSpot() {
+// θout 30–34°, φout 100–110° of the θin = `blind_theta_in` slice flagged invalid (a blind
+// spot); other θin lists for tables measured elsewhere.
+Measurement CaptureWithBlindSpot(const std::vector<double>& theta_in_deg = {0, 20, 40, 60},
+                                 double blind_theta_in = 20.0) {
   Measurement m;
   m.metadata.sample_name = "blind";
-  for (double theta_in : {0.0, 20.0, 40.0, 60.0}) {
+  for (double theta_in : theta_in_deg) {
     Slice slice;
     slice.theta_in_deg = theta_in;
     for (int t = 0; t <= 75; ++t) {
@@ -30,7 +34,7 @@ Measurement CaptureWithBlindSpot() {
         s.phi_out_deg = static_cast<float>(p);
         s.rgb = {static_cast<float>(0.3 / kPi), static_cast<float>(0.6 / kPi),
                  static_cast<float>(0.9 / kPi)};
-        if (theta_in == 20.0 && t >= 30 && t <= 34 && p >= 100 && p <= 110) {
+        if (theta_in == blind_theta_in && t >= 30 && t <= 34 && p >= 100 && p <= 110) {
           s.flags = kFlagInvalid;
           s.rgb = {1e6f, -5.0f, 0.0f};  // garbage, as an invalid sample may hold
         }
@@ -122,6 +126,26 @@ TEST(Coverage, BlindSpotIsUnmeasuredOnlyWhereSamplesWereInvalid) {
   const LobeMesh mesh = BuildLobe(source, options);
   EXPECT_EQ(mesh.coverage[32 * 360 + 105], Coverage::kUnmeasured);
   EXPECT_EQ(mesh.coverage[32 * 360 + 120], Coverage::kMeasured);
+}
+
+// A LUT at θin 0, 10, 50° (a table, not k·Δin; ViewSourceFromResampled as brdf-view gets it):
+// θin 30° lies halfway between the 10° and 50° slices (Lut::SliceCoordinate 1.5), so the blind
+// direction of the 10° slice, moved into the 30° specular frame, is unmeasured there.
+TEST(Coverage, BetweenUnevenlySpacedSlicesBothNeighboursCount) {
+  const Measurement m = CaptureWithBlindSpot({0, 10, 50}, 10.0);
+  processing::ResampleOptions options;
+  options.require_uniform_theta_in = false;
+  processing::ResampleReport report;
+  Lut lut = processing::BuildLut(m, {}, options, &report);
+  const ViewSource source = ViewSourceFromResampled(m, std::move(lut), report, "table");
+  const Vec3 w_d = SpecularFrame::FromThetaInDeg(10).ToSpecular(SphericalDirectionDeg(32, 105));
+  const Vec3 w30 = SpecularFrame::FromThetaInDeg(30).FromSpecular(w_d);
+  EXPECT_EQ(source.CoverageAt(30.0, RadToDeg(ThetaOf(w30)), RadToDeg(PhiOf(w30))),
+            Coverage::kUnmeasured);
+  // The same direction seen from θin 50° itself, where only the intact slice counts.
+  const Vec3 w50 = SpecularFrame::FromThetaInDeg(50).FromSpecular(w_d);
+  EXPECT_EQ(source.CoverageAt(50.0, RadToDeg(ThetaOf(w50)), RadToDeg(PhiOf(w50))),
+            Coverage::kMeasured);
 }
 
 TEST(Coverage, ExportedLutWithoutMeasurementCountsAsMeasuredUpToThetaB) {

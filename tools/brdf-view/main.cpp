@@ -19,6 +19,7 @@
 #include <vector>
 
 #include "brdf/core/error.h"
+#include "brdf/core/file_util.h"
 #include "brdf/core/measurement.h"
 #include "brdf/viewer/app.h"
 #include "open_source.h"
@@ -172,7 +173,8 @@ int main(int argc, char** argv) {
   double theta_in_deg = 0;
   app.add_option("source", source,
                  "File to view (.bpc, material .json, .ktx2/.dds/sidecar, RGL .bsdf, MERL "
-                 ".binary, Zemax/LightTools/CSV table) or a library material name")
+                 ".binary, Zemax/LightTools/CSV table) or a library material name ('brdf "
+                 "materials' lists them; a file of the same name wins)")
       ->required();
   app.add_option("--compare", compare,
                  "Second source drawn over the first (e.g. a fit over its measurement)");
@@ -203,6 +205,9 @@ int main(int argc, char** argv) {
   app.add_flag("--log", log_scale, "Log scale for the lobe radius and the colours");
   app.add_flag("--cos", cosine_weighted, "Lobe radius f_r·cosθo instead of f_r");
   app.add_flag("--all-slices", all_slices, "Every measured slice at once");
+  bool force = false;
+  app.add_flag("--force", force,
+               "With --screenshot: overwrite FILE.png and FILE.png.json if they already exist");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -227,6 +232,17 @@ int main(int argc, char** argv) {
   // LP_NUM_THREADS=0 (a documented Mesa variable) draws on the calling thread; the user's own
   // setting wins, and other OpenGL drivers ignore it.
   if (!screenshot.empty()) setenv("LP_NUM_THREADS", "0", /*overwrite=*/0);
+
+  if (!screenshot.empty()) {
+    // The overwrite rule of every writing command (brdf/core/file_util.h), before any work.
+    try {
+      brdf::CheckWritableOutputs({screenshot, screenshot + ".json"}, force);
+    } catch (const brdf::Error& e) {
+      std::fprintf(stderr, "brdf-view: error: %s%s\n", e.what(),
+                   brdf::view_tool::RemedyText(e.remedy()).c_str());
+      return Finish(1);
+    }
+  }
 
   const std::string display_problem = brdf::viewer::DisplayProblem();
   if (!display_problem.empty()) {

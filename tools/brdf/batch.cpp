@@ -13,6 +13,7 @@
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
 #include "brdf/core/parallel.h"
+#include "brdf/sources/material_library.h"
 #include "cli_support.h"
 
 namespace brdf::cli {
@@ -48,7 +49,15 @@ DiscoveredInputs DiscoverInputs(const std::vector<std::string>& arguments,
     if (!seen.insert(Identity(path)).second) return;
     out.inputs.push_back(BatchInput{path, sources::OutputNameOf(path), kind});
   };
-  for (const std::string& arg : arguments) {
+  for (const std::string& given : arguments) {
+    // A library material name stands for its file (brdf/sources/material_library.h).
+    std::string arg;
+    try {
+      arg = sources::ResolveSource(given);
+    } catch (const Error& e) {
+      out.failures.push_back({given, ReasonWithoutPath(given, e.what())});
+      continue;
+    }
     std::error_code ec;
     const fs::file_status st = fs::status(arg, ec);
     if (fs::is_directory(st)) {

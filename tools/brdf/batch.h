@@ -39,12 +39,13 @@ struct InputKinds {
   bool exported_luts = false;  // also accept .ktx2, .dds and sidecars (brdf atlas)
 };
 
-// Expands the arguments in order. A file argument must be a capture (.bpc) or a material file
-// (or, with `kinds.exported_luts`, an exported LUT); anything else, or a missing path, becomes a
-// failure naming it. A folder contributes its captures and material files (not recursively;
-// sorted by file name); sidecars, atlas manifests, "<name>.extrapolate.json" files and other
-// files in it are skipped (listed in `skipped`), and a .json that does not parse there is a
-// failure. A path given twice is taken once.
+// Expands the arguments in order; an argument that names nothing on disk may name a library
+// material (sources::ResolveSource; a file of that name wins). A file argument must be a capture
+// (.bpc) or a material file (or, with `kinds.exported_luts`, an exported LUT); anything else, or a
+// missing path, becomes a failure naming it. A folder contributes its captures and material files
+// (not recursively; sorted by file name); sidecars, atlas manifests, "<name>.extrapolate.json"
+// files and other files in it are skipped (listed in `skipped`), and a .json that does not parse
+// there is a failure. A path given twice is taken once.
 DiscoveredInputs DiscoverInputs(const std::vector<std::string>& arguments,
                                 const InputKinds& kinds = {});
 

@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cctype>
 #include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 
 #include "brdf/core/error.h"
@@ -47,7 +46,8 @@ std::string RemedyText(const Remedy& remedy, const std::string& command) {
     case RemedyKind::kRecapture:
       return "recapture the sample";
     case RemedyKind::kForceOverwrite:
-      return "add --force to overwrite " + f;
+      // An empty file: several outputs exist (the message names the first and counts the rest).
+      return std::string("use --force to overwrite ") + (f.empty() ? "them" : "it");
     case RemedyKind::kAllowBtdf:
       return command == "import" ? "add --allow-btdf to store it mirrored into the reflection "
                                    "hemisphere; 'brdf info' reads it as it is"
@@ -75,37 +75,12 @@ std::string ErrorLine(const std::exception& error, const std::string& command) {
   return line;
 }
 
-std::string MaterialLibraryDir() {
-  if (const char* env = std::getenv("BRDF_MATERIALS_DIR"); env != nullptr && *env != '\0')
-    return env;
-  return std::string(BRDF_SOURCE_DIR) + "/data-samples/materials";
-}
-
-std::vector<std::string> MaterialLibraryFiles() {
-  std::vector<std::string> files;
-  const fs::path dir = MaterialLibraryDir();
-  std::error_code ec;
-  if (!fs::is_directory(dir, ec))
-    throw IoError(dir.string() + ": material library folder not found (set BRDF_MATERIALS_DIR)");
-  for (const auto& entry : fs::directory_iterator(dir, ec))
-    if (entry.is_regular_file() && entry.path().extension() == ".json")
-      files.push_back(entry.path().string());
-  std::sort(files.begin(), files.end());
-  return files;
-}
-
-std::string ResolveMaterial(const std::string& name_or_file) {
-  std::error_code ec;
-  if (fs::is_regular_file(name_or_file, ec)) return name_or_file;
-  const fs::path candidate = fs::path(MaterialLibraryDir()) / (name_or_file + ".json");
-  if (fs::is_regular_file(candidate, ec)) return candidate.string();
-  std::string names;
-  for (const auto& f : MaterialLibraryFiles()) {
-    if (!names.empty()) names += ", ";
-    names += fs::path(f).stem().string();
+processing::ExtrapolationParams ParseExtrapolationOption(const std::string& text) {
+  try {
+    return processing::ParseExtrapolation(text);
+  } catch (const InvalidArgument& e) {
+    throw InvalidArgument(std::string("--extrapolate: ") + e.what());
   }
-  throw InvalidArgument("'" + name_or_file +
-                        "' is neither a file nor a library material (library: " + names + ")");
 }
 
 std::string LowerExtension(const std::string& path) {

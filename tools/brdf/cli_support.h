@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "brdf/core/error.h"
+#include "brdf/processing/extrapolation.h"
 
 namespace brdf::cli {
 
@@ -17,16 +18,9 @@ std::string RemedyText(const Remedy& remedy, const std::string& command = {});
 // The one line printed for an error: its message, then "; <remedy>" when it carries one.
 std::string ErrorLine(const std::exception& error, const std::string& command = {});
 
-// The folder of the virtual sample library: $BRDF_MATERIALS_DIR if set, else the
-// repository's data-samples/materials.
-std::string MaterialLibraryDir();
-
-// Paths of every material file in the library, sorted by name.
-std::vector<std::string> MaterialLibraryFiles();
-
-// Resolves `name_or_file`: an existing file path is returned as is; otherwise the library
-// material of that name. Throws InvalidArgument listing the library names when neither exists.
-std::string ResolveMaterial(const std::string& name_or_file);
+// --extrapolate P,L (processing::ParseExtrapolation), a bad value reported under the option's
+// name. Throws InvalidArgument.
+processing::ExtrapolationParams ParseExtrapolationOption(const std::string& text);
 
 // The command-line arguments joined with ", " (for "nothing found in a, b").
 std::string JoinArguments(const std::vector<std::string>& arguments);

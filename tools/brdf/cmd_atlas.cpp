@@ -32,7 +32,7 @@ int RunAtlas(const AtlasOptions& options) {
   std::optional<processing::ExtrapolationParams> extrapolate;
   const bool auto_extrapolate = options.extrapolate == "auto";  // fitted per input (brdf fit)
   if (!options.extrapolate.empty() && !auto_extrapolate)
-    extrapolate = processing::ParseExtrapolation(options.extrapolate);
+    extrapolate = ParseExtrapolationOption(options.extrapolate);
   const exporter::ExrOptions exr_options =
       ParseExrOptions(options.exr_type, options.exr_compression);
   const engines::EngineSet engine_set = engines::ParseEngines(options.engines);
@@ -45,8 +45,8 @@ int RunAtlas(const AtlasOptions& options) {
                           JoinArguments(options.inputs));
   }
 
-  std::vector<std::string> outputs = {options.out + ".ktx2", options.out + ".dds",
-                                      options.out + ".exr", options.out + ".json"};
+  // The writers' own lists (exporter::AtlasOutputPaths, engines::EngineOutputPaths).
+  std::vector<std::string> outputs = exporter::AtlasOutputPaths(options.out);
   const fs::path prefix(options.out);
   const std::string engine_dir =
       prefix.has_parent_path() ? prefix.parent_path().string() : std::string(".");

@@ -22,6 +22,7 @@
 #include "brdf/device/simulator.h"
 #include "brdf/device/transport.h"
 #include "brdf/device/usb_models.h"
+#include "brdf/sources/open.h"
 #include "cli_support.h"
 #include "commands.h"
 
@@ -211,9 +212,15 @@ int RunCapture(const CaptureOptions& o) {
   const device::ExposureSetting exposure = ParseExposure(o.exposure);
   if (sim && o.material.empty())
     throw InvalidArgument("--material: the simulated instrument needs a virtual sample");
-  const std::string material_path = sim ? ResolveMaterial(o.material) : std::string();
-  std::shared_ptr<const BrdfSource> source =
-      sim ? OpenBrdfSource(material_path) : std::shared_ptr<const BrdfSource>();
+  // The virtual sample: a library name or any evaluable file, opened by content
+  // (brdf::sources::OpenBrdf, the rule of every command).
+  const std::string material_path = sim ? sources::ResolveSource(o.material) : std::string();
+  std::shared_ptr<const BrdfSource> source;
+  if (sim) {
+    sources::OpenedSource opened = sources::OpenBrdf(material_path);
+    for (const std::string& w : opened.warnings) std::fprintf(stderr, "%s\n", w.c_str());
+    source = std::move(opened.brdf);
+  }
 
   // The simulated instrument: the reference model with the requested light-arm positions and
   // detector steps (a real instrument reports its own and refuses what it cannot do).

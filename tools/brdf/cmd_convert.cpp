@@ -29,21 +29,6 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// The files ExportLut writes for `name`, in its order.
-std::vector<std::string> OutputPaths(const fs::path& dir, const std::string& name,
-                                     const exporter::LutExportFormats& f) {
-  std::vector<std::string> paths;
-  const auto add = [&](bool on, const char* ext) {
-    if (on) paths.push_back((dir / (name + ext)).string());
-  };
-  add(f.ktx2, ".ktx2");
-  add(f.dds, ".dds");
-  add(f.exr, ".exr");
-  add(f.png, ".png");
-  add(f.json, ".json");
-  return paths;
-}
-
 // Refuses inputs whose outputs would collide with another input's outputs or overwrite an
 // input (a material "gold.json" converted into its own folder would be replaced by the sidecar
 // "gold.json"). Such inputs move from `inputs` to `failures`.
@@ -67,7 +52,8 @@ void RefuseCollisions(const fs::path& out_dir, const exporter::LutExportFormats&
   }
   for (std::size_t i = 0; i < inputs.size(); ++i) {
     if (reasons.count(i)) continue;
-    for (const std::string& out : OutputPaths(out_dir, inputs[i].name, formats))
+    for (const std::string& out :
+         exporter::LutExportPaths(out_dir.string(), inputs[i].name, formats))
       if (input_paths.count(Identity(out))) {
         reasons[i] = "its output " + out + " would overwrite an input; choose another --out folder";
         break;
@@ -103,7 +89,7 @@ int RunConvert(const ConvertOptions& options) {
   std::optional<processing::ExtrapolationParams> extrapolate;
   const bool auto_extrapolate = options.extrapolate == "auto";  // fitted per input (brdf fit)
   if (!options.extrapolate.empty() && !auto_extrapolate)
-    extrapolate = processing::ParseExtrapolation(options.extrapolate);
+    extrapolate = ParseExtrapolationOption(options.extrapolate);
   if (options.jobs < 1)
     throw InvalidArgument("--jobs: expected at least 1, got " + std::to_string(options.jobs));
 
@@ -123,7 +109,8 @@ int RunConvert(const ConvertOptions& options) {
     // The overwrite rule, for every output of the run before any work is done.
     std::vector<std::string> outputs, names;
     for (const BatchInput& in : found.inputs) {
-      for (std::string& p : OutputPaths(out_dir, in.name, export_options.formats))
+      for (std::string& p :
+           exporter::LutExportPaths(out_dir.string(), in.name, export_options.formats))
         outputs.push_back(std::move(p));
       names.push_back(in.name);
     }
@@ -169,7 +156,8 @@ int RunConvert(const ConvertOptions& options) {
         metadata.source = in.path;
         metadata.extrapolation = built.extrapolation;
         metadata.saturated_samples = built.saturated_samples;
-        std::vector<std::string> outputs = OutputPaths(out_dir, in.name, export_options.formats);
+        std::vector<std::string> outputs =
+            exporter::LutExportPaths(out_dir.string(), in.name, export_options.formats);
         for (std::string& p : engines::EngineOutputPaths(out_dir.string(), in.name, engine_set))
           outputs.push_back(std::move(p));
         const OutputGuard guard(std::move(outputs));

@@ -18,6 +18,7 @@
 #include "brdf/core/file_util.h"
 #include "brdf/core/geometry.h"
 #include "brdf/sources/open.h"
+#include "cli_support.h"
 #include "commands.h"
 
 namespace brdf::cli {
@@ -83,8 +84,7 @@ int RunEval(const EvalOptions& options) {
         {options.theta_in_deg, options.phi_in_deg, options.theta_out_deg, options.phi_out_deg});
   }
   std::optional<processing::ExtrapolationParams> extrapolate;
-  if (!options.extrapolate.empty())
-    extrapolate = processing::ParseExtrapolation(options.extrapolate);
+  if (!options.extrapolate.empty()) extrapolate = ParseExtrapolationOption(options.extrapolate);
   sources::OpenOptions open_options;
   open_options.extrapolation = extrapolate;
   const sources::OpenedSource source = sources::OpenBrdf(options.file, open_options);

@@ -12,6 +12,7 @@
 #include "brdf/core/measurement.h"
 #include "brdf/sources/capture.h"
 #include "brdf/sources/detect.h"
+#include "brdf/sources/material_library.h"
 #include "cli_support.h"
 #include "commands.h"
 
@@ -44,31 +45,33 @@ void CheckFinite(const Measurement& m, const std::string& file) {
 }  // namespace
 
 int RunExportCsv(const ExportCsvOptions& options) {
+  // A library material name stands for its file (brdf/sources/material_library.h).
+  const std::string file = sources::ResolveSource(options.file);
   // By content, as every command recognises a file (a capture under another name is one).
-  const sources::FileKind kind = sources::DetectFileKind(options.file);
+  const sources::FileKind kind = sources::DetectFileKind(file);
   if (kind != sources::FileKind::kCapture)
-    throw InvalidArgument(options.file + ": a " + sources::FileKindName(kind) +
+    throw InvalidArgument(file + ": a " + sources::FileKindName(kind) +
                           "; export-csv reads .bpc captures (bring other formats in with "
                           "`brdf import` first)");
-  CheckOutputPath(options.out, options.file, ".csv", options.force);
+  CheckOutputPath(options.out, file, ".csv", options.force);
   // The capture rule of every command (brdf/sources/capture.h), for a copy: damage and
   // inconsistent structure are refused as convert refuses them; an unfinished capture is
   // exported with its incomplete slices marked; a cut end chunk or bytes after it are warnings.
   std::vector<std::string> warnings;
-  const Measurement m = sources::LoadCaptureForCopy(options.file, &warnings);
-  CheckFinite(m, options.file);
+  const Measurement m = sources::LoadCaptureForCopy(file, &warnings);
+  CheckFinite(m, file);
   const std::string text = FormatCsv(m);
   // What is written must read back: a value outside the CSV's validated ranges (θout > 90°,
   // say) is refused now rather than leaving a file `brdf import` rejects.
   try {
     ParseCsv(text, options.out);
   } catch (const FormatError& e) {
-    throw InvalidArgument(options.file + " cannot be written as a CSV point cloud: " + e.what());
+    throw InvalidArgument(file + " cannot be written as a CSV point cloud: " + e.what());
   }
   WriteFileAtomically(options.out, text);
   // Warnings after the work: a refusal stays the one line on stderr.
   for (const std::string& w : warnings) std::fprintf(stderr, "%s\n", w.c_str());
-  std::printf("%s -> %s: %zu slices, %zu samples\n", options.file.c_str(), options.out.c_str(),
+  std::printf("%s -> %s: %zu slices, %zu samples\n", file.c_str(), options.out.c_str(),
               m.slices.size(), m.SampleCount());
   return 0;
 }

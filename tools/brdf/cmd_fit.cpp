@@ -19,6 +19,7 @@
 #include "brdf/core/file_util.h"
 #include "brdf/core/importers.h"
 #include "brdf/fit/fit.h"
+#include "brdf/fit/result_files.h"
 #include "brdf/sources/detect.h"
 #include "brdf/sources/open.h"
 #include "cli_support.h"
@@ -37,33 +38,32 @@ struct FitInput {
   std::string name;
 };
 
-bool IsEvaluableFile(const std::string& path) {
-  const std::string ext = LowerExtension(path);
-  return ext == ".bsdf" || ext == ".binary";
+// The kind of `path` by content (sources::DetectFileKind), kUnknown when it cannot be read or
+// classified (the convert rules then report it).
+sources::FileKind KindOf(const std::string& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return sources::FileKind::kUnknown;
+  try {
+    return sources::DetectFileKind(path);
+  } catch (const Error&) {
+    return sources::FileKind::kUnknown;
+  }
+}
+
+// Measured BRDF files a folder contributes besides its captures and material files.
+bool IsMeasuredBrdf(sources::FileKind kind) {
+  using sources::FileKind;
+  return kind == FileKind::kRgl || kind == FileKind::kMerl || kind == FileKind::kZemax ||
+         kind == FileKind::kLightTools;
 }
 
 // A file named on the command line that is fitted as it is, not through the convert rules:
 // measured databases, imported tables and exported LUTs (sources::PrepareMeasurement).
 bool IsDirectInput(const std::string& path) {
-  if (IsEvaluableFile(path)) return true;
-  std::error_code ec;
-  if (!fs::is_regular_file(path, ec)) return false;
-  try {
-    switch (sources::DetectFileKind(path)) {
-      case sources::FileKind::kZemax:
-      case sources::FileKind::kLightTools:
-      case sources::FileKind::kCsv:
-      case sources::FileKind::kGonio:
-      case sources::FileKind::kKtx2:
-      case sources::FileKind::kDds:
-      case sources::FileKind::kSidecar:
-        return true;
-      default:
-        return false;
-    }
-  } catch (const Error&) {
-    return false;  // the convert rules report it
-  }
+  using sources::FileKind;
+  const FileKind kind = KindOf(path);
+  return IsMeasuredBrdf(kind) || kind == FileKind::kCsv || kind == FileKind::kGonio ||
+         kind == FileKind::kKtx2 || kind == FileKind::kDds || kind == FileKind::kSidecar;
 }
 
 Measurement OpenForFit(const std::string& path, std::vector<std::string>* warnings) {
@@ -119,8 +119,9 @@ int RunFit(const FitCommandOptions& options) {
   if (options.max_theta_out_deg > 0) fit.max_theta_out_deg = options.max_theta_out_deg;
   fit.starts = options.starts;
 
-  // Inputs: measured BRDF files (.bsdf, .binary) directly or from folders, everything else
-  // through the convert rules (captures and material files).
+  // Inputs: measured BRDF files (RGL, MERL, Zemax, LightTools; by content) directly or from
+  // folders, tables and exported LUTs directly, everything else through the convert rules
+  // (captures and material files).
   std::vector<FitInput> inputs;
   std::vector<BatchFailure> failures;
   std::vector<std::string> rest;
@@ -129,7 +130,7 @@ int RunFit(const FitCommandOptions& options) {
     if (fs::is_directory(arg, ec)) {
       std::vector<std::string> evaluable;
       for (const auto& e : fs::directory_iterator(arg, ec))
-        if (e.is_regular_file() && IsEvaluableFile(e.path().string()))
+        if (e.is_regular_file() && IsMeasuredBrdf(KindOf(e.path().string())))
           evaluable.push_back(e.path().string());
       std::sort(evaluable.begin(), evaluable.end());
       for (const std::string& f : evaluable) inputs.push_back({f, sources::OutputNameOf(f)});
@@ -177,38 +178,32 @@ int RunFit(const FitCommandOptions& options) {
     inputs = std::move(kept);
   }
 
-  // Output names: one input and one model write --out itself.
-  const bool single = inputs.size() == 1 && failures.empty() && models.size() == 1;
-  auto output_of = [&](const FitInput& in, Model m) {
-    if (single) return options.out;
-    if (inputs.size() == 1 && LowerExtension(options.out) == ".json") {
-      const fs::path p(options.out);
-      return (p.parent_path() / (p.stem().string() + "." + std::string(ModelName(m)) + ".json"))
-          .string();
+  // Output names (brdf/fit/result_files.h): one input and one model write --out itself.
+  const processing::FitResultFiles files{
+      options.out, inputs.size() == 1 && failures.empty() && models.size() == 1,
+      inputs.size() == 1};
+  auto output_of = [&](const FitInput& in, Model m) { return files.PathOf(in.name, m); };
+  // The overwrite rule of every writing command, on exactly the files the fits will write,
+  // before any fit runs.
+  {
+    std::vector<std::string> names;
+    for (const FitInput& in : inputs) names.push_back(in.name);
+    const std::vector<std::string> outputs = files.Paths(names, models);
+    if (files.single) {
+      CheckOutputPath(options.out, inputs.front().path, ".json", options.force);
+    } else {
+      std::set<std::string> input_paths;
+      for (const FitInput& in : inputs) input_paths.insert(Identity(in.path));
+      for (const FitInput& in : inputs)
+        for (Model m : models)
+          if (input_paths.count(Identity(output_of(in, m))))
+            throw InvalidArgument(output_of(in, m) + ": the result of " + in.path +
+                                  " would overwrite an input; choose another --out");
+      ReportRemovedTemporaries(CheckWritableOutputs(outputs, options.force));
     }
-    return (fs::path(options.out) / (in.name + "." + std::string(ModelName(m)) + ".json")).string();
-  };
-  // The folder the results go to exists before any fit runs (the parent of a .json --out).
-  if (single) {
-    CheckOutputPath(options.out, inputs.front().path, ".json", options.force);
-    CreateOutputFolder(fs::path(options.out).parent_path().string());
-  } else if (inputs.size() == 1 && LowerExtension(options.out) == ".json") {
-    CreateOutputFolder(fs::path(options.out).parent_path().string());
-  } else {
-    CreateOutputFolder(options.out);
   }
-  std::set<std::string> input_paths;
-  for (const FitInput& in : inputs) input_paths.insert(Identity(in.path));
-  for (const FitInput& in : inputs)
-    for (Model m : models) {
-      const std::string out = output_of(in, m);
-      if (input_paths.count(Identity(out)))
-        throw InvalidArgument(out + ": the result of " + in.path +
-                              " would overwrite an input; choose another --out");
-      std::error_code ec;
-      if (!options.force && fs::exists(out, ec))
-        throw InvalidArgument(out + ": already exists; pass --force to overwrite it");
-    }
+  // The folder the results go to exists before any fit runs (the parent of a .json --out).
+  CreateOutputFolder(files.Folder());
 
   for (const BatchFailure& f : failures)
     std::fprintf(stderr, "%s: FAILED: %s\n", f.path.c_str(), f.reason.c_str());

@@ -24,44 +24,46 @@
 #include "brdf/core/rgl.h"
 #include "brdf/core/virtual_capture.h"
 #include "brdf/sources/detect.h"
+#include "brdf/sources/material_library.h"
 #include "cli_support.h"
 #include "commands.h"
 
 namespace brdf::cli {
 
 int RunImport(const ImportOptions& options) {
+  // A library material name stands for its file (brdf/sources/material_library.h).
+  const std::string file = sources::ResolveSource(options.file);
   const ImportFormat requested = ImportFormatFromName(options.format);
   // Detecting first also checks that the input can be opened before the output is judged.
   ImportFormat format = requested;
   if (requested == ImportFormat::kAuto) {
-    const sources::FileKind kind = sources::DetectFileKind(options.file);
+    const sources::FileKind kind = sources::DetectFileKind(file);
     const std::optional<ImportFormat> detected = sources::ImportFormatOf(kind);
     if (!detected)
-      throw FormatError(options.file, "file content",
-                        "a third-party measurement (RGL .bsdf, Zemax or LightTools BSDF text, "
-                        "MERL .binary, CSV point cloud, goniometer table)",
-                        std::string("a ") + sources::FileKindName(kind), {},
-                        kind == sources::FileKind::kUnknown
-                            ? Remedy{RemedyKind::kNameFormat, options.file}
-                            : Remedy{});
+      throw FormatError(
+          file, "file content",
+          "a third-party measurement (RGL .bsdf, Zemax or LightTools BSDF text, "
+          "MERL .binary, CSV point cloud, goniometer table)",
+          std::string("a ") + sources::FileKindName(kind), {},
+          kind == sources::FileKind::kUnknown ? Remedy{RemedyKind::kNameFormat, file} : Remedy{});
     format = *detected;
   }
-  CheckOutputPath(options.out, options.file, ".bpc", options.force);
+  CheckOutputPath(options.out, file, ".bpc", options.force);
 
   Measurement m;
   if (format == ImportFormat::kRgl || format == ImportFormat::kMerl) {
     // By format, not extension: `--format rgl` may name a file called anything.
     if (format == ImportFormat::kRgl)
-      m = CaptureNoiseFree(RglBrdf::Load(options.file));
+      m = CaptureNoiseFree(RglBrdf::Load(file));
     else
-      m = CaptureNoiseFree(MerlBrdf::Load(options.file));
-    m.metadata.sample_name = options.file;
-    m.metadata.extra["source_file"] = options.file;
+      m = CaptureNoiseFree(MerlBrdf::Load(file));
+    m.metadata.sample_name = file;
+    m.metadata.extra["source_file"] = file;
     m.metadata.extra["source_format"] = ImportFormatName(format);
   } else {
     brdf::ImportOptions import_options;
     import_options.allow_btdf = options.allow_btdf;
-    m = ImportFile(options.file, format, import_options);
+    m = ImportFile(file, format, import_options);
   }
   if (!options.sample.empty()) m.metadata.sample_name = options.sample;
   // A CSV written by `brdf export-csv` names the software that made the capture; keep it.
@@ -77,7 +79,7 @@ int RunImport(const ImportOptions& options) {
     std::snprintf(buf, sizeof buf, "%s%g", thetas.empty() ? "" : ", ", t);
     thetas += buf;
   }
-  std::printf("%s: %s file -> %s: %zu slices (theta_in %s deg), %zu samples", options.file.c_str(),
+  std::printf("%s: %s file -> %s: %zu slices (theta_in %s deg), %zu samples", file.c_str(),
               ImportFormatName(format).c_str(), options.out.c_str(), m.slices.size(),
               thetas.c_str(), m.SampleCount());
   if (invalid > 0) std::printf(", %zu flagged invalid", invalid);

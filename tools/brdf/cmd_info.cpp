@@ -657,18 +657,20 @@ void PrintTextureText(const Json& j) {
 
 int RunInfo(const InfoOptions& options) {
   using sources::FileKind;
-  const FileKind kind = sources::DetectFileKind(options.file);
+  // A library material name stands for its file (brdf/sources/material_library.h).
+  const std::string file = sources::ResolveSource(options.file);
+  const FileKind kind = sources::DetectFileKind(file);
   Json j;
   if (kind == FileKind::kCapture) {
-    j = DescribeBpc(options.file);
+    j = DescribeBpc(file);
   } else if (kind == FileKind::kMaterial) {
-    j = DescribeMaterial(options.file);
+    j = DescribeMaterial(file);
   } else if (sources::IsExportedLut(kind)) {
-    j = DescribeTexture(options.file);
+    j = DescribeTexture(file);
   } else if (const std::optional<ImportFormat> format = sources::ImportFormatOf(kind)) {
-    j = DescribeImported(options.file, *format);
+    j = DescribeImported(file, *format);
   } else {
-    throw InvalidArgument(options.file + ": a " + std::string(sources::FileKindName(kind)) +
+    throw InvalidArgument(file + ": a " + std::string(sources::FileKindName(kind)) +
                           "; brdf info reads captures (.bpc), material files, exported LUTs "
                           "(.ktx2, .dds, sidecar and atlas manifest .json), RGL .bsdf, MERL "
                           ".binary, Zemax and LightTools BSDF tables, CSV point clouds and "
@@ -689,7 +691,7 @@ int RunInfo(const InfoOptions& options) {
   // can check files with `brdf info`.
   if (j.contains("usable") && !j["usable"].get<bool>()) {
     const std::size_t n = j["refusals"].size();
-    std::fprintf(stderr, "brdf: %s: %zu problem%s that %s refuse%s%s\n", options.file.c_str(), n,
+    std::fprintf(stderr, "brdf: %s: %zu problem%s that %s refuse%s%s\n", file.c_str(), n,
                  n == 1 ? "" : "s", JudgingCommands(j), IsImportedFormat(j) ? "s" : "",
                  options.json ? " (listed under \"refusals\")" : " (listed above)");
     return 1;

@@ -4,7 +4,7 @@
 #include <string>
 
 #include "brdf/core/models.h"
-#include "cli_support.h"
+#include "brdf/sources/material_library.h"
 #include "commands.h"
 
 namespace brdf::cli {
@@ -12,7 +12,7 @@ namespace brdf::cli {
 int RunMaterials(const MaterialsOptions& options) {
   nlohmann::ordered_json list = nlohmann::ordered_json::array();
   if (!options.json) std::printf("%-22s %-12s %s\n", "NAME", "MODEL", "DESCRIPTION");
-  for (const std::string& file : MaterialLibraryFiles()) {
+  for (const std::string& file : sources::MaterialLibraryFiles()) {
     const Material m = LoadMaterialFile(file);
     const std::string name = std::filesystem::path(file).stem().string();
     if (options.json) {

@@ -257,7 +257,7 @@ int RunPreview(const PreviewCommandOptions& cli) {
   const preview::EnvironmentMap map = preview::EnvironmentMap::FromName(cli.env);
 
   std::optional<processing::ExtrapolationParams> extrapolate;
-  if (!cli.extrapolate.empty()) extrapolate = processing::ParseExtrapolation(cli.extrapolate);
+  if (!cli.extrapolate.empty()) extrapolate = ParseExtrapolationOption(cli.extrapolate);
   std::vector<std::string> warnings;
   sources::OpenOptions open_options;
   open_options.extrapolation = extrapolate;

@@ -6,6 +6,7 @@
 
 #include "brdf/core/error.h"
 #include "brdf/sources/capture.h"
+#include "brdf/sources/material_library.h"
 #include "cli_support.h"
 #include "commands.h"
 
@@ -25,8 +26,10 @@ std::string DegList(const std::vector<double>& values) {
 }  // namespace
 
 int RunRepair(const RepairOptions& options) {
-  CheckOutputPath(options.out, options.file, ".bpc", options.force);
-  const sources::RepairReport r = sources::RepairCapture(options.file, options.out, options.force);
+  // A library material name stands for its file (brdf/sources/material_library.h).
+  const std::string file = sources::ResolveSource(options.file);
+  CheckOutputPath(options.out, file, ".bpc", options.force);
+  const sources::RepairReport r = sources::RepairCapture(file, options.out, options.force);
   std::printf("%s -> %s: kept %zu slice%s (theta_in %s deg), %llu bytes\n", r.input.c_str(),
               r.output.c_str(), r.kept_theta_in_deg.size(),
               r.kept_theta_in_deg.size() == 1 ? "" : "s", DegList(r.kept_theta_in_deg).c_str(),

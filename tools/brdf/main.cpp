@@ -133,6 +133,11 @@ std::string OptionWithoutValue(CLI::App& app, int argc, char** argv) {
   return {};
 }
 
+// Said wherever a source argument is described: how a name and a file of that name are told apart
+// (brdf/sources/material_library.h).
+constexpr const char* kLibraryNames =
+    " ('brdf materials' lists them; a file of the same name wins)";
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -158,7 +163,8 @@ int main(int argc, char** argv) {
                    "Material file (.json), capture (.bpc), exported LUT (.ktx2, .dds), LUT "
                    "sidecar (.json), or measured data: RGL .bsdf, MERL .binary, or a table "
                    "interpolated like a capture (Zemax or LightTools .bsdf, CSV point cloud, "
-                   "goniometer table; detected by content)")
+                   "goniometer table; detected by content), or a library material name" +
+                       std::string(kLibraryNames))
       ->required();
   auto* eval_in_opt = eval_cmd->add_option("--in", eval_in, "Light direction THETA,PHI in degrees")
                           ->check(AnglePairValidator());
@@ -210,8 +216,9 @@ int main(int argc, char** argv) {
                    "under umockdev-wrapper)")
       ->capture_default_str();
   capture_cmd->add_option("--material", capture.material,
-                          "Virtual sample of --device sim (required for it): a library name ('brdf "
-                          "materials') or a material .json");
+                          "Virtual sample of --device sim (required for it): a library material "
+                          "name or any file 'brdf eval' reads" +
+                              std::string(kLibraryNames));
   capture_cmd->add_option("--sample", capture.sample, "Sample name recorded in the file")
       ->required();
   capture_cmd->add_option("--out", capture.out, "Output .bpc file")->required();
@@ -299,7 +306,9 @@ int main(int argc, char** argv) {
       "MERL .binary)");
   info_cmd
       ->add_option("file", info.file,
-                   "File to describe (.bpc, .json, .ktx2, .dds, .bsdf, .csv, .binary)")
+                   "File to describe (.bpc, .json, .ktx2, .dds, .bsdf, .csv, .binary) or a "
+                   "library material name" +
+                       std::string(kLibraryNames))
       ->required();
   info_cmd->add_flag("--json", info.json, "Print JSON instead of text");
   info_cmd->callback([&] { exit_code = brdf::cli::RunInfo(info); });
@@ -313,7 +322,9 @@ int main(int argc, char** argv) {
       "contact image) and .json (sidecar)");
   convert_cmd
       ->add_option("inputs", convert.inputs,
-                   "Capture files, material files, or folders of them (not recursive)")
+                   "Capture files, material files, or folders of them (not recursive), or "
+                   "library material names" +
+                       std::string(kLibraryNames))
       ->required();
   convert_cmd->add_option("--out", convert.out, "Output folder (created if missing)")->required();
   convert_cmd
@@ -371,7 +382,8 @@ int main(int argc, char** argv) {
   atlas_cmd
       ->add_option("inputs", atlas.inputs,
                    "Captures, material files, exported LUTs (.ktx2, .dds, sidecar .json), "
-                   "or folders of captures and material files")
+                   "or folders of captures and material files, or library material names" +
+                       std::string(kLibraryNames))
       ->required();
   atlas_cmd->add_option("--out", atlas.out, "Output prefix (PREFIX.ktx2, ...)")->required();
   atlas_cmd
@@ -403,8 +415,15 @@ int main(int argc, char** argv) {
   // brdf materials
   brdf::cli::MaterialsOptions materials;
   auto* materials_cmd =
-      app.add_subcommand("materials", "List the virtual sample library of the simulator");
+      app.add_subcommand("materials",
+                         "List the virtual sample library: the material names every command "
+                         "that reads a source accepts, and the simulator's samples");
   materials_cmd->add_flag("--json", materials.json, "Print JSON instead of a table");
+  materials_cmd->footer(
+      "The library is the folder $BRDF_MATERIALS_DIR when set, else the installed "
+      "<prefix>/share/brdf-toolchain/materials (found from the brdf executable's folder), else "
+      "the source tree's data-samples/materials. A file of the same name as a library material "
+      "wins over it: 'brdf eval gold' reads ./gold if it exists.");
   materials_cmd->callback([&] { exit_code = brdf::cli::RunMaterials(materials); });
 
   // brdf import
@@ -470,7 +489,9 @@ int main(int argc, char** argv) {
                    "Captures (.bpc), material files (.json), RGL .bsdf or MERL .binary files, "
                    "third-party tables (Zemax, LightTools, CSV, goniometer), exported LUTs "
                    "(.ktx2, .dds, sidecar .json), or folders of captures, material files and "
-                   ".bsdf/.binary files")
+                   "measured BRDF files (RGL, MERL, Zemax, LightTools; recognised by content), "
+                   "or library material names" +
+                       std::string(kLibraryNames))
       ->required();
   fit_cmd
       ->add_option("--model", fit.model,
@@ -614,12 +635,8 @@ int main(int argc, char** argv) {
     if (e.get_exit_code() == 0) return app.exit(e);
     std::fprintf(stderr, "%s\n", OneLineParseError(app, e).c_str());
     return 2;
-  } catch (const brdf::OutputExistsError& e) {
-    // The overwrite rule of every writing command (brdf/core/file_util.h), in our words.
-    std::fprintf(stderr, "brdf: error: %s; use --force to overwrite %s\n", e.what(),
-                 e.paths().size() == 1 ? "it" : "them");
-    return 1;
   } catch (const brdf::Error& e) {
+    // Every remedy (--force for an existing output included) rendered by cli::RemedyText.
     const std::string command =
         app.get_subcommands().empty() ? std::string() : app.get_subcommands().front()->get_name();
     std::fprintf(stderr, "brdf: error: %s\n", brdf::cli::ErrorLine(e, command).c_str());

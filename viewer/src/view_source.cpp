@@ -5,6 +5,7 @@
 
 #include "brdf/core/error.h"
 #include "brdf/core/geometry.h"
+#include "brdf/core/virtual_capture.h"
 #include "brdf/processing/resample.h"
 #include "brdf/viewer/lobe.h"
 
@@ -106,9 +107,8 @@ Coverage ViewSource::CoverageAt(double theta_in_deg, double theta_out_deg,
   if (coverage.empty() || lut.slices() == 0) return Coverage::kMeasured;
   // The LUT blends slices k and k+1 at the same specular-frame coordinates (θd, φd), which
   // are different outgoing directions in each slice: check each slice at its own direction.
-  const double delta = lut.DeltaInDeg();
-  double k_real = delta > 0 ? (theta_in_deg - lut.theta_in_deg.front()) / delta : 0.0;
-  k_real = std::clamp(k_real, 0.0, static_cast<double>(lut.slices() - 1));
+  const double k_real =
+      std::clamp(lut.SliceCoordinate(theta_in_deg), 0.0, static_cast<double>(lut.slices() - 1));
   const int k0 = static_cast<int>(std::floor(k_real));
   const int k1 = std::min(k0 + 1, lut.slices() - 1);
   const double frac = k_real - k0;
@@ -140,13 +140,11 @@ double ViewSource::MaxValue(int channel) const {
   return max_value;
 }
 
-ViewSource ViewSourceFromMeasurement(const Measurement& measurement,
-                                     const processing::ExtrapolationParams& params,
-                                     std::string name) {
-  processing::ResampleReport report;
+ViewSource ViewSourceFromResampled(const Measurement& measurement, Lut lut,
+                                   const processing::ResampleReport& report, std::string name) {
   ViewSource out;
   out.name = std::move(name);
-  out.lut = processing::BuildLut(measurement, params, {}, &report);
+  out.lut = std::move(lut);
   out.theta_b_deg = report.theta_b_deg;
   for (int k = 0; k < out.lut.slices(); ++k) {
     const double theta_in = out.lut.theta_in_deg[k];
@@ -166,6 +164,14 @@ ViewSource ViewSourceFromMeasurement(const Measurement& measurement,
   return out;
 }
 
+ViewSource ViewSourceFromMeasurement(const Measurement& measurement,
+                                     const processing::ExtrapolationParams& params,
+                                     std::string name) {
+  processing::ResampleReport report;
+  Lut lut = processing::BuildLut(measurement, params, {}, &report);
+  return ViewSourceFromResampled(measurement, std::move(lut), report, std::move(name));
+}
+
 ViewSource ViewSourceFromLut(Lut lut, std::string name, double theta_b_deg) {
   ViewSource out;
   out.name = std::move(name);
@@ -175,28 +181,7 @@ ViewSource ViewSourceFromLut(Lut lut, std::string name, double theta_b_deg) {
 }
 
 ViewSource ViewSourceFromBrdf(const BrdfSource& source, std::string name) {
-  Measurement m;
-  m.metadata.sample_name = source.Name();
-  m.metadata.instrument_model = "noise-free evaluation at the reference geometry";
-  for (double theta_in : {0.0, 20.0, 40.0, 60.0}) {
-    Slice slice;
-    slice.theta_in_deg = theta_in;
-    const Vec3 wi = SphericalDirectionDeg(theta_in, 0.0);
-    slice.samples.reserve(76 * 360);
-    for (int t = 0; t <= 75; ++t) {
-      for (int p = 0; p < 360; ++p) {
-        const Rgb f = source.Eval(wi, SphericalDirectionDeg(t, p));
-        Sample s;
-        s.theta_in_deg = static_cast<float>(theta_in);
-        s.theta_out_deg = static_cast<float>(t);
-        s.phi_out_deg = static_cast<float>(p);
-        s.rgb = {static_cast<float>(f[0]), static_cast<float>(f[1]), static_cast<float>(f[2])};
-        slice.samples.push_back(s);
-      }
-    }
-    m.slices.push_back(std::move(slice));
-  }
-  return ViewSourceFromMeasurement(m, {}, std::move(name));
+  return ViewSourceFromMeasurement(CaptureNoiseFree(source), {}, std::move(name));
 }
 
 }  // namespace brdf::viewer

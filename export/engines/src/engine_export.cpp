@@ -740,7 +740,7 @@ std::vector<std::string> EngineOutputsToCheck(const std::string& out_dir,
 std::vector<std::string> ReadFitResults(const std::string& fits_dir, const std::string& name) {
   std::error_code ec;
   if (!fs::is_directory(fits_dir, ec))
-    throw IoError(fits_dir + ": not a folder (expected the folder `brdf fit --out` wrote)");
+    throw IoError(fits_dir + ": not a folder (expected a folder of fit results NAME.MODEL.json)");
   std::vector<std::string> files;
   const std::string prefix = name + ".";
   for (fs::directory_iterator it(fits_dir, ec), end; !ec && it != end; it.increment(ec)) {

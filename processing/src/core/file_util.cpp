@@ -95,7 +95,9 @@ std::vector<std::string> RemoveStaleTemporaries(const std::string& dir) {
 }
 
 OutputExistsError::OutputExistsError(std::vector<std::string> paths)
-    : IoError(ExistsMessage(paths)), paths_(std::move(paths)) {}
+    : IoError(ExistsMessage(paths), Remedy{RemedyKind::kForceOverwrite,
+                                           paths.size() == 1 ? paths.front() : std::string()}),
+      paths_(std::move(paths)) {}
 
 std::vector<std::string> CheckWritableOutputs(const std::vector<std::string>& paths,
                                               bool overwrite) {

@@ -80,7 +80,7 @@ double ExtrapolationFactor(double theta_out_deg, double theta_b_deg,
 
 ExtrapolationParams ParseExtrapolation(std::string_view text) {
   const auto fail = [&](const std::string& why) -> ExtrapolationParams {
-    throw InvalidArgument("--extrapolate '" + std::string(text) +
+    throw InvalidArgument("extrapolation parameters '" + std::string(text) +
                           "': expected P,L (two numbers, e.g. 0.2,0.3): " + why);
   };
   const auto comma = text.find(',');

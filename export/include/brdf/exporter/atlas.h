@@ -73,6 +73,10 @@ FloatImage AtlasImage(const std::vector<AtlasMaterial>& materials);
 // The manifest JSON. `files` lists the written file names (no folder).
 std::string AtlasManifestJson(const Atlas& atlas, const std::vector<std::string>& files);
 
+// The files WriteAtlas writes for `prefix`, in its order: PREFIX.ktx2, .dds, .exr, .json (the
+// list a caller's overwrite check covers before any work).
+std::vector<std::string> AtlasOutputPaths(const std::string& prefix);
+
 // Writes PREFIX.ktx2, PREFIX.dds, PREFIX.exr and PREFIX.json (the manifest), each atomically,
 // and returns the paths written. The manifest is also embedded in the KTX2 ("brdf.atlas") and
 // the EXR ("brdf:atlas"). Throws InvalidArgument / IoError.

@@ -37,6 +37,11 @@ struct LutExportResult {
   std::uint32_t payload_crc32 = 0;   // the sidecar's checksum
 };
 
+// The files ExportLut writes for `name` into `out_dir` with `formats`, in its order (ktx2, dds,
+// exr, png, json): the list a caller's overwrite check covers before any work.
+std::vector<std::string> LutExportPaths(const std::string& out_dir, const std::string& name,
+                                        const LutExportFormats& formats);
+
 // `metadata.name` names the files (must be non-empty and a plain file name);
 // `metadata.companion_files` is filled in here. The folder must exist.
 // Throws InvalidArgument (bad name, unexportable LUT) or IoError.

@@ -1,6 +1,7 @@
 // Anything that can be evaluated as a BRDF: an analytic material, a measured database file
 // (RGL, MERL), an interpolated capture. The simulated scatterometer captures any BrdfSource,
-// and `brdf eval` prints one.
+// and `brdf eval` prints one. Files are opened as BrdfSources by brdf::sources::OpenBrdf
+// (brdf/sources/open.h), by content.
 #pragma once
 
 #include <memory>
@@ -47,10 +48,5 @@ class AnalyticBrdf final : public BrdfSource {
  private:
   Material material_;
 };
-
-// Opens any evaluable file by its content and extension. Material JSON files are
-// supported here; measured formats register as their readers land.
-// Throws FormatError / IoError naming the file.
-std::unique_ptr<BrdfSource> OpenBrdfSource(const std::string& path);
 
 }  // namespace brdf

@@ -22,8 +22,8 @@ namespace brdf {
 // said so (the tools' --force); an existing path that is not a regular file (a folder, a FIFO,
 // a device) is never replaced. Call it for every output before any work is done.
 //
-// Thrown when an output exists and overwriting was not allowed. The remedy is structured: the
-// caller knows the user can allow it (brdf's --force) and says so in its own words.
+// Thrown when an output exists and overwriting was not allowed, with Remedy kForceOverwrite (its
+// file: the one existing output, empty when several exist) that each tool renders in its words.
 class OutputExistsError : public IoError {
  public:
   explicit OutputExistsError(std::vector<std::string> paths);

@@ -3,7 +3,7 @@
 //
 // Point-cloud formats (Zemax and LightTools BSDF tables, CSV point clouds, goniometer tables)
 // become a Measurement directly. RGL `.bsdf` and MERL `.binary` files are evaluable BRDFs, not
-// point clouds: they are opened with OpenBrdfSource (brdf_source.h) and turned into a
+// point clouds: they are loaded by their readers (rgl.h, merl.h) and turned into a
 // Measurement by a virtual capture; ImportFile recognises them and says so (see ImportFile).
 #pragma once
 

@@ -108,7 +108,7 @@ struct RepairReport {
 // slices renumbered 0…n−1, no end chunk), so that resuming `output` captures exactly the
 // missing slices. The file appears atomically (written beside `output` under a temporary name
 // and renamed). `output` must not be `input`, and must not exist unless `overwrite`
-// (InvalidArgument with RemedyKind::kForceOverwrite). An intact finished capture has nothing
+// (brdf::CheckWritableOutput: OutputExistsError, kForceOverwrite). An intact capture has nothing
 // to repair: InvalidArgument. Throws FormatError when not even the header is readable, IoError.
 RepairReport RepairCapture(const std::string& input, const std::string& output,
                            bool overwrite = false);

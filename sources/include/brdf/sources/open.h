@@ -1,10 +1,17 @@
 // Opening any input of the toolchain with one call: the fitter, the previewer, the viewer and
 // every `brdf` command ask these functions, so they agree on what a file holds.
 //
-//  - OpenBrdf: any evaluable file as a BrdfSource (`brdf eval`, the viewer, comparisons).
+//  - OpenBrdf: any evaluable file as a BrdfSource (`brdf eval`, `brdf preview`, `capture
+//    --material`).
+//  - OpenForView: the BRDF and the LUT of one source from one read and one resampling
+//    (brdf-view's lobes, heat maps and preview).
 //  - LutFromInput: any input as the float LUT of docs/design.md §5 (`brdf convert`, `atlas`).
 //  - OpenExportedTexture: an exported LUT or atlas read back with its sidecar or manifest.
 //  - ChooseExtrapolation: the §6 parameters that apply to one input.
+//
+// OpenBrdf and OpenForView take a file or the name of a library material ("gold"; the rule of
+// brdf/sources/material_library.h: a file of that name wins). The functions that take a
+// FileKind take a path the caller has resolved (ResolveSource) and classified (DetectFileKind).
 //
 // One evaluation path. A capture (or an imported table) is evaluated by resampling it into the
 // float LUT exactly as `brdf convert` does (processing::MeasurementAsBrdf) and reading that LUT
@@ -41,6 +48,7 @@
 #include "brdf/processing/extrapolation.h"
 #include "brdf/processing/resample.h"
 #include "brdf/sources/detect.h"
+#include "brdf/sources/material_library.h"
 
 namespace brdf::sources {
 
@@ -138,7 +146,34 @@ struct OpenedSource {
 // RGL .bsdf, MERL .binary, Zemax / LightTools tables, CSV point clouds and goniometer tables
 // (tables evaluated like a capture; transmission tables mirrored, with a warning). Atlases are
 // refused (RemedyKind::kEvaluateSingleLut). Throws IoError / FormatError / InvalidArgument.
-OpenedSource OpenBrdf(const std::string& path, const OpenOptions& options = {});
+OpenedSource OpenBrdf(const std::string& path_or_name, const OpenOptions& options = {});
+
+// One source as brdf-view shows it: the BRDF its preview renders and the LUT its lobes and heat
+// maps sample (docs/design.md §5), both from one read of the file and at most one resampling.
+//  - captures and tables (kResampledLut): the measurement is resampled once (the convert path,
+//    any distinct θin accepted as OpenBrdf accepts them); `brdf` samples that very LUT;
+//  - material files (kAnalytic), RGL and MERL files (kMeasuredDatabase): `brdf` is the
+//    model's formula or the database's interpolation, as OpenBrdf gives it; the LUT is that of
+//    their noise-free capture on the reference geometry (brdf/core/virtual_capture.h) with the
+//    input's extrapolation, as `brdf convert` makes it;
+//  - exported LUTs (kExportedLut): the texture's LUT as stored, `brdf` sampling it.
+// `measurement` and `resample_report` are what the LUT was resampled from and how (absent for
+// exported LUTs), so the viewer can show which directions were measured. Throws what OpenBrdf
+// throws.
+struct OpenedForView {
+  std::string path;  // the file read (a library name resolved to its file)
+  FileKind kind = FileKind::kUnknown;
+  Evaluation evaluation = Evaluation::kAnalytic;
+  std::shared_ptr<const BrdfSource> brdf;
+  Lut lut;
+  // Last measured θout (θb, degrees): the resampling's, an exported LUT's sidecar's, else 90.
+  double theta_b_deg = 90;
+  std::optional<Measurement> measurement;
+  std::optional<processing::ResampleReport> resample_report;
+  std::optional<ExtrapolationChoice> extrapolation;  // what filled θout > θb when resampled
+  std::vector<std::string> warnings;                 // full sentences starting with the path
+};
+OpenedForView OpenForView(const std::string& path_or_name, const OpenOptions& options = {});
 
 // A LUT ready to export or to place in an atlas, built from any input `brdf convert` or
 // `brdf atlas` accepts: captures and material files are resampled (processing::BuildLut with

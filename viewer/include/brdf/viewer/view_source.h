@@ -5,8 +5,9 @@
 // Every picture in brdf-view (lobes, slice heat maps) is drawn from the LUT and sampled the way
 // a GPU samples it (brdf::Lut::SampleAngles: trilinear in the specular frame, so a θin between
 // two measured slices shows the lobe the LUT interpolates, with its peak following the mirror
-// direction). Sources are opened by the tools (tools/brdf/sources.h); this header only turns
-// what they return into a ViewSource. No VTK here.
+// direction). Sources are opened by brdf::sources::OpenForView (brdf/sources/open.h, called by
+// tools/brdf-view), which reads and resamples each once; this header only turns what it
+// returns into a ViewSource. No VTK here.
 #pragma once
 
 #include <cstdint>
@@ -17,6 +18,7 @@
 #include "brdf/core/lut.h"
 #include "brdf/core/measurement.h"
 #include "brdf/processing/extrapolation.h"
+#include "brdf/processing/resample.h"
 
 namespace brdf::viewer {
 
@@ -59,9 +61,14 @@ struct ViewSource {
   double MaxValue(int channel) const;
 };
 
-// A measurement (capture, imported table, noise-free capture of a material): resampled with
-// processing::BuildLut and the given §6 parameters; coverage from its valid samples (a sample
-// covers the 1° cells within its lattice step, or within 1° for scattered data). Throws what
+// A measurement (capture, imported table, noise-free capture of a material) and the LUT that
+// processing::BuildLut made of it, with its report: coverage from the measurement's valid
+// samples (a sample covers the 1° cells within its lattice step, or within 1° for scattered
+// data). Throws InvalidArgument when `report` does not describe `lut`'s slices.
+ViewSource ViewSourceFromResampled(const Measurement& measurement, Lut lut,
+                                   const processing::ResampleReport& report, std::string name);
+
+// ViewSourceFromResampled of BuildLut(measurement, params): resamples it here. Throws what
 // BuildLut throws (InvalidArgument for a measurement it cannot resample).
 ViewSource ViewSourceFromMeasurement(const Measurement& measurement,
                                      const processing::ExtrapolationParams& params,
@@ -70,9 +77,10 @@ ViewSource ViewSourceFromMeasurement(const Measurement& measurement,
 // An exported LUT as stored (no coverage information). `theta_b_deg` from its sidecar if known.
 ViewSource ViewSourceFromLut(Lut lut, std::string name, double theta_b_deg = 90);
 
-// Any evaluable BRDF (RGL, MERL, a fit): captured noise-free on the reference instrument's
-// geometry (θin 0/20/40/60°, θout 0–75°, φout 0–359° at 1°, docs/design.md §1) and resampled with
-// the default §6 parameters, i.e. exactly the LUT `brdf convert` would make from that capture.
+// Any evaluable BRDF (an analytic material, a fit): the virtual capture on the reference
+// instrument's geometry (brdf::CaptureNoiseFree: θin 0/20/40/60°, θout 0–75°, φout 0–359° at 1°,
+// docs/design.md §1) resampled with the default §6 parameters, i.e. exactly the LUT `brdf
+// convert` would make from that capture.
 ViewSource ViewSourceFromBrdf(const BrdfSource& source, std::string name);
 
 }  // namespace brdf::viewer
