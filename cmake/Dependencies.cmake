@@ -30,6 +30,8 @@ endforeach()
 if(BRDF_BUILD_TESTS)
   find_package(GTest REQUIRED)
   include(GoogleTest)
+  # zlib's crc32: the independent oracle of brdf::Crc32 and of the exported payload checksums.
+  find_package(ZLIB REQUIRED)
   find_program(BRDF_PYTHON3 NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH REQUIRED)
   find_program(BRDF_XVFB_RUN xvfb-run)
   find_program(BRDF_NODE node)

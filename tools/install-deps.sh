@@ -16,7 +16,7 @@ packages=(
   libusb-1.0-0-dev libhidapi-dev
   libcli11-dev nlohmann-json3-dev libfmt-dev libspdlog-dev libtbb-dev
   libgtest-dev libgmock-dev libbenchmark-dev
-  umockdev libumockdev-dev
+  umockdev libumockdev-dev  # brdf::device_emulation and the usb tests (BRDF_BUILD_DEVICE_EMULATION)
   xvfb xauth
   clang libclang-rt-14-dev
   python3 python3-numpy python3-scipy

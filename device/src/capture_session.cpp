@@ -11,6 +11,8 @@
 #include "brdf/core/bpc.h"
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
+#include "brdf/core/text_format.h"
+#include "brdf/core/virtual_capture.h"
 
 namespace brdf::device {
 namespace {
@@ -44,18 +46,6 @@ class BackgroundWriter {
  private:
   std::future<void> pending_;
 };
-
-std::string Num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g", v);
-  return buf;
-}
-
-std::string ThetaList(const std::vector<double>& theta_in_deg) {
-  std::string s;
-  for (double t : theta_in_deg) s += (s.empty() ? "" : ",") + Num(t);
-  return s;
-}
 
 bool EndsWithBpc(const std::string& path) {
   const std::string name = fs::path(path).filename().string();
@@ -137,7 +127,7 @@ bool RestoreFromMetadata(Driver& driver, const Metadata& recorded,
   d.time = Text(x, "dark_time");
   std::vector<WhiteCalibration> whites;
   for (double t : theta_in_deg) {
-    const std::string key = "white_theta_in_" + Num(t);
+    const std::string key = "white_theta_in_" + ShortNumberText(t);
     const auto counts = ParseTriple(x, key + "_counts");
     const auto exposure = ParseNumber(x, key + "_exposure_ms");
     const auto frames = ParseNumber(x, key + "_frames");
@@ -159,10 +149,11 @@ bool RestoreFromMetadata(Driver& driver, const Metadata& recorded,
 
 std::string GeometryText(const GeometryInfo& g) {
   std::string theta_in;
-  for (float t : g.theta_in_deg) theta_in += (theta_in.empty() ? "" : ",") + Num(t);
-  return "theta_in " + theta_in + "; theta_out 0-" + Num(g.theta_out_max_deg) + " step " +
-         Num(g.theta_out_step_deg) + "; phi_out step " + Num(g.phi_out_step_deg) + "; " +
-         std::to_string(g.rows) + "x" + std::to_string(g.columns);
+  for (float t : g.theta_in_deg) theta_in += (theta_in.empty() ? "" : ",") + ShortNumberText(t);
+  return "theta_in " + theta_in + "; theta_out 0-" + ShortNumberText(g.theta_out_max_deg) +
+         " step " + ShortNumberText(g.theta_out_step_deg) + "; phi_out step " +
+         ShortNumberText(g.phi_out_step_deg) + "; " + std::to_string(g.rows) + "x" +
+         std::to_string(g.columns);
 }
 
 CaptureSessionResult RunCaptureSession(const CaptureRequest& request, Transport& link,
@@ -177,7 +168,7 @@ CaptureSessionResult RunCaptureSession(const CaptureRequest& request, Transport&
   CaptureSessionResult result;
   result.slices_planned = request.theta_in_deg.size();
   std::map<std::string, std::string> settings = request.settings;
-  settings["theta_in_deg"] = ThetaList(request.theta_in_deg);
+  settings[kPlannedThetaInKey] = EncodeThetaInList(request.theta_in_deg);
 
   // What is already on disk, by the rule of every writing command: resuming a file is a
   // deliberate way of writing into it, as --force is.
@@ -228,7 +219,7 @@ CaptureSessionResult RunCaptureSession(const CaptureRequest& request, Transport&
         return std::fabs(t - done.theta_in_deg) <= 1e-6;
       });
       if (it == pending.end())
-        return refuse(path + " holds a slice at θin " + Num(done.theta_in_deg) +
+        return refuse(path + " holds a slice at θin " + ShortNumberText(done.theta_in_deg) +
                       "° that this capture does not plan");
       pending.erase(it);
     }
@@ -367,7 +358,7 @@ CaptureSessionResult RunCaptureSession(const CaptureRequest& request, Transport&
       merged.extra["calibration_time_resume"] = final_metadata.calibration_time;
       merged.extra["capture_start_resume"] = final_metadata.capture_start;
     }
-    merged.extra["resumed_theta_in_deg"] = ThetaList(pending);
+    merged.extra["resumed_theta_in_deg"] = EncodeThetaInList(pending);
     merged.capture_end = UtcNowIso8601();
     final_metadata = merged;
     if (!appender) appender.emplace(BpcAppender::Resume(path, nullptr));

@@ -12,6 +12,7 @@
 
 #include "brdf/core/error.h"
 #include "brdf/core/geometry.h"
+#include "brdf/core/text_format.h"
 
 namespace brdf::device {
 namespace {
@@ -27,8 +28,6 @@ std::string Fmt(const char* format, double v) {
 std::string Triple(const std::array<double, 3>& v, const char* format = "%.9g") {
   return Fmt(format, v[0]) + " " + Fmt(format, v[1]) + " " + Fmt(format, v[2]);
 }
-
-std::string AngleText(double deg) { return Fmt("%g", deg); }
 
 // One row segment calibrated channel by channel (the formula in MeasureSlice) over arrays of
 // the longest segment, so that each loop has a fixed length the compiler turns into vector
@@ -236,7 +235,7 @@ const WhiteCalibration& Driver::MeasureWhite(double theta_in_deg) {
       DecodeWhite(Expect(MessageType::kMeasureWhite, MessageType::kWhite).payload);
   if (r.clipped_channels != 0)
     Fail(FaultKind::kInstrumentError,
-         "white reference at θin " + AngleText(theta_in_deg) + "° saturated (clip bits " +
+         "white reference at θin " + ShortNumberText(theta_in_deg) + "° saturated (clip bits " +
              std::to_string(r.clipped_channels) + "); cannot calibrate");
   WhiteCalibration w;
   w.theta_in_deg = r.theta_in_deg;
@@ -249,11 +248,11 @@ const WhiteCalibration& Driver::MeasureWhite(double theta_in_deg) {
   for (int c = 0; c < 3; ++c) {
     w.counts[c] = r.counts[c];
     if (!(w.counts[c] - dark_.mean_counts[c] > 0))
-      Fail(FaultKind::kInstrumentError, "white reference at θin " + AngleText(theta_in_deg) +
-                                            "° gives no signal above dark in channel " +
-                                            std::to_string(c) + " (" + Fmt("%g", w.counts[c]) +
-                                            " counts, dark " + Fmt("%g", dark_.mean_counts[c]) +
-                                            "); is the panel in place?");
+      Fail(FaultKind::kInstrumentError,
+           "white reference at θin " + ShortNumberText(theta_in_deg) +
+               "° gives no signal above dark in channel " + std::to_string(c) + " (" +
+               ShortNumberText(w.counts[c]) + " counts, dark " +
+               ShortNumberText(dark_.mean_counts[c]) + "); is the panel in place?");
   }
   w.frames = r.frames;
   w.time = UtcNowIso8601();
@@ -271,7 +270,7 @@ Slice Driver::MeasureSlice(double theta_in_deg, SliceReport* report) {
   const WhiteCalibration* white = FindWhite(theta_in_deg);
   if (white == nullptr)
     throw InvalidArgument("MeasureSlice: measure the white reference at θin " +
-                          AngleText(theta_in_deg) + "° first");
+                          ShortNumberText(theta_in_deg) + "° first");
   const GeometryInfo& g = info_.geometry;
 
   Send(MessageType::kMeasureSlice, EncodeThetaIn(static_cast<float>(theta_in_deg)));
@@ -335,14 +334,14 @@ Slice Driver::MeasureSlice(double theta_in_deg, SliceReport* report) {
     if (cancelled()) {
       Abort();
       Fail(FaultKind::kCancelled, "capture cancelled during the slice at θin " +
-                                      AngleText(theta_in_deg) + "°; the scan was stopped");
+                                      ShortNumberText(theta_in_deg) + "°; the scan was stopped");
     }
     const Frame f = NextFrame("ROW_DATA");
     if (f.type == static_cast<std::uint8_t>(MessageType::kSliceEnd)) {
       const SliceEnd end = DecodeSliceEnd(f.payload);
       if (received != total || end.samples != total)
-        Fail(FaultKind::kOutOfSequence, "slice θin " + AngleText(theta_in_deg) + "° ended after " +
-                                            std::to_string(received) + " of " +
+        Fail(FaultKind::kOutOfSequence, "slice θin " + ShortNumberText(theta_in_deg) +
+                                            "° ended after " + std::to_string(received) + " of " +
                                             std::to_string(total) + " samples");
       break;
     }
@@ -356,7 +355,8 @@ Slice Driver::MeasureSlice(double theta_in_deg, SliceReport* report) {
                std::to_string(next_column) + ", got row " + std::to_string(row.row) + " columns " +
                std::to_string(row.first_column) + "+" + std::to_string(row.size()));
     if (!(row.exposure_ms > 0))
-      Fail(FaultKind::kProtocol, "ROW_DATA with exposure " + Fmt("%g", row.exposure_ms) + " ms");
+      Fail(FaultKind::kProtocol,
+           "ROW_DATA with exposure " + ShortNumberText(row.exposure_ms) + " ms");
     const float theta_out = g.ThetaOutDeg(row.row);
     if (row.nd_index >= g.nd_transmittance.size())
       Fail(FaultKind::kProtocol, "ROW_DATA names ND filter " + std::to_string(row.nd_index) +
@@ -481,7 +481,7 @@ Metadata Driver::CalibrationMetadata() const {
     m.extra["dark_time"] = dark_.time;
   }
   for (const WhiteCalibration& wc : whites_) {
-    const std::string key = "white_theta_in_" + AngleText(wc.theta_in_deg);
+    const std::string key = "white_theta_in_" + ShortNumberText(wc.theta_in_deg);
     m.extra[key + "_counts"] = Triple(wc.counts);
     m.extra[key + "_exposure_ms"] = Fmt("%.9g", wc.exposure_ms);
     if (wc.nd_transmittance != 1)
@@ -521,14 +521,14 @@ Metadata Capture(Driver& driver, const CapturePlan& plan, const CaptureCallbacks
     std::string list;
     for (float a : info.geometry.theta_in_deg) {
       offered = offered || std::fabs(a - t) <= kThetaMatchDeg;
-      list += (list.empty() ? "" : ", ") + AngleText(a);
+      list += (list.empty() ? "" : ", ") + ShortNumberText(a);
     }
     if (!offered)
-      throw InvalidArgument("θin " + AngleText(t) + "° is not offered by " + info.identity.model +
-                            " (it measures θin = " + list + "°)");
+      throw InvalidArgument("θin " + ShortNumberText(t) + "° is not offered by " +
+                            info.identity.model + " (it measures θin = " + list + "°)");
     for (std::size_t j = 0; j < i; ++j)
       if (std::fabs(plan.theta_in_deg[j] - t) <= kThetaMatchDeg)
-        throw InvalidArgument("θin " + AngleText(t) + "° is listed twice");
+        throw InvalidArgument("θin " + ShortNumberText(t) + "° is listed twice");
   }
   if (callbacks.on_connected) callbacks.on_connected(info);
   WithRetries(driver, callbacks, [&] { driver.SetExposure(plan.exposure); });
@@ -550,7 +550,7 @@ Metadata Capture(Driver& driver, const CapturePlan& plan, const CaptureCallbacks
   for (double t : plan.theta_in_deg) {
     if (driver.cancelled())
       throw DriverFault(FaultKind::kCancelled,
-                        "capture cancelled before the slice at θin " + AngleText(t) + "°");
+                        "capture cancelled before the slice at θin " + ShortNumberText(t) + "°");
     SliceReport report;
     Slice slice = WithRetries(driver, callbacks, [&] { return driver.MeasureSlice(t, &report); });
     if (callbacks.on_slice) callbacks.on_slice(std::move(slice), report);

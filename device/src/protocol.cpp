@@ -5,6 +5,7 @@
 
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
+#include "brdf/core/text_format.h"
 
 namespace brdf::device {
 namespace {
@@ -40,12 +41,6 @@ class PayloadWriter {
 std::uint32_t LoadU32(const std::uint8_t* p) {
   return static_cast<std::uint32_t>(p[0]) | (static_cast<std::uint32_t>(p[1]) << 8) |
          (static_cast<std::uint32_t>(p[2]) << 16) | (static_cast<std::uint32_t>(p[3]) << 24);
-}
-
-std::string Hex32(std::uint32_t v) {
-  char buf[16];
-  std::snprintf(buf, sizeof buf, "0x%08x", v);
-  return buf;
 }
 
 // Runs `parse` over a payload with a ByteReader named after the message, turning the reader's
@@ -178,7 +173,7 @@ DecodeResult DecodeFrame(std::span<const std::uint8_t> bytes) {
     result.consumed = 1;
     result.corrupt = true;
     result.reason = MessageTypeName(bytes[2]) + " frame " + std::to_string(bytes[3]) +
-                    ": CRC-32: expected " + Hex32(computed) + ", got " + Hex32(stored);
+                    ": CRC-32: expected " + Hex32Text(computed) + ", got " + Hex32Text(stored);
     return result;
   }
   result.status = DecodeStatus::kComplete;

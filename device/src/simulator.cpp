@@ -19,11 +19,7 @@ InstrumentModel MakeReferenceModel() {
   m.model = "BRDF-SIM MD2";
   m.firmware_version = "2.4.1-sim";
   // The reference geometry is defined once, in brdf::core (virtual_capture.h).
-  const CaptureGeometry& g = ReferenceGeometry();
-  m.theta_in_deg.assign(g.theta_in_deg.begin(), g.theta_in_deg.end());
-  m.theta_out_max_deg = static_cast<float>(g.theta_out_max_deg);
-  m.theta_out_step_deg = static_cast<float>(g.theta_out_step_deg);
-  m.phi_out_step_deg = static_cast<float>(g.phi_out_step_deg);
+  m.SetGeometry(ReferenceGeometry());
   // A 16-bit camera-type detector: ~32,800 e⁻ full well at 2 counts per electron, 6 counts of
   // read noise, a bias near 500 counts. Responsivities give the Spectralon panel at normal
   // incidence (L = 0.315) about 600 counts/ms, so it auto-ranges to ~80 ms; the darkest
@@ -42,6 +38,17 @@ InstrumentModel MakeReferenceModel() {
   m.autorange_target_fraction = 0.8;
   return m;
 }
+
+}  // namespace
+
+void InstrumentModel::SetGeometry(const CaptureGeometry& g) {
+  theta_in_deg.assign(g.theta_in_deg.begin(), g.theta_in_deg.end());
+  theta_out_max_deg = static_cast<float>(g.theta_out_max_deg);
+  theta_out_step_deg = static_cast<float>(g.theta_out_step_deg);
+  phi_out_step_deg = static_cast<float>(g.phi_out_step_deg);
+}
+
+namespace {
 
 const std::vector<InstrumentModel>& ModelTable() {
   static const std::vector<InstrumentModel> kTable = {MakeReferenceModel()};

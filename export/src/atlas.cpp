@@ -7,6 +7,7 @@
 
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
+#include "brdf/core/text_format.h"
 #include "brdf/exporter/dds.h"
 #include "brdf/exporter/ktx2.h"
 #include "brdf/exporter/rgb9e5.h"
@@ -225,7 +226,7 @@ std::vector<std::string> WriteAtlas(const std::string& prefix,
                          "row-major, ascending theta_in, top-left first",
                          atlas.layout.composite.columns, atlas.layout.composite.rows,
                          atlas.layout.cells.columns, atlas.layout.cells.rows)},
-            {"brdf:payload_crc32", detail::Hex32(atlas.volume.Crc32())}});
+            {"brdf:payload_crc32", Hex32Text(atlas.volume.Crc32())}});
   written.push_back(prefix + ".exr");
   WriteFileAtomically(prefix + ".json", manifest);
   written.push_back(prefix + ".json");

@@ -6,12 +6,12 @@
 
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
+#include "brdf/core/text_format.h"
 #include "container_util.h"
 
 namespace brdf::exporter {
 namespace {
 
-constexpr std::uint32_t kMagic = 0x20534444;       // "DDS "
 constexpr std::uint32_t kFourCcDx10 = 0x30315844;  // "DX10"
 constexpr std::uint32_t kDdsdCaps = 0x1, kDdsdHeight = 0x2, kDdsdWidth = 0x4, kDdsdPitch = 0x8,
                         kDdsdPixelFormat = 0x1000, kDdsdMipMapCount = 0x20000,
@@ -36,7 +36,7 @@ std::string DdsVolumeHeader(int width, int height, int depth, std::uint32_t dxgi
                             int bytes_per_texel) {
   std::string out;
   out.reserve(kDdsDataOffset);
-  AppendU32(out, kMagic);
+  out.append(kDdsMagic.begin(), kDdsMagic.end());
   AppendU32(out, 124);  // dwSize
   AppendU32(out, kDdsdCaps | kDdsdHeight | kDdsdWidth | kDdsdPitch | kDdsdPixelFormat |
                      kDdsdMipMapCount | kDdsdDepth);
@@ -85,7 +85,7 @@ void WriteDds(const std::string& path, const Lut& lut) { WriteDds(path, PackLut(
 LoadedTexture ParseDds(const std::uint8_t* data, std::size_t size, const std::string& file,
                        const std::vector<double>& theta_in_deg) {
   ByteReader r(data, size, file);
-  if (size < 4 || std::memcmp(data, "DDS ", 4) != 0) {
+  if (size < 4 || std::memcmp(data, kDdsMagic.data(), kDdsMagic.size()) != 0) {
     std::uint32_t got = 0;
     for (std::size_t i = 0; i < std::min<std::size_t>(size, 4); ++i)
       got |= std::uint32_t{data[i]} << (8 * i);
@@ -110,7 +110,7 @@ LoadedTexture ParseDds(const std::uint8_t* data, std::size_t size, const std::st
   if ((flags & required) != required)
     throw FormatError(file, BytePosition(at_flags),
                       "dwFlags with CAPS, HEIGHT, WIDTH, PIXELFORMAT and DEPTH (a volume texture)",
-                      fmt::format("0x{:08x}", flags));
+                      Hex32Text(flags));
   LoadedTexture t;
   t.file = file;
   t.container = TextureContainer::kDds;
@@ -140,7 +140,7 @@ LoadedTexture ParseDds(const std::uint8_t* data, std::size_t size, const std::st
     const std::uint32_t pf_flags = r.U32("DDS_PIXELFORMAT.dwFlags");
     if (!(pf_flags & kDdpfFourCc))
       throw FormatError(file, BytePosition(at), "DDS_PIXELFORMAT.dwFlags with DDPF_FOURCC (0x4)",
-                        fmt::format("0x{:08x}", pf_flags));
+                        Hex32Text(pf_flags));
     const std::uint64_t at_cc = r.offset();
     const std::uint32_t four_cc = r.U32("DDS_PIXELFORMAT.dwFourCC");
     if (four_cc != kFourCcDx10)
@@ -155,7 +155,7 @@ LoadedTexture ParseDds(const std::uint8_t* data, std::size_t size, const std::st
     const std::uint32_t caps2 = r.U32("dwCaps2");
     if (!(caps2 & kDdsCaps2Volume))
       throw FormatError(file, BytePosition(at), "dwCaps2 with DDSCAPS2_VOLUME (0x200000)",
-                        fmt::format("0x{:08x}", caps2));
+                        Hex32Text(caps2));
   }
   r.Bytes(12, "dwCaps3, dwCaps4 and dwReserved2");
   {

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "brdf/core/error.h"
+#include "brdf/core/text_format.h"
 #include "brdf/exporter/atlas.h"
 #include "brdf/exporter/sidecar.h"
 #include "json_util.h"
@@ -93,7 +94,7 @@ void WriteExrComposite(const std::string& path, const Lut& lut, const PackedVolu
                                         "theta_in, top-left first",
                                         grid.columns, grid.rows)},
             {"brdf:texel_convention", TexelCentreFormula()},
-            {"brdf:payload_crc32", detail::Hex32(packed.Crc32())}});
+            {"brdf:payload_crc32", Hex32Text(packed.Crc32())}});
 }
 
 void WriteExrComposite(const std::string& path, const Lut& lut, const TextureMetadata& metadata,

@@ -3,10 +3,9 @@
 #include <cmath>
 #include <limits>
 
-#include <fmt/format.h>
-
 #include "brdf/core/error.h"
 #include "brdf/core/json_error.h"
+#include "brdf/core/text_format.h"
 #include "brdf/exporter/metadata.h"
 
 namespace brdf::exporter::detail {
@@ -35,8 +34,6 @@ ordered_json TexelConventionJson(const std::vector<double>& theta_in_deg) {
                       {"glsl", ShaderSnippetGlsl(theta_in_deg)}};
 }
 
-std::string Hex32(std::uint32_t v) { return fmt::format("0x{:08x}", v); }
-
 std::uint32_t ParseHex32(const std::string& text, const std::string& file,
                          const std::string& position) {
   const bool ok = text.size() == 10 && text[0] == '0' && (text[1] == 'x' || text[1] == 'X') &&
@@ -61,7 +58,7 @@ ordered_json PayloadJson(const PackedVolume& payload) {
         {"definition",
          "CRC-32 (IEEE 802.3, polynomial 0xEDB88320 reflected, as zlib crc32) of "
          "the payload bytes as stored in the KTX2 level 0 image and the DDS data"},
-        {"value", Hex32(payload.Crc32())}}}};
+        {"value", Hex32Text(payload.Crc32())}}}};
 }
 
 ordered_json ParseEmbeddedJson(const std::string& text, const std::string& what) {

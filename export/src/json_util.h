@@ -21,8 +21,8 @@ ordered_json GridJson(const PackedVolume& payload, const std::vector<double>& th
 ordered_json TexelConventionJson(const std::vector<double>& theta_in_deg);
 // {"encoding": ..., "texel_order": ..., "bytes": N, "checksum": {"algorithm": "crc32", ...}}
 ordered_json PayloadJson(const PackedVolume& payload);
-// "0x1234abcd"
-std::string Hex32(std::uint32_t v);
+// "0x1234abcd" (as brdf::Hex32Text writes it) back to the number; throws FormatError naming
+// `file` and `position`.
 std::uint32_t ParseHex32(const std::string& text, const std::string& file,
                          const std::string& position);
 

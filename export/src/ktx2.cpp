@@ -14,8 +14,6 @@
 namespace brdf::exporter {
 namespace {
 
-constexpr std::array<std::uint8_t, 12> kIdentifier = {0xAB, 'K',  'T',  'X',  ' ',  '2',
-                                                      '0',  0xBB, '\r', '\n', 0x1A, '\n'};
 constexpr std::size_t kHeaderEnd = 12 + 9 * 4;          // identifier + header
 constexpr std::size_t kIndexEnd = kHeaderEnd + 32;      // + dfd/kvd/sgd index
 constexpr std::size_t kLevelIndexEnd = kIndexEnd + 24;  // + one level index entry
@@ -181,7 +179,7 @@ std::string EncodeKtx2(const PackedVolume& volume, const KeyValues& key_values) 
   const std::size_t level_length = volume.ByteSize();
 
   std::string out(level_offset, '\0');
-  std::memcpy(out.data(), kIdentifier.data(), kIdentifier.size());
+  std::memcpy(out.data(), kKtx2Identifier.data(), kKtx2Identifier.size());
   const std::uint32_t header[9] = {kVkFormatE5b9g9r9UfloatPack32,
                                    4,  // typeSize: _PACK32
                                    static_cast<std::uint32_t>(volume.width),
@@ -222,7 +220,7 @@ void WriteKtx2(const std::string& path, const Lut& lut, const TextureMetadata& m
 
 LoadedTexture ParseKtx2(const std::uint8_t* data, std::size_t size, const std::string& file) {
   ByteReader r(data, size, file);
-  if (size < 12 || std::memcmp(data, kIdentifier.data(), 12) != 0) {
+  if (size < 12 || std::memcmp(data, kKtx2Identifier.data(), 12) != 0) {
     std::string got = size < 12 ? fmt::format("a file of {} bytes", size) : std::string("bytes");
     for (std::size_t i = 0; i < std::min<std::size_t>(size, 12); ++i)
       got += fmt::format(" {:02x}", data[i]);

@@ -7,6 +7,7 @@
 
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
+#include "brdf/core/text_format.h"
 #include "brdf/exporter/atlas.h"
 #include "brdf/exporter/dds.h"
 #include "brdf/exporter/ktx2.h"
@@ -29,9 +30,8 @@ void CheckRecordedPayload(const LoadedTexture& t, const std::string& what, int w
                       std::to_string(v.ByteSize()) + " bytes");
   const std::uint32_t actual = v.Crc32();
   if (actual != crc)
-    throw FormatError(t.file, what,
-                      fmt::format("payload CRC-32 0x{:08x} as the metadata records", crc),
-                      fmt::format("0x{:08x}", actual), "the texel data was changed or damaged");
+    throw FormatError(t.file, what, "payload CRC-32 " + Hex32Text(crc) + " as the metadata records",
+                      Hex32Text(actual), "the texel data was changed or damaged");
 }
 
 }  // namespace
@@ -68,9 +68,12 @@ void FinishLoadedTexture(LoadedTexture& t) {
 
 LoadedTexture ReadTextureFile(const std::string& path) {
   const std::vector<std::uint8_t> bytes = ReadFileBytes(path, kMaxTextureFileBytes);
-  if (bytes.size() >= 12 && bytes[0] == 0xAB && std::memcmp(bytes.data() + 1, "KTX 20", 6) == 0)
+  // «KTX 20 names the family: a file whose identifier is damaged after it is the KTX2 reader's
+  // to report.
+  if (bytes.size() >= 12 && std::memcmp(bytes.data(), kKtx2Identifier.data(), 7) == 0)
     return ParseKtx2(bytes.data(), bytes.size(), path);
-  if (bytes.size() >= 4 && std::memcmp(bytes.data(), "DDS ", 4) == 0) {
+  if (bytes.size() >= kDdsMagic.size() &&
+      std::memcmp(bytes.data(), kDdsMagic.data(), kDdsMagic.size()) == 0) {
     LoadedTexture t = ParseDds(bytes.data(), bytes.size(), path);
     std::filesystem::path sidecar(path);
     sidecar.replace_extension(".json");

@@ -14,8 +14,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-using internal::Deg;
-using internal::DegList;
+using detail::Deg;
+using detail::DegList;
 
 bool ContainsAngle(const std::vector<double>& values, double v) {
   return std::any_of(values.begin(), values.end(),

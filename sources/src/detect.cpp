@@ -8,9 +8,12 @@
 #include <nlohmann/json.hpp>
 #include <string_view>
 
+#include "brdf/core/bpc.h"
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
 #include "brdf/core/json_error.h"
+#include "brdf/exporter/dds.h"
+#include "brdf/exporter/ktx2.h"
 
 namespace brdf::sources {
 namespace {
@@ -18,12 +21,10 @@ namespace {
 namespace fs = std::filesystem;
 
 constexpr std::uint64_t kMaxJsonBytes = 16u << 20;
-constexpr std::array<unsigned char, 8> kBpcMagic = {0x89, 'B', 'P', 'C', '\r', '\n', 0x1a, '\n'};
-constexpr std::array<unsigned char, 12> kKtx2Magic = {0xab, 'K',  'T',  'X',  ' ',  '2',
-                                                      '0',  0xbb, '\r', '\n', 0x1a, '\n'};
-
-bool StartsWith(std::string_view head, const unsigned char* magic, std::size_t n) {
-  return head.size() >= n && std::memcmp(head.data(), magic, n) == 0;
+// Each format's signature, from the format's own header.
+template <std::size_t N>
+bool StartsWith(std::string_view head, const std::array<std::uint8_t, N>& magic) {
+  return head.size() >= N && std::memcmp(head.data(), magic.data(), N) == 0;
 }
 
 bool EndsWith(const std::string& s, std::string_view suffix) {
@@ -108,9 +109,9 @@ FileKind DetectFileKind(const std::string& path) {
   const std::string ext = Lower(fs::path(path).extension().string());
 
   // 1. Magic bytes.
-  if (StartsWith(head, kBpcMagic.data(), kBpcMagic.size())) return FileKind::kCapture;
-  if (StartsWith(head, kKtx2Magic.data(), kKtx2Magic.size())) return FileKind::kKtx2;
-  if (head.size() >= 4 && std::memcmp(head.data(), "DDS ", 4) == 0) return FileKind::kDds;
+  if (StartsWith(head, kBpcMagic)) return FileKind::kCapture;
+  if (StartsWith(head, exporter::kKtx2Identifier)) return FileKind::kKtx2;
+  if (StartsWith(head, exporter::kDdsMagic)) return FileKind::kDds;
   const ImportFormat binary = DetectImportFormatFromHead(head, size, ext);
   if (binary == ImportFormat::kRgl || binary == ImportFormat::kMerl) return FileKindOf(binary);
 

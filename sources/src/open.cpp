@@ -23,8 +23,8 @@ namespace {
 
 constexpr std::uint64_t kMaxJsonBytes = 16u << 20;
 
-using internal::Deg;
-using internal::DegList;
+using detail::Deg;
+using detail::DegList;
 
 std::string LowerExtension(const std::string& path) {
   std::string ext = fs::path(path).extension().string();

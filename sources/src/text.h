@@ -1,17 +1,15 @@
 // Angle lists in messages of brdf::sources ("0, 20, 40, 60").
 #pragma once
 
-#include <sstream>
 #include <string>
 #include <vector>
 
-namespace brdf::sources::internal {
+#include "brdf/core/text_format.h"
 
-inline std::string Deg(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
+namespace brdf::sources::detail {
+
+// "%g" (brdf/core/text_format.h): the spelling of angles in capture metadata.
+inline std::string Deg(double v) { return ShortNumberText(v); }
 
 inline std::string DegList(const std::vector<double>& values) {
   std::string out;
@@ -19,4 +17,4 @@ inline std::string DegList(const std::vector<double>& values) {
   return out;
 }
 
-}  // namespace brdf::sources::internal
+}  // namespace brdf::sources::detail

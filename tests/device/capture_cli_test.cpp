@@ -359,13 +359,14 @@ TEST_F(CaptureCli, HelpShowsTheDefaultsOfTheCode) {
     return std::string(buf);
   };
   std::string theta_in;
-  for (double t : defaults.theta_in_deg) theta_in += (theta_in.empty() ? "" : ",") + number(t);
+  for (double t : defaults.geometry.theta_in_deg)
+    theta_in += (theta_in.empty() ? "" : ",") + number(t);
   EXPECT_NE(r.out.find("--theta-in FLOAT=[" + theta_in + "]"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("--noise FLOAT=" + number(defaults.noise)), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("--seed UINT=" + std::to_string(defaults.seed)), std::string::npos);
   EXPECT_NE(r.out.find("--device TEXT=" + defaults.device), std::string::npos);
   EXPECT_NE(r.out.find("--exposure TEXT=" + defaults.exposure), std::string::npos);
-  EXPECT_NE(r.out.find("--theta-out-step FLOAT=" + number(defaults.theta_out_step_deg)),
+  EXPECT_NE(r.out.find("--theta-out-step FLOAT=" + number(defaults.geometry.theta_out_step_deg)),
             std::string::npos);
 }
 

@@ -101,6 +101,31 @@ std::string RunTool(const std::string& args, int* exit_code, const std::string& 
   return out;
 }
 
+// `capture --device sim --transport usb|hid` opens the simulated firmware behind real libusb or
+// hidapi (brdf::device_emulation's link, in the tool's own process): the file holds the values
+// of the same capture over the in-process loopback.
+TEST_P(UsbCapture, ToolCaptureOverTheEmulatedTransportEqualsTheLoopbackCapture) {
+  char tmpl[] = "/tmp/brdf_usb_sim_XXXXXX";
+  ASSERT_NE(::mkdtemp(tmpl), nullptr);
+  const std::string dir = tmpl;
+  const std::string common =
+      " --device sim --material gold --sample g --theta-in 20,60 --theta-out-step 15 "
+      "--phi-out-step 15 --seed 3 --quiet --out ";
+  const std::string transport = GetParam() == UsbPersonality::kBulk ? "usb" : "hid";
+  int code = -1;
+  const std::string loop_log = RunTool("capture" + common + dir + "/loop.bpc", &code);
+  ASSERT_EQ(code, 0) << loop_log;
+  const std::string emulated_log =
+      RunTool("capture --transport " + transport + common + dir + "/emulated.bpc", &code);
+  ASSERT_EQ(code, 0) << emulated_log;
+  const Measurement loop = LoadBpc(dir + "/loop.bpc");
+  const Measurement emulated = LoadBpc(dir + "/emulated.bpc");
+  ASSERT_EQ(emulated.slices.size(), 2u);
+  ExpectSameValues(emulated.slices, loop.slices);
+  EXPECT_EQ(emulated.metadata.instrument_serial, loop.metadata.instrument_serial);
+  std::filesystem::remove_all(dir);
+}
+
 TEST_P(UsbCapture, DevicesListsTheInstrumentAndCaptureOpensItByVidPidSerial) {
   int code = -1;
   EXPECT_NE(RunTool("devices", &code).find("no instruments found"), std::string::npos);

@@ -18,18 +18,31 @@
 #include "brdf/core/error.h"
 #include "brdf/device/capture_session.h"
 #include "brdf/device/driver.h"
-#include "brdf/device_emulation/emulated_usb.h"
+#include "brdf/device/instrument_link.h"
 #include "brdf/device/simulator.h"
 #include "brdf/device/transport.h"
 #include "brdf/device/usb_models.h"
 #include "brdf/sources/open.h"
 #include "cli_support.h"
 #include "commands.h"
+#ifdef BRDF_HAVE_DEVICE_EMULATION
+#include "brdf/device_emulation/emulated_usb.h"
+#endif
 
 namespace brdf::cli {
 namespace {
 
 namespace fs = std::filesystem;
+
+// The umockdev-emulated USB and HID links of the simulated instrument, when this build has them
+// (BRDF_BUILD_DEVICE_EMULATION).
+#ifdef BRDF_HAVE_DEVICE_EMULATION
+constexpr bool kHaveEmulatedLinks = true;
+constexpr device::EmulatedLinkOpener kEmulatedLinks = &device::OpenEmulatedLink;
+#else
+constexpr bool kHaveEmulatedLinks = false;
+constexpr device::EmulatedLinkOpener kEmulatedLinks = nullptr;
+#endif
 
 // "109440" → "109,440".
 std::string Thousands(std::size_t n) {
@@ -70,44 +83,39 @@ void Validate(const CaptureOptions& o) {
   if (o.out.empty()) throw InvalidArgument("--out: an output .bpc path is required");
   if (LowerExtension(o.out) != ".bpc")
     throw InvalidArgument("--out: a capture is written as a .bpc file, got '" + o.out + "'");
-  if (o.theta_in_deg.empty()) throw InvalidArgument("--theta-in: at least one angle is required");
-  for (double t : o.theta_in_deg)
+  const CaptureGeometry& g = o.geometry;
+  if (g.theta_in_deg.empty()) throw InvalidArgument("--theta-in: at least one angle is required");
+  for (double t : g.theta_in_deg)
     if (!(t >= 0 && t < 90))
       throw InvalidArgument("--theta-in: angles must be in [0, 90) degrees, got " + Deg(t));
   if (!(o.noise >= 0) || !std::isfinite(o.noise))
     throw InvalidArgument("--noise: expected a level ≥ 0 (1 = reference instrument), got " +
                           Deg(o.noise));
-  if (!(o.theta_out_max_deg >= 0 && o.theta_out_max_deg < 90))
+  if (!(g.theta_out_max_deg >= 0 && g.theta_out_max_deg < 90))
     throw InvalidArgument("--theta-out-max: expected [0, 90) degrees, got " +
-                          Deg(o.theta_out_max_deg));
-  if (!(o.theta_out_step_deg >= 0.01 && o.theta_out_step_deg <= 90))
+                          Deg(g.theta_out_max_deg));
+  if (!(g.theta_out_step_deg >= 0.01 && g.theta_out_step_deg <= 90))
     throw InvalidArgument("--theta-out-step: expected [0.01, 90] degrees, got " +
-                          Deg(o.theta_out_step_deg));
-  if (!(o.phi_out_step_deg >= 0.01 && o.phi_out_step_deg <= 360))
+                          Deg(g.theta_out_step_deg));
+  if (!(g.phi_out_step_deg >= 0.01 && g.phi_out_step_deg <= 360))
     throw InvalidArgument("--phi-out-step: expected [0.01, 360] degrees, got " +
-                          Deg(o.phi_out_step_deg));
+                          Deg(g.phi_out_step_deg));
 }
 
-// Settings that must agree between an interrupted capture and its resumption, as recorded in
-// the metadata `extra` map. "theta_in_deg" is the planned θin list ("0,20,40,60"), written into
-// the header before the first slice so that `brdf convert` can tell an interrupted capture
-// missing slices from a complete one (brdf::PlannedThetaInDeg in brdf/core/virtual_capture.h reads
-// it). A resumption must plan the same list: the header on disk is not rewritten, so a different
-// list would make the recorded plan untrue.
+// Settings of the simulated instrument that must agree between an interrupted capture and its
+// resumption, as recorded in the metadata `extra` map. The planned θin list is the session's
+// (CaptureRequest::theta_in_deg, recorded as "theta_in_deg").
 std::map<std::string, std::string> SettingsOf(const CaptureOptions& o,
                                               const std::string& material) {
   char seed[32];
   std::snprintf(seed, sizeof seed, "%llu", static_cast<unsigned long long>(o.seed));
-  std::string theta_in;
-  for (double t : o.theta_in_deg) theta_in += (theta_in.empty() ? "" : ",") + Deg(t);
   return {{"device", o.device},
-          {"theta_in_deg", theta_in},
           {"material", material},
           {"noise_level", Deg(o.noise)},
           {"seed", seed},
-          {"theta_out_max_deg", Deg(o.theta_out_max_deg)},
-          {"theta_out_step_deg", Deg(o.theta_out_step_deg)},
-          {"phi_out_step_deg", Deg(o.phi_out_step_deg)},
+          {"theta_out_max_deg", Deg(o.geometry.theta_out_max_deg)},
+          {"theta_out_step_deg", Deg(o.geometry.theta_out_step_deg)},
+          {"phi_out_step_deg", Deg(o.geometry.phi_out_step_deg)},
           {"exposure", o.exposure}};
 }
 
@@ -203,6 +211,10 @@ int RunCapture(const CaptureOptions& o) {
   const bool sim = spec.kind == device::DeviceSpec::Kind::kSim;
   if (!sim && (o.transport != "loopback" || !o.sim_fault.empty()))
     throw InvalidArgument("--transport and --sim-fault apply to --device sim only");
+  if (sim_link != device::SimLink::kLoopback && !kHaveEmulatedLinks)
+    throw InvalidArgument("--transport " + o.transport +
+                          ": the emulated usb and hid transports are not part of this build "
+                          "(configured with BRDF_BUILD_DEVICE_EMULATION=OFF); use loopback");
   device::FaultPlan faults;
   try {
     faults = device::ParseFaultPlan(o.sim_fault);
@@ -229,17 +241,14 @@ int RunCapture(const CaptureOptions& o) {
   config.noise_level = o.noise;
   config.seed = o.seed;
   config.faults = faults;
-  config.model.theta_in_deg.assign(o.theta_in_deg.begin(), o.theta_in_deg.end());
-  config.model.theta_out_max_deg = static_cast<float>(o.theta_out_max_deg);
-  config.model.theta_out_step_deg = static_cast<float>(o.theta_out_step_deg);
-  config.model.phi_out_step_deg = static_cast<float>(o.phi_out_step_deg);
+  config.model.SetGeometry(o.geometry);
   config.pace_ms_per_row = o.sim_pace_ms;
   const std::unique_ptr<device::InstrumentLink> link =
-      device::OpenInstrumentLink(spec, config, sim_link);
+      device::OpenInstrumentLink(spec, config, sim_link, kEmulatedLinks);
 
   device::CaptureRequest request;
   request.out_path = o.out;
-  request.theta_in_deg = o.theta_in_deg;
+  request.theta_in_deg = o.geometry.theta_in_deg;
   request.exposure = exposure;
   request.sample_name = o.sample;
   request.operator_notes = o.operator_notes;

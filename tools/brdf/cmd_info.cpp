@@ -25,6 +25,7 @@
 #include "brdf/core/merl.h"
 #include "brdf/core/models.h"
 #include "brdf/core/rgl.h"
+#include "brdf/core/text_format.h"
 #include "brdf/core/zemax.h"
 #include "brdf/exporter/packed_volume.h"
 #include "brdf/exporter/rgb9e5.h"
@@ -330,12 +331,6 @@ bool IsImportedFormat(const Json& j) {
          f == "merl";
 }
 
-std::string Hex32(std::uint32_t v) {
-  char buf[16];
-  std::snprintf(buf, sizeof buf, "0x%08x", v);
-  return buf;
-}
-
 // An exported LUT or atlas (.ktx2, .dds) or the sidecar / manifest describing one. Value ranges
 // are of the RGB9E5 values as stored (decoded exactly), per θin slice; for an atlas over the
 // cells that hold a material.
@@ -358,7 +353,7 @@ Json DescribeTexture(const std::string& path) {
   j["theta_in_deg"] = tex.theta_in_deg;
   j["theta_in_from_metadata"] = tex.theta_in_from_metadata;
   j["payload_bytes"] = v.ByteSize();
-  j["payload_crc32"] = Hex32(v.Crc32());
+  j["payload_crc32"] = Hex32Text(v.Crc32());
   j["checksum"] = t.checksum_verified ? "verified against the recorded CRC-32"
                                       : "not verified (no sidecar or manifest)";
   if (t.sidecar) {

@@ -99,17 +99,16 @@ struct CaptureOptions {
   // "sim", "usb[:VID:PID[:SERIAL]]" or "hid[:VID:PID[:SERIAL]]" (brdf/device/usb_models.h).
   std::string device = "sim";
   // How --device sim is connected: "loopback" (in-process), "usb" or "hid" (the simulated
-  // firmware behind real libusb / hidapi through umockdev; run under umockdev-wrapper).
+  // firmware behind real libusb / hidapi through umockdev; run under umockdev-wrapper; only in
+  // a build with the emulation, BRDF_BUILD_DEVICE_EMULATION).
   std::string transport = "loopback";
   double sim_pace_ms = 0;  // testing: real time per θout row of the simulated firmware
   std::string material;    // library name or file
   std::string sample;      // sample name recorded in the metadata
   std::string out;         // .bpc path
-  // Defaults: the reference geometry (brdf/core/virtual_capture.h).
-  std::vector<double> theta_in_deg = ReferenceGeometry().theta_in_deg;
-  double theta_out_max_deg = ReferenceGeometry().theta_out_max_deg;
-  double theta_out_step_deg = ReferenceGeometry().theta_out_step_deg;
-  double phi_out_step_deg = ReferenceGeometry().phi_out_step_deg;
+  // The planned θin (every instrument) and the detector steps (--device sim only); default:
+  // the reference geometry (brdf/core/virtual_capture.h).
+  CaptureGeometry geometry = ReferenceGeometry();
   double noise = 1.0;  // 0 = noise-free and unsaturated; 1 = the reference instrument's noise
   std::uint64_t seed = 1;
   std::string operator_notes;

@@ -199,6 +199,15 @@ int main(int argc, char** argv) {
 
   // brdf capture
   brdf::cli::CaptureOptions capture;
+#ifdef BRDF_HAVE_DEVICE_EMULATION
+  const char* const kTransportHelp =
+      "How --device sim is connected: loopback (in-process), usb or hid (the simulated firmware "
+      "behind real libusb or hidapi through umockdev; run under umockdev-wrapper)";
+#else
+  const char* const kTransportHelp =
+      "How --device sim is connected: loopback (in-process); the emulated usb and hid transports "
+      "are not part of this build";
+#endif
   auto* capture_cmd = app.add_subcommand(
       "capture",
       "Capture a sample slice by slice with a scatterometer into a .bpc file (each completed "
@@ -209,12 +218,7 @@ int main(int argc, char** argv) {
                    "(vendor bulk interface, libusb) or hid[:VID:PID[:SERIAL]] (HID reports, "
                    "hidapi); IDs in hexadecimal, the first instrument found when omitted")
       ->capture_default_str();
-  capture_cmd
-      ->add_option("--transport", capture.transport,
-                   "How --device sim is connected: loopback (in-process), usb or hid (the "
-                   "simulated firmware behind real libusb or hidapi through umockdev; run "
-                   "under umockdev-wrapper)")
-      ->capture_default_str();
+  capture_cmd->add_option("--transport", capture.transport, kTransportHelp)->capture_default_str();
   capture_cmd->add_option("--material", capture.material,
                           "Virtual sample of --device sim (required for it): a library material "
                           "name or any file 'brdf eval' reads" +
@@ -223,20 +227,20 @@ int main(int argc, char** argv) {
       ->required();
   capture_cmd->add_option("--out", capture.out, "Output .bpc file")->required();
   capture_cmd
-      ->add_option("--theta-in", capture.theta_in_deg,
+      ->add_option("--theta-in", capture.geometry.theta_in_deg,
                    "Incidence angles in degrees, comma separated, in capture order")
       ->delimiter(',')
       ->capture_default_str();
   capture_cmd
-      ->add_option("--theta-out-max", capture.theta_out_max_deg,
+      ->add_option("--theta-out-max", capture.geometry.theta_out_max_deg,
                    "Largest detector polar angle, degrees (sim)")
       ->capture_default_str();
   capture_cmd
-      ->add_option("--theta-out-step", capture.theta_out_step_deg,
+      ->add_option("--theta-out-step", capture.geometry.theta_out_step_deg,
                    "Detector polar step, degrees (sim)")
       ->capture_default_str();
   capture_cmd
-      ->add_option("--phi-out-step", capture.phi_out_step_deg,
+      ->add_option("--phi-out-step", capture.geometry.phi_out_step_deg,
                    "Detector azimuth step, degrees (sim)")
       ->capture_default_str();
   capture_cmd

@@ -472,33 +472,7 @@ void EmulatedUsbInstrument::SetNodeMode(unsigned mode) {
 
 std::string EmulatedUsbInstrument::DeviceNode() const { return impl_->devnode; }
 
-SimLink ParseSimLink(std::string_view text) {
-  if (text == "loopback") return SimLink::kLoopback;
-  if (text == "usb") return SimLink::kUsb;
-  if (text == "hid") return SimLink::kHid;
-  throw InvalidArgument("expected loopback, usb or hid, got '" + std::string(text) + "'");
-}
-
 namespace {
-
-class RealLink final : public InstrumentLink {
- public:
-  explicit RealLink(std::unique_ptr<Transport> t) : transport_(std::move(t)) {}
-  Transport& transport() override { return *transport_; }
-
- private:
-  std::unique_ptr<Transport> transport_;
-};
-
-class LoopbackLink final : public InstrumentLink {
- public:
-  explicit LoopbackLink(const SimulatorConfig& c) : firmware_(c), loop_(firmware_) {}
-  Transport& transport() override { return loop_; }
-
- private:
-  SimulatedFirmware firmware_;
-  LoopbackTransport loop_;
-};
 
 class EmulatedLink final : public InstrumentLink {
  public:
@@ -515,22 +489,9 @@ class EmulatedLink final : public InstrumentLink {
 
 }  // namespace
 
-std::unique_ptr<InstrumentLink> OpenInstrumentLink(const DeviceSpec& spec,
-                                                   const SimulatorConfig& sim, SimLink link) {
-  switch (spec.kind) {
-    case DeviceSpec::Kind::kUsb:
-      return std::make_unique<RealLink>(OpenUsbTransport(spec));
-    case DeviceSpec::Kind::kHid:
-      return std::make_unique<RealLink>(OpenHidTransport(spec));
-    case DeviceSpec::Kind::kSim:
-      break;
-  }
-  if (link == SimLink::kLoopback) {
-    for (const Fault& f : sim.faults.faults)
-      if (f.type == FaultType::kEndpointHalt)
-        throw InvalidArgument("an endpoint halt needs a USB or HID link, not the loopback");
-    return std::make_unique<LoopbackLink>(sim);
-  }
+std::unique_ptr<InstrumentLink> OpenEmulatedLink(const SimulatorConfig& sim, SimLink link) {
+  if (link == SimLink::kLoopback)
+    throw InvalidArgument("the loopback is not an emulated USB or HID link");
   return std::make_unique<EmulatedLink>(
       sim, link == SimLink::kUsb ? UsbPersonality::kBulk : UsbPersonality::kHid);
 }

@@ -64,9 +64,9 @@ class Bytes {
   std::uint64_t size_ = 0, offset_ = 0;
 };
 
-std::string Num(std::uint64_t v) { return std::to_string(v); }
-
-std::string EndOfFile(const Bytes& b) { return "the end of the file at byte " + Num(b.size()); }
+std::string EndOfFile(const Bytes& b) {
+  return "the end of the file at byte " + std::to_string(b.size());
+}
 
 // Printable text of a header line for a message: at most 40 characters, others as '?'.
 std::string Shown(const std::string& text) {
@@ -123,35 +123,39 @@ std::optional<Damage> LocateRadianceDamage(const std::string& path) {
     while ((c = b.Get()) >= 0 && c != '\n') {
       line += static_cast<char>(c);
       if (line.size() > 4096)
-        return Damage{"line " + Num(line_number) + " of the header (byte " + Num(line_start) + ")",
+        return Damage{"line " + std::to_string(line_number) + " of the header (byte " +
+                          std::to_string(line_start) + ")",
                       "a header line of at most 4096 characters",
-                      "a line that goes on past byte " + Num(b.offset())};
+                      "a line that goes on past byte " + std::to_string(b.offset())};
     }
     if (line_number == 1 && line.rfind("#?", 0) != 0)
       return Damage{"byte 0", "a Radiance HDR file starting with '#?' (e.g. '#?RADIANCE')",
                     line.empty() && c < 0 ? "an empty file" : Shown(line)};
     if (c < 0)
-      return Damage{"line " + Num(line_number) + " of the header (byte " + Num(line_start) + ")",
+      return Damage{"line " + std::to_string(line_number) + " of the header (byte " +
+                        std::to_string(line_start) + ")",
                     blank_seen ? "the image size line ('-Y HEIGHT +X WIDTH')"
                                : "the end of the header (a blank line, then the image size)",
                     EndOfFile(b)};
     if (blank_seen) {
       if (!ParseResolution(line, &rows, &columns))
-        return Damage{"line " + Num(line_number) + " of the header (byte " + Num(line_start) + ")",
+        return Damage{"line " + std::to_string(line_number) + " of the header (byte " +
+                          std::to_string(line_start) + ")",
                       "the image size as '-Y HEIGHT +X WIDTH' with positive numbers", Shown(line)};
       break;
     }
     if (line.rfind("FORMAT=", 0) == 0) {
       if (line != "FORMAT=32-bit_rle_rgbe")
-        return Damage{"line " + Num(line_number) + " of the header (byte " + Num(line_start) + ")",
+        return Damage{"line " + std::to_string(line_number) + " of the header (byte " +
+                          std::to_string(line_start) + ")",
                       "FORMAT=32-bit_rle_rgbe (RGB radiance)", Shown(line)};
       format_seen = true;
     }
     if (line.empty()) {
       // The readers require the FORMAT line (the format notes make it the one required one).
       if (!format_seen)
-        return Damage{"line " + Num(line_number) + " of the header (byte " + Num(line_start) +
-                          ", the blank line that ends it)",
+        return Damage{"line " + std::to_string(line_number) + " of the header (byte " +
+                          std::to_string(line_start) + ", the blank line that ends it)",
                       "a line FORMAT=32-bit_rle_rgbe before it", "no FORMAT line"};
       blank_seen = true;
     }
@@ -161,7 +165,8 @@ std::optional<Damage> LocateRadianceDamage(const std::string& path) {
   // The scanlines, in file order.
   const std::uint64_t w = columns;
   auto where = [&](std::uint64_t row, std::uint64_t byte) {
-    return "scanline " + Num(row + 1) + " of " + Num(rows) + " (byte " + Num(byte) + ")";
+    return "scanline " + std::to_string(row + 1) + " of " + std::to_string(rows) + " (byte " +
+           std::to_string(byte) + ")";
   };
   for (std::uint64_t row = 0; row < rows; ++row) {
     const std::uint64_t start = b.offset();
@@ -175,18 +180,19 @@ std::optional<Damage> LocateRadianceDamage(const std::string& path) {
       if (left >= need) return std::nullopt;
       const std::uint64_t whole = left / (4 * w);
       return Damage{where(row + whole, start + whole * 4 * w),
-                    Num(need) + " bytes of pixels (4 a pixel) for the last " + Num(rows - row) +
-                        " scanlines, up to byte " + Num(start + need),
+                    std::to_string(need) + " bytes of pixels (4 a pixel) for the last " +
+                        std::to_string(rows - row) + " scanlines, up to byte " +
+                        std::to_string(start + need),
                     EndOfFile(b)};
     }
     const std::uint64_t encoded = (static_cast<std::uint64_t>(head[2]) << 8) | head[3];
     const unsigned char expected[4] = {2, 2, static_cast<unsigned char>(w >> 8),
                                        static_cast<unsigned char>(w & 255)};
     if (encoded != w)
-      return Damage{
-          where(row, start),
-          "a run-length scanline of " + Num(w) + " pixels (bytes " + Hex(expected, 4) + ")",
-          "one of " + Num(encoded) + " pixels (bytes " + Hex(head, 4) + ")"};
+      return Damage{where(row, start),
+                    "a run-length scanline of " + std::to_string(w) + " pixels (bytes " +
+                        Hex(expected, 4) + ")",
+                    "one of " + std::to_string(encoded) + " pixels (bytes " + Hex(head, 4) + ")"};
     for (int component = 0; component < 4; ++component) {
       std::uint64_t filled = 0;
       while (filled < w) {
@@ -195,19 +201,20 @@ std::optional<Damage> LocateRadianceDamage(const std::string& path) {
         if (count < 0)
           return Damage{where(row, start),
                         "the " + std::string(kComponent[component]) + " values of pixels " +
-                            Num(filled + 1) + " to " + Num(w),
+                            std::to_string(filled + 1) + " to " + std::to_string(w),
                         EndOfFile(b)};
         const bool run = count > 128;
         const std::uint64_t n = run ? static_cast<std::uint64_t>(count - 128) : count;
         if (n == 0 || n > w - filled)
-          return Damage{where(row, start) + ", run at byte " + Num(at),
-                        "a run of 1 to " + Num(w - filled) + " " + kComponent[component] +
-                            " values (the rest of the " + Num(w) + " pixels)",
-                        "a run of " + Num(n) + " (count byte " + Num(count) + ")"};
+          return Damage{
+              where(row, start) + ", run at byte " + std::to_string(at),
+              "a run of 1 to " + std::to_string(w - filled) + " " + kComponent[component] +
+                  " values (the rest of the " + std::to_string(w) + " pixels)",
+              "a run of " + std::to_string(n) + " (count byte " + std::to_string(count) + ")"};
         for (std::uint64_t k = 0; k < (run ? 1 : n); ++k)
           if (b.Get() < 0)
-            return Damage{where(row, start) + ", run at byte " + Num(at),
-                          Num(run ? 1 : n) + " " + kComponent[component] +
+            return Damage{where(row, start) + ", run at byte " + std::to_string(at),
+                          std::to_string(run ? 1 : n) + " " + kComponent[component] +
                               (run || n == 1 ? " value" : " values"),
                           EndOfFile(b)};
         filled += n;
@@ -276,11 +283,14 @@ bool ReadName(Bytes& b, std::string* name) {
 std::string ExrBlockPosition(const ExrLayout& layout, std::uint64_t block) {
   const std::uint64_t first = block * layout.lines_per_block;
   const std::uint64_t last = std::min<std::uint64_t>(first + layout.lines_per_block, layout.rows);
-  std::string where = "pixel block " + Num(block + 1) + " of " + Num(layout.blocks) + " (";
-  where += last - first == 1 ? "scanline " + Num(first + 1)
-                             : "scanlines " + Num(first + 1) + "–" + Num(last);
-  where += " of " + Num(layout.rows);
-  if (block < layout.block_offsets.size()) where += ", byte " + Num(layout.block_offsets[block]);
+  std::string where =
+      "pixel block " + std::to_string(block + 1) + " of " + std::to_string(layout.blocks) + " (";
+  where += last - first == 1
+               ? "scanline " + std::to_string(first + 1)
+               : "scanlines " + std::to_string(first + 1) + "–" + std::to_string(last);
+  where += " of " + std::to_string(layout.rows);
+  if (block < layout.block_offsets.size())
+    where += ", byte " + std::to_string(layout.block_offsets[block]);
   return where + ")";
 }
 
@@ -290,7 +300,7 @@ std::optional<Damage> LocateExrDamage(const std::string& path, ExrLayout* layout
   unsigned char head[8];
   if (!b.Read(head, 8))
     return Damage{"byte 0", "the 8-byte OpenEXR signature (76 2f 31 01 and the version)",
-                  "a file of " + Num(b.size()) + (b.size() == 1 ? " byte" : " bytes")};
+                  "a file of " + std::to_string(b.size()) + (b.size() == 1 ? " byte" : " bytes")};
   static const unsigned char kMagic[4] = {0x76, 0x2f, 0x31, 0x01};
   if (!std::equal(head, head + 4, kMagic))
     return Damage{"byte 0", "the OpenEXR magic number 76 2f 31 01", "bytes " + Hex(head, 4)};
@@ -304,20 +314,20 @@ std::optional<Damage> LocateExrDamage(const std::string& path, ExrLayout* layout
     const std::uint64_t at = b.offset();
     std::string name, type;
     if (!ReadName(b, &name))
-      return Damage{"header attribute at byte " + Num(at),
+      return Damage{"header attribute at byte " + std::to_string(at),
                     "an attribute name ended by a zero byte (at most 255 characters)",
                     b.offset() >= b.size() ? EndOfFile(b) : "a longer name"};
     if (name.empty()) break;  // the end of the header
     unsigned char size_bytes[4];
     if (!ReadName(b, &type) || !b.Read(size_bytes, 4))
-      return Damage{"header attribute '" + name + "' at byte " + Num(at),
+      return Damage{"header attribute '" + name + "' at byte " + std::to_string(at),
                     "its type name and 4-byte size", EndOfFile(b)};
     const std::uint32_t size = Le32(size_bytes);
     if (size > b.size() - b.offset())
-      return Damage{
-          "header attribute '" + name + "' at byte " + Num(at),
-          "a value size of at most the " + Num(b.size() - b.offset()) + " bytes left in the file",
-          Num(size) + " bytes"};
+      return Damage{"header attribute '" + name + "' at byte " + std::to_string(at),
+                    "a value size of at most the " + std::to_string(b.size() - b.offset()) +
+                        " bytes left in the file",
+                    std::to_string(size) + " bytes"};
     // Only the small values this walk reads are loaded; the others are skipped.
     std::vector<unsigned char> value(std::min<std::uint32_t>(size, 16));
     b.Read(value.data(), value.size());
@@ -325,11 +335,12 @@ std::optional<Damage> LocateExrDamage(const std::string& path, ExrLayout* layout
     for (const RequiredAttribute& r : kRequired)
       if (name == r.name) {
         if (type != r.type)
-          return Damage{"header attribute '" + name + "' at byte " + Num(at),
+          return Damage{"header attribute '" + name + "' at byte " + std::to_string(at),
                         "the type '" + std::string(r.type) + "'", "'" + type + "'"};
         if (r.size > 0 && size != r.size)
-          return Damage{"header attribute '" + name + "' at byte " + Num(at),
-                        "a value of " + Num(r.size) + " bytes", Num(size) + " bytes"};
+          return Damage{"header attribute '" + name + "' at byte " + std::to_string(at),
+                        "a value of " + std::to_string(r.size) + " bytes",
+                        std::to_string(size) + " bytes"};
         seen.insert(name);
       }
     if (name == "dataWindow" && type == "box2i" && size == 16) {
@@ -343,7 +354,7 @@ std::optional<Damage> LocateExrDamage(const std::string& path, ExrLayout* layout
   const std::uint64_t header_end = b.offset();
   for (const RequiredAttribute& r : kRequired)
     if (seen.count(r.name) == 0)
-      return Damage{"the header (ending at byte " + Num(header_end - 1) + ")",
+      return Damage{"the header (ending at byte " + std::to_string(header_end - 1) + ")",
                     "the required attribute '" + std::string(r.name) + "' of type '" + r.type + "'",
                     "no such attribute"};
   if (!have_window || compression < 0 || y_max < y_min) return std::nullopt;  // OpenEXR says it
@@ -358,19 +369,21 @@ std::optional<Damage> LocateExrDamage(const std::string& path, ExrLayout* layout
     unsigned char entry[8];
     const std::uint64_t at = b.offset();
     if (!b.Read(entry, 8))
-      return Damage{"entry " + Num(k + 1) + " of the table of " + Num(found.blocks) +
-                        " pixel-block offsets (byte " + Num(at) + ")",
+      return Damage{"entry " + std::to_string(k + 1) + " of the table of " +
+                        std::to_string(found.blocks) + " pixel-block offsets (byte " +
+                        std::to_string(at) + ")",
                     "an 8-byte offset", EndOfFile(b)};
     found.block_offsets.push_back(Le64(entry));
   }
   for (std::uint64_t k = 0; k < found.blocks; ++k) {
     const std::uint64_t o = found.block_offsets[k];
     if (o < table_end || o >= b.size())
-      return Damage{"entry " + Num(k + 1) + " of the table of " + Num(found.blocks) +
-                        " pixel-block offsets (byte " + Num(header_end + 8 * k) + ")",
-                    "an offset from " + Num(table_end) + " to " + Num(b.size() - 1) +
-                        " (inside the file's pixel data)",
-                    Num(o)};
+      return Damage{"entry " + std::to_string(k + 1) + " of the table of " +
+                        std::to_string(found.blocks) + " pixel-block offsets (byte " +
+                        std::to_string(header_end + 8 * k) + ")",
+                    "an offset from " + std::to_string(table_end) + " to " +
+                        std::to_string(b.size() - 1) + " (inside the file's pixel data)",
+                    std::to_string(o)};
     b.Seek(o);
     unsigned char block_head[8];
     if (!b.Read(block_head, 8))
@@ -385,9 +398,9 @@ std::optional<Damage> LocateExrDamage(const std::string& path, ExrLayout* layout
                     std::to_string(y)};
     if (size == 0 || size > b.size() - b.offset())
       return Damage{ExrBlockPosition(found, k),
-                    size == 0
-                        ? std::string("a pixel data size above 0")
-                        : Num(size) + " bytes of pixel data, up to byte " + Num(b.offset() + size),
+                    size == 0 ? std::string("a pixel data size above 0")
+                              : std::to_string(size) + " bytes of pixel data, up to byte " +
+                                    std::to_string(b.offset() + size),
                     size == 0 ? std::string("0") : EndOfFile(b)};
   }
   if (layout != nullptr) *layout = std::move(found);

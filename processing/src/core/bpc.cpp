@@ -17,6 +17,7 @@
 
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
+#include "brdf/core/text_format.h"
 
 namespace brdf {
 
@@ -40,12 +41,6 @@ constexpr char kTagSlice[5] = "SLCE";
 constexpr char kTagEnd[5] = "END ";
 
 std::string ErrnoText() { return std::strerror(errno); }
-
-std::string Hex32(std::uint32_t v) {
-  char buf[16];
-  std::snprintf(buf, sizeof buf, "0x%08x", v);
-  return buf;
-}
 
 // Printable form of a 4-byte tag for messages ("SLCE", "\x00\x00\x00\x00").
 std::string TagText(const std::uint8_t* p) {
@@ -369,9 +364,10 @@ class BpcParser {
         const std::size_t next = FindNextChunk(pos + 1);
         const std::uint64_t region = next - pos;
         AddProblem(BpcProblemKind::kCorrupt, pos, region, slice,
-                   "chunk header CRC-32 " + Hex32(h.header_crc),
-                   Hex32(Crc32(p, 20)) + " (tag " + TagText(p) + "); " + std::to_string(region) +
-                       " bytes skipped" + (next == size_ ? " to the end of the file" : ""));
+                   "chunk header CRC-32 " + Hex32Text(h.header_crc),
+                   Hex32Text(Crc32(p, 20)) + " (tag " + TagText(p) + "); " +
+                       std::to_string(region) + " bytes skipped" +
+                       (next == size_ ? " to the end of the file" : ""));
         if (slice >= 0) ++expected_slice;
         prefix_intact = false;
         pos = next;
@@ -395,8 +391,8 @@ class BpcParser {
       const std::uint32_t crc = Crc32(payload, n);
       if (crc != h.payload_crc) {
         AddProblem(BpcProblemKind::kCorrupt, pos, end - pos, stored_slice,
-                   "payload CRC-32 " + Hex32(h.payload_crc) + " of chunk " + TagText(p),
-                   Hex32(crc));
+                   "payload CRC-32 " + Hex32Text(h.payload_crc) + " of chunk " + TagText(p),
+                   Hex32Text(crc));
         if (stored_slice >= 0) expected_slice = stored_slice + 1;
         prefix_intact = false;
         pos = end;
@@ -480,8 +476,8 @@ class BpcParser {
     const std::uint8_t* p = data_ + pos;
     if (!TagIs(p, kTagHead)) FailHeader(pos, "chunk tag 'HEAD'", TagText(p));
     if (!HeaderCrcOk(p))
-      FailHeader(pos + 20, "header chunk header CRC-32 " + Hex32(LoadU32(p + 20)),
-                 Hex32(Crc32(p, 20)));
+      FailHeader(pos + 20, "header chunk header CRC-32 " + Hex32Text(LoadU32(p + 20)),
+                 Hex32Text(Crc32(p, 20)));
     const ChunkHeader h = DecodeChunkHeader(p);
     if (h.payload_size > size_ - pos - kChunkHeaderSize)
       FailHeader(pos + 8, std::to_string(h.payload_size) + " bytes of header JSON",
@@ -489,7 +485,8 @@ class BpcParser {
     const std::size_t n = static_cast<std::size_t>(h.payload_size);
     const std::uint8_t* payload = p + kChunkHeaderSize;
     if (const std::uint32_t crc = Crc32(payload, n); crc != h.payload_crc)
-      FailHeader(pos + kChunkHeaderSize, "header JSON CRC-32 " + Hex32(h.payload_crc), Hex32(crc));
+      FailHeader(pos + kChunkHeaderSize, "header JSON CRC-32 " + Hex32Text(h.payload_crc),
+                 Hex32Text(crc));
     const Json j = ParseJsonPayload(payload, n, file_, pos + kChunkHeaderSize, "header");
     // The preamble's version is outside any CRC; the JSON repeats it, so a damaged version
     // field is caught rather than silently accepted.

@@ -8,17 +8,9 @@
 
 #include "brdf/core/error.h"
 #include "brdf/core/geometry.h"
+#include "brdf/core/text_format.h"
 
 namespace brdf {
-namespace {
-
-std::string Deg(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
-}
-
-}  // namespace
 
 std::vector<double> CaptureGeometry::ThetaOutDeg() const {
   // The simulator's rule: rows = ⌊max/step + 1e-6⌋ + 1, so 75/1 gives 76 rows (0…75).
@@ -37,14 +29,14 @@ std::vector<double> CaptureGeometry::PhiOutDeg() const {
 
 std::string CaptureGeometry::Describe() const {
   std::string thetas;
-  for (double t : theta_in_deg) thetas += (thetas.empty() ? "" : ", ") + Deg(t);
+  for (double t : theta_in_deg) thetas += (thetas.empty() ? "" : ", ") + NumberText(t);
   const std::vector<double> phi = PhiOutDeg();
-  std::string text = "theta_in " + thetas + "; theta_out 0-" + Deg(ThetaOutDeg().back()) +
-                     "; phi_out 0-" + Deg(phi.back());
+  std::string text = "theta_in " + thetas + "; theta_out 0-" + NumberText(ThetaOutDeg().back()) +
+                     "; phi_out 0-" + NumberText(phi.back());
   if (theta_out_step_deg == phi_out_step_deg)
-    return text + "; " + Deg(theta_out_step_deg) + " deg steps";
-  return text + "; steps " + Deg(theta_out_step_deg) + " deg (theta_out), " +
-         Deg(phi_out_step_deg) + " deg (phi_out)";
+    return text + "; " + NumberText(theta_out_step_deg) + " deg steps";
+  return text + "; steps " + NumberText(theta_out_step_deg) + " deg (theta_out), " +
+         NumberText(phi_out_step_deg) + " deg (phi_out)";
 }
 
 void CaptureGeometry::Validate() const {
@@ -52,20 +44,21 @@ void CaptureGeometry::Validate() const {
   for (std::size_t i = 0; i < theta_in_deg.size(); ++i) {
     const double t = theta_in_deg[i];
     if (!(t >= 0.0 && t < 90.0))
-      throw InvalidArgument("capture geometry: θin must be in [0, 90) degrees, got " + Deg(t));
+      throw InvalidArgument("capture geometry: θin must be in [0, 90) degrees, got " +
+                            NumberText(t));
     for (std::size_t j = 0; j < i; ++j)
       if (std::fabs(theta_in_deg[j] - t) <= 1e-6)
-        throw InvalidArgument("capture geometry: θin " + Deg(t) + "° is listed twice");
+        throw InvalidArgument("capture geometry: θin " + NumberText(t) + "° is listed twice");
   }
   if (!(theta_out_max_deg >= 0.0 && theta_out_max_deg < 90.0))
     throw InvalidArgument("capture geometry: θout max must be in [0, 90) degrees, got " +
-                          Deg(theta_out_max_deg));
+                          NumberText(theta_out_max_deg));
   if (!(theta_out_step_deg >= 0.01 && theta_out_step_deg <= 90.0))
     throw InvalidArgument("capture geometry: θout step must be in [0.01, 90] degrees, got " +
-                          Deg(theta_out_step_deg));
+                          NumberText(theta_out_step_deg));
   if (!(phi_out_step_deg >= 0.01 && phi_out_step_deg <= 360.0))
     throw InvalidArgument("capture geometry: φout step must be in [0.01, 360] degrees, got " +
-                          Deg(phi_out_step_deg));
+                          NumberText(phi_out_step_deg));
 }
 
 const CaptureGeometry& ReferenceGeometry() {
@@ -110,11 +103,10 @@ Measurement CaptureNoiseFree(const BrdfSource& source, const CaptureGeometry& ge
 std::string EncodeThetaInList(const std::vector<double>& theta_in_deg) {
   std::string out;
   for (double t : theta_in_deg) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%g", t);
+    std::string text = ShortNumberText(t);
     // %g keeps 6 significant digits; fall back to the round-trip form when that loses bits.
-    if (std::strtod(buf, nullptr) != t) std::snprintf(buf, sizeof buf, "%.17g", t);
-    out += (out.empty() ? "" : ",") + std::string(buf);
+    if (std::strtod(text.c_str(), nullptr) != t) text = ExactNumberText(t);
+    out += (out.empty() ? "" : ",") + text;
   }
   return out;
 }

@@ -11,15 +11,10 @@
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
 #include "brdf/core/json_error.h"
+#include "brdf/core/text_format.h"
 
 namespace brdf::processing {
 namespace {
-
-std::string Num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
 
 std::string_view Trim(std::string_view s) {
   while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
@@ -47,16 +42,17 @@ void ExtrapolationParams::Validate() const {
   if (!(std::isfinite(p) && p >= 0.0))
     throw InvalidArgument(
         "extrapolation parameter p must be a finite number >= 0 (docs/design.md §6), got " +
-        Num(p));
+        ExactNumberText(p));
   if (!(l >= 0.0 && l <= 1.0))
     throw InvalidArgument("extrapolation parameter l must be in [0, 1] (docs/design.md §6), got " +
-                          Num(l));
+                          ExactNumberText(l));
 }
 
 double BezierB(double x, double l) {
   if (std::isnan(x)) throw InvalidArgument("BezierB: x must be a number in [0, 1], got NaN");
   if (!(l >= 0.0 && l <= 1.0))
-    throw InvalidArgument("BezierB: l must be in [0, 1] (docs/design.md §6), got " + Num(l));
+    throw InvalidArgument("BezierB: l must be in [0, 1] (docs/design.md §6), got " +
+                          ExactNumberText(l));
   x = std::clamp(x, 0.0, 1.0);
   if (x == 0.0) return 0.0;  // t = 0; also avoids 0/0 when l = 0
   // Root of x(t) = (1 − 2l)t² + 2l·t in the conjugate form of docs/design.md §6: well defined at l
@@ -69,7 +65,8 @@ double ExtrapolationFactor(double theta_out_deg, double theta_b_deg,
                            const ExtrapolationParams& params) {
   params.Validate();
   if (!(theta_b_deg >= 0.0 && theta_b_deg <= 90.0))
-    throw InvalidArgument("extrapolation: θb must be in [0°, 90°], got " + Num(theta_b_deg));
+    throw InvalidArgument("extrapolation: θb must be in [0°, 90°], got " +
+                          ExactNumberText(theta_b_deg));
   if (std::isnan(theta_out_deg)) throw InvalidArgument("extrapolation: θout is NaN");
   if (theta_out_deg <= theta_b_deg || theta_b_deg >= 90.0) return 1.0;
   const double m = 90.0 - theta_b_deg;
@@ -98,7 +95,7 @@ ExtrapolationParams ParseExtrapolation(std::string_view text) {
 }
 
 std::string FormatExtrapolation(const ExtrapolationParams& params) {
-  return Num(params.p) + "," + Num(params.l);
+  return ExactNumberText(params.p) + "," + ExactNumberText(params.l);
 }
 
 std::optional<ExtrapolationParams> ExtrapolationFromJson(std::string_view json_text,

@@ -20,12 +20,6 @@ constexpr double kThetaInTolDeg = 1e-3;
 // Texels 1° from the nadir are 0.017 away from the axis; rounding puts the nadir ~1e-16 away.
 constexpr double kNadirRadius2 = 1e-18;
 
-std::string Num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
-}
-
 std::string Who(const Measurement& m) {
   return m.metadata.sample_name.empty() ? "measurement"
                                         : "measurement '" + m.metadata.sample_name + "'";
@@ -37,12 +31,13 @@ std::vector<std::size_t> ThetaInOrder(const Measurement& m, bool uniform, double
   if (m.slices.empty()) throw InvalidArgument(Who(m) + " has no slices; cannot build a LUT");
   std::vector<std::size_t> order(m.slices.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
-  for (std::size_t i : order) internal::CheckSliceThetaIn(m.slices[i], i);
+  for (std::size_t i : order) detail::CheckSliceThetaIn(m.slices[i], i);
   std::stable_sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
     return m.slices[a].theta_in_deg < m.slices[b].theta_in_deg;
   });
   std::string list;
-  for (std::size_t i : order) list += (list.empty() ? "" : ", ") + Num(m.slices[i].theta_in_deg);
+  for (std::size_t i : order)
+    list += (list.empty() ? "" : ", ") + NumberText(m.slices[i].theta_in_deg);
   const auto fail = [&](const std::string& why) {
     throw InvalidArgument(Who(m) +
                           ": the LUT needs incidence angles θin,k = k·Δin starting at 0° "
@@ -51,8 +46,8 @@ std::vector<std::size_t> ThetaInOrder(const Measurement& m, bool uniform, double
   };
   for (std::size_t k = 1; k < order.size(); ++k)
     if (m.slices[order[k]].theta_in_deg - m.slices[order[k - 1]].theta_in_deg <= kThetaInTolDeg)
-      fail("duplicate incidence angle " + Num(m.slices[order[k]].theta_in_deg) + "° (slices " +
-           std::to_string(order[k - 1]) + " and " + std::to_string(order[k]) + ")");
+      fail("duplicate incidence angle " + NumberText(m.slices[order[k]].theta_in_deg) +
+           "° (slices " + std::to_string(order[k - 1]) + " and " + std::to_string(order[k]) + ")");
   *delta_in = 0.0;
   if (!uniform) return order;
   const double first = m.slices[order.front()].theta_in_deg;
@@ -64,7 +59,7 @@ std::vector<std::size_t> ThetaInOrder(const Measurement& m, bool uniform, double
   for (std::size_t k = 0; k < order.size(); ++k) {
     const double expected = static_cast<double>(k) * delta;
     if (std::fabs(m.slices[order[k]].theta_in_deg - expected) > kThetaInTolDeg)
-      fail("the steps are not uniform (expected " + Num(expected) + "° as number " +
+      fail("the steps are not uniform (expected " + NumberText(expected) + "° as number " +
            std::to_string(k + 1) + " in ascending order)");
   }
   *delta_in = delta;
@@ -107,7 +102,7 @@ std::vector<LutInputProblem> FindLutInputProblems(const Measurement& m,
     return out;
   }
   const auto name = [&](std::size_t i) {
-    return "slice " + std::to_string(i) + " (θin = " + Num(m.slices[i].theta_in_deg) + "°)";
+    return "slice " + std::to_string(i) + " (θin = " + NumberText(m.slices[i].theta_in_deg) + "°)";
   };
   bool angles_ok = true;
   for (std::size_t i = 0; i < m.slices.size(); ++i) {
@@ -148,7 +143,7 @@ std::vector<LutInputProblem> FindLutInputProblems(const Measurement& m,
         ++invalid;
         continue;
       }
-      if (const char* d = internal::SampleDefect(x)) {
+      if (const char* d = detail::SampleDefect(x)) {
         auto it = std::find_if(defects.begin(), defects.end(),
                                [&](const Defect& e) { return e.what == d; });
         if (it == defects.end())
@@ -162,9 +157,9 @@ std::vector<LutInputProblem> FindLutInputProblems(const Measurement& m,
     }
     for (const Defect& d : defects) {
       const Sample& x = s.samples[d.first];
-      const std::string values = "θout " + Num(x.theta_out_deg) + "°, φout " + Num(x.phi_out_deg) +
-                                 "°, rgb " + Num(x.rgb[0]) + " " + Num(x.rgb[1]) + " " +
-                                 Num(x.rgb[2]);
+      const std::string values = "θout " + NumberText(x.theta_out_deg) + "°, φout " +
+                                 NumberText(x.phi_out_deg) + "°, rgb " + NumberText(x.rgb[0]) +
+                                 " " + NumberText(x.rgb[1]) + " " + NumberText(x.rgb[2]);
       LutInputProblem* p =
           add(Kind::kBadSamples, static_cast<int>(i),
               name(i) + ": " + std::to_string(d.count) + " sample" + (d.count == 1 ? "" : "s") +
@@ -197,10 +192,10 @@ Lut BuildLut(const Measurement& measurement, const ExtrapolationParams& params,
       ThetaInOrder(measurement, options.require_uniform_theta_in, &delta_in);
   const int k_slices = static_cast<int>(order.size());
 
-  std::vector<std::unique_ptr<internal::SliceInterpolator>> slices(order.size());
+  std::vector<std::unique_ptr<detail::SliceInterpolator>> slices(order.size());
   const auto build_slice = [&](std::size_t k) {
-    slices[k] = std::make_unique<internal::SliceInterpolator>(measurement.slices[order[k]],
-                                                              order[k], options);
+    slices[k] = std::make_unique<detail::SliceInterpolator>(measurement.slices[order[k]], order[k],
+                                                            options);
   };
   if (options.parallel && order.size() > 1) {
     tbb::parallel_for(std::size_t{0}, order.size(), build_slice);
@@ -237,7 +232,7 @@ Lut BuildLut(const Measurement& measurement, const ExtrapolationParams& params,
   sin_t[kH - 1] = 0.0;
 
   // The texel's value from its outgoing direction (ω_out, θout, φout) per docs/design.md §5 and §6.
-  const auto texel_value = [&](const internal::SliceInterpolator& slice, const Vec3& w_out,
+  const auto texel_value = [&](const detail::SliceInterpolator& slice, const Vec3& w_out,
                                double theta_out, double phi_out) {
     Rgb v;
     if (w_out.z <= 0.0) {  // at or below the horizon: the 90° value at this φout
@@ -257,7 +252,7 @@ Lut BuildLut(const Measurement& measurement, const ExtrapolationParams& params,
   };
   const auto do_row = [&](int row) {
     const int k = row / kH, j = row % kH;
-    const internal::SliceInterpolator& slice = *slices[static_cast<std::size_t>(k)];
+    const detail::SliceInterpolator& slice = *slices[static_cast<std::size_t>(k)];
     const SpecularFrame frame =
         SpecularFrame::FromThetaInDeg(lut.theta_in_deg[static_cast<std::size_t>(k)]);
     const double st = sin_t[static_cast<std::size_t>(j)], ct = cos_t[static_cast<std::size_t>(j)];

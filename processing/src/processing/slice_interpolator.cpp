@@ -8,7 +8,7 @@
 
 #include "brdf/core/error.h"
 
-namespace brdf::processing::internal {
+namespace brdf::processing::detail {
 namespace {
 
 // Lattice coordinates of float32 angles agree to ~1e-5°; 1e-3° separates distinct lattice
@@ -17,14 +17,8 @@ constexpr double kAngleTolDeg = 1e-3;
 constexpr double kMinStepDeg = 0.05;
 constexpr int kRingSize = 3600;  // horizon table of the scattered method: 0.1° steps
 
-std::string Num(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
-}
-
 std::string SliceName(const Slice& slice, std::size_t index) {
-  return "slice " + std::to_string(index) + " (θin = " + Num(slice.theta_in_deg) + "°)";
+  return "slice " + std::to_string(index) + " (θin = " + NumberText(slice.theta_in_deg) + "°)";
 }
 
 // Distinct values (within kAngleTolDeg) of angles in [0°, range]: how many, the first and
@@ -463,4 +457,4 @@ Rgb SliceInterpolator::RingAt(double phi_deg) const {
   return {a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t, a[2] + (b[2] - a[2]) * t};
 }
 
-}  // namespace brdf::processing::internal
+}  // namespace brdf::processing::detail

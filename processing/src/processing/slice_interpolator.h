@@ -16,7 +16,7 @@
 #include "brdf/processing/extrapolation.h"
 #include "brdf/processing/resample.h"
 
-namespace brdf::processing::internal {
+namespace brdf::processing::detail {
 
 // One valid sample after normalisation: θ ∈ [0°, 90°], φ ∈ [0°, 360°) relative to φin.
 struct Point {
@@ -137,4 +137,4 @@ class SliceInterpolator {
   SliceResampleReport report_;
 };
 
-}  // namespace brdf::processing::internal
+}  // namespace brdf::processing::detail

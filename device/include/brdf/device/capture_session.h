@@ -32,8 +32,12 @@
 namespace brdf::device {
 
 struct CaptureRequest {
-  std::string out_path;              // the capture file; must end in .bpc
-  std::vector<double> theta_in_deg;  // the planned slices, in capture order
+  std::string out_path;  // the capture file; must end in .bpc
+  // The planned slices, in capture order. The session records the plan in the header before
+  // the first slice (extra "theta_in_deg", brdf::EncodeThetaInList of brdf/core/virtual_capture.h),
+  // so that an interrupted capture missing slices can be told from a complete one; a resumption
+  // must plan the same list, since the header on disk is not rewritten.
+  std::vector<double> theta_in_deg;
   ExposureSetting exposure;
   std::string sample_name;
   std::string operator_notes;

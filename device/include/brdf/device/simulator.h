@@ -3,8 +3,8 @@
 //
 // The simulator is the instrument, not a shortcut around it: the host driver talks to it
 // through LoopbackTransport exactly as it would talk to hardware, and receives raw detector
-// counts that it must calibrate itself. The virtual sample is any brdf::BrdfSource (an
-// analytic material now, measured databases later).
+// counts that it must calibrate itself. The virtual sample is any brdf::BrdfSource: an
+// analytic material or a measured one (a MERL or RGL file).
 //
 // Detector model, per channel c, for one ADC frame of exposure t (ms):
 //   counts = t · R_c · L_c + D_c + shot noise + read noise, clipped to [0, full scale]
@@ -44,6 +44,7 @@
 #include <vector>
 
 #include "brdf/core/brdf_source.h"
+#include "brdf/core/virtual_capture.h"
 #include "brdf/device/protocol.h"
 
 namespace brdf::device {
@@ -72,6 +73,11 @@ struct InstrumentModel {
   std::vector<float> nd_transmittance = {1.0f, 0.1f, 0.01f, 0.001f};
   double max_exposure_ms = 2000;
   double autorange_target_fraction = 0.8;  // of (full scale − dark)
+
+  // Sets the light-arm positions and detector steps to `geometry`'s, in float32 as the
+  // instrument reports them (GET_GEOMETRY). Not validated here: the firmware refuses what it
+  // cannot do.
+  void SetGeometry(const CaptureGeometry& geometry);
 };
 
 // Every known model; the first is the reference instrument of docs/design.md §1 (MiniDiff V2 class:

@@ -15,6 +15,7 @@
 // DDS has no place for metadata: the θin list travels in the sidecar (sidecar.h) beside it.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -25,6 +26,9 @@
 #include "brdf/exporter/texture_file.h"
 
 namespace brdf::exporter {
+
+// The 4 bytes every DDS file starts with: "DDS " (the little-endian word 0x20534444).
+inline constexpr std::array<std::uint8_t, 4> kDdsMagic = {'D', 'D', 'S', ' '};
 
 inline constexpr std::uint32_t kDxgiFormatR9g9b9e5Sharedexp = 67;
 inline constexpr std::size_t kDdsDataOffset = 4 + 124 + 20;

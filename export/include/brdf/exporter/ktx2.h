@@ -21,6 +21,7 @@
 // atlas. Values are NUL-terminated UTF-8.
 #pragma once
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 #include <string>
@@ -33,6 +34,11 @@
 #include "brdf/exporter/texture_file.h"
 
 namespace brdf::exporter {
+
+// The 12-byte file identifier every KTX 2.0 file starts with (KTX 2.0 §3.1):
+// «KTX 20» CR LF 0x1A LF.
+inline constexpr std::array<std::uint8_t, 12> kKtx2Identifier = {
+    0xAB, 'K', 'T', 'X', ' ', '2', '0', 0xBB, '\r', '\n', 0x1A, '\n'};
 
 inline constexpr std::uint32_t kVkFormatE5b9g9r9UfloatPack32 = 123;
 

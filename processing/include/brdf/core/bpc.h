@@ -12,6 +12,7 @@
 // (NaN payloads, -0.0 and denormals included), θin/φin of a Slice as float64.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <cstdio>
 #include <string>
@@ -21,6 +22,10 @@
 
 namespace brdf {
 
+// The 8 bytes every .bpc file starts with (docs/formats/bpc.md): 0x89 "BPC" CR LF 0x1A LF, so a
+// transfer that mangles line ends or stops at the DOS end-of-file byte shows in the first bytes.
+inline constexpr std::array<std::uint8_t, 8> kBpcMagic = {0x89, 'B',  'P',  'C',
+                                                          '\r', '\n', 0x1a, '\n'};
 // The format version this code writes and the newest it reads (docs/formats/bpc.md, versioning).
 inline constexpr std::uint16_t kBpcVersionMajor = 1;
 inline constexpr std::uint16_t kBpcVersionMinor = 0;

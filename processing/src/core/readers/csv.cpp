@@ -36,10 +36,10 @@ constexpr const char* kColumnNames[kColumnCount] = {"theta_in", "phi_in",  "thet
 int ColumnOf(std::string_view name) {
   for (int c = 0; c < kColumnCount; ++c) {
     const std::string_view known = kColumnNames[c];
-    if (text::EqualsIgnoreCase(name, known)) return c;
+    if (detail::EqualsIgnoreCase(name, known)) return c;
     if (c <= kPhiOut && name.size() == known.size() + 4 &&
-        text::EqualsIgnoreCase(name.substr(0, known.size()), known) &&
-        text::EqualsIgnoreCase(name.substr(known.size()), "_deg"))
+        detail::EqualsIgnoreCase(name.substr(0, known.size()), known) &&
+        detail::EqualsIgnoreCase(name.substr(known.size()), "_deg"))
       return c;
   }
   return -1;
@@ -121,7 +121,7 @@ void AppendFloat(std::string& out, float v) {
 }  // namespace
 
 Measurement ParseCsv(std::string_view text_in, const std::string& file) {
-  text::LineCursor lines(text_in, file);
+  detail::LineCursor lines(text_in, file);
   Measurement m;
   std::string_view line;
   std::vector<std::string_view> fields;
@@ -133,44 +133,44 @@ Measurement ParseCsv(std::string_view text_in, const std::string& file) {
   std::size_t field_count = 0;
   while (lines.Next(&line)) {
     if (lines.line_number() == 1 && line.substr(0, 3) == "\xEF\xBB\xBF") line.remove_prefix(3);
-    const std::string_view t = text::Trim(line);
+    const std::string_view t = detail::Trim(line);
     if (t.empty()) continue;
-    if (!text::IsValidUtf8(t)) lines.Fail("UTF-8 text", text::Printable(t));
+    if (!detail::IsValidUtf8(t)) lines.Fail("UTF-8 text", detail::Printable(t));
     if (t.front() == '#') {
-      const std::string_view body = text::Trim(t.substr(1));
+      const std::string_view body = detail::Trim(t.substr(1));
       const std::size_t eq = body.find('=');
       if (eq == std::string_view::npos || eq == 0) continue;  // a plain comment
-      const std::string key(text::Trim(body.substr(0, eq)));
-      const std::string value = Unescape(text::Trim(body.substr(eq + 1)));
+      const std::string key(detail::Trim(body.substr(0, eq)));
+      const std::string value = Unescape(detail::Trim(body.substr(eq + 1)));
       if (key == "incomplete_slice") {
-        text::SplitCsvLine(value, &fields);
+        detail::SplitCsvLine(value, &fields);
         if (fields.size() != 2)
-          lines.Fail("incomplete_slice=<theta_in>,<phi_in>", text::Printable(value));
-        incomplete.emplace_back(text::ParseFiniteDouble(fields[0], file, lines.line_number(),
-                                                        "incomplete_slice theta_in"),
-                                text::ParseFiniteDouble(fields[1], file, lines.line_number(),
-                                                        "incomplete_slice phi_in"));
+          lines.Fail("incomplete_slice=<theta_in>,<phi_in>", detail::Printable(value));
+        incomplete.emplace_back(detail::ParseFiniteDouble(fields[0], file, lines.line_number(),
+                                                          "incomplete_slice theta_in"),
+                                detail::ParseFiniteDouble(fields[1], file, lines.line_number(),
+                                                          "incomplete_slice phi_in"));
       } else if (key.find(' ') == std::string::npos) {
         SetMetadata(m.metadata, key, value);
       }
       continue;
     }
-    text::SplitCsvLine(t, &fields);
+    detail::SplitCsvLine(t, &fields);
     for (std::size_t i = 0; i < fields.size(); ++i) {
       const int c = ColumnOf(fields[i]);
       if (c < 0) {
         lines.Fail(
             "a header of known column names (theta_in, phi_in, theta_out, phi_out, r, g, "
             "b, sigma_r, sigma_g, sigma_b, flags)",
-            "column " + std::to_string(i + 1) + " " + text::Printable(fields[i]));
+            "column " + std::to_string(i + 1) + " " + detail::Printable(fields[i]));
       }
-      if (index[c] >= 0) lines.Fail("each column once", "a second " + text::Printable(fields[i]));
+      if (index[c] >= 0) lines.Fail("each column once", "a second " + detail::Printable(fields[i]));
       index[c] = static_cast<int>(i);
     }
     for (int c = kThetaIn; c <= kB; ++c) {
       if (index[c] < 0)
         lines.Fail(std::string("a header with a ") + kColumnNames[c] + " column",
-                   text::Printable(t));
+                   detail::Printable(t));
     }
     const int sigmas = (index[kSigmaR] >= 0) + (index[kSigmaG] >= 0) + (index[kSigmaB] >= 0);
     if (sigmas != 0 && sigmas != 3)
@@ -181,30 +181,30 @@ Measurement ParseCsv(std::string_view text_in, const std::string& file) {
     break;
   }
   if (!have_header)
-    text::Fail(file, lines.line_number() + 1,
-               "a header line 'theta_in,phi_in,theta_out,phi_out,r,g,b'", "end of file");
+    detail::Fail(file, lines.line_number() + 1,
+                 "a header line 'theta_in,phi_in,theta_out,phi_out,r,g,b'", "end of file");
   const bool has_sigma = index[kSigmaR] >= 0;
 
   std::map<std::pair<float, float>, std::size_t> slice_of;
   std::vector<Slice> slices;
   while (lines.Next(&line)) {
-    const std::string_view t = text::Trim(line);
+    const std::string_view t = detail::Trim(line);
     if (t.empty()) continue;
     if (t.front() == '#') continue;
-    text::SplitCsvLine(t, &fields);
+    detail::SplitCsvLine(t, &fields);
     const std::uint64_t ln = lines.line_number();
     if (fields.size() != field_count)
       lines.Fail(std::to_string(field_count) + " comma-separated fields",
                  std::to_string(fields.size()) + " fields");
     const auto number = [&](int c) {
-      return text::ParseFiniteDouble(fields[index[c]], file, ln, kColumnNames[c]);
+      return detail::ParseFiniteDouble(fields[index[c]], file, ln, kColumnNames[c]);
     };
     const auto in_range = [&](int c, double lo, double hi, bool hi_open) {
       const double v = number(c);
       if (v < lo || v > hi || (hi_open && v == hi)) {
-        lines.Fail(std::string(kColumnNames[c]) + " in [" + text::FormatShortest(lo) + ", " +
-                       text::FormatShortest(hi) + (hi_open ? ")" : "]"),
-                   text::Printable(fields[index[c]]));
+        lines.Fail(std::string(kColumnNames[c]) + " in [" + detail::FormatShortest(lo) + ", " +
+                       detail::FormatShortest(hi) + (hi_open ? ")" : "]"),
+                   detail::Printable(fields[index[c]]));
       }
       return v;
     };
@@ -221,7 +221,7 @@ Measurement ParseCsv(std::string_view text_in, const std::string& file) {
         const double v = number(kSigmaR + c);
         if (v < 0)
           lines.Fail(std::string("a non-negative ") + kColumnNames[kSigmaR + c],
-                     text::Printable(fields[index[kSigmaR + c]]));
+                     detail::Printable(fields[index[kSigmaR + c]]));
         s.sigma[c] = static_cast<float>(v);
       }
     }
@@ -230,7 +230,7 @@ Measurement ParseCsv(std::string_view text_in, const std::string& file) {
       unsigned v = 0;
       const auto [ptr, ec] = std::from_chars(f.data(), f.data() + f.size(), v);
       if (ec != std::errc() || ptr != f.data() + f.size() || v > kKnownSampleFlags)
-        lines.Fail("flags as a whole number in [0, 15]", text::Printable(f));
+        lines.Fail("flags as a whole number in [0, 15]", detail::Printable(f));
       s.flags = static_cast<std::uint8_t>(v);
     }
     const auto key = std::make_pair(s.theta_in_deg, s.phi_in_deg);
@@ -246,8 +246,8 @@ Measurement ParseCsv(std::string_view text_in, const std::string& file) {
     slices[it->second].samples.push_back(s);
   }
   if (slices.empty())
-    text::Fail(file, lines.line_number() + 1, "at least one data row after the header",
-               "end of file");
+    detail::Fail(file, lines.line_number() + 1, "at least one data row after the header",
+                 "end of file");
   for (const auto& [theta, phi] : incomplete) {
     const auto it = slice_of.find({static_cast<float>(theta), static_cast<float>(phi)});
     if (it != slice_of.end()) slices[it->second].complete = false;
@@ -261,7 +261,7 @@ Measurement ParseCsv(std::string_view text_in, const std::string& file) {
 }
 
 Measurement ReadCsv(const std::string& path) {
-  return ParseCsv(text::ReadTextFile(path, text::kMaxCsvBytes), path);
+  return ParseCsv(detail::ReadTextFile(path, detail::kMaxCsvBytes), path);
 }
 
 std::string FormatCsv(const Measurement& m) {

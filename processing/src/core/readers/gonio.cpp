@@ -60,7 +60,7 @@ int BandIndex(double wavelength_nm) {
 int RequireBand(double wavelength_nm) {
   const int i = BandIndex(wavelength_nm);
   if (i < 0)
-    throw InvalidArgument("wavelength " + text::FormatShortest(wavelength_nm) +
+    throw InvalidArgument("wavelength " + detail::FormatShortest(wavelength_nm) +
                           " nm is not on the CIE 10 nm grid 380..780 nm");
   return i;
 }
@@ -68,13 +68,13 @@ int RequireBand(double wavelength_nm) {
 // "390nm" → 390.
 double ParseBandHeader(std::string_view field, const std::string& file) {
   std::string_view f = field;
-  if (f.size() < 3 || !text::EqualsIgnoreCase(f.substr(f.size() - 2), "nm"))
-    text::Fail(file, 1, "a band column named like '550nm'", text::Printable(field));
+  if (f.size() < 3 || !detail::EqualsIgnoreCase(f.substr(f.size() - 2), "nm"))
+    detail::Fail(file, 1, "a band column named like '550nm'", detail::Printable(field));
   f.remove_suffix(2);
-  const double nm = text::ParseFiniteDouble(text::Trim(f), file, 1, "band wavelength in nm");
+  const double nm = detail::ParseFiniteDouble(detail::Trim(f), file, 1, "band wavelength in nm");
   if (BandIndex(nm) < 0)
-    text::Fail(file, 1, "a band on the CIE 10 nm grid between 380 and 780 nm",
-               text::Printable(field));
+    detail::Fail(file, 1, "a band on the CIE 10 nm grid between 380 and 780 nm",
+                 detail::Printable(field));
   return nm;
 }
 
@@ -123,60 +123,62 @@ std::array<double, 3> ReflectanceToLinearRec709(const std::vector<double>& wavel
 }
 
 GonioTable ParseGonioTable(std::string_view text, const std::string& file) {
-  text::LineCursor lines(text, file);
+  detail::LineCursor lines(text, file);
   std::string_view line;
   std::vector<std::string_view> fields;
   if (!lines.Next(&line))
-    text::Fail(file, 1, "a header 'Incident_angle,Measure_angle,...'", "an empty file");
+    detail::Fail(file, 1, "a header 'Incident_angle,Measure_angle,...'", "an empty file");
   // A UTF-8 byte order mark is tolerated on the header.
   if (line.substr(0, 3) == "\xEF\xBB\xBF") line.remove_prefix(3);
-  text::SplitCsvLine(line, &fields);
-  if (fields.size() < 3 || !text::EqualsIgnoreCase(fields[0], "Incident_angle") ||
-      !text::EqualsIgnoreCase(fields[1], "Measure_angle")) {
-    lines.Fail("a header 'Incident_angle,Measure_angle,<band>nm,...'", text::Printable(line));
+  detail::SplitCsvLine(line, &fields);
+  if (fields.size() < 3 || !detail::EqualsIgnoreCase(fields[0], "Incident_angle") ||
+      !detail::EqualsIgnoreCase(fields[1], "Measure_angle")) {
+    lines.Fail("a header 'Incident_angle,Measure_angle,<band>nm,...'", detail::Printable(line));
   }
   GonioTable table;
   for (std::size_t i = 2; i < fields.size(); ++i) {
     table.wavelengths_nm.push_back(ParseBandHeader(fields[i], file));
     if (i > 2 && !(table.wavelengths_nm[i - 2] > table.wavelengths_nm[i - 3]))
-      lines.Fail("band wavelengths in ascending order", text::Printable(fields[i]));
+      lines.Fail("band wavelengths in ascending order", detail::Printable(fields[i]));
   }
   const std::size_t bands = table.wavelengths_nm.size();
   std::set<std::pair<double, double>> seen;
   while (lines.Next(&line)) {
-    if (text::Trim(line).empty()) continue;
-    text::SplitCsvLine(line, &fields);
+    if (detail::Trim(line).empty()) continue;
+    detail::SplitCsvLine(line, &fields);
     if (fields.size() != bands + 2) {
       lines.Fail(std::to_string(bands + 2) + " comma-separated fields",
                  std::to_string(fields.size()) + " fields");
     }
     GonioRow row;
     row.line = lines.line_number();
-    row.incidence_deg = text::ParseFiniteDouble(fields[0], file, row.line, "Incident_angle");
-    row.measurement_angle_deg = text::ParseFiniteDouble(fields[1], file, row.line, "Measure_angle");
+    row.incidence_deg = detail::ParseFiniteDouble(fields[0], file, row.line, "Incident_angle");
+    row.measurement_angle_deg =
+        detail::ParseFiniteDouble(fields[1], file, row.line, "Measure_angle");
     if (row.incidence_deg < 0 || row.incidence_deg >= 90)
-      lines.Fail("Incident_angle in [0, 90)", text::Printable(fields[0]));
+      lines.Fail("Incident_angle in [0, 90)", detail::Printable(fields[0]));
     if (row.measurement_angle_deg < -90 || row.measurement_angle_deg > 90)
-      lines.Fail("Measure_angle in [-90, 90]", text::Printable(fields[1]));
+      lines.Fail("Measure_angle in [-90, 90]", detail::Printable(fields[1]));
     if (!seen.emplace(row.incidence_deg, row.measurement_angle_deg).second)
       lines.Fail(
           "one row per (Incident_angle, Measure_angle)",
-          "a repeated pair " + text::Printable(fields[0]) + ", " + text::Printable(fields[1]));
+          "a repeated pair " + detail::Printable(fields[0]) + ", " + detail::Printable(fields[1]));
     row.reflectance_factor.reserve(bands);
     for (std::size_t b = 0; b < bands; ++b) {
-      const double v = text::ParseFiniteDouble(fields[b + 2], file, row.line, "reflectance factor");
-      if (v < 0) lines.Fail("a non-negative reflectance factor", text::Printable(fields[b + 2]));
+      const double v =
+          detail::ParseFiniteDouble(fields[b + 2], file, row.line, "reflectance factor");
+      if (v < 0) lines.Fail("a non-negative reflectance factor", detail::Printable(fields[b + 2]));
       row.reflectance_factor.push_back(v);
     }
     table.rows.push_back(std::move(row));
   }
   if (table.rows.empty())
-    text::Fail(file, lines.line_number() + 1, "at least one data row", "end of file");
+    detail::Fail(file, lines.line_number() + 1, "at least one data row", "end of file");
   return table;
 }
 
 GonioTable ReadGonioTable(const std::string& path) {
-  return ParseGonioTable(text::ReadTextFile(path, text::kMaxGonioBytes), path);
+  return ParseGonioTable(detail::ReadTextFile(path, detail::kMaxGonioBytes), path);
 }
 
 Measurement GonioToMeasurement(const GonioTable& table, const std::string& file) {
@@ -186,7 +188,7 @@ Measurement GonioToMeasurement(const GonioTable& table, const std::string& file)
   m.metadata.extra["source_format"] = "gonio";
   std::string bands;
   for (double nm : table.wavelengths_nm)
-    bands += (bands.empty() ? "" : ",") + text::FormatShortest(nm);
+    bands += (bands.empty() ? "" : ",") + detail::FormatShortest(nm);
   m.metadata.extra["gonio_wavelengths_nm"] = bands;
   m.metadata.extra["conversion"] =
       "f_r = reflectance factor / pi; spectrum -> XYZ (CIE 1931 2deg, D65) -> linear Rec.709, "

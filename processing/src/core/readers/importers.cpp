@@ -11,6 +11,7 @@
 #include "brdf/core/gonio.h"
 #include "brdf/core/lighttools.h"
 #include "brdf/core/zemax.h"
+#include "readers/rgl_internal.h"
 #include "readers/text_util.h"
 
 namespace brdf {
@@ -50,11 +51,11 @@ bool HasToken(std::string_view head, std::string_view word) {
 
 // First line of the text that is neither blank nor a '#' comment.
 std::string_view FirstDataLine(std::string_view head) {
-  text::LineCursor lines(head, "");
+  detail::LineCursor lines(head, "");
   std::string_view line;
   while (lines.Next(&line)) {
-    std::string_view t = text::Trim(line);
-    if (t.substr(0, 3) == "\xEF\xBB\xBF") t = text::Trim(t.substr(3));
+    std::string_view t = detail::Trim(line);
+    if (t.substr(0, 3) == "\xEF\xBB\xBF") t = detail::Trim(t.substr(3));
     if (!t.empty() && t.front() != '#') return t;
   }
   return {};
@@ -70,7 +71,7 @@ std::string ImportFormatName(ImportFormat format) {
 
 ImportFormat ImportFormatFromName(std::string_view name) {
   for (const Named& n : kNames)
-    if (text::EqualsIgnoreCase(name, n.name)) return n.format;
+    if (detail::EqualsIgnoreCase(name, n.name)) return n.format;
   throw InvalidArgument("unknown import format '" + std::string(name) +
                         "' (known: auto, rgl, zemax, lighttools, merl, csv, gonio)");
 }
@@ -78,7 +79,7 @@ ImportFormat ImportFormatFromName(std::string_view name) {
 ImportFormat DetectImportFormatFromHead(std::string_view head, std::uint64_t file_size,
                                         std::string_view extension) {
   const std::string ext = Lower(std::string(extension));
-  if (head.size() >= 12 && std::memcmp(head.data(), "tensor_file\0", 12) == 0)
+  if (head.size() >= 12 && std::memcmp(head.data(), kTensorFileMagic, sizeof kTensorFileMagic) == 0)
     return ImportFormat::kRgl;
   if (ext == ".binary") return ImportFormat::kMerl;
   if (file_size == kMerlBytes && head.size() >= 12) {
@@ -98,7 +99,7 @@ ImportFormat DetectImportFormatFromHead(std::string_view head, std::uint64_t fil
     return ImportFormat::kLightTools;
   const std::string first = Lower(std::string(FirstDataLine(head)));
   std::vector<std::string_view> fields;
-  text::SplitCsvLine(first, &fields);
+  detail::SplitCsvLine(first, &fields);
   if (fields.size() >= 2 && fields[0] == "incident_angle" && fields[1] == "measure_angle")
     return ImportFormat::kGonio;
   bool theta_in = false, theta_out = false;

@@ -20,7 +20,7 @@ namespace {
 constexpr std::size_t kMaxAngles = 100000;
 constexpr double kMaxDouble = std::numeric_limits<double>::max();
 
-void ReadAngleList(text::TokenStream& ts, std::string_view name, double min, double max,
+void ReadAngleList(detail::TokenStream& ts, std::string_view name, double min, double max,
                    std::vector<double>* out) {
   const std::size_t n = ts.NextCount(std::string(name) + " count", 1, kMaxAngles, 2);
   out->clear();
@@ -29,14 +29,14 @@ void ReadAngleList(text::TokenStream& ts, std::string_view name, double min, dou
     const double v = ts.NextInRange(std::string(name) + " angle (degrees)", min, max);
     if (!out->empty() && !(v > out->back()))
       ts.Fail(std::string(name) + " angles in strictly ascending order",
-              text::FormatShortest(v) + " after " + text::FormatShortest(out->back()));
+              detail::FormatShortest(v) + " after " + detail::FormatShortest(out->back()));
     out->push_back(v);
   }
 }
 
 // Channel index of a TristimulusValue token for the file's spectral content, or -1.
 int ChannelOf(std::string_view v, LightToolsSpectral spectral) {
-  using text::EqualsIgnoreCase;
+  using detail::EqualsIgnoreCase;
   switch (spectral) {
     case LightToolsSpectral::kMonochrome:
       return 0;
@@ -67,51 +67,51 @@ const char* ChannelName(LightToolsSpectral s, int channel) {
 }  // namespace
 
 LightToolsBsdf ParseLightToolsBsdf(std::string_view text_in, const std::string& file) {
-  text::TokenStream ts(text_in, file);
+  detail::TokenStream ts(text_in, file);
   LightToolsBsdf lt;
   bool have_symmetry = false, have_spectral = false, have_azimuth = false, have_radial = false;
-  const auto once = [&](bool* seen, const text::TokenStream::Token& t) {
-    if (*seen) ts.FailAt(t.line, "each keyword once", "a second " + text::Printable(t.text));
+  const auto once = [&](bool* seen, const detail::TokenStream::Token& t) {
+    if (*seen) ts.FailAt(t.line, "each keyword once", "a second " + detail::Printable(t.text));
     *seen = true;
   };
   while (true) {
     const auto t = ts.Next("a header keyword or DataBegin");
     const std::string_view k = t.text;
-    if (text::EqualsIgnoreCase(k, "DataBegin")) break;
-    if (text::EqualsIgnoreCase(k, "Symmetry")) {
+    if (detail::EqualsIgnoreCase(k, "DataBegin")) break;
+    if (detail::EqualsIgnoreCase(k, "Symmetry")) {
       once(&have_symmetry, t);
       const auto v = ts.Next("PlaneSymmetrical or Asymmetrical");
-      if (text::EqualsIgnoreCase(v.text, "PlaneSymmetrical")) {
+      if (detail::EqualsIgnoreCase(v.text, "PlaneSymmetrical")) {
         lt.plane_symmetric = true;
-      } else if (text::EqualsIgnoreCase(v.text, "Asymmetrical") ||
-                 text::EqualsIgnoreCase(v.text, "Asymmetric")) {
+      } else if (detail::EqualsIgnoreCase(v.text, "Asymmetrical") ||
+                 detail::EqualsIgnoreCase(v.text, "Asymmetric")) {
         lt.plane_symmetric = false;
       } else {
-        ts.Fail("Symmetry PlaneSymmetrical or Asymmetrical", text::Printable(v.text));
+        ts.Fail("Symmetry PlaneSymmetrical or Asymmetrical", detail::Printable(v.text));
       }
-    } else if (text::EqualsIgnoreCase(k, "SpectralContent")) {
+    } else if (detail::EqualsIgnoreCase(k, "SpectralContent")) {
       once(&have_spectral, t);
       const auto v = ts.Next("Monochrome, XYZ or RGB");
-      if (text::EqualsIgnoreCase(v.text, "Monochrome")) {
+      if (detail::EqualsIgnoreCase(v.text, "Monochrome")) {
         lt.spectral = LightToolsSpectral::kMonochrome;
-      } else if (text::EqualsIgnoreCase(v.text, "XYZ")) {
+      } else if (detail::EqualsIgnoreCase(v.text, "XYZ")) {
         lt.spectral = LightToolsSpectral::kXyz;
-      } else if (text::EqualsIgnoreCase(v.text, "RGB")) {
+      } else if (detail::EqualsIgnoreCase(v.text, "RGB")) {
         lt.spectral = LightToolsSpectral::kRgb;
       } else {
-        ts.Fail("SpectralContent Monochrome, XYZ or RGB", text::Printable(v.text));
+        ts.Fail("SpectralContent Monochrome, XYZ or RGB", detail::Printable(v.text));
       }
-    } else if (text::EqualsIgnoreCase(k, "ScatterAzimuth")) {
+    } else if (detail::EqualsIgnoreCase(k, "ScatterAzimuth")) {
       once(&have_azimuth, t);
       ReadAngleList(ts, "ScatterAzimuth", 0.0, 360.0, &lt.scatter_azimuth_deg);
-    } else if (text::EqualsIgnoreCase(k, "ScatterRadial")) {
+    } else if (detail::EqualsIgnoreCase(k, "ScatterRadial")) {
       once(&have_radial, t);
       ReadAngleList(ts, "ScatterRadial", 0.0, 90.0, &lt.scatter_radial_deg);
     } else {
       ts.FailAt(t.line,
                 "a header keyword (Symmetry, SpectralContent, ScatterAzimuth, ScatterRadial) "
                 "or DataBegin",
-                text::Printable(k));
+                detail::Printable(k));
     }
   }
   const std::uint64_t begin_line = ts.line();
@@ -125,7 +125,7 @@ LightToolsBsdf ParseLightToolsBsdf(std::string_view text_in, const std::string& 
 
   while (true) {
     const auto first = ts.Next("a block keyword (AOI, ...) or DataEnd");
-    if (text::EqualsIgnoreCase(first.text, "DataEnd")) break;
+    if (detail::EqualsIgnoreCase(first.text, "DataEnd")) break;
     LightToolsBlock block;
     block.line = first.line;
     bool aoi = false, poi = false, side = false, wavelength = false, type = false, tris = false,
@@ -133,36 +133,36 @@ LightToolsBsdf ParseLightToolsBsdf(std::string_view text_in, const std::string& 
     for (auto t = first;; t = ts.Next("a block keyword (AOI, POI, Side, Wavelength, "
                                       "ScatterType, TristimulusValue, TIS)")) {
       const std::string_view k = t.text;
-      if (text::EqualsIgnoreCase(k, "AOI")) {
+      if (detail::EqualsIgnoreCase(k, "AOI")) {
         once(&aoi, t);
         block.aoi_deg = ts.NextInRange("AOI (degrees)", 0.0, 90.0, true);
-      } else if (text::EqualsIgnoreCase(k, "POI")) {
+      } else if (detail::EqualsIgnoreCase(k, "POI")) {
         once(&poi, t);
         block.poi_deg = ts.NextInRange("POI (degrees)", -360.0, 360.0);
-      } else if (text::EqualsIgnoreCase(k, "Side")) {
+      } else if (detail::EqualsIgnoreCase(k, "Side")) {
         once(&side, t);
         const auto v = ts.Next("Front or Back");
-        if (text::EqualsIgnoreCase(v.text, "Front")) {
+        if (detail::EqualsIgnoreCase(v.text, "Front")) {
           block.back_side = false;
-        } else if (text::EqualsIgnoreCase(v.text, "Back")) {
+        } else if (detail::EqualsIgnoreCase(v.text, "Back")) {
           block.back_side = true;
         } else {
-          ts.Fail("Side Front or Back", text::Printable(v.text));
+          ts.Fail("Side Front or Back", detail::Printable(v.text));
         }
-      } else if (text::EqualsIgnoreCase(k, "Wavelength")) {
+      } else if (detail::EqualsIgnoreCase(k, "Wavelength")) {
         once(&wavelength, t);
         block.wavelength = ts.NextInRange("Wavelength", 0.0, kMaxDouble);
-      } else if (text::EqualsIgnoreCase(k, "ScatterType")) {
+      } else if (detail::EqualsIgnoreCase(k, "ScatterType")) {
         once(&type, t);
         const auto v = ts.Next("BRDF or BTDF");
-        if (text::EqualsIgnoreCase(v.text, "BRDF")) {
+        if (detail::EqualsIgnoreCase(v.text, "BRDF")) {
           block.btdf = false;
-        } else if (text::EqualsIgnoreCase(v.text, "BTDF")) {
+        } else if (detail::EqualsIgnoreCase(v.text, "BTDF")) {
           block.btdf = true;
         } else {
-          ts.Fail("ScatterType BRDF or BTDF", text::Printable(v.text));
+          ts.Fail("ScatterType BRDF or BTDF", detail::Printable(v.text));
         }
-      } else if (text::EqualsIgnoreCase(k, "TristimulusValue")) {
+      } else if (detail::EqualsIgnoreCase(k, "TristimulusValue")) {
         once(&tris, t);
         const auto v = ts.Next("a TristimulusValue channel");
         const int c = ChannelOf(v.text, lt.spectral);
@@ -170,9 +170,9 @@ LightToolsBsdf ParseLightToolsBsdf(std::string_view text_in, const std::string& 
           ts.Fail(lt.spectral == LightToolsSpectral::kXyz
                       ? "TristimulusValue TrisX, TrisY or TrisZ (SpectralContent XYZ)"
                       : "TristimulusValue R, G or B (SpectralContent RGB)",
-                  text::Printable(v.text));
+                  detail::Printable(v.text));
         block.channel = c;
-      } else if (text::EqualsIgnoreCase(k, "TIS")) {
+      } else if (detail::EqualsIgnoreCase(k, "TIS")) {
         once(&tis, t);
         block.tis = ts.NextInRange("TIS value", 0.0, kMaxDouble);
         break;
@@ -180,7 +180,7 @@ LightToolsBsdf ParseLightToolsBsdf(std::string_view text_in, const std::string& 
         ts.FailAt(t.line,
                   "a block keyword (AOI, POI, Side, Wavelength, ScatterType, TristimulusValue, "
                   "TIS)",
-                  text::Printable(k));
+                  detail::Printable(k));
       }
     }
     if (!aoi) ts.FailAt(block.line, "an AOI line in the block", "a block without AOI");
@@ -192,22 +192,22 @@ LightToolsBsdf ParseLightToolsBsdf(std::string_view text_in, const std::string& 
     block.values.reserve(per_block);
     for (std::size_t i = 0; i < per_block; ++i) {
       const auto t = ts.Next("a BSDF value");
-      const double v = text::ParseFiniteDouble(t.text, file, t.line, "a BSDF value");
-      if (v < 0) ts.Fail("a non-negative BSDF value", text::Printable(t.text));
+      const double v = detail::ParseFiniteDouble(t.text, file, t.line, "a BSDF value");
+      if (v < 0) ts.Fail("a non-negative BSDF value", detail::Printable(t.text));
       block.values.push_back(v);
     }
     lt.blocks.push_back(std::move(block));
   }
   if (!ts.AtEnd()) {
     const auto t = ts.Peek();
-    ts.FailAt(t.line, "end of file after DataEnd", text::Printable(t.text));
+    ts.FailAt(t.line, "end of file after DataEnd", detail::Printable(t.text));
   }
   lt.comments = ts.comments();
   return lt;
 }
 
 LightToolsBsdf ReadLightToolsBsdf(const std::string& path) {
-  return ParseLightToolsBsdf(text::ReadTextFile(path, text::kMaxLightToolsBytes), path);
+  return ParseLightToolsBsdf(detail::ReadTextFile(path, detail::kMaxLightToolsBytes), path);
 }
 
 std::string FormatLightToolsBsdf(const LightToolsBsdf& lt) {
@@ -226,7 +226,7 @@ std::string FormatLightToolsBsdf(const LightToolsBsdf& lt) {
          "\n";
   const auto list = [&](const char* name, const std::vector<double>& v) {
     out += std::string(name) + " " + std::to_string(v.size());
-    for (double a : v) out += " " + text::FormatShortest(a);
+    for (double a : v) out += " " + detail::FormatShortest(a);
     out += "\n";
   };
   list("ScatterAzimuth", lt.scatter_azimuth_deg);
@@ -236,10 +236,10 @@ std::string FormatLightToolsBsdf(const LightToolsBsdf& lt) {
     if (b.values.size() != n_az * n_rad)
       throw InvalidArgument("LightTools BSDF: a block holds " + std::to_string(b.values.size()) +
                             " values, expected " + std::to_string(n_az * n_rad));
-    out += "AOI " + text::FormatShortest(b.aoi_deg) + "\n";
-    out += "POI " + text::FormatShortest(b.poi_deg) + "\n";
+    out += "AOI " + detail::FormatShortest(b.aoi_deg) + "\n";
+    out += "POI " + detail::FormatShortest(b.poi_deg) + "\n";
     out += std::string("Side ") + (b.back_side ? "Back" : "Front") + "\n";
-    out += "Wavelength " + text::FormatShortest(b.wavelength) + "\n";
+    out += "Wavelength " + detail::FormatShortest(b.wavelength) + "\n";
     out += std::string("ScatterType ") + (b.btdf ? "BTDF" : "BRDF") + "\n";
     if (lt.spectral != LightToolsSpectral::kMonochrome) {
       if (b.channel < 0 || b.channel > 2)
@@ -297,8 +297,8 @@ Measurement LightToolsToMeasurement(const LightToolsBsdf& lt, const std::string&
     auto& g = groups[{b.aoi_deg, b.poi_deg}];
     if (g[b.channel] != nullptr) {
       throw FormatError(file, LinePosition(b.line),
-                        "one block per channel for AOI " + text::FormatShortest(b.aoi_deg) +
-                            ", POI " + text::FormatShortest(b.poi_deg),
+                        "one block per channel for AOI " + detail::FormatShortest(b.aoi_deg) +
+                            ", POI " + detail::FormatShortest(b.poi_deg),
                         "a second block for channel " + std::to_string(b.channel) +
                             " (first at line " + std::to_string(g[b.channel]->line) + ")");
     }
@@ -335,8 +335,8 @@ Measurement LightToolsToMeasurement(const LightToolsBsdf& lt, const std::string&
         const LightToolsBlock* any = g[0] ? g[0] : g[1] ? g[1] : g[2];
         throw FormatError(file, LinePosition(any->line),
                           std::string("a ") + ChannelName(lt.spectral, static_cast<int>(c)) +
-                              " block for AOI " + text::FormatShortest(aoi) + ", POI " +
-                              text::FormatShortest(poi),
+                              " block for AOI " + detail::FormatShortest(aoi) + ", POI " +
+                              detail::FormatShortest(poi),
                           "none");
       }
     }
@@ -354,8 +354,8 @@ Measurement LightToolsToMeasurement(const LightToolsBsdf& lt, const std::string&
         std::array<double, 3> v{};
         for (std::size_t c = 0; c < channels; ++c) v[c] = g[c]->values[a * n_rad + r];
         if (lt.spectral == LightToolsSpectral::kXyz) v = XyzToLinearRec709(v);
-        if (!(text::FitsFloat(v[0]) && text::FitsFloat(v[1]) && text::FitsFloat(v[2])))
-          throw FormatError(file, "data block at AOI " + text::FormatShortest(aoi),
+        if (!(detail::FitsFloat(v[0]) && detail::FitsFloat(v[1]) && detail::FitsFloat(v[2])))
+          throw FormatError(file, "data block at AOI " + detail::FormatShortest(aoi),
                             "tristimulus values whose linear RGB stays within float32 range",
                             "values beyond it");
         if (lt.spectral == LightToolsSpectral::kMonochrome) v = {v[0], v[0], v[0]};

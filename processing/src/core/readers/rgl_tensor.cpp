@@ -14,7 +14,6 @@
 namespace brdf {
 namespace {
 
-constexpr char kMagic[12] = {'t', 'e', 'n', 's', 'o', 'r', '_', 'f', 'i', 'l', 'e', '\0'};
 // Smallest field header: name length, empty name, rank, dtype, offset.
 constexpr std::uint64_t kMinFieldHeaderBytes = 2 + 2 + 1 + 8;
 
@@ -93,19 +92,21 @@ TensorFile TensorFile::Parse(std::vector<std::uint8_t> bytes, std::string file) 
   const std::uint64_t file_size = out.bytes_.size();
   ByteReader r(out.bytes_.data(), out.bytes_.size(), out.file_);
 
-  if (file_size < sizeof kMagic || std::memcmp(out.bytes_.data(), kMagic, sizeof kMagic) != 0) {
+  if (file_size < sizeof kTensorFileMagic ||
+      std::memcmp(out.bytes_.data(), kTensorFileMagic, sizeof kTensorFileMagic) != 0) {
     std::string got;
-    for (std::size_t i = 0; i < std::min<std::size_t>(file_size, sizeof kMagic); ++i) {
+    for (std::size_t i = 0; i < std::min<std::size_t>(file_size, sizeof kTensorFileMagic); ++i) {
       const unsigned char c = out.bytes_[i];
       got += (c >= 0x20 && c < 0x7f) ? std::string(1, static_cast<char>(c))
                                      : "\\x" + std::string(1, "0123456789abcdef"[c >> 4]) +
                                            std::string(1, "0123456789abcdef"[c & 15]);
     }
-    throw FormatError(out.file_, BytePosition(0), "the tensor file magic \"tensor_file\\0\"",
-                      "\"" + got + "\"" + (file_size < sizeof kMagic ? " (file too short)" : ""),
-                      "RGL .bsdf files start with this signature");
+    throw FormatError(
+        out.file_, BytePosition(0), "the tensor file magic \"tensor_file\\0\"",
+        "\"" + got + "\"" + (file_size < sizeof kTensorFileMagic ? " (file too short)" : ""),
+        "RGL .bsdf files start with this signature");
   }
-  r.Skip(sizeof kMagic);
+  r.Skip(sizeof kTensorFileMagic);
   const std::uint64_t version_at = r.offset();
   const std::uint8_t major = r.U8("the version");
   const std::uint8_t minor = r.U8("the version");
@@ -219,11 +220,11 @@ std::vector<float> TensorFile::Float32(const TensorField& field) const {
 }
 
 std::string EncodeTensorFile(std::span<const TensorFieldData> fields) {
-  std::uint64_t header = sizeof kMagic + 2 + 4;
+  std::uint64_t header = sizeof kTensorFileMagic + 2 + 4;
   for (const TensorFieldData& f : fields)
     header += 2 + f.name.size() + 2 + 1 + 8 + 8 * f.shape.size();
   auto align8 = [](std::uint64_t v) { return (v + 7) & ~std::uint64_t{7}; };
-  std::string out(kMagic, sizeof kMagic);
+  std::string out(kTensorFileMagic, sizeof kTensorFileMagic);
   out.push_back(1);
   out.push_back(0);
   AppendU32(out, static_cast<std::uint32_t>(fields.size()));

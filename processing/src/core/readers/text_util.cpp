@@ -10,7 +10,7 @@
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
 
-namespace brdf::text {
+namespace brdf::detail {
 
 std::string ReadTextFile(const std::string& path, std::uint64_t max_bytes) {
   return ReadFileText(path, max_bytes);
@@ -141,7 +141,7 @@ void TokenStream::SkipBlanksAndComments() {
       std::string_view comment =
           text_.substr(pos_ + 1, (end == std::string_view::npos ? text_.size() : end) - pos_ - 1);
       comment = Trim(comment);
-      if (!IsValidUtf8(comment)) text::Fail(file_, line_, "a UTF-8 comment", Printable(comment));
+      if (!IsValidUtf8(comment)) detail::Fail(file_, line_, "a UTF-8 comment", Printable(comment));
       comments_.emplace_back(comment);
       pos_ = end == std::string_view::npos ? text_.size() : end;
     } else {
@@ -164,7 +164,7 @@ TokenStream::Token TokenStream::Peek() {
 
 TokenStream::Token TokenStream::Next(std::string_view expected) {
   const Token t = Peek();
-  if (t.text.empty()) text::Fail(file_, line_, expected, "end of file");
+  if (t.text.empty()) detail::Fail(file_, line_, expected, "end of file");
   pos_ += t.text.size();
   line_of_last_ = t.line;
   return t;
@@ -228,12 +228,12 @@ std::size_t TokenStream::NextCount(std::string_view what, std::size_t min_count,
 }
 
 void TokenStream::Fail(std::string_view expected, std::string_view got) const {
-  text::Fail(file_, line_of_last_, expected, got);
+  detail::Fail(file_, line_of_last_, expected, got);
 }
 
 void TokenStream::FailAt(std::uint64_t line, std::string_view expected,
                          std::string_view got) const {
-  text::Fail(file_, line, expected, got);
+  detail::Fail(file_, line, expected, got);
 }
 
 bool LineCursor::Next(std::string_view* line) {
@@ -274,4 +274,4 @@ std::string FormatShortest(double v) {
   return ec == std::errc() ? std::string(buf, ptr) : std::to_string(v);
 }
 
-}  // namespace brdf::text
+}  // namespace brdf::detail

@@ -16,7 +16,7 @@
 #include <string_view>
 #include <vector>
 
-namespace brdf::text {
+namespace brdf::detail {
 
 // Largest files the readers accept (checked before reading). Parsed data takes up to about
 // four times the text size (8-byte doubles from 2-byte "0 " tokens, 44-byte samples from
@@ -114,7 +114,7 @@ class LineCursor {
   std::uint64_t line_number() const { return line_; }  // of the line last returned
   const std::string& file() const { return file_; }
   [[noreturn]] void Fail(std::string_view expected, std::string_view got) const {
-    text::Fail(file_, line_, expected, got);
+    detail::Fail(file_, line_, expected, got);
   }
 
  private:
@@ -133,4 +133,4 @@ std::string_view Trim(std::string_view s);
 // Formats a double so that parsing it back gives the same double (shortest round-trip form).
 std::string FormatShortest(double v);
 
-}  // namespace brdf::text
+}  // namespace brdf::detail

@@ -16,7 +16,7 @@ namespace {
 // product of four counts from overflowing before the remaining-bytes check.
 constexpr std::size_t kMaxAngles = 100000;
 
-void ReadAngleList(text::TokenStream& ts, std::string_view name, double min, double max,
+void ReadAngleList(detail::TokenStream& ts, std::string_view name, double min, double max,
                    std::vector<double>* out, bool max_open = false) {
   const std::size_t n = ts.NextCount(std::string(name) + " count", 1, kMaxAngles, 2);
   out->clear();
@@ -25,16 +25,16 @@ void ReadAngleList(text::TokenStream& ts, std::string_view name, double min, dou
     const double v = ts.NextInRange(std::string(name) + " angle (degrees)", min, max, max_open);
     if (!out->empty() && !(v > out->back()))
       ts.Fail(std::string(name) + " angles in strictly ascending order",
-              text::FormatShortest(v) + " after " + text::FormatShortest(out->back()));
+              detail::FormatShortest(v) + " after " + detail::FormatShortest(out->back()));
     out->push_back(v);
   }
 }
 
 int ChannelOfIndicator(std::string_view token, bool xyz) {
-  if (!xyz) return text::EqualsIgnoreCase(token, "Monochrome") ? 0 : -1;
-  if (text::EqualsIgnoreCase(token, "TristimulusX")) return 0;
-  if (text::EqualsIgnoreCase(token, "TristimulusY")) return 1;
-  if (text::EqualsIgnoreCase(token, "TristimulusZ")) return 2;
+  if (!xyz) return detail::EqualsIgnoreCase(token, "Monochrome") ? 0 : -1;
+  if (detail::EqualsIgnoreCase(token, "TristimulusX")) return 0;
+  if (detail::EqualsIgnoreCase(token, "TristimulusY")) return 1;
+  if (detail::EqualsIgnoreCase(token, "TristimulusZ")) return 2;
   return -1;
 }
 
@@ -80,80 +80,81 @@ Vec3 RotateAboutZ(const Vec3& v, double angle_deg) {
 }  // namespace
 
 ZemaxBsdf ParseZemaxBsdf(std::string_view text_in, const std::string& file) {
-  text::TokenStream ts(text_in, file);
+  detail::TokenStream ts(text_in, file);
   ZemaxBsdf z;
   bool have_source = false, have_symmetry = false, have_spectral = false, have_type = false,
        have_rotation = false, have_aoi = false, have_azimuth = false, have_radial = false;
   std::uint64_t azimuth_line = 0;
-  const auto once = [&](bool* seen, const text::TokenStream::Token& t) {
-    if (*seen) ts.FailAt(t.line, "each header keyword once", "a second " + text::Printable(t.text));
+  const auto once = [&](bool* seen, const detail::TokenStream::Token& t) {
+    if (*seen)
+      ts.FailAt(t.line, "each header keyword once", "a second " + detail::Printable(t.text));
     *seen = true;
   };
   while (true) {
-    const text::TokenStream::Token peek = ts.Peek();
+    const detail::TokenStream::Token peek = ts.Peek();
     if (peek.text.empty())
       ts.FailAt(peek.line, "a data section (Monochrome or TristimulusX, then DataBegin)",
                 "end of file");
     if (IsChannelIndicator(peek.text)) break;
-    const text::TokenStream::Token t = ts.Next("a header keyword");
+    const detail::TokenStream::Token t = ts.Next("a header keyword");
     const std::string_view k = t.text;
-    if (text::EqualsIgnoreCase(k, "Source")) {
+    if (detail::EqualsIgnoreCase(k, "Source")) {
       once(&have_source, t);
       z.source = ts.RestOfLine("Source");
-    } else if (text::EqualsIgnoreCase(k, "Symmetry")) {
+    } else if (detail::EqualsIgnoreCase(k, "Symmetry")) {
       once(&have_symmetry, t);
       const auto v = ts.Next("PlaneSymmetrical or Asymmetrical");
-      if (text::EqualsIgnoreCase(v.text, "PlaneSymmetrical")) {
+      if (detail::EqualsIgnoreCase(v.text, "PlaneSymmetrical")) {
         z.plane_symmetric = true;
-      } else if (text::EqualsIgnoreCase(v.text, "Asymmetrical") ||
-                 text::EqualsIgnoreCase(v.text, "Asymmetrical4D")) {
+      } else if (detail::EqualsIgnoreCase(v.text, "Asymmetrical") ||
+                 detail::EqualsIgnoreCase(v.text, "Asymmetrical4D")) {
         z.plane_symmetric = false;
       } else {
         ts.Fail("Symmetry PlaneSymmetrical, Asymmetrical or ASymmetrical4D",
-                text::Printable(v.text));
+                detail::Printable(v.text));
       }
-    } else if (text::EqualsIgnoreCase(k, "SpectralContent")) {
+    } else if (detail::EqualsIgnoreCase(k, "SpectralContent")) {
       once(&have_spectral, t);
       const auto v = ts.Next("Monochrome or XYZ");
-      if (text::EqualsIgnoreCase(v.text, "Monochrome")) {
+      if (detail::EqualsIgnoreCase(v.text, "Monochrome")) {
         z.xyz = false;
-      } else if (text::EqualsIgnoreCase(v.text, "XYZ")) {
+      } else if (detail::EqualsIgnoreCase(v.text, "XYZ")) {
         z.xyz = true;
       } else {
-        ts.Fail("SpectralContent Monochrome or XYZ", text::Printable(v.text));
+        ts.Fail("SpectralContent Monochrome or XYZ", detail::Printable(v.text));
       }
-    } else if (text::EqualsIgnoreCase(k, "ScatterType")) {
+    } else if (detail::EqualsIgnoreCase(k, "ScatterType")) {
       once(&have_type, t);
       const auto v = ts.Next("BRDF or BTDF");
       z.scatter_type_line = v.line;
-      if (text::EqualsIgnoreCase(v.text, "BRDF")) {
+      if (detail::EqualsIgnoreCase(v.text, "BRDF")) {
         z.btdf = false;
-      } else if (text::EqualsIgnoreCase(v.text, "BTDF")) {
+      } else if (detail::EqualsIgnoreCase(v.text, "BTDF")) {
         z.btdf = true;
       } else {
-        ts.Fail("ScatterType BRDF or BTDF", text::Printable(v.text));
+        ts.Fail("ScatterType BRDF or BTDF", detail::Printable(v.text));
       }
-    } else if (text::EqualsIgnoreCase(k, "SampleRotation")) {
+    } else if (detail::EqualsIgnoreCase(k, "SampleRotation")) {
       once(&have_rotation, t);
       ReadAngleList(ts, "SampleRotation", -360.0, 360.0, &z.sample_rotation_deg);
-    } else if (text::EqualsIgnoreCase(k, "AngleOfIncidence")) {
+    } else if (detail::EqualsIgnoreCase(k, "AngleOfIncidence")) {
       once(&have_aoi, t);
       ReadAngleList(ts, "AngleOfIncidence", 0.0, 90.0, &z.angle_of_incidence_deg, true);
-    } else if (text::EqualsIgnoreCase(k, "ScatterAzimuth")) {
+    } else if (detail::EqualsIgnoreCase(k, "ScatterAzimuth")) {
       once(&have_azimuth, t);
       azimuth_line = t.line;
       ReadAngleList(ts, "ScatterAzimuth", 0.0, 360.0, &z.scatter_azimuth_deg);
-    } else if (text::EqualsIgnoreCase(k, "ScatterRadial")) {
+    } else if (detail::EqualsIgnoreCase(k, "ScatterRadial")) {
       once(&have_radial, t);
       ReadAngleList(ts, "ScatterRadial", 0.0, 180.0, &z.scatter_radial_deg);
-    } else if (text::EqualsIgnoreCase(k, "DataBegin")) {
+    } else if (detail::EqualsIgnoreCase(k, "DataBegin")) {
       ts.FailAt(t.line, "a channel keyword (Monochrome or TristimulusX) before DataBegin",
                 "DataBegin");
     } else {
       ts.FailAt(t.line,
                 "a header keyword (Source, Symmetry, SpectralContent, ScatterType, "
                 "SampleRotation, AngleOfIncidence, ScatterAzimuth, ScatterRadial)",
-                text::Printable(k));
+                detail::Printable(k));
     }
   }
   const std::uint64_t data_line = ts.Peek().line;
@@ -170,7 +171,7 @@ ZemaxBsdf ParseZemaxBsdf(std::string_view text_in, const std::string& file) {
   if (!have_rotation) z.sample_rotation_deg = {0.0};
   if (z.plane_symmetric && z.scatter_azimuth_deg.back() > 180.0)
     ts.FailAt(azimuth_line, "ScatterAzimuth angles in [0, 180] for a PlaneSymmetrical file",
-              text::FormatShortest(z.scatter_azimuth_deg.back()));
+              detail::FormatShortest(z.scatter_azimuth_deg.back()));
 
   // Refuse a table the rest of the file cannot hold before allocating it (each value takes
   // at least two bytes: a digit and a separator).
@@ -199,9 +200,9 @@ ZemaxBsdf ParseZemaxBsdf(std::string_view text_in, const std::string& file) {
     if (channel < 0)
       ts.Fail(z.xyz ? "a channel keyword TristimulusX, TristimulusY or TristimulusZ"
                     : "the channel keyword Monochrome",
-              text::Printable(ind.text));
+              detail::Printable(ind.text));
     if (seen_channel[channel])
-      ts.Fail("each channel section once", "a second " + text::Printable(ind.text));
+      ts.Fail("each channel section once", "a second " + detail::Printable(ind.text));
     seen_channel[channel] = true;
     ts.Expect("DataBegin");
     std::vector<double>& vals = z.values[channel];
@@ -209,7 +210,7 @@ ZemaxBsdf ParseZemaxBsdf(std::string_view text_in, const std::string& file) {
     vals.reserve(blocks * per_block);
     tis.reserve(blocks);
     for (std::size_t b = 0; b < blocks; ++b) {
-      if (text::EqualsIgnoreCase(ts.Peek().text, "TIS")) {
+      if (detail::EqualsIgnoreCase(ts.Peek().text, "TIS")) {
         ts.Next("TIS");
         tis.push_back(ts.NextInRange("TIS value", 0.0, std::numeric_limits<double>::max()));
       } else {
@@ -217,8 +218,8 @@ ZemaxBsdf ParseZemaxBsdf(std::string_view text_in, const std::string& file) {
       }
       for (std::size_t i = 0; i < per_block; ++i) {
         const auto t = ts.Next("a BSDF value");
-        const double v = text::ParseFiniteDouble(t.text, file, t.line, "a BSDF value");
-        if (v < 0) ts.Fail("a non-negative BSDF value", text::Printable(t.text));
+        const double v = detail::ParseFiniteDouble(t.text, file, t.line, "a BSDF value");
+        if (v < 0) ts.Fail("a non-negative BSDF value", detail::Printable(t.text));
         vals.push_back(v);
       }
     }
@@ -226,14 +227,14 @@ ZemaxBsdf ParseZemaxBsdf(std::string_view text_in, const std::string& file) {
   }
   if (!ts.AtEnd()) {
     const auto t = ts.Peek();
-    ts.FailAt(t.line, "end of file after DataEnd", text::Printable(t.text));
+    ts.FailAt(t.line, "end of file after DataEnd", detail::Printable(t.text));
   }
   z.comments = ts.comments();
   return z;
 }
 
 ZemaxBsdf ReadZemaxBsdf(const std::string& path) {
-  return ParseZemaxBsdf(text::ReadTextFile(path, text::kMaxZemaxBytes), path);
+  return ParseZemaxBsdf(detail::ReadTextFile(path, detail::kMaxZemaxBytes), path);
 }
 
 std::string FormatZemaxBsdf(const ZemaxBsdf& z) {
@@ -247,7 +248,7 @@ std::string FormatZemaxBsdf(const ZemaxBsdf& z) {
   out += std::string("ScatterType  ") + (z.btdf ? "BTDF" : "BRDF") + "\n";
   const auto list = [&](const char* name, const std::vector<double>& v) {
     out += std::string(name) + " " + std::to_string(v.size()) + "\n";
-    for (double a : v) out += text::FormatShortest(a) + "\t";
+    for (double a : v) out += detail::FormatShortest(a) + "\t";
     out += "\n";
   };
   list("SampleRotation", z.sample_rotation_deg);
@@ -396,8 +397,8 @@ Measurement ZemaxToMeasurement(const ZemaxBsdf& z, const std::string& file,
             const std::array<double, 3> c =
                 XyzToLinearRec709({z.Value(0, rot, aoi, a, r), z.Value(1, rot, aoi, a, r),
                                    z.Value(2, rot, aoi, a, r)});
-            if (!(text::FitsFloat(c[0]) && text::FitsFloat(c[1]) && text::FitsFloat(c[2])))
-              throw FormatError(file, "data at AOI " + text::FormatShortest(s.theta_in_deg),
+            if (!(detail::FitsFloat(c[0]) && detail::FitsFloat(c[1]) && detail::FitsFloat(c[2])))
+              throw FormatError(file, "data at AOI " + detail::FormatShortest(s.theta_in_deg),
                                 "tristimulus values whose linear RGB stays within float32 range",
                                 "values beyond it");
             for (int i = 0; i < 3; ++i) rgb[i] = static_cast<float>(c[i]);

@@ -7,7 +7,9 @@
 //
 // Needs the process to run under umockdev's preload library (`umockdev-wrapper PROGRAM`, or
 // LD_PRELOAD=libumockdev-preload.so.0); the constructor throws DeviceError otherwise. This is
-// a test and demo facility: brdf links it for `capture --device sim --transport usb|hid`.
+// a test and demo facility, optional in the build (BRDF_BUILD_DEVICE_EMULATION): brdf links it
+// for `capture --device sim --transport usb|hid`; opening real instruments, and the simulated
+// one over the loopback, is brdf::device's (brdf/device/instrument_link.h).
 //
 // Pacing: IN transfers of the HID personality complete at most once per millisecond (an
 // interrupt endpoint polled every full-speed frame, 64 KB/s), as a real device's would.
@@ -28,8 +30,8 @@
 #include <cstdint>
 #include <memory>
 #include <string>
-#include <string_view>
 
+#include "brdf/device/instrument_link.h"
 #include "brdf/device/simulator.h"
 #include "brdf/device/transport.h"
 #include "brdf/device/usb_models.h"
@@ -70,24 +72,10 @@ class EmulatedUsbInstrument {
 // True when umockdev's preload library is active in this process.
 bool UmockdevAvailable();
 
-// How the simulated instrument is connected: in-process, or behind real libusb or hidapi
-// through umockdev.
-enum class SimLink { kLoopback, kUsb, kHid };
-// "loopback", "usb", "hid"; throws InvalidArgument otherwise.
-SimLink ParseSimLink(std::string_view text);
-
-// An open connection to an instrument: the transport and whatever must live as long as it
-// (the simulated firmware, its emulated USB device).
-class InstrumentLink {
- public:
-  virtual ~InstrumentLink() = default;
-  virtual Transport& transport() = 0;
-};
-
-// Opens what `spec` names: a real instrument over USB or HID, or (kSim) a simulated one built
-// from `sim` and connected over `link`. Throws DeviceError when no instrument answers to the
-// spec or umockdev is missing for an emulated link, InvalidArgument for a bad configuration.
-std::unique_ptr<InstrumentLink> OpenInstrumentLink(const DeviceSpec& spec,
-                                                   const SimulatorConfig& sim, SimLink link);
+// The EmulatedLinkOpener of brdf/device/instrument_link.h: the firmware of `sim` behind an
+// EmulatedUsbInstrument (kUsb: the bulk personality opened through libusb, kHid: the HID one
+// through hidapi), which lives as long as the link. Throws DeviceError when umockdev's preload
+// library is not active or no transport opens, InvalidArgument for kLoopback.
+std::unique_ptr<InstrumentLink> OpenEmulatedLink(const SimulatorConfig& sim, SimLink link);
 
 }  // namespace brdf::device
