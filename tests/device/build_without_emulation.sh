@@ -17,7 +17,13 @@ src="$(cd "$1" && pwd)"
 work="$2"
 reference="${3:-}"
 mkdir -p "$work"
-build="$work/build"
+# The build folder is WORK_DIR itself (logs and scratch files inside it): placed beside the
+# calling build tree, at the same depth below the source, the compile commands match that
+# tree's (ccache's base_dir makes paths relative to the build folder), and with
+# CCACHE_NOHASHDIR the build folder's own name is not hashed either, so the libraries come
+# from the cache and only the tool's own objects are compiled.
+build="$work"
+export CCACHE_NOHASHDIR=1
 
 fail() {
   echo "FAIL: $*" >&2
@@ -30,9 +36,9 @@ compilers=()
 [ -n "${BRDF_CXX:-}" ] && compilers+=("-DCMAKE_CXX_COMPILER=$BRDF_CXX")
 cmake -S "$src" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo "${compilers[@]}" \
   -DBRDF_BUILD_DEVICE_EMULATION=OFF -DBRDF_BUILD_TESTS=OFF -DBRDF_BUILD_BENCH=OFF \
-  -DBRDF_BUILD_VIEWER=OFF > "$work/configure.log" 2>&1 || { cat "$work/configure.log"; exit 1; }
-cmake --build "$build" --target brdf -j "${BRDF_SUBBUILD_JOBS:-2}" > "$work/build.log" 2>&1 ||
-  { tail -60 "$work/build.log"; exit 1; }
+  -DBRDF_BUILD_VIEWER=OFF > "$work/brdf-configure.log" 2>&1 || { cat "$work/brdf-configure.log"; exit 1; }
+cmake --build "$build" --target brdf -j "${BRDF_SUBBUILD_JOBS:-2}" > "$work/brdf-build.log" 2>&1 ||
+  { tail -60 "$work/brdf-build.log"; exit 1; }
 tool="$build/tools/brdf"
 [ -x "$tool" ] || fail "the build produced no $tool"
 
