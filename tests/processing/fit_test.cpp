@@ -107,7 +107,7 @@ TEST(FitRecovery, NoiseFreeCapturesGiveTheParametersBackWithinOnePercent) {
     FitOptions o;
     o.model = c.truth.model;
     const FitResult r = FitMaterial(NoiseFreeCapture(c.truth), o);
-    EXPECT_EQ(r.report.status, "converged") << c.label << ": " << r.report.message;
+    EXPECT_EQ(r.report.status, FitStatus::kConverged) << c.label << ": " << r.report.message;
     ExpectParameters(r.material, c.truth, 0.01, 1e-4, c.label);
     EXPECT_LT(r.report.median_relative_error, 1e-3) << c.label;
     EXPECT_EQ(r.report.slices.size(), 4u) << c.label;
@@ -129,7 +129,7 @@ TEST(FitRecovery, NoisyCapturesGiveTheParametersBackWithinStatedTolerances) {
     FitOptions o;
     o.model = c.truth.model;
     const FitResult r = FitMaterial(NoisyCapture(c.truth), o);
-    EXPECT_EQ(r.report.status, "converged") << c.label << ": " << r.report.message;
+    EXPECT_EQ(r.report.status, FitStatus::kConverged) << c.label << ": " << r.report.message;
     const ModelInfo& info = DescribeModel(c.truth.model);
     for (const ParameterInfo& p : info.parameters)
       for (int ch = 0; ch < p.Count(); ++ch) {

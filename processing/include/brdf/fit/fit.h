@@ -63,6 +63,16 @@ struct FitOptions {
   std::optional<Material> start;
 };
 
+// How a fit ended. Files carry FitStatusName's text ("converged", "no-convergence", "failed",
+// "evaluated").
+enum class FitStatus {
+  kConverged,      // Ceres reached a tolerance
+  kNoConvergence,  // the iteration limit was reached; the result is still the best found
+  kFailed,         // no usable result
+  kEvaluated,      // no fit: EvaluateFit's report of a given material
+};
+std::string_view FitStatusName(FitStatus status);
+
 // Error of the fitted material against the measurement over the samples used.
 struct SliceFitError {
   double theta_in_deg = 0;
@@ -80,10 +90,7 @@ struct FitReport {
   // The Cauchy scale b the robust loss used (FitOptions::robust_scale, or the one chosen from
   // the data), in residual units; 0 without `robust`. final_cost is ½·Σ b²·ln(1 + r²/b²).
   double robust_scale = 0;
-  // "converged" (Ceres reached a tolerance), "no-convergence" (iteration limit reached; the
-  // result is still the best found) or "failed" (no usable result).
-  std::string status;
-  bool converged = false;
+  FitStatus status = FitStatus::kFailed;
   std::string message;                      // Ceres' termination message of the winning refinement
   double initial_cost = 0, final_cost = 0;  // in the loss above, at the winning start and end
   double rmse = 0;                          // over all slices, as SliceFitError::rmse
@@ -121,11 +128,17 @@ struct FitResult {
 // naming the measurement's sample name when no sample is usable.
 FitResult FitMaterial(const Measurement& measurement, const FitOptions& options);
 
+// The warning FitReport::warnings carries for a colour shift (FitReport::colour_shift, a
+// property of the measurement: every model's fit of it says so) with the measurement's
+// FitReport::hue_spread, naming `model`; without a model, the same sentence for several models
+// at once, so that a comparison of models can say it once.
+std::string ColourShiftWarning(double hue_spread, std::optional<Model> model = std::nullopt);
+
 // The report as a JSON object text (compact).
 std::string FitReportJson(const FitReport& report);
 
 // The error `material` has on `measurement` under `options` (loss, exclusions, robust), without
-// fitting: the same numbers FitMaterial reports for its result (status "evaluated"). With
+// fitting: the same numbers FitMaterial reports for its result (status kEvaluated). With
 // `robust` and robust_scale 0 the scale is chosen at `material` as FitMaterial chooses it at
 // its start.
 FitReport EvaluateFit(const Measurement& measurement, const Material& material,
