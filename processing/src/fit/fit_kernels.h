@@ -287,7 +287,7 @@ struct UrpKernel {
   }
 };
 
-// Linear forms of the engine models (LinearCost in fit.cpp).
+// Linear forms of the engine models (LinearCost in summed_cost.h).
 //
 // For a fixed shape slider (roughness or smoothness) each engine model is linear in a few
 // coefficients made of the other values: f_c = Σ_j coef[c][j]·basis_j, where the basis functions
