@@ -228,7 +228,7 @@ int RunFit(const FitCommandOptions& options) {
           o.model = m;
           processing::FitResult r = processing::FitMaterial(meas, o);
           r.material.name = inputs[i].name;
-          WriteFileAtomically(output_of(inputs[i], m), MaterialToJson(r.material));
+          WriteFileAtomically(output_of(inputs[i], m), FittedMaterialToJson(r));
           char done[96];
           std::snprintf(done, sizeof done, " %s (%s, %.2f s)", std::string(ModelName(m)).c_str(),
                         std::string(processing::FitStatusName(r.report.status)).c_str(),

@@ -325,7 +325,7 @@ std::string ManifestJson(const Handoff& h, const std::vector<Engine>& engines) {
        "S(theta_in) v; theta_d = atan2(|omega_d.xy|, omega_d.z)"},
       {"cells", cells},
       {"probe_texels", ProbeJson(h)},
-      {"fallback_material", FallbackMaterialJson(h.fitted_models_json)},
+      {"fallback_material", FallbackMaterialJson(h.fitted_models_json, h.fits)},
       {"engines", sections},
       {"tool", {{"name", "brdf-toolchain"}, {"version", exporter::BrdfToolVersion()}}}};
   return j.dump(2) + "\n";
@@ -611,7 +611,7 @@ EngineExportResult ExportLutWithEngines(const std::string& out_dir, const Lut& l
                                         exporter::TextureMetadata metadata,
                                         const exporter::LutExportOptions& options,
                                         const EngineSet& engines,
-                                        const std::vector<std::string>& fits_json) {
+                                        const std::vector<FittedMaterial>& fits) {
   EngineExportResult result;
   const exporter::PackedVolume packed = exporter::PackLut(lut);
   result.lut = exporter::ExportLut(out_dir, lut, packed, metadata, options);
@@ -625,7 +625,7 @@ EngineExportResult ExportLutWithEngines(const std::string& out_dir, const Lut& l
   h.cells = {{metadata.name, 0, 0}};
   h.composite = exporter::SquareishGrid(lut.slices());
   h.fitted_models_json = metadata.fitted_models_json;
-  h.fitted_models_json.insert(h.fitted_models_json.end(), fits_json.begin(), fits_json.end());
+  h.fits = fits;
   const fs::path dir(out_dir);
   const auto main_file = [&](bool written, const char* ext) {
     return written ? (dir / (metadata.name + ext)).string() : std::string();

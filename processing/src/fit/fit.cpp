@@ -4,7 +4,6 @@
 
 #include <chrono>
 #include <cstdio>
-#include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
 
@@ -27,24 +26,6 @@ std::string Format(const char* fmt, double a, double b = 0, double c = 0, double
 
 }  // namespace
 
-std::string_view FitLossName(FitLoss loss) {
-  switch (loss) {
-    case FitLoss::kNgan:
-      return "ngan";
-    case FitLoss::kLog:
-      return "log";
-    case FitLoss::kCbrt:
-      return "cbrt";
-  }
-  return "ngan";
-}
-
-FitLoss FitLossFromName(std::string_view name) {
-  for (FitLoss l : {FitLoss::kNgan, FitLoss::kLog, FitLoss::kCbrt})
-    if (FitLossName(l) == name) return l;
-  throw InvalidArgument("unknown fit loss '" + std::string(name) + "' (known: ngan, log, cbrt)");
-}
-
 FitReport EvaluateFit(const Measurement& measurement, const Material& material,
                       const FitOptions& options) {
   const FitData data = PrepareFitData(measurement, options);
@@ -53,6 +34,7 @@ FitReport EvaluateFit(const Measurement& measurement, const Material& material,
   report.loss = options.loss;
   report.robust = options.robust;
   report.status = FitStatus::kEvaluated;
+  report.software_version = SoftwareVersion();
   report.robust_scale = options.robust ? detail::RobustScale(data.samples, material, options) : 0.0;
   report.final_cost = report.initial_cost =
       detail::Cost(data.samples, material, options.loss, report.robust_scale);
@@ -107,15 +89,13 @@ FitResult FitMaterial(const Measurement& measurement, const FitOptions& options)
     }
   }
   report.seconds = std::chrono::duration<double>(Clock::now() - t0).count();
+  report.software_version = SoftwareVersion();
 
   FitResult result;
   result.material = best->material;
   result.material.name = measurement.metadata.sample_name;
   result.material.description =
       "fit of " + std::string(ModelName(model)) + " to " + measurement.metadata.sample_name;
-  nlohmann::json extra = nlohmann::json::object();
-  extra["fit"] = nlohmann::json::parse(FitReportJson(report));
-  result.material.extra_json = extra.dump();
   result.report = std::move(report);
   return result;
 }
