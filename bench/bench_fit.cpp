@@ -74,9 +74,15 @@ int main(int argc, char** argv) {
   WriteData(out_dir + "/fit_data.csv", processing::PrepareFitData(meas, FitOptions{}));
   std::fprintf(stderr, "%zu samples\n", meas.SampleCount());
 
-  const Model models[] = {Model::kGgx,        Model::kLafortune,        Model::kBlinnPhong,
-                          Model::kWard,       Model::kUnrealDefaultLit, Model::kUnityHdrpLit,
-                          Model::kUnityUrpLit};
+  const Model models[] = {Model::kGgx,
+                          Model::kLafortune,
+                          Model::kBlinnPhong,
+                          Model::kWard,
+                          Model::kUnrealDefaultLit,
+                          Model::kUnityHdrpLit,
+                          Model::kUnityHdrpLitSpecular,
+                          Model::kUnityUrpLit,
+                          Model::kUnityUrpLitSpecular};
   for (Model model : models) {
     const std::string name(ModelName(model));
     if (argc > 4 && name != argv[4]) continue;

@@ -9,7 +9,7 @@ set -eu
 build=${1:?usage: compare_scipy.sh BUILD_DIR [REPEATS [MODEL...]]}
 repeats=${2:-5}
 shift $(( $# < 2 ? $# : 2 ))
-models=${*:-ggx lafortune blinn-phong ward unreal-defaultlit unity-hdrp-lit unity-urp-lit}
+models=${*:-ggx lafortune blinn-phong ward unreal-defaultlit unity-hdrp-lit unity-hdrp-lit-specular unity-urp-lit unity-urp-lit-specular}
 here=$(cd "$(dirname "$0")" && pwd)
 work=$(mktemp -d "${TMPDIR:-/tmp}/brdf_bench_fit.XXXXXX")
 trap 'rm -rf "$work"' EXIT

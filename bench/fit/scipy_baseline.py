@@ -116,6 +116,36 @@ def urp(d, x):
             for c in range(3)]
 
 
+def hdrp_specular(d, x):
+    """HDRP Lit, specular colour: fresnel0 = specularColor, diffuseColor = baseColor·(1 − max(specularColor))."""
+    base, spec, smoothness = x[0:3], x[3:6], x[6]
+    perceptual = 1 - smoothness
+    alpha = max(perceptual * perceptual, 1e-4)
+    a2 = alpha * alpha
+    nol, noh, lov, loh = d["n_dot_l"], d["n_dot_h"], d["l_dot_v"], d["v_dot_h"]
+    nov = np.maximum(d["n_dot_v"], 1e-4)
+    s = (noh * a2 - noh) * noh + 1
+    dist = a2 / (np.pi * s * s)
+    vis = 0.5 / (nol * np.sqrt((-nov * a2 + nov) * nov + a2) + nov * np.sqrt((-nol * a2 + nol) * nol + a2))
+    fd90 = 0.5 + perceptual * (1 + lov)
+    disney = (1 + (fd90 - 1) * pow5(1 - nol)) * (1 + (fd90 - 1) * pow5(1 - nov)) / (1.03571 * np.pi)
+    fc = pow5(1 - loh)
+    keep = 1 - max(spec)
+    return [base[c] * keep * disney + (spec[c] + (1 - spec[c]) * fc) * dist * vis for c in range(3)]
+
+
+def urp_specular(d, x):
+    """URP Lit, specular setup: diffuse = albedo·(1 − specular) per channel, specular = specular colour."""
+    albedo, spec, smoothness = x[0:3], x[3:6], x[6]
+    perceptual = 1 - smoothness
+    roughness = max(perceptual * perceptual, 2.0 ** -7)
+    r2 = max(roughness * roughness, 2.0 ** -14)
+    noh, loh = d["n_dot_h"], d["v_dot_h"]
+    dd = noh * noh * (r2 - 1) + 1.00001
+    term = r2 / (dd * dd * np.maximum(0.1, loh * loh) * (4 * roughness + 2))
+    return [(albedo[c] * (1 - spec[c]) + term * spec[c]) / np.pi for c in range(3)]
+
+
 # Per-channel models: function, parameter names, bounds (the material file's ranges).
 LEGACY = {"ggx": (ggx, ["kd", "f0", "alpha"], [(0, 1), (0, 1), (1e-3, 1)]),
           "lafortune": (lafortune, ["kd", "ks", "n"], [(0, 1), (0, 1), (1e-3, 1e6)]),
@@ -124,7 +154,9 @@ LEGACY = {"ggx": (ggx, ["kd", "f0", "alpha"], [(0, 1), (0, 1), (1e-3, 1)]),
 # Engine models: function of the whole value vector, parameter names (all in [0, 1]).
 ENGINE = {"unreal-defaultlit": (unreal, ["base_color", "metallic", "specular", "roughness"]),
           "unity-hdrp-lit": (hdrp, ["base_color", "metallic", "smoothness"]),
-          "unity-urp-lit": (urp, ["base_color", "metallic", "smoothness"])}
+          "unity-hdrp-lit-specular": (hdrp_specular, ["base_color", "specular_color", "smoothness"]),
+          "unity-urp-lit": (urp, ["base_color", "metallic", "smoothness"]),
+          "unity-urp-lit-specular": (urp_specular, ["base_color", "specular_color", "smoothness"])}
 
 
 def as_rgb(v):
@@ -134,11 +166,12 @@ def as_rgb(v):
 def vector_of(model, material):
     """The parameter vector of a material file's values in this script's order (legacy models:
     the first parameter's r, g, b, then the second's, then the shape's; engine models: base colour
-    r, g, b, then the scalars)."""
+    r, g, b (and the specular colour's), then the scalars)."""
     if model in LEGACY:
         return np.concatenate([as_rgb(material[n]) for n in LEGACY[model][1]])
     names = ENGINE[model][1]
-    return np.concatenate([as_rgb(material[n]) if n == "base_color" else [float(material[n])] for n in names])
+    rgb = ("base_color", "specular_color")
+    return np.concatenate([as_rgb(material[n]) if n in rgb else [float(material[n])] for n in names])
 
 
 def problem(d, model, start, loss="ngan"):

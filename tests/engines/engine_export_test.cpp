@@ -309,14 +309,15 @@ TEST_F(EngineExport, FitResultsOfTheMaterialBecomeTheFallbackWithGltfValues) {
   fs::create_directories(fits);
   std::ofstream(fits / "f.unreal-defaultlit.json")
       << R"({"name": "f", "model": "unreal-defaultlit", "base_color": [0.8, 0.5, 0.2],
-             "metallic": 0.25, "specular": 0.6, "roughness": 0.4, "fit": {"rmse": 0.03}})";
+             "metallic": 0.25, "specular": 0.6, "roughness": 0.4,
+             "fit": {"status": "converged", "rmse": 0.03}})";
   std::ofstream(fits / "f.unity-urp-lit.json")
-      << R"({"model": "unity-urp-lit", "base_map": [0.7, 0.4, 0.2], "metallic": 0.2,
-             "smoothness": 0.6, "fit": {"rmse": 0.05}})";
+      << R"({"model": "unity-urp-lit", "base_color": [0.7, 0.4, 0.2], "metallic": 0.2,
+             "smoothness": 0.6, "fit": {"status": "converged", "rmse": 0.05}})";
   std::ofstream(fits / "g.ggx.json") << R"({"model": "ggx", "fit": {"rmse": 1}})";
   std::ofstream(fits / "f.json") << R"({"model": "ggx"})";
   std::ofstream(fits / "f.ggx.extra.json") << R"({"model": "ggx"})";
-  const std::vector<std::string> read = engines::ReadFitResults(fits.string(), "f");
+  const std::vector<FittedMaterial> read = engines::ReadFitResults(fits.string(), "f");
   ASSERT_EQ(read.size(), 2u);
   exporter::TextureMetadata meta;
   meta.name = "f";

@@ -100,6 +100,9 @@ TEST(FitKernels, EngineModelsMatchTheirFormulaAndItsJetDerivatives) {
   CheckEngine<UnrealKernel>(Model::kUnrealDefaultLit, 0.05, 1.0);  // roughness
   CheckEngine<HdrpKernel>(Model::kUnityHdrpLit, 0.0, 0.95);        // smoothness, floor at 0.99
   CheckEngine<UrpKernel>(Model::kUnityUrpLit, 0.0, 0.9);           // smoothness, floor at 0.9116
+  // The specular-colour variants, evaluated through their linear forms.
+  CheckEngine<HdrpSpecularKernel>(Model::kUnityHdrpLitSpecular, 0.0, 0.95);
+  CheckEngine<UrpSpecularKernel>(Model::kUnityUrpLitSpecular, 0.0, 0.9);
 }
 
 // Linear forms (LinearCost): f_c = Σ_j coef[c][j]·basis_j against the formula, and the
@@ -164,6 +167,31 @@ TEST(FitKernels, LinearFormsMatchTheFormulaAndItsJetDerivatives) {
   CheckLinear<UnrealLinear>(Model::kUnrealDefaultLit, 0.05, 1.0, /*smooth=*/true);
   CheckLinear<HdrpLinear>(Model::kUnityHdrpLit, 0.0, 0.95);
   CheckLinear<UrpLinear>(Model::kUnityUrpLit, 0.0, 0.9);
+  CheckLinear<HdrpSpecularLinear>(Model::kUnityHdrpLitSpecular, 0.0, 0.95);
+  CheckLinear<UrpSpecularLinear>(Model::kUnityUrpLitSpecular, 0.0, 0.9);
+}
+
+// HDRP's diffuse colour is base·(1 − max(specular colour)): with two channels tied for the
+// largest, the formula's comparisons pick the first, and so does the slope (as on Jets).
+TEST(FitKernels, HdrpSpecularMaxSlopeGoesToTheFirstLargestChannel) {
+  std::mt19937_64 rng(23);
+  const ShadingGeometry g = RandomGeometry(rng);
+  for (const std::array<double, 3>& spec :
+       {std::array<double, 3>{0.4, 0.4, 0.1}, std::array<double, 3>{0.1, 0.4, 0.4},
+        std::array<double, 3>{0.3, 0.3, 0.3}}) {
+    const double v[7] = {0.6, 0.5, 0.4, spec[0], spec[1], spec[2], 0.5};
+    double f[3], grad[3][7];
+    HdrpSpecularKernel::Eval(HdrpSpecularKernel::Prepare(g), v, f, grad);
+    using J = ceres::Jet<double, 7>;
+    J x[7];
+    for (int i = 0; i < 7; ++i) x[i] = J(v[i], i);
+    const std::array<J, 3> jet = models::EvaluateRgb(Model::kUnityHdrpLitSpecular, g, x);
+    for (int c = 0; c < 3; ++c)
+      for (int i = 3; i < 6; ++i)
+        ExpectClose(grad[c][i], jet[static_cast<std::size_t>(c)].v[i], 1e-9,
+                    "tie " + std::to_string(spec[0]) + " channel " + std::to_string(c) +
+                        " d/dspecular " + std::to_string(i - 3));
+  }
 }
 
 // Below the floors the shape no longer changes the value: the slope in it is 0, as for Jets.

@@ -76,7 +76,7 @@ TEST(FitRgl, EveryMaterialConvergesGgxBeatsLambertOnGlossyOnesAndFilmsAreFlagged
     o.model = Model::kLambert;
     const FitReport lambert = FitMaterial(meas, o).report;
     for (const FitReport* r : {&ggx, &lambert}) {
-      EXPECT_EQ(r->status, "converged") << name << ": " << r->message;
+      EXPECT_EQ(r->status, FitStatus::kConverged) << name << ": " << r->message;
       EXPECT_TRUE(std::isfinite(r->final_cost) && std::isfinite(r->rmse)) << name;
       EXPECT_EQ(r->slices.size(), 4u) << name;
       EXPECT_EQ(r->samples_used, meas.SampleCount()) << name;

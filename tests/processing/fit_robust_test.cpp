@@ -95,7 +95,7 @@ TEST(FitRobust, OutliersPullThePlainFitAwayButNotTheRobustOne) {
     const FitResult plain = FitMaterial(meas, o);
     o.robust = true;
     const FitResult robust = FitMaterial(meas, o);
-    ASSERT_NE(robust.report.status, "failed") << robust.report.message;
+    ASSERT_NE(robust.report.status, FitStatus::kFailed) << robust.report.message;
     EXPECT_TRUE(robust.report.robust);
     EXPECT_GT(robust.report.robust_scale, 0);
 
@@ -151,7 +151,7 @@ TEST(FitRobust, CostScaleAndOptimumAgreeWithScipyCauchy) {
       o.start = start;
       o.starts = 1;
       const FitResult r = FitMaterial(meas, o);
-      ASSERT_NE(r.report.status, "failed") << r.report.message;
+      ASSERT_NE(r.report.status, FitStatus::kFailed) << r.report.message;
 
       const std::filesystem::path dir =
           tmp / (std::string(c.label) + "-" + std::string(FitLossName(loss)));

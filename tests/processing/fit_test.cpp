@@ -107,7 +107,7 @@ TEST(FitRecovery, NoiseFreeCapturesGiveTheParametersBackWithinOnePercent) {
     FitOptions o;
     o.model = c.truth.model;
     const FitResult r = FitMaterial(NoiseFreeCapture(c.truth), o);
-    EXPECT_EQ(r.report.status, "converged") << c.label << ": " << r.report.message;
+    EXPECT_EQ(r.report.status, FitStatus::kConverged) << c.label << ": " << r.report.message;
     ExpectParameters(r.material, c.truth, 0.01, 1e-4, c.label);
     EXPECT_LT(r.report.median_relative_error, 1e-3) << c.label;
     EXPECT_EQ(r.report.slices.size(), 4u) << c.label;
@@ -129,7 +129,7 @@ TEST(FitRecovery, NoisyCapturesGiveTheParametersBackWithinStatedTolerances) {
     FitOptions o;
     o.model = c.truth.model;
     const FitResult r = FitMaterial(NoisyCapture(c.truth), o);
-    EXPECT_EQ(r.report.status, "converged") << c.label << ": " << r.report.message;
+    EXPECT_EQ(r.report.status, FitStatus::kConverged) << c.label << ": " << r.report.message;
     const ModelInfo& info = DescribeModel(c.truth.model);
     for (const ParameterInfo& p : info.parameters)
       for (int ch = 0; ch < p.Count(); ++ch) {
@@ -272,11 +272,58 @@ TEST(FitReportTest, CountsExcludedSamplesAndWritesAMaterialFileWithTheReport) {
   EXPECT_EQ(r.report.samples_used + flagged_invalid + flagged_saturated + beyond,
             meas.SampleCount());
   ExpectParameters(r.material, truth, 0.01, 1e-3, "ggx with flagged samples");
-  // The result is a material file: it parses back with the report under "fit".
-  const Material again = ParseMaterialJson(MaterialToJson(r.material), "fit.json");
-  EXPECT_EQ(again.values, r.material.values);
-  EXPECT_NE(again.extra_json.find("\"final_cost\""), std::string::npos);
-  EXPECT_NE(again.extra_json.find("\"slices\""), std::string::npos);
+  // The result is a material file with the report under "fit"; any material reader takes it,
+  // and the fitted-material reader gives back the report it was written from.
+  const std::string file = FittedMaterialToJson(r);
+  const Material plain = ParseMaterialJson(file, "fit.json");
+  EXPECT_EQ(plain.values, r.material.values);
+  EXPECT_NE(plain.extra_json.find("\"final_cost\""), std::string::npos);
+  const FittedMaterial again = ParseFittedMaterialJson(file, "fit.json");
+  EXPECT_EQ(again.material.values, r.material.values);
+  EXPECT_EQ(again.material.extra_json, "{}");
+  const FitReport& a = again.report;
+  const FitReport& b = r.report;
+  EXPECT_EQ(a.model, b.model);
+  EXPECT_EQ(a.loss, b.loss);
+  EXPECT_EQ(a.status, b.status);
+  EXPECT_EQ(a.message, b.message);
+  EXPECT_EQ(a.final_cost, b.final_cost);
+  EXPECT_EQ(a.rmse, b.rmse);
+  EXPECT_EQ(a.iterations, b.iterations);
+  EXPECT_EQ(a.samples_used, b.samples_used);
+  EXPECT_EQ(a.excluded_invalid, b.excluded_invalid);
+  EXPECT_EQ(a.excluded_saturated, b.excluded_saturated);
+  EXPECT_EQ(a.excluded_theta_out, b.excluded_theta_out);
+  EXPECT_EQ(a.warnings, b.warnings);
+  EXPECT_EQ(a.software_version, b.software_version);
+  ASSERT_EQ(a.slices.size(), b.slices.size());
+  for (std::size_t i = 0; i < a.slices.size(); ++i) {
+    EXPECT_EQ(a.slices[i].theta_in_deg, b.slices[i].theta_in_deg);
+    EXPECT_EQ(a.slices[i].samples, b.slices[i].samples);
+    EXPECT_EQ(a.slices[i].rmse, b.slices[i].rmse);
+  }
+  // Written again, the file is the same text.
+  EXPECT_EQ(FittedMaterialToJson(again), file);
+}
+
+TEST(FittedMaterialTest, AFileWithoutAUsableReportIsRefused) {
+  const std::string material = R"("model": "ggx", "kd": 0.1, "f0": 0.04, "alpha": 0.2)";
+  for (const auto& [fit, member] : std::vector<std::pair<std::string, std::string>>{
+           {"", "\"fit\""},
+           {R"(, "fit": 3)", "\"fit\""},
+           {R"(, "fit": {"rmse": 0.1})", "\"status\""},
+           {R"(, "fit": {"status": "done", "rmse": 0.1})", "\"status\""},
+           {R"(, "fit": {"status": "converged"})", "\"rmse\""},
+           {R"(, "fit": {"status": "converged", "rmse": 0.1, "iterations": -2})",
+            "\"iterations\""}}) {
+    try {
+      ParseFittedMaterialJson("{" + material + fit + "}", "m.json");
+      ADD_FAILURE() << "accepted " << fit;
+    } catch (const FormatError& e) {
+      EXPECT_NE(std::string(e.what()).find("m.json"), std::string::npos) << e.what();
+      EXPECT_NE(e.position().find(member), std::string::npos) << fit << ": " << e.position();
+    }
+  }
 }
 
 TEST(FitOptionsTest, BadOptionsAreRefused) {

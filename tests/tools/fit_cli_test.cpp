@@ -68,6 +68,31 @@ TEST_F(FitCommand, AllModelsWriteOneFileEachAndSayWhatToTypeInTheEngines) {
   EXPECT_NE(r.out.find("Unity URP: Base Map "), std::string::npos) << r.out;
 }
 
+// A colour shift is a property of the measurement, not of a model: every model's report
+// records it, the table says it once. RGL's vch_silk_blue is such a measurement: its hue
+// changes with angle beyond any mix of two colours.
+TEST_F(FitCommand, AWarningEveryModelSharesIsPrintedOnce) {
+  const std::string input = brdf::test::DataPath("rgl/vch_silk_blue_rgb.bsdf");
+  const ToolRun r =
+      RunTool("fit " + Quote(input) + " --model all --out " + Quote(dir_ / "fits"), dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string warning = "the measured hue changes with angle";
+  std::size_t count = 0;
+  for (std::size_t at = r.out.find(warning); at != std::string::npos;
+       at = r.out.find(warning, at + 1))
+    ++count;
+  EXPECT_EQ(count, 1u) << r.out;
+  EXPECT_NE(r.out.find("that none of these models can represent"), std::string::npos) << r.out;
+  for (const char* m : {"ggx", "unity-hdrp-lit-specular", "unity-urp-lit"}) {
+    const Json fit = Json::parse(
+        ReadAll(dir_ / "fits" / (std::string("vch_silk_blue_rgb.") + m + ".json")))["fit"];
+    EXPECT_TRUE(fit["colour_shift"].get<bool>()) << m;
+    bool recorded = false;
+    for (const Json& w : fit["warnings"]) recorded |= w.get<std::string>().find(warning) == 0;
+    EXPECT_TRUE(recorded) << m << ": " << fit["warnings"].dump();
+  }
+}
+
 TEST_F(FitCommand, BadInputsAreReportedAndSkipped) {
   WriteText(dir_ / "good.json", R"({"model":"lambert","rho":0.5})");
   WriteText(dir_ / "bad.json", R"({"model":"lambert","rho":-0.5})");

@@ -164,7 +164,7 @@ int RunConvert(const ConvertOptions& options) {
         try {
           engines::ExportLutWithEngines(
               out_dir.string(), built.lut, metadata, export_options, engine_set,
-              options.engine_fits.empty() ? std::vector<std::string>{}
+              options.engine_fits.empty() ? std::vector<FittedMaterial>{}
                                           : engines::ReadFitResults(options.engine_fits, in.name));
         } catch (...) {
           // No partial set: remove what this conversion already renamed into place (the

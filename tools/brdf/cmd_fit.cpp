@@ -223,10 +223,11 @@ int RunFit(const FitCommandOptions& options) {
           o.model = m;
           processing::FitResult r = processing::FitMaterial(meas, o);
           r.material.name = inputs[i].name;
-          WriteFileAtomically(output_of(inputs[i], m), MaterialToJson(r.material));
+          WriteFileAtomically(output_of(inputs[i], m), FittedMaterialToJson(r));
           char done[96];
           std::snprintf(done, sizeof done, " %s (%s, %.2f s)", std::string(ModelName(m)).c_str(),
-                        r.report.status.c_str(), r.report.seconds);
+                        std::string(processing::FitStatusName(r.report.status)).c_str(),
+                        r.report.seconds);
           results[i].push_back(std::move(r));
           progress.Advance(inputs[i].path + done);
         }
@@ -259,17 +260,30 @@ int RunFit(const FitCommandOptions& options) {
       width = std::max(width, static_cast<int>(SliceErrors(r.report).size()));
     std::printf("  %-24s %-15s %-*s %10s %8s %7s\n", "model", "status", width,
                 "rmse per theta_in (1/sr)", "rmse", "med.rel", "seconds");
+    // A colour shift is the measurement's: with several models it is said once, under the table.
+    bool shared_shift = results[i].size() > 1;
+    double hue_spread = 0;
+    for (const processing::FitResult& r : results[i]) {
+      shared_shift &= r.report.colour_shift;
+      hue_spread = std::max(hue_spread, r.report.hue_spread);
+    }
     for (const processing::FitResult& r : results[i]) {
       std::printf("  %-24s %-15s %-*s %10.4g %8.4f %7.2f\n",
-                  std::string(ModelName(r.material.model)).c_str(), r.report.status.c_str(), width,
+                  std::string(ModelName(r.material.model)).c_str(),
+                  std::string(processing::FitStatusName(r.report.status)).c_str(), width,
                   SliceErrors(r.report).c_str(), r.report.rmse, r.report.median_relative_error,
                   r.report.seconds);
       const std::string engine = EngineInstructions(r.material);
       if (!engine.empty())
         std::printf("    %s: %s\n", std::string(DescribeModel(r.material.model).engine).c_str(),
                     engine.c_str());
-      for (const std::string& w : r.report.warnings) std::printf("    warning: %s\n", w.c_str());
+      const std::string shift =
+          processing::ColourShiftWarning(r.report.hue_spread, r.material.model);
+      for (const std::string& w : r.report.warnings)
+        if (!shared_shift || w != shift) std::printf("    warning: %s\n", w.c_str());
     }
+    if (shared_shift)
+      std::printf("  warning: %s\n", processing::ColourShiftWarning(hue_spread).c_str());
     std::printf("  written: ");
     for (std::size_t k = 0; k < models.size(); ++k)
       std::printf("%s%s", k ? ", " : "", output_of(inputs[i], models[k]).c_str());

@@ -1,6 +1,6 @@
 // Private to brdf::viewer: the environment-lit preview as the window shows it, an image that
 // gets better each time the window is idle. The renderer itself is brdf::processing's preview
-// module (no VTK); this interface keeps app.cpp independent of its API.
+// module (no VTK); this interface keeps the window (app_window.h) independent of its API.
 #pragma once
 
 #include <memory>

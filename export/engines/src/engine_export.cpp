@@ -1,11 +1,10 @@
+// The engine hand-off folders: which files go into which engine folder, the manifest, and the
+// one call per conversion and per atlas (brdf/engines/engine_export.h).
 #include "brdf/engines/engine_export.h"
 
 #include <algorithm>
-#include <array>
-#include <bit>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <filesystem>
 #include <functional>
 #include <mutex>
@@ -25,19 +24,21 @@
 #include "brdf/exporter/shader_code.h"
 #include "brdf/exporter/sidecar.h"
 #include "engine_files.h"
+#include "fit_results.h"
+#include "rgba16f.h"
 #include "staged_files.h"
 
 namespace brdf::engines {
 
 namespace fs = std::filesystem;
 using ordered_json = nlohmann::ordered_json;
+using detail::FallbackMaterialJson;
 using detail::Handoff;
 using detail::HandoffCell;
 using detail::StagedFiles;
+using detail::WriteRgba16fDds;
 
 namespace {
-
-constexpr std::uint32_t kDxgiFormatR16g16b16a16Float = 10;
 
 enum class Engine { kUnity, kUnreal, kGodot, kWeb };
 
@@ -190,28 +191,6 @@ ordered_json ProbeJson(const Handoff& h) {
   return probes;
 }
 
-// The hook for `brdf fit`: its engine-model parameters arrive as fitted material JSON objects
-// in TextureMetadata::fitted_models_json (docs/design.md §9 form, with the fit's own "fit"
-// diagnostics). They are carried verbatim so an engine can fall back to an analytic material
-// (e.g. glTF KHR_materials_* values or the Unity/Unreal parameters the fitter adds) with its
-// error; until a fit exists the member is null.
-ordered_json FallbackMaterialJson(const std::vector<std::string>& fitted_models_json) {
-  if (fitted_models_json.empty()) return nullptr;
-  ordered_json models = ordered_json::array();
-  ordered_json gltf = nullptr;
-  for (const std::string& m : fitted_models_json) {
-    ordered_json model = ordered_json::parse(m);
-    if (gltf.is_null() && model.is_object() && model.value("model", "") == "unreal-defaultlit")
-      gltf = ordered_json::parse(GltfFromUnrealDefaultLit(m));
-    models.push_back(std::move(model));
-  }
-  return ordered_json{{"note",
-                       "analytic fits of the same data, for engines or LODs that cannot "
-                       "sample the 3D LUT; see each model's \"fit\" member for its error"},
-                      {"models", std::move(models)},
-                      {"gltf", std::move(gltf)}};
-}
-
 // What one engine's folder holds and how it imports (a member of "engines" in the manifest).
 ordered_json EngineSectionJson(Engine e, const Handoff& h) {
   const exporter::PackedVolume& vol = *h.volume;
@@ -346,7 +325,7 @@ std::string ManifestJson(const Handoff& h, const std::vector<Engine>& engines) {
        "S(theta_in) v; theta_d = atan2(|omega_d.xy|, omega_d.z)"},
       {"cells", cells},
       {"probe_texels", ProbeJson(h)},
-      {"fallback_material", FallbackMaterialJson(h.fitted_models_json)},
+      {"fallback_material", FallbackMaterialJson(h.fitted_models_json, h.fits)},
       {"engines", sections},
       {"tool", {{"name", "brdf-toolchain"}, {"version", exporter::BrdfToolVersion()}}}};
   return j.dump(2) + "\n";
@@ -397,10 +376,6 @@ class SharedFiles {
   std::mutex mutex_;
   std::unordered_map<std::string, std::uintmax_t> sizes_;
 };
-
-// The RGBA16F volume DDS streamed into `w`: header, then the texels converted chunk by chunk
-// (no copy of the whole payload in memory).
-void WriteRgba16fDds(StagedFiles::Writer& w, const exporter::PackedVolume& volume);
 
 // Stages one engine folder's per-material files in `staged` and writes its shared files;
 // returns the shared files it had to write.
@@ -551,111 +526,6 @@ std::vector<std::string> EngineFolderNames(const EngineSet& engines) {
   return out;
 }
 
-std::uint16_t FloatToHalf(float value) {
-  const std::uint32_t bits = std::bit_cast<std::uint32_t>(value);
-  const std::uint16_t sign = static_cast<std::uint16_t>((bits >> 16) & 0x8000u);
-  const std::uint32_t abs_bits = bits & 0x7fffffffu;
-  if (abs_bits >= 0x7f800000u)  // inf or NaN (keep a quiet NaN)
-    return sign | (abs_bits > 0x7f800000u ? 0x7e00u : 0x7c00u);
-  if (abs_bits >= 0x477ff000u) return sign | 0x7c00u;  // rounds to ≥ 65520: overflow to inf
-  const int exponent = static_cast<int>(abs_bits >> 23) - 127;
-  if (exponent < -25) return sign;  // below half the smallest subnormal: ±0
-  std::uint32_t mantissa = (abs_bits & 0x7fffffu) | 0x800000u;  // 24 significant bits
-  // Shift so the result has 10 fraction bits at the half exponent (or subnormal scale 2^-24).
-  const int shift = exponent < -14 ? (-14 - exponent) + 13 : 13;
-  const std::uint32_t kept = mantissa >> shift;
-  const std::uint32_t rest = mantissa & ((1u << shift) - 1u);
-  const std::uint32_t halfway = 1u << (shift - 1);
-  std::uint32_t rounded = kept + ((rest > halfway || (rest == halfway && (kept & 1u))) ? 1u : 0u);
-  if (exponent < -14) return sign | static_cast<std::uint16_t>(rounded);  // subnormal (may carry)
-  // Normal: kept holds the implicit bit at 2^10; a carry to 2^11 bumps the exponent.
-  const std::uint32_t half = (static_cast<std::uint32_t>(exponent + 15) << 10) + (rounded - 0x400u);
-  return sign | static_cast<std::uint16_t>(half);
-}
-
-namespace {
-
-// Binary16 bits of one RGB9E5 channel value m · 2^(e − 24) (mantissa m < 512, exponent e < 32).
-// Every such value is exact in half, so there is nothing to round: it has at most 9
-// significant bits and lies in [2^−24, 65408], within half's subnormal step 2^−24 and largest
-// finite 65504. Half stores n · 2^−24 for n < 1024 as the subnormal n (here n = m · 2^e), else
-// exponent field p + e − 9 (p: the position of m's leading bit, so the value is
-// 2^(p + e − 24) · 1.f) and the 10 fraction bits below the leading one.
-constexpr std::uint16_t HalfOfRgb9e5Channel(std::uint32_t m, std::uint32_t e) {
-  if (m == 0) return 0;
-  const int p = std::bit_width(m) - 1;
-  const int field = p + static_cast<int>(e) - 9;
-  if (field <= 0) return static_cast<std::uint16_t>(m << e);
-  return static_cast<std::uint16_t>((static_cast<std::uint32_t>(field) << 10) |
-                                    ((m << (10 - p)) & 0x3ffu));
-}
-
-// All 32 × 512 channel values, indexed by e · 512 + m (32 KiB, built at compile time).
-constexpr auto kHalfOfChannel = [] {
-  std::array<std::uint16_t, 32 * 512> t{};
-  for (std::uint32_t e = 0; e < 32; ++e)
-    for (std::uint32_t m = 0; m < 512; ++m) t[e * 512 + m] = HalfOfRgb9e5Channel(m, e);
-  return t;
-}();
-
-// One texel: R, G, B halves and alpha 1.0 (0x3c00), little-endian, 8 bytes at `out`.
-inline void PutRgba16fTexel(std::uint32_t word, char* out) {
-  const std::uint16_t* row = &kHalfOfChannel[(word >> 27) * 512];
-  const std::uint64_t texel =
-      std::uint64_t{row[word & 511u]} | (std::uint64_t{row[(word >> 9) & 511u]} << 16) |
-      (std::uint64_t{row[(word >> 18) & 511u]} << 32) | (std::uint64_t{0x3c00} << 48);
-  if constexpr (std::endian::native == std::endian::little) {
-    std::memcpy(out, &texel, 8);
-  } else {
-    for (int b = 0; b < 8; ++b) out[b] = static_cast<char>((texel >> (8 * b)) & 0xffu);
-  }
-}
-
-void CheckVolume(const exporter::PackedVolume& volume) {
-  if (volume.width < 1 || volume.height < 1 || volume.depth < 1 ||
-      volume.words.size() != static_cast<std::size_t>(volume.width) * volume.height * volume.depth)
-    throw InvalidArgument(fmt::format("RGBA16F DDS: inconsistent volume {} × {} × {}", volume.width,
-                                      volume.height, volume.depth));
-}
-
-std::string Rgba16fDdsHeader(const exporter::PackedVolume& volume) {
-  return exporter::DdsVolumeHeader(volume.width, volume.height, volume.depth,
-                                   kDxgiFormatR16g16b16a16Float, 8);
-}
-
-void WriteRgba16fDds(StagedFiles::Writer& w, const exporter::PackedVolume& volume) {
-  CheckVolume(volume);
-  w.Append(Rgba16fDdsHeader(volume));
-  constexpr std::size_t kTexelsPerChunk = StagedFiles::Writer::kChunkBytes / 8;
-  for (std::size_t t = 0; t < volume.words.size(); t += kTexelsPerChunk) {
-    const std::size_t n = std::min(kTexelsPerChunk, volume.words.size() - t);
-    char* out = w.Reserve(n * 8);
-    for (std::size_t i = 0; i < n; ++i) PutRgba16fTexel(volume.words[t + i], out + 8 * i);
-    w.Keep(n * 8);
-  }
-}
-
-}  // namespace
-
-std::uint16_t Rgb9e5ChannelToHalf(std::uint32_t mantissa, std::uint32_t exponent) {
-  if (mantissa > 511 || exponent > 31)
-    throw InvalidArgument(fmt::format("RGB9E5 channel: mantissa {} (0..511), exponent {} (0..31)",
-                                      mantissa, exponent));
-  return kHalfOfChannel[exponent * 512 + mantissa];
-}
-
-std::string Rgba16fBytes(const exporter::PackedVolume& volume) {
-  std::string out(volume.words.size() * 8, '\0');
-  for (std::size_t t = 0; t < volume.words.size(); ++t)
-    PutRgba16fTexel(volume.words[t], out.data() + 8 * t);
-  return out;
-}
-
-std::string EncodeRgba16fDds(const exporter::PackedVolume& volume) {
-  CheckVolume(volume);
-  return Rgba16fDdsHeader(volume) + Rgba16fBytes(volume);
-}
-
 std::vector<std::string> EngineOutputPaths(const std::string& out_dir, const std::string& name,
                                            const EngineSet& engines) {
   std::vector<std::string> paths;
@@ -737,76 +607,11 @@ std::vector<std::string> EngineOutputsToCheck(const std::string& out_dir,
   return paths;
 }
 
-std::vector<std::string> ReadFitResults(const std::string& fits_dir, const std::string& name) {
-  std::error_code ec;
-  if (!fs::is_directory(fits_dir, ec))
-    throw IoError(fits_dir + ": not a folder (expected a folder of fit results NAME.MODEL.json)");
-  std::vector<std::string> files;
-  const std::string prefix = name + ".";
-  for (fs::directory_iterator it(fits_dir, ec), end; !ec && it != end; it.increment(ec)) {
-    const std::string f = it->path().filename().string();
-    if (f.size() > prefix.size() + 5 && f.starts_with(prefix) && f.ends_with(".json") &&
-        f.find('.', prefix.size()) == f.size() - 5)
-      files.push_back(it->path().string());
-  }
-  std::sort(files.begin(), files.end());
-  std::vector<std::string> fits;
-  for (const std::string& path : files) {
-    const std::string text = ReadFileText(path, 16u << 20);
-    const nlohmann::json j = nlohmann::json::parse(text, nullptr, false);
-    if (j.is_discarded() || !j.is_object())
-      throw FormatError(path, "the whole file", "a `brdf fit` result (a JSON object)",
-                        "text that is not a JSON object");
-    const auto kind = [&](const char* key) {
-      return j.contains(key) ? std::string("a ") + j[key].type_name() : std::string("none");
-    };
-    if (!j.contains("model") || !j["model"].is_string())
-      throw FormatError(path, "member \"model\"", "the fitted model's name", kind("model"));
-    if (!j.contains("fit") || !j["fit"].is_object())
-      throw FormatError(path, "member \"fit\"", "the fit report of `brdf fit`", kind("fit"));
-    fits.push_back(j.dump());
-  }
-  return fits;
-}
-
-std::string GltfFromUnrealDefaultLit(const std::string& fit_json) {
-  const nlohmann::json j = nlohmann::json::parse(fit_json, nullptr, false);
-  if (j.is_discarded() || !j.is_object() || j.value("model", "") != "unreal-defaultlit")
-    throw InvalidArgument("glTF values: expected an unreal-defaultlit fit");
-  const auto number = [&](const char* key) {
-    if (!j.contains(key) || !j[key].is_number())
-      throw InvalidArgument(std::string("glTF values: the unreal-defaultlit fit has no ") + key);
-    return j[key].get<double>();
-  };
-  if (!j.contains("base_color") || !j["base_color"].is_array() || j["base_color"].size() != 3)
-    throw InvalidArgument("glTF values: the unreal-defaultlit fit has no base_color");
-  const std::vector<double> base = j["base_color"].get<std::vector<double>>();
-  const double metallic = number("metallic"), specular = number("specular"),
-               roughness = number("roughness");
-  const double grey = 2.0 * specular;
-  ordered_json out = {
-      {"note",
-       "glTF 2.0 values from the unreal-defaultlit fit: same base colour, metallic, roughness "
-       "(alpha = roughness^2) and dielectric F0 = 0.08 * Specular = 0.04 * specularColorFactor; "
-       "glTF's BRDF differs in its Fresnel-weighted diffuse and Smith term"},
-      {"from", "unreal-defaultlit"},
-      {"rmse", j.contains("fit") && j["fit"].is_object() ? j["fit"].value("rmse", -1.0) : -1.0},
-      {"material",
-       {{"pbrMetallicRoughness",
-         {{"baseColorFactor", {base[0], base[1], base[2], 1.0}},
-          {"metallicFactor", metallic},
-          {"roughnessFactor", roughness}}},
-        {"extensions",
-         {{"KHR_materials_specular",
-           {{"specularFactor", 1.0}, {"specularColorFactor", {grey, grey, grey}}}}}}}}};
-  return out.dump();
-}
-
 EngineExportResult ExportLutWithEngines(const std::string& out_dir, const Lut& lut,
                                         exporter::TextureMetadata metadata,
                                         const exporter::LutExportOptions& options,
                                         const EngineSet& engines,
-                                        const std::vector<std::string>& fits_json) {
+                                        const std::vector<FittedMaterial>& fits) {
   EngineExportResult result;
   const exporter::PackedVolume packed = exporter::PackLut(lut);
   result.lut = exporter::ExportLut(out_dir, lut, packed, metadata, options);
@@ -820,7 +625,7 @@ EngineExportResult ExportLutWithEngines(const std::string& out_dir, const Lut& l
   h.cells = {{metadata.name, 0, 0}};
   h.composite = exporter::SquareishGrid(lut.slices());
   h.fitted_models_json = metadata.fitted_models_json;
-  h.fitted_models_json.insert(h.fitted_models_json.end(), fits_json.begin(), fits_json.end());
+  h.fits = fits;
   const fs::path dir(out_dir);
   const auto main_file = [&](bool written, const char* ext) {
     return written ? (dir / (metadata.name + ext)).string() : std::string();

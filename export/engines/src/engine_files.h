@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "brdf/core/fitted_material.h"
 #include "brdf/exporter/exr.h"
 #include "brdf/exporter/packed_volume.h"
 #include "brdf/exporter/shader_code.h"
@@ -28,6 +29,7 @@ struct Handoff {
   std::vector<HandoffCell> cells;
   exporter::GridLayout composite;  // slice grid of the flat EXR image (C × R)
   std::vector<std::string> fitted_models_json;
+  std::vector<FittedMaterial> fits;  // `brdf fit` results, after fitted_models_json
 };
 
 // "MeasuredBrdf" for the reference layout (θin 0, 20, 40, 60, a single 361 × 181 LUT), else

@@ -7,8 +7,8 @@
 
 #include "brdf/core/error.h"
 #include "brdf/core/geometry.h"
-#include "brdf/processing/extrapolation.h"
 #include "brdf/fit/fit.h"
+#include "brdf/processing/extrapolation.h"
 
 namespace brdf::processing {
 
@@ -122,8 +122,7 @@ std::string AutoExtrapolationJson(const AutoExtrapolationResult& result) {
       "theta_b and 90 deg";
   j["band_rmse"] = result.band_rmse;
   j["band_rmse_clamp"] = result.band_rmse_clamp;
-  if (result.fit)
-    j["ggx_fit"] = nlohmann::ordered_json::parse(MaterialToJson(result.fit->material));
+  if (result.fit) j["ggx_fit"] = nlohmann::ordered_json::parse(FittedMaterialToJson(*result.fit));
   return j.dump();
 }
 

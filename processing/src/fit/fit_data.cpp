@@ -285,13 +285,7 @@ void FillErrors(const FitData& data, const Material& material, FitReport* report
   report->colour_shift = spread > 0.02;
   report->representable = !report->colour_shift && worst <= 0.05;
   if (report->colour_shift) {
-    char buf[400];
-    std::snprintf(buf, sizeof buf,
-                  "the measured hue changes with angle beyond any mix of a diffuse and a specular "
-                  "colour (chromaticities up to %.3f off one line): a colour-shifting finish "
-                  "(thin film, interference or pearlescent pigment) that %s cannot represent",
-                  spread, std::string(ModelName(material.model)).c_str());
-    report->warnings.push_back(buf);
+    report->warnings.push_back(ColourShiftWarning(spread, material.model));
   } else if (worst > 0.05) {
     char buf[400];
     std::snprintf(buf, sizeof buf,
@@ -300,6 +294,18 @@ void FillErrors(const FitData& data, const Material& material, FitReport* report
                   worst, where.c_str(), std::string(ModelName(material.model)).c_str());
     report->warnings.push_back(buf);
   }
+}
+
+std::string ColourShiftWarning(double hue_spread, std::optional<Model> model) {
+  char buf[400];
+  std::snprintf(buf, sizeof buf,
+                "the measured hue changes with angle beyond any mix of a diffuse and a specular "
+                "colour (chromaticities up to %.3f off one line): a colour-shifting finish "
+                "(thin film, interference or pearlescent pigment) that %s",
+                hue_spread,
+                model ? (std::string(ModelName(*model)) + " cannot represent").c_str()
+                      : "none of these models can represent");
+  return buf;
 }
 
 }  // namespace brdf::processing

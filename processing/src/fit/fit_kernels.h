@@ -20,8 +20,6 @@
 // give it.
 #pragma once
 
-#include <ceres/jet.h>
-
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -29,9 +27,6 @@
 #include "brdf/core/models.h"
 
 namespace brdf::processing::kernels {
-
-// ---------------------------------------------------------------------------------------------
-// Legacy models.
 
 struct LambertKernel {
   static constexpr bool kLegacy = true;
@@ -135,14 +130,12 @@ struct WardKernel {
   }
 };
 
-// ---------------------------------------------------------------------------------------------
-// Engine models (models.h documents each formula and its source).
-
 struct UnrealLinear;
 struct HdrpLinear;
 struct UrpLinear;
 
-// Unreal DefaultLit. v = {base r, g, b, metallic, specular, roughness}.
+// Unreal DefaultLit (models.h documents each engine formula and its source).
+// v = {base r, g, b, metallic, specular, roughness}.
 struct UnrealKernel {
   static constexpr bool kLegacy = false;
   using Linear = UnrealLinear;  // its linear form (below)
@@ -294,8 +287,7 @@ struct UrpKernel {
   }
 };
 
-// ---------------------------------------------------------------------------------------------
-// Linear forms of the engine models (LinearCost in fit.cpp).
+// Linear forms of the engine models (LinearCost in summed_cost.h).
 //
 // For a fixed shape slider (roughness or smoothness) each engine model is linear in a few
 // coefficients made of the other values: f_c = Σ_j coef[c][j]·basis_j, where the basis functions
@@ -512,32 +504,87 @@ struct UrpLinear {
   }
 };
 
-// Any engine model through models::EvaluateRgb, derivatives by Jets (the specular-colour
-// variants, whose max() and fewer users do not justify their own code).
-template <Model kModel, int kValues>
-struct JetEngineKernel {
-  static constexpr bool kLegacy = false;
-  static constexpr int kN = kValues;
-  using Geom = ShadingGeometry;
-  static Geom Prepare(const ShadingGeometry& g) { return g; }
-  [[gnu::always_inline]] static void Eval(const Geom& g, const double* v, double* f,
-                                          double (*grad)[kN]) {
-    if (!grad) {
-      const std::array<double, 3> out = models::EvaluateRgb(kModel, g, v);
-      for (int c = 0; c < 3; ++c) f[c] = out[c];
-      return;
-    }
-    using J = ceres::Jet<double, kN>;
-    J x[kN];
-    for (int i = 0; i < kN; ++i) x[i] = J(v[i], i);
-    const std::array<J, 3> out = models::EvaluateRgb(kModel, g, x);
+// Unity HDRP Lit, specular colour: the metallic form's basis functions with
+// f_c = b_c(1 − max(s))·Disney + s_c·(D·V·(1 − Fc)) + 1·(D·V·Fc), v = {b r, g, b, s r, g, b,
+// smoothness}. max(s) takes the first of the largest channels, as models.h's comparisons do
+// (on Jets too), so its slope goes to that channel alone.
+struct HdrpSpecularLinear : HdrpLinear {
+  static constexpr int kN = 7;
+  static int MaxSpecular(const double* v) {
+    int k = 0;
+    if (v[4] > v[3 + k]) k = 1;
+    if (v[5] > v[3 + k]) k = 2;
+    return k;
+  }
+  static void Coefficients(const double* v, bool, double (*coef)[kBasis],
+                           double (*dcoef)[kBasis][kN]) {
+    const int k = MaxSpecular(v);
+    const double keep = 1.0 - v[3 + k];
     for (int c = 0; c < 3; ++c) {
-      f[c] = out[c].a;
-      for (int i = 0; i < kN; ++i) grad[c][i] = out[c].v[i];
+      for (int j = 0; j < kBasis; ++j)
+        for (int i = 0; i < kN; ++i) dcoef[c][j][i] = 0;
+      coef[c][0] = v[c] * keep;
+      coef[c][1] = v[3 + c];
+      coef[c][2] = 1.0;
+      dcoef[c][0][c] = keep;
+      dcoef[c][0][3 + k] = -v[c];
+      dcoef[c][1][3 + c] = 1.0;
     }
   }
 };
-using HdrpSpecularKernel = JetEngineKernel<Model::kUnityHdrpLitSpecular, 7>;
-using UrpSpecularKernel = JetEngineKernel<Model::kUnityUrpLitSpecular, 7>;
+
+// Unity URP Lit, specular setup: the metallic form's basis functions (0.96/π and
+// specularTerm/π) with f_c = (b_c(1 − s_c)/0.96)·(0.96/π) + s_c·(specularTerm/π),
+// v = {albedo r, g, b, s r, g, b, smoothness}.
+struct UrpSpecularLinear : UrpLinear {
+  static constexpr int kN = 7;
+  static void Coefficients(const double* v, bool, double (*coef)[kBasis],
+                           double (*dcoef)[kBasis][kN]) {
+    constexpr double kInvDiffuse = 1.0 / 0.96;
+    for (int c = 0; c < 3; ++c) {
+      for (int j = 0; j < kBasis; ++j)
+        for (int i = 0; i < kN; ++i) dcoef[c][j][i] = 0;
+      const double s = v[3 + c];
+      coef[c][0] = v[c] * (1.0 - s) * kInvDiffuse;
+      coef[c][1] = s;
+      dcoef[c][0][c] = (1.0 - s) * kInvDiffuse;
+      dcoef[c][0][3 + c] = -v[c] * kInvDiffuse;
+      dcoef[c][1][3 + c] = 1.0;
+    }
+  }
+};
+
+// An engine kernel evaluated through its linear form L: f_c = Σ_j coef[c][j]·basis_j, the slopes
+// Σ_j dcoef[c][j][i]·basis_j for the non-shape values and Σ_j coef[c][j]·dbasis_j for the shape
+// (the assembly LinearCost makes from sums). For the models whose linear form is all the
+// hand-written code they need: the sweep, the other losses and the robust loss use it.
+template <class L>
+struct LinearFormKernel {
+  static constexpr bool kLegacy = false;
+  using Linear = L;
+  static constexpr int kN = L::kN;
+  using Geom = typename L::Geom;
+  static Geom Prepare(const ShadingGeometry& g) { return L::Prepare(g); }
+  [[gnu::always_inline]] static void Eval(const Geom& g, const double* v, double* f,
+                                          double (*grad)[kN]) {
+    constexpr int kB = L::kBasis;
+    double b[kB], db[kB], coef[3][kB], dcoef[3][kB][kN];
+    L::Basis(g, L::ShapeOf(v[kN - 1]), b, grad ? db : nullptr);
+    L::Coefficients(v, false, coef, dcoef);
+    for (int c = 0; c < 3; ++c) {
+      double sum = 0;
+      for (int j = 0; j < kB; ++j) sum += coef[c][j] * b[j];
+      f[c] = sum;
+      if (!grad) continue;
+      for (int i = 0; i < kN; ++i) grad[c][i] = 0;
+      for (int j = 0; j < kB; ++j) {
+        for (int i = 0; i + 1 < kN; ++i) grad[c][i] += dcoef[c][j][i] * b[j];
+        grad[c][kN - 1] += coef[c][j] * db[j];
+      }
+    }
+  }
+};
+using HdrpSpecularKernel = LinearFormKernel<HdrpSpecularLinear>;
+using UrpSpecularKernel = LinearFormKernel<UrpSpecularLinear>;
 
 }  // namespace brdf::processing::kernels

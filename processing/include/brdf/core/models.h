@@ -121,9 +121,6 @@ struct ShadingGeometry {
 
 namespace models {
 
-// ---------------------------------------------------------------------------------------------
-// Shared pieces.
-
 template <class T>
 T Pow5(const T& x) {
   const T x2 = x * x;
@@ -148,9 +145,6 @@ T GgxG1(double cos_theta, const T& a2) {
   const double tan2 = (1.0 - cos2) / cos2;
   return T(2) / (T(1) + sqrt(T(1) + a2 * tan2));
 }
-
-// ---------------------------------------------------------------------------------------------
-// docs/design.md §9 models, one channel each.
 
 template <class T>
 T Lambert(const T& rho) {
@@ -189,10 +183,9 @@ T Ward(const ShadingGeometry& g, const T& rho_d, const T& rho_s, const T& alpha)
          rho_s * exp(-tan2 / a2) / (T(4 * kPi) * a2 * std::sqrt(g.n_dot_l * g.n_dot_v));
 }
 
-// ---------------------------------------------------------------------------------------------
-// Engine shading models (direct lighting by one punctual light, as the engines evaluate it).
-// Written from the engines' public shader sources; the functions named are where each term
-// lives. Terms the engines add outside the BRDF (energy compensation from pre-integrated
+// The engine models give direct lighting by one punctual light as the engines evaluate it,
+// written from the engines' public shader sources (the functions named are where each term
+// lives). Terms the engines add outside the BRDF (energy compensation from pre-integrated
 // tables, specular occlusion, wrapped diffuse) are not part of a punctual light's BRDF and are
 // left out.
 
@@ -363,7 +356,6 @@ T EvaluateChannel(Model model, const ShadingGeometry& g, const T& a, const T& b,
   }
 }
 
-// ---------------------------------------------------------------------------------------------
 // Any model: `values` in the Material::values layout of DescribeModel(model). Zero when l or v
 // is at or below the horizon.
 template <class T>

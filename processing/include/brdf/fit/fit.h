@@ -37,16 +37,23 @@
 #include <string_view>
 #include <vector>
 
+#include "brdf/core/fitted_material.h"
 #include "brdf/core/measurement.h"
 #include "brdf/core/models.h"
 #include "brdf/processing/extrapolation.h"
 
 namespace brdf::processing {
 
-enum class FitLoss { kNgan, kLog, kCbrt };
-// "ngan", "log", "cbrt"; FitLossFromName throws InvalidArgument listing them.
-std::string_view FitLossName(FitLoss loss);
-FitLoss FitLossFromName(std::string_view name);
+// The report types live in brdf::core (brdf/core/fitted_material.h), so a fit can travel to
+// the libraries above without Ceres or this header.
+using brdf::FitLoss;
+using brdf::FitLossFromName;
+using brdf::FitLossName;
+using brdf::FitReport;
+using brdf::FitReportJson;
+using brdf::FitStatus;
+using brdf::FitStatusName;
+using brdf::SliceFitError;
 
 struct FitOptions {
   Model model = Model::kGgx;
@@ -63,69 +70,21 @@ struct FitOptions {
   std::optional<Material> start;
 };
 
-// Error of the fitted material against the measurement over the samples used.
-struct SliceFitError {
-  double theta_in_deg = 0;
-  std::size_t samples = 0;
-  double rmse = 0;  // √(mean over samples and channels of (f − m)²), 1/sr, unweighted
-  // Median over samples and channels of |f − m| / max(m, 1e-3 1/sr).
-  double median_relative_error = 0;
-};
-
-// What a fit did and how good the result is (like Ceres' summary, as a value).
-struct FitReport {
-  Model model = Model::kGgx;
-  FitLoss loss = FitLoss::kNgan;
-  bool robust = false;
-  // The Cauchy scale b the robust loss used (FitOptions::robust_scale, or the one chosen from
-  // the data), in residual units; 0 without `robust`. final_cost is ½·Σ b²·ln(1 + r²/b²).
-  double robust_scale = 0;
-  // "converged" (Ceres reached a tolerance), "no-convergence" (iteration limit reached; the
-  // result is still the best found) or "failed" (no usable result).
-  std::string status;
-  bool converged = false;
-  std::string message;                      // Ceres' termination message of the winning refinement
-  double initial_cost = 0, final_cost = 0;  // in the loss above, at the winning start and end
-  double rmse = 0;                          // over all slices, as SliceFitError::rmse
-  double median_relative_error = 0;
-  std::vector<SliceFitError> slices;  // ascending θin
-  int iterations = 0;                 // Ceres iterations, summed over every refinement
-  int starts = 0;                     // refinements run
-  double seconds = 0;                 // wall time of the whole fit, sweep included
-  std::size_t samples_used = 0;
-  std::size_t excluded_invalid = 0;    // flagged invalid or not finite
-  std::size_t excluded_saturated = 0;  // flagged saturated (and not invalid)
-  std::size_t excluded_theta_out = 0;  // beyond max_theta_out_deg or at/below the horizon
-  // False when the data has a feature the model cannot represent; `warnings` says which.
-  bool representable = true;
-  // Largest difference in rg chromaticity between measurement and fit over the (θin, θh)
-  // bins (θh edges 0, 2, 5, 10, 20, 35, 60, 90°) that carry at least 2 % of a slice's
-  // luminance. Warned above 0.05.
-  double chromaticity_error = 0;
-  // How far the measured chromaticities of those bins stray from one straight line in the rg
-  // plane (mixtures of two colours, a diffuse and a specular one, lie on a line). Above 0.02
-  // the hue changes with angle in a way no model here represents: colour_shift, warned.
-  double hue_spread = 0;
-  bool colour_shift = false;
-  std::vector<std::string> warnings;
-};
-
-struct FitResult {
-  // The fitted material; its extra_json holds {"fit": FitReportJson(report)}, so
-  // MaterialToJson writes a docs/design.md §9 material file with the report under "fit".
-  Material material;
-  FitReport report;
-};
+// The fitted material (named after the measurement's sample) and its report.
+using FitResult = FittedMaterial;
 
 // Fits options.model to `measurement`. Throws InvalidArgument for bad options and FormatError
 // naming the measurement's sample name when no sample is usable.
 FitResult FitMaterial(const Measurement& measurement, const FitOptions& options);
 
-// The report as a JSON object text (compact).
-std::string FitReportJson(const FitReport& report);
+// The warning FitReport::warnings carries for a colour shift (FitReport::colour_shift, a
+// property of the measurement: every model's fit of it says so) with the measurement's
+// FitReport::hue_spread, naming `model`; without a model, the same sentence for several models
+// at once, so that a comparison of models can say it once.
+std::string ColourShiftWarning(double hue_spread, std::optional<Model> model = std::nullopt);
 
 // The error `material` has on `measurement` under `options` (loss, exclusions, robust), without
-// fitting: the same numbers FitMaterial reports for its result (status "evaluated"). With
+// fitting: the same numbers FitMaterial reports for its result (status kEvaluated). With
 // `robust` and robust_scale 0 the scale is chosen at `material` as FitMaterial chooses it at
 // its start.
 FitReport EvaluateFit(const Measurement& measurement, const Material& material,

@@ -34,12 +34,13 @@
 // written only when missing or different. The engine copies of OUT/NAME.ktx2, .dds and .exr are
 // hard links to them when they were written (else written in full: the EXR then in half).
 //
-// A fit is carried as a fallback material: `brdf fit` results (engine-model parameters such as
-// unreal-defaultlit or unity-urp-lit, analytic models, each with its error) passed to
-// ExportLutWithEngines (`brdf convert --engine-fits DIR`), and the fits the metadata carries
-// (TextureMetadata::fitted_models_json, e.g. --extrapolate auto's GGX), go verbatim into every
-// manifest's "fallback_material": {"models": [...], "gltf": glTF 2.0 values derived from an
-// unreal-defaultlit fit or null}; null when there is no fit.
+// A fit is carried as a fallback material: `brdf fit` results (FittedMaterial values:
+// engine-model parameters such as unreal-defaultlit or unity-urp-lit, analytic models, each
+// with its report) passed to ExportLutWithEngines (`brdf convert --engine-fits DIR`), written as
+// their material files, and the fits the metadata carries (TextureMetadata::fitted_models_json,
+// e.g. --extrapolate auto's GGX, verbatim), go into every manifest's "fallback_material":
+// {"models": [...], "gltf": glTF 2.0 values derived from an unreal-defaultlit fit or null};
+// null when there is no fit.
 #pragma once
 
 #include <cstdint>
@@ -47,6 +48,7 @@
 #include <string_view>
 #include <vector>
 
+#include "brdf/core/fitted_material.h"
 #include "brdf/core/lut.h"
 #include "brdf/exporter/atlas.h"
 #include "brdf/exporter/lut_export.h"
@@ -77,21 +79,22 @@ struct EngineExportResult {
 // is written atomically; the per-material engine files of one call are synced together (each
 // file's data before its rename, then each folder once), so no partial file is ever visible
 // under a final name. Throws InvalidArgument / IoError.
-// `fits_json`: `brdf fit` results for this material (ReadFitResults), carried into every
-// manifest's "fallback_material" with the fit's error (after the fits the metadata carries);
-// an unreal-defaultlit fit also gives the glTF 2.0 values (GltfFromUnrealDefaultLit).
+// `fits`: `brdf fit` results for this material (ReadFitResults), carried into every
+// manifest's "fallback_material" as their material files with the fit's error (after the fits
+// the metadata carries); an unreal-defaultlit fit also gives the glTF 2.0 values
+// (GltfFromUnrealDefaultLit).
 EngineExportResult ExportLutWithEngines(const std::string& out_dir, const Lut& lut,
                                         exporter::TextureMetadata metadata,
                                         const exporter::LutExportOptions& options,
                                         const EngineSet& engines,
-                                        const std::vector<std::string>& fits_json = {});
+                                        const std::vector<FittedMaterial>& fits = {});
 
 // The `brdf fit` results for material `name` in `fits_dir`: every file NAME.<model>.json there
 // (the names `brdf fit INPUT... --out DIR` writes), each a material JSON object with its
-// "model" and the fit report "fit" (rmse in 1/sr, per-slice errors), as compact JSON texts in
-// file-name order; none is fine (an empty list). Throws IoError when `fits_dir` is not a
-// folder and FormatError naming a file that is not a fit result.
-std::vector<std::string> ReadFitResults(const std::string& fits_dir, const std::string& name);
+// "model" and the fit report "fit" (rmse in 1/sr, per-slice errors), read by
+// ParseFittedMaterialJson, in file-name order; none is fine (an empty list). Throws IoError
+// when `fits_dir` is not a folder and FormatError naming a file that is not a fit result.
+std::vector<FittedMaterial> ReadFitResults(const std::string& fits_dir, const std::string& name);
 
 // glTF 2.0 material values (pbrMetallicRoughness with KHR_materials_specular) equivalent to an
 // Unreal DefaultLit fit (brdf/core/models.h UnrealDefaultLit): baseColorFactor = Base Color
@@ -100,10 +103,10 @@ std::vector<std::string> ReadFitResults(const std::string& fits_dir, const std::
 // 0.04·specularColorFactor·specularFactor with specularFactor 1 and specularColorFactor
 // 2·Specular (grey; the extension allows factors above 1). Differences that remain: glTF's
 // Fresnel-weighted diffuse and Smith G against Unreal's Lambert and Vis_SmithJointApprox.
-// `fit_json`: one unreal-defaultlit fit (the member "model" must say so). Returns the JSON
-// object text {"material": {...glTF material...}, "from": "unreal-defaultlit", "rmse": ...}.
-// Throws InvalidArgument for another model or missing parameters.
-std::string GltfFromUnrealDefaultLit(const std::string& fit_json);
+// `fit`: one unreal-defaultlit fit. Returns the JSON object text {"material": {...glTF
+// material...}, "from": "unreal-defaultlit", "rmse": the fit's RMSE in 1/sr}. Throws
+// InvalidArgument for another model.
+std::string GltfFromUnrealDefaultLit(const FittedMaterial& fit);
 
 // The files the engine folders would receive for `name` (for collision checks and cleanup).
 std::vector<std::string> EngineOutputPaths(const std::string& out_dir, const std::string& name,
