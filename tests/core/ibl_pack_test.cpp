@@ -1,8 +1,9 @@
 // The IBL pack (brdf/core/ibl_pack.h) against analytic truths: a Lambertian's albedo is ρ at
 // every view and has no specular part; a GGX material's albedo against a brute-force quadrature
-// written here in the normal frame (a different grid from the pack's); at views near the normal,
-// where the split sum's assumption n = v = R holds, a GGX lobe's fitted α_eq is its own α; the
-// kernel's Legendre coefficients against the closed form of the limit α → 0 and a direct sum.
+// in the normal frame (tests/brute_force_albedo.h, a different grid from the pack's); at views near
+// the normal, where the split sum's assumption n = v = R holds, a GGX lobe's fitted α_eq is its own
+// α; the kernel's Legendre coefficients against the closed form of the limit α → 0 and a direct
+// sum.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,6 +11,7 @@
 #include "brdf/core/brdf_source.h"
 #include "brdf/core/ibl_pack.h"
 #include "brdf/core/models.h"
+#include "brute_force_albedo.h"
 
 namespace brdf {
 namespace {
@@ -35,29 +37,13 @@ TEST(IblPack, LambertianAlbedoIsRhoAndAllDiffuseAtEveryView) {
   }
 }
 
-// ∫ f cosθl dω by the midpoint rule in (cosθl, φl) over the normal frame, 1500 × 1440 nodes.
-Rgb BruteForceAlbedo(const BrdfSource& source, double mu) {
-  const Vec3 v = {std::sqrt(1.0 - mu * mu), 0.0, mu};
-  constexpr int kCos = 1500, kPhi = 1440;
-  Rgb e = {0, 0, 0};
-  for (int a = 0; a < kCos; ++a) {
-    const double z = (a + 0.5) / kCos, s = std::sqrt(1.0 - z * z);
-    for (int b = 0; b < kPhi; ++b) {
-      const double phi = (b + 0.5) * 2.0 * kPi / kPhi;
-      const Rgb f = source.Eval({s * std::cos(phi), s * std::sin(phi), z}, v);
-      for (int c = 0; c < 3; ++c) e[c] += f[c] * z * (1.0 / kCos) * (2.0 * kPi / kPhi);
-    }
-  }
-  return e;
-}
-
 TEST(IblPack, GgxAlbedoMatchesABruteForceQuadrature) {
   for (double alpha : {0.15, 0.4}) {
     const AnalyticBrdf ggx = Ggx(0.2, 0.5, alpha);
     const IblPack pack = ComputeIblPack(ggx);
     for (int i : {0, 5, 16, 32, 48, 63}) {
-      const Rgb truth = BruteForceAlbedo(ggx, pack.mu[i]);
-      EXPECT_NEAR(pack.albedo[i][0], truth[0], 2e-3 * truth[0])
+      const Rgb truth = testing::BruteForceAlbedo(ggx, pack.mu[i], 1500, 1440);
+      EXPECT_NEAR(pack.albedo[i][0], truth[0], 3e-3 * truth[0])
           << "alpha " << alpha << " mu " << pack.mu[i];
     }
   }

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "brdf/core/geometry.h"
+#include "brdf/core/lut_brdf.h"
 
 namespace brdf {
 namespace {
@@ -157,10 +158,10 @@ namespace {
 // Midpoint nodes and weights on [lo, hi] for the density a + b·exp(−½((x − c)/σ)²) (a share
 // `peak` of the nodes in the Gaussian, the rest uniform): node i sits at the inverse CDF of
 // (i + 0.5)/n, weight 1/(n·ρ(x)). Smooth, so the rule stays second order; the CDF is tabulated
-// on 4096 intervals and inverted linearly.
+// on 512 intervals and inverted linearly.
 void ConcentratedNodes(double lo, double hi, double c, double sigma, double peak, int n,
                        std::vector<double>* x, std::vector<double>* w) {
-  constexpr int kTable = 4096;
+  constexpr int kTable = 512;
   const double h = (hi - lo) / kTable;
   // Gaussian mass inside [lo, hi], by the same table (normalised below).
   std::vector<double> cdf(kTable + 1, 0.0);
@@ -189,7 +190,7 @@ IblPack ComputeIblPack(const BrdfSource& source) {
   constexpr int kTheta = IblPack::kThetaSteps, kPhi = IblPack::kPhiSteps;
   // Histogram of the lobe over γ, the angle between l and R, in [0, π], for the moments about
   // R (linear splatting: exact for constant and linear functions of γ, second order otherwise).
-  constexpr int kBins = 2048;
+  constexpr int kBins = 1024;
   IblPack pack;
   pack.mu.resize(kRows);
   pack.albedo.resize(kRows);
@@ -204,6 +205,11 @@ IblPack ComputeIblPack(const BrdfSource& source) {
   Bands p{};
   const KappaTable& table = Kappa();
   std::vector<double> theta_x, theta_w, phi_x, phi_w, cos_phi(kPhi), sin_phi(kPhi);
+  // A LUT is sampled by its own rule directly from the grid's angles (Lut::SampleAngles with the
+  // light at φ = 0 and the view at the relative azimuth, exactly what LutBrdf::Eval computes
+  // from the vectors), which saves the vectors' trigonometry: most of the pack's cost.
+  const auto* lut = dynamic_cast<const LutBrdf*>(&source);
+  std::vector<double> phi_out_deg(kPhi);
 
   for (int row = 0; row < kRows; ++row) {
     const double mu = (row + 0.5) / kRows;
@@ -221,17 +227,27 @@ IblPack ComputeIblPack(const BrdfSource& source) {
     for (int k = 0; k < kPhi; ++k) {
       cos_phi[k] = std::cos(phi_x[k]);
       sin_phi[k] = std::sin(phi_x[k]);
+      phi_out_deg[k] = WrapDeg360(-RadToDeg(phi_x[k]));
     }
+    const double theta_v_deg = RadToDeg(theta_v);
     std::fill(hist.begin(), hist.end(), Rgb{0, 0, 0});
     std::array<Moments, 3> m{};
     Rgb e = {0, 0, 0};
     for (int j = 0; j < kTheta; ++j) {
       const double st = std::sin(theta_x[j]), ct = std::cos(theta_x[j]);
       const double row_weight = st * ct * theta_w[j];
+      const double theta_l_deg = RadToDeg(theta_x[j]);
       Rgb ring = {0, 0, 0};
       for (int k = 0; k < kPhi; ++k) {
         const Vec3 l = {st * cos_phi[k], st * sin_phi[k], ct};
-        const Rgb f = source.Eval(l, v);
+        Rgb f;
+        if (lut != nullptr) {
+          const std::array<float, 3> t =
+              lut->lut().SampleAngles(theta_l_deg, theta_v_deg, phi_out_deg[k]);
+          f = {t[0], t[1], t[2]};
+        } else {
+          f = source.Eval(l, v);
+        }
         const double w = row_weight * phi_w[k];
         const double cos_gamma = std::clamp(Dot(l, r), -1.0, 1.0);
         const double x = std::acos(cos_gamma) * (1.0 / kPi) * (kBins - 1);
