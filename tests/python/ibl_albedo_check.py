@@ -9,6 +9,9 @@ docs/design.md §5), and compares it with what the pack reports for the same fil
 (ibl_pack_print FILE, the same OpenBrdf path). Nothing here calls the pack's quadrature.
 
   ibl_albedo_check.py --tool BRDF --driver IBL_PACK_PRINT --work DIR FILE...
+  ibl_albedo_check.py --tool BRDF --manifest NAME.manifest.json --work DIR FILE
+      the pack as `brdf convert --engine` wrote it (the manifest's "ibl"), against `brdf eval`
+      of FILE (the exported texture).
 Fails (exit 1) when a channel differs by more than TOLERANCE of the NumPy value.
 """
 import argparse
@@ -45,15 +48,20 @@ def numpy_albedo(tool, path, mu, work):
 def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--tool", required=True)
-    parser.add_argument("--driver", required=True)
+    parser.add_argument("--driver")
+    parser.add_argument("--manifest")
     parser.add_argument("--work", required=True)
     parser.add_argument("files", nargs="+")
     args = parser.parse_args()
     os.makedirs(args.work, exist_ok=True)
     failures = 0
     for path in args.files:
-        pack = json.loads(subprocess.run([args.driver, path], check=True, capture_output=True,
-                                         text=True).stdout)
+        if args.manifest:
+            with open(args.manifest) as f:
+                pack = json.load(f)["ibl"]
+        else:
+            pack = json.loads(subprocess.run([args.driver, path], check=True,
+                                             capture_output=True, text=True).stdout)
         if len(pack["mu"]) != 64 or len(pack["albedo_rgb"]) != 64:
             print(f"{path}: expected 64 rows, got {len(pack['mu'])}")
             return 1

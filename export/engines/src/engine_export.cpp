@@ -18,6 +18,8 @@
 
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
+#include "brdf/core/ibl_pack.h"
+#include "brdf/core/lut_brdf.h"
 #include "brdf/exporter/dds.h"
 #include "brdf/exporter/exr.h"
 #include "brdf/exporter/ktx2.h"
@@ -347,6 +349,7 @@ std::string ManifestJson(const Handoff& h, const std::vector<Engine>& engines) {
       {"cells", cells},
       {"probe_texels", ProbeJson(h)},
       {"fallback_material", FallbackMaterialJson(h.fitted_models_json)},
+      {"ibl", h.ibl_json.empty() ? ordered_json(nullptr) : ordered_json::parse(h.ibl_json)},
       {"engines", sections},
       {"tool", {{"name", "brdf-toolchain"}, {"version", exporter::BrdfToolVersion()}}}};
   return j.dump(2) + "\n";
@@ -821,6 +824,8 @@ EngineExportResult ExportLutWithEngines(const std::string& out_dir, const Lut& l
   h.composite = exporter::SquareishGrid(lut.slices());
   h.fitted_models_json = metadata.fitted_models_json;
   h.fitted_models_json.insert(h.fitted_models_json.end(), fits_json.begin(), fits_json.end());
+  // Image-based lighting: the pack of this LUT evaluated by its own rule (brdf/core/ibl_pack.h).
+  h.ibl_json = IblPackJson(ComputeIblPack(LutBrdf(lut, metadata.name)));
   const fs::path dir(out_dir);
   const auto main_file = [&](bool written, const char* ext) {
     return written ? (dir / (metadata.name + ext)).string() : std::string();
