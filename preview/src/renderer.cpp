@@ -14,6 +14,7 @@
 #include "hierarchical.h"
 #include "preview_internal.h"
 #include "scene.h"
+#include "split_sum.h"
 
 namespace brdf::preview {
 namespace {
@@ -343,9 +344,12 @@ struct PreviewRenderer::Impl {
       return 1;
     }
     if (options.estimator == Estimator::kQuadrature ||
-        options.estimator == Estimator::kHierarchical) {
+        options.estimator == Estimator::kHierarchical ||
+        options.estimator == Estimator::kEngineSplitSum) {
       if (options.estimator == Estimator::kQuadrature)
         Quadrature();
+      else if (options.estimator == Estimator::kEngineSplitSum)
+        SplitSum();
       else
         Hierarchical();
       if (cancel != nullptr && cancel->load()) return 0;
@@ -372,6 +376,33 @@ struct PreviewRenderer::Impl {
     for (std::size_t i = 0; i < sum_sq.size(); ++i) sum_sq[i] += call_sq[i];
     passes += count;
     return count;
+  }
+
+  // The engines' split sum (PreviewOptions::engine_ibl): two probe lookups per pixel.
+  void SplitSum() {
+    const detail::SplitSumLighting lighting(environment);
+    const IblPack& pack = *options.engine_ibl;
+    PassFraction progress(options, setup.size(), pass_start);
+    ParallelChunks(
+        setup.size(), 64, jobs, options.cancel,
+        [&](std::size_t b, std::size_t e) {
+          for (std::size_t k = b; k < e; ++k) {
+            const PixelSetup& s = setup[k];
+            const double mu = std::clamp(s.wo.z, 0.0, 1.0);
+            const Vec3 n = s.frame.n;
+            const Vec3 wo = s.frame.ToWorld(s.wo);
+            const Vec3 r = Normalize(n * (2.0 * mu) - wo);
+            const IblPack::Row row = pack.At(mu);
+            const Rgb irradiance = lighting.Irradiance(ToMap(n));
+            const Rgb prefiltered = lighting.Prefiltered(row.alpha, ToMap(r));
+            for (int ch = 0; ch < 3; ++ch)
+              sum[3 * k + ch] =
+                  row.diffuse[ch] * irradiance[ch] + row.specular[ch] * prefiltered[ch];
+          }
+          progress.Add(e - b);
+        },
+        progress.Reporter());
+    progress.Finish();
   }
 
   // Σ over map pixels (split n × n, midpoint rule in solid angle) of L · f · cos · ΔΩ.
@@ -715,6 +746,10 @@ PreviewRenderer::PreviewRenderer(const BrdfSource& source, const EnvironmentMap&
                                  PreviewOptions options, std::shared_ptr<const BrdfSampler> sampler)
     : impl_(std::make_unique<Impl>(source, environment, std::move(options), std::move(sampler))) {
   const auto start = std::chrono::steady_clock::now();
+  if (impl_->options.engine_ibl != nullptr)
+    impl_->options.estimator = Estimator::kEngineSplitSum;
+  else if (impl_->options.estimator == Estimator::kEngineSplitSum)
+    throw InvalidArgument("preview: the engine split sum needs PreviewOptions::engine_ibl");
   if (impl_->options.estimator == Estimator::kAuto)
     impl_->options.estimator =
         impl_->options.shape == Shape::kSphere ? Estimator::kHierarchical : Estimator::kMis;
@@ -722,7 +757,8 @@ PreviewRenderer::PreviewRenderer(const BrdfSource& source, const EnvironmentMap&
   impl_->jobs = ResolveJobs(impl_->options.jobs);
   const bool sampling = impl_->options.environment_lighting &&
                         impl_->options.estimator != Estimator::kQuadrature &&
-                        impl_->options.estimator != Estimator::kHierarchical;
+                        impl_->options.estimator != Estimator::kHierarchical &&
+                        impl_->options.estimator != Estimator::kEngineSplitSum;
   if (sampling) {
     if (impl_->sampler == nullptr) impl_->sampler = MakeBrdfSampler(source, impl_->jobs);
     impl_->environment_sampler = std::make_unique<EnvironmentSampler>(environment);

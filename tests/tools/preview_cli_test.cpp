@@ -64,6 +64,36 @@ TEST_F(PreviewCli, TheSphereDefaultsToTheHierarchicalQuadrature) {
   EXPECT_EQ(exporter::ReadExr((dir_ / "p.exr").string()).Attribute("brdf:estimator"), "mis");
 }
 
+// --ibl engine: the engines' split sum of the source's IBL pack. A white Lambertian reflects
+// exactly the furnace's radiance 1 at every view (its albedo is 1); the EXR says what ran; with
+// --compare of the same source the second panel is the true image, so a glossy material under
+// the studio map shows a difference, and the Lambertian under the furnace almost none.
+TEST_F(PreviewCli, IblEngineRendersTheSplitSumAndComparesItWithTheTruth) {
+  std::ofstream(dir_ / "white.json") << R"({"model": "lambert", "rho": 1.0})";
+  const ToolRun furnace =
+      Run("preview " + Quote(dir_ / "white.json") + " --ibl engine --env furnace --size 48 --out " +
+          Quote(dir_ / "e.exr"));
+  ASSERT_EQ(furnace.exit_code, 0) << furnace.err;
+  EXPECT_NE(furnace.err.find("split sum"), std::string::npos) << furnace.err;
+  const exporter::ExrFile exr = exporter::ReadExr((dir_ / "e.exr").string());
+  EXPECT_EQ(exr.Attribute("brdf:estimator"), "engine-split-sum");
+  EXPECT_EQ(exr.Attribute("brdf:ibl"), "engine");
+  for (int y = 6; y < 42; ++y)
+    for (int x = 6; x < 42; ++x)
+      if (std::hypot(x + 0.5 - 24.0, y + 0.5 - 24.0) < 0.45 * 48 - 1.5)
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(exr.image.Pixel(x, y)[c], 1.0, 5e-3);
+  const ToolRun gold =
+      Run("preview " + Quote(kMaterials + "gold.json") + " --ibl engine" + " --compare " +
+          Quote(kMaterials + "gold.json") + " --size 32 --quiet --out " + Quote(dir_ / "g.exr"));
+  ASSERT_EQ(gold.exit_code, 0) << gold.err;
+  EXPECT_EQ(gold.out.find("RMS difference: 0 "), std::string::npos) << gold.out;
+  EXPECT_NE(gold.out.find("RMS difference: "), std::string::npos) << gold.out;
+  const ToolRun bad = Run("preview " + Quote(kMaterials + "gold.json") + " --ibl probe --out " +
+                          Quote(dir_ / "b.exr"));
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.err.find("--ibl"), std::string::npos) << bad.err;
+}
+
 TEST_F(PreviewCli, CompareWritesThreePanelsAndPrintsTheRms) {
   const ToolRun same = Run("preview " + Quote(kMaterials + "gold.json") + " --compare " +
                            Quote(kMaterials + "gold.json") + " --size 32 --spp 4 --quiet --out " +

@@ -15,6 +15,7 @@
 
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
+#include "brdf/core/ibl_pack.h"
 #include "brdf/preview/preview.h"
 #include "brdf/sources/open.h"
 #include "cli_support.h"
@@ -60,6 +61,8 @@ const char* EstimatorName(preview::Estimator e) {
       return "env";
     case preview::Estimator::kBrdf:
       return "brdf";
+    case preview::Estimator::kEngineSplitSum:
+      return "engine-split-sum";
     default:
       return "mis";
   }
@@ -131,6 +134,14 @@ class PassProgress {
       for (std::uint8_t o : image.object) object += o;
       std::fprintf(stderr, "%s%s: the directional light only (exact), %zu object pixels, %s\n",
                    tty_ ? "\r\033[K" : "", label_.c_str(), object,
+                   Progress::FormatDuration(image.seconds).c_str());
+      return;
+    }
+    if (image.estimator == preview::Estimator::kEngineSplitSum) {
+      std::fprintf(stderr,
+                   "%s%s: the engine's split sum (IBL pack, SH irradiance, GGX-prefiltered "
+                   "map), %s\n",
+                   tty_ ? "\r\033[K" : "", label_.c_str(),
                    Progress::FormatDuration(image.seconds).c_str());
       return;
     }
@@ -278,13 +289,24 @@ int RunPreview(const PreviewCommandOptions& cli) {
   if (!cli.quiet && options.shape != preview::Shape::kPlane)
     for (const std::string& n : notes) std::fprintf(stderr, "%s\n", n.c_str());
 
-  const preview::PreviewImage first = Render(*source, map, options, cli);
+  // --ibl engine: the source's IBL pack, lit as an engine's probes light it; --compare's
+  // source keeps the integral (the truth the engine is compared with).
+  IblPack pack;
+  preview::PreviewOptions first_options = options;
+  if (cli.ibl == "engine") {
+    pack = ComputeIblPack(*source);
+    first_options.engine_ibl = &pack;
+  } else if (cli.ibl != "true") {
+    throw InvalidArgument("--ibl: expected true or engine, got '" + cli.ibl + "'");
+  }
+  const preview::PreviewImage first = Render(*source, map, first_options, cli);
   preview::PreviewImage out = first;
   std::vector<std::pair<std::string, std::string>> attributes = {
       {"brdf:source", cli.file},
       {"brdf:environment", map.name()},
       {"brdf:object", cli.mesh},
-      {"brdf:estimator", EstimatorName(first.estimator)}};
+      {"brdf:estimator", EstimatorName(first.estimator)},
+      {"brdf:ibl", cli.ibl}};
   if (second) {
     const preview::PreviewImage other = Render(*second, map, options, cli);
     const preview::ImageDifference d = preview::CompareImages(first, other);

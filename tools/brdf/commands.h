@@ -159,6 +159,7 @@ int RunDevices(const DevicesOptions& options);
 struct PreviewCommandOptions {
   std::string file;
   std::string compare;         // second source; empty: none
+  std::string ibl = "true";    // true: the integral; engine: the split sum of the IBL pack
   std::string env = "studio";  // studio, sky, furnace, axes, or an .exr/.hdr file
   bool env_given = false;      // --env on the command line (with --light: map lighting too)
   double env_rotation_deg = 0;

@@ -544,7 +544,17 @@ int main(int argc, char** argv) {
   preview_cmd->add_option("source", preview.file, "Anything 'brdf eval' reads")->required();
   preview_cmd->add_option("--compare", preview.compare,
                           "A second source: both renders side by side with their signed "
-                          "difference, and the RMS difference printed");
+                          "difference, and the RMS difference printed (the second source is "
+                          "always lit by the true integral, whatever --ibl says)");
+  preview_cmd
+      ->add_option("--ibl", preview.ibl,
+                   "How the map lights the source: true (default: the rendering integral) or "
+                   "engine (what an engine's probes give: the split sum of the material's IBL "
+                   "pack, SH irradiance and a GGX-prefiltered map at the pack's equivalent "
+                   "roughness; docs/preview.md). 'SOURCE --ibl engine --compare SOURCE' shows "
+                   "the engine's error")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"true", "engine"}));
   auto* preview_env =
       preview_cmd
           ->add_option("--env", preview.env,

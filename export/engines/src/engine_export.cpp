@@ -17,6 +17,8 @@
 
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
+#include "brdf/core/ibl_pack.h"
+#include "brdf/core/lut_brdf.h"
 #include "brdf/exporter/dds.h"
 #include "brdf/exporter/exr.h"
 #include "brdf/exporter/ktx2.h"
@@ -326,6 +328,7 @@ std::string ManifestJson(const Handoff& h, const std::vector<Engine>& engines) {
       {"cells", cells},
       {"probe_texels", ProbeJson(h)},
       {"fallback_material", FallbackMaterialJson(h.fitted_models_json, h.fits)},
+      {"ibl", h.ibl_json.empty() ? ordered_json(nullptr) : ordered_json::parse(h.ibl_json)},
       {"engines", sections},
       {"tool", {{"name", "brdf-toolchain"}, {"version", exporter::BrdfToolVersion()}}}};
   return j.dump(2) + "\n";
@@ -626,6 +629,8 @@ EngineExportResult ExportLutWithEngines(const std::string& out_dir, const Lut& l
   h.composite = exporter::SquareishGrid(lut.slices());
   h.fitted_models_json = metadata.fitted_models_json;
   h.fits = fits;
+  // Image-based lighting: the pack of this LUT evaluated by its own rule (brdf/core/ibl_pack.h).
+  h.ibl_json = IblPackJson(ComputeIblPack(LutBrdf(lut, metadata.name)));
   const fs::path dir(out_dir);
   const auto main_file = [&](bool written, const char* ext) {
     return written ? (dir / (metadata.name + ext)).string() : std::string();

@@ -30,6 +30,9 @@ struct Handoff {
   exporter::GridLayout composite;  // slice grid of the flat EXR image (C × R)
   std::vector<std::string> fitted_models_json;
   std::vector<FittedMaterial> fits;  // `brdf fit` results, after fitted_models_json
+  // The material's IBL pack (brdf::IblPackJson of the LUT), the manifest's "ibl"; empty: null
+  // (atlases for now).
+  std::string ibl_json;
 };
 
 // "MeasuredBrdf" for the reference layout (θin 0, 20, 40, 60, a single 361 × 181 LUT), else

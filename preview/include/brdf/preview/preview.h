@@ -54,6 +54,7 @@
 
 #include "brdf/core/brdf_source.h"
 #include "brdf/core/geometry.h"
+#include "brdf/core/ibl_pack.h"
 #include "brdf/core/models.h"
 
 namespace brdf::preview {
@@ -171,6 +172,9 @@ enum class Estimator {
   kHierarchical,
   // kHierarchical for the sphere, kMis otherwise (what `brdf preview` uses by default).
   kAuto,
+  // Not an estimator of the integral: the engines' split-sum image of PreviewOptions::engine_ibl
+  // (what an image rendered with it reports; set whenever engine_ibl is given).
+  kEngineSplitSum,
 };
 
 // The documented tone map of the 8-bit output (ToneMap below).
@@ -232,6 +236,16 @@ struct PreviewOptions {
   // Checked between tiles; when it becomes true the current pass is abandoned and the render
   // returns with the passes completed so far.
   const std::atomic<bool>* cancel = nullptr;
+  // When set (it must outlive the renderer), the map lights the object the way an engine's
+  // probes light this material instead of by the integral above (`brdf preview --ibl engine`):
+  // per pixel, with μ = n·ω_o and R = 2μn − ω_o, the split sum of brdf/core/ibl_pack.h,
+  //   L_o = D(μ)·Ē(n) + S(μ)·P(α_eq(μ), R),
+  // the pack's row read at μ as a linear texture, Ē from the map's order-2 SH and P from a GGX
+  // filtered-importance-sampled mip pyramid of the map (256 samples; docs/preview.md). One
+  // deterministic pass; any shape; no shadowing from the map (an engine's probe has none);
+  // `estimator` is ignored and the image reports kEngineSplitSum. The directional light, if
+  // any, is still f_r from the source.
+  const IblPack* engine_ibl = nullptr;
 };
 
 // A linear HDR image and what produced it.

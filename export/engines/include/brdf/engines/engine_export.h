@@ -23,7 +23,8 @@
 //            index.html (viewer: ?material=NAME), package.json (three ≥ r180),
 //            MeasuredBrdf*.es300.glsl and MeasuredBrdf*.450.glsl (the lookup as GLSL files)
 //   each     NAME.manifest.json   axes and ranges, texel-centre mapping, units, colour space,
-//                                 probe texels (index → RGB f_r), and under "engines" each
+//                                 probe texels (index → RGB f_r), the IBL pack under "ibl"
+//                                 (brdf/core/ibl_pack.h; null for atlases), and under "engines" each
 //                                 folder's files, texture format, orientation per import
 //                                 path and import settings (one text, hard-linked into every
 //                                 engine folder of the conversion)

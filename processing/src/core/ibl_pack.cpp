@@ -1,0 +1,381 @@
+// The IBL pack of a BrdfSource (brdf/core/ibl_pack.h): directional albedo by quadrature around
+// the mirror direction, and the diffuse/specular split with the equivalent GGX roughness fitted
+// to the lobe's responses to Legendre rings about the normal and the mirror direction.
+#include "brdf/core/ibl_pack.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "brdf/core/geometry.h"
+#include "brdf/core/lut_brdf.h"
+
+namespace brdf {
+namespace {
+
+constexpr int kBands = IblPack::kMaxBand + 1;
+using Bands = std::array<double, kBands>;
+
+// P_0…P_L at x (Bonnet's recurrence).
+void Legendre(double x, Bands* p) {
+  (*p)[0] = 1.0;
+  (*p)[1] = x;
+  for (int l = 1; l + 1 < kBands; ++l)
+    (*p)[l + 1] = ((2.0 * l + 1.0) * x * (*p)[l] - l * (*p)[l - 1]) / (l + 1.0);
+}
+
+// A_ℓ/π with A_ℓ = 2π∫₀¹ t P_ℓ(t) dt, the clamped cosine's Legendre coefficients in closed form
+// (Ramamoorthi & Hanrahan 2001): A_0 = π, A_1 = 2π/3, 0 for odd ℓ > 1, and for even ℓ ≥ 2
+// 2π·(−1)^(ℓ/2−1)/((ℓ+2)(ℓ−1)) · ℓ!/(2^ℓ·((ℓ/2)!)²).
+const Bands& CosineCoefficients() {
+  static const Bands table = [] {
+    Bands a{};
+    a[0] = 1.0;
+    a[1] = 2.0 / 3.0;
+    for (int l = 2; l < kBands; l += 2) {
+      // ℓ!/(2^ℓ (ℓ/2)!²) = C(ℓ, ℓ/2)/2^ℓ, by lgamma to stay finite.
+      const double central =
+          std::exp(std::lgamma(l + 1.0) - 2.0 * std::lgamma(l / 2 + 1.0) - l * std::log(2.0));
+      const double sign = (l / 2 - 1) % 2 == 0 ? 1.0 : -1.0;
+      a[l] = 2.0 * sign / ((l + 2.0) * (l - 1.0)) * central;
+    }
+    return a;
+  }();
+  return table;
+}
+
+// GGX D at half-vector polar angle θh (docs/design.md §9), without the 1/π (it cancels).
+double GgxD(double alpha, double theta_h) {
+  const double c = std::cos(theta_h);
+  const double t = std::tan(theta_h);
+  const double a2 = alpha * alpha;
+  const double d = a2 + t * t;
+  return a2 / (c * c * c * c * d * d);
+}
+
+// κ_ℓ(α) on a log-spaced α grid, computed once: ∫ over γ ∈ [0, π/2] with γ = (π/2)·u² (nodes
+// dense near γ = 0, where narrow kernels live), kernel D(γ/2)·cosγ normalised by its integral.
+constexpr int kAlphaGrid = 64;
+struct KappaTable {
+  std::array<double, kAlphaGrid> log_alpha{};
+  std::vector<Bands> kappa;
+  KappaTable() {
+    kappa.resize(kAlphaGrid);
+    const double lo = std::log(IblPack::kMinAlpha);
+    constexpr int kNodes = 2048;
+    Bands p{};
+    for (int a = 0; a < kAlphaGrid; ++a) {
+      log_alpha[a] = lo + (0.0 - lo) * a / (kAlphaGrid - 1);
+      const double alpha = std::exp(log_alpha[a]);
+      Bands sum{};
+      double norm = 0.0;
+      for (int n = 0; n < kNodes; ++n) {
+        const double u = (n + 0.5) / kNodes;
+        const double gamma = 0.5 * kPi * u * u;
+        const double dgamma = kPi * u / kNodes;
+        const double c = std::cos(gamma);
+        const double w = GgxD(alpha, 0.5 * gamma) * c * std::sin(gamma) * dgamma;
+        norm += w;
+        Legendre(c, &p);
+        for (int l = 0; l < kBands; ++l) sum[l] += w * p[l];
+      }
+      for (int l = 0; l < kBands; ++l) kappa[a][l] = sum[l] / norm;
+    }
+  }
+};
+const KappaTable& Kappa() {
+  static const KappaTable table;
+  return table;
+}
+
+// The fit criterion of one view for a given α (luminance or one channel): S by least squares
+// with D = E − S, clamped to [0, E]; returns the weighted squared residual, *s the S used.
+struct Moments {
+  double e = 0.0;
+  Bands at_n{}, at_r{};  // t_{n,ℓ}, t_{R,ℓ}
+};
+double Criterion(const Moments& m, const Bands& kappa, const Bands& p_mu, double* s_out) {
+  const Bands& cosine = CosineCoefficients();
+  // Model response: (E − S)·a + S·b = E·a + S·(b − a).
+  double num = 0.0, den = 0.0;
+  for (int l = 1; l < kBands; ++l) {
+    const double weight = 2.0 * l + 1.0;
+    const double a_n = cosine[l], b_n = p_mu[l] * kappa[l];
+    const double a_r = p_mu[l] * cosine[l], b_r = kappa[l];
+    num += weight * ((m.at_n[l] - m.e * a_n) * (b_n - a_n) + (m.at_r[l] - m.e * a_r) * (b_r - a_r));
+    den += weight * ((b_n - a_n) * (b_n - a_n) + (b_r - a_r) * (b_r - a_r));
+  }
+  double s = den > 0.0 ? num / den : 0.0;
+  s = std::clamp(s, 0.0, std::max(0.0, m.e));
+  double residual = 0.0;
+  for (int l = 1; l < kBands; ++l) {
+    const double weight = 2.0 * l + 1.0;
+    const double rn = m.at_n[l] - (m.e * cosine[l] + s * (p_mu[l] * kappa[l] - cosine[l]));
+    const double rr =
+        m.at_r[l] - (m.e * p_mu[l] * cosine[l] + s * (kappa[l] - p_mu[l] * cosine[l]));
+    residual += weight * (rn * rn + rr * rr);
+  }
+  *s_out = s;
+  return residual;
+}
+
+double Luma(const Rgb& c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
+
+}  // namespace
+
+Bands GgxPrefilterLegendre(double alpha) {
+  const KappaTable& t = Kappa();
+  const double la = std::log(std::clamp(alpha, IblPack::kMinAlpha, 1.0));
+  const double x = (la - t.log_alpha[0]) / (t.log_alpha[1] - t.log_alpha[0]);
+  const int i = std::clamp(static_cast<int>(std::floor(x)), 0, kAlphaGrid - 2);
+  const double f = std::clamp(x - i, 0.0, 1.0);
+  Bands k{};
+  for (int l = 0; l < kBands; ++l) k[l] = (1.0 - f) * t.kappa[i][l] + f * t.kappa[i + 1][l];
+  return k;
+}
+
+IblPack::Row IblPack::At(double m) const {
+  Row row;
+  if (mu.empty()) return row;
+  const double x = m * kRows - 0.5;
+  const int n = static_cast<int>(mu.size());
+  const int i = std::clamp(static_cast<int>(std::floor(x)), 0, n - 1);
+  const int j = std::min(i + 1, n - 1);
+  const double f = std::clamp(x - i, 0.0, 1.0);
+  for (int c = 0; c < 3; ++c) {
+    row.albedo[c] = (1.0 - f) * albedo[i][c] + f * albedo[j][c];
+    row.diffuse[c] = (1.0 - f) * diffuse[i][c] + f * diffuse[j][c];
+    row.specular[c] = (1.0 - f) * specular[i][c] + f * specular[j][c];
+  }
+  row.alpha = (1.0 - f) * alpha[i] + f * alpha[j];
+  return row;
+}
+
+namespace {
+
+// Midpoint nodes and weights on [lo, hi] for the density a + b·exp(−½((x − c)/σ)²) (a share
+// `peak` of the nodes in the Gaussian, the rest uniform): node i sits at the inverse CDF of
+// (i + 0.5)/n, weight 1/(n·ρ(x)). Smooth, so the rule stays second order; the CDF is tabulated
+// on 512 intervals and inverted linearly.
+void ConcentratedNodes(double lo, double hi, double c, double sigma, double peak, int n,
+                       std::vector<double>* x, std::vector<double>* w) {
+  constexpr int kTable = 512;
+  const double h = (hi - lo) / kTable;
+  // Gaussian mass inside [lo, hi], by the same table (normalised below).
+  std::vector<double> cdf(kTable + 1, 0.0);
+  auto gauss = [&](double t) { return std::exp(-0.5 * ((t - c) / sigma) * ((t - c) / sigma)); };
+  double gauss_mass = 0.0;
+  for (int k = 0; k < kTable; ++k) gauss_mass += gauss(lo + (k + 0.5) * h) * h;
+  const double a = (1.0 - peak) / (hi - lo), b = peak / gauss_mass;
+  auto density = [&](double t) { return a + b * gauss(t); };
+  for (int k = 0; k < kTable; ++k) cdf[k + 1] = cdf[k] + density(lo + (k + 0.5) * h) * h;
+  x->resize(n);
+  w->resize(n);
+  int k = 0;
+  for (int i = 0; i < n; ++i) {
+    const double target = (i + 0.5) / n * cdf[kTable];
+    while (k + 1 < kTable && cdf[k + 1] < target) ++k;
+    const double t = lo + (k + (target - cdf[k]) / (cdf[k + 1] - cdf[k])) * h;
+    (*x)[i] = t;
+    (*w)[i] = cdf[kTable] / (n * density(t));
+  }
+}
+
+}  // namespace
+
+IblPack ComputeIblPack(const BrdfSource& source) {
+  constexpr int kRows = IblPack::kRows;
+  constexpr int kTheta = IblPack::kThetaSteps, kPhi = IblPack::kPhiSteps;
+  // Histogram of the lobe over γ, the angle between l and R, in [0, π], for the moments about
+  // R (linear splatting: exact for constant and linear functions of γ, second order otherwise).
+  constexpr int kBins = 1024;
+  IblPack pack;
+  pack.mu.resize(kRows);
+  pack.albedo.resize(kRows);
+  pack.diffuse.resize(kRows);
+  pack.specular.resize(kRows);
+  pack.alpha.resize(kRows);
+  pack.residual.resize(kRows);
+
+  std::vector<Bands> p_bins(kBins);
+  for (int b = 0; b < kBins; ++b) Legendre(std::cos(kPi * b / (kBins - 1)), &p_bins[b]);
+  std::vector<Rgb> hist(kBins);
+  Bands p{};
+  const KappaTable& table = Kappa();
+  std::vector<double> theta_x, theta_w, phi_x, phi_w, cos_phi(kPhi), sin_phi(kPhi);
+  // A LUT is sampled by its own rule directly from the grid's angles (Lut::SampleAngles with the
+  // light at φ = 0 and the view at the relative azimuth, exactly what LutBrdf::Eval computes
+  // from the vectors), which saves the vectors' trigonometry: most of the pack's cost.
+  const auto* lut = dynamic_cast<const LutBrdf*>(&source);
+  std::vector<double> phi_out_deg(kPhi);
+
+  for (int row = 0; row < kRows; ++row) {
+    const double mu = (row + 0.5) / kRows;
+    const double s = std::sqrt(std::max(0.0, 1.0 - mu * mu));
+    const double theta_v = std::acos(mu);
+    const Vec3 v = {s, 0.0, mu};
+    const Vec3 r = {-s, 0.0, mu};
+    // Nodes in the normal frame, so the horizon is an edge of the grid, concentrated around
+    // the mirror direction R = (θv, 180°): 40 % of the θ nodes within a few degrees of θv, and
+    // of the φ nodes within a few degrees of arc of 180°.
+    constexpr double kSigma = 0.1;  // rad, about 6°
+    ConcentratedNodes(0.0, 0.5 * kPi, theta_v, kSigma, 0.3, kTheta, &theta_x, &theta_w);
+    ConcentratedNodes(0.0, 2.0 * kPi, kPi, std::min(1.0, kSigma / std::max(s, 0.05)), 0.3, kPhi,
+                      &phi_x, &phi_w);
+    for (int k = 0; k < kPhi; ++k) {
+      cos_phi[k] = std::cos(phi_x[k]);
+      sin_phi[k] = std::sin(phi_x[k]);
+      phi_out_deg[k] = WrapDeg360(-RadToDeg(phi_x[k]));
+    }
+    const double theta_v_deg = RadToDeg(theta_v);
+    std::fill(hist.begin(), hist.end(), Rgb{0, 0, 0});
+    std::array<Moments, 3> m{};
+    Rgb e = {0, 0, 0};
+    for (int j = 0; j < kTheta; ++j) {
+      const double st = std::sin(theta_x[j]), ct = std::cos(theta_x[j]);
+      const double row_weight = st * ct * theta_w[j];
+      const double theta_l_deg = RadToDeg(theta_x[j]);
+      Rgb ring = {0, 0, 0};
+      for (int k = 0; k < kPhi; ++k) {
+        const Vec3 l = {st * cos_phi[k], st * sin_phi[k], ct};
+        Rgb f;
+        if (lut != nullptr) {
+          const std::array<float, 3> t =
+              lut->lut().SampleAngles(theta_l_deg, theta_v_deg, phi_out_deg[k]);
+          f = {t[0], t[1], t[2]};
+        } else {
+          f = source.Eval(l, v);
+        }
+        const double w = row_weight * phi_w[k];
+        const double cos_gamma = std::clamp(Dot(l, r), -1.0, 1.0);
+        const double x = std::acos(cos_gamma) * (1.0 / kPi) * (kBins - 1);
+        const int b = std::min(kBins - 2, static_cast<int>(x));
+        const double frac = x - b;
+        for (int c = 0; c < 3; ++c) {
+          const double wc = f[c] * w;
+          ring[c] += wc;
+          hist[b][c] += (1.0 - frac) * wc;
+          hist[b + 1][c] += frac * wc;
+        }
+      }
+      Legendre(ct, &p);
+      for (int c = 0; c < 3; ++c) {
+        e[c] += ring[c];
+        for (int l = 0; l < kBands; ++l) m[c].at_n[l] += ring[c] * p[l];
+      }
+    }
+    for (int b = 0; b < kBins; ++b)
+      for (int c = 0; c < 3; ++c)
+        if (hist[b][c] != 0.0)
+          for (int l = 0; l < kBands; ++l) m[c].at_r[l] += hist[b][c] * p_bins[b][l];
+    for (int c = 0; c < 3; ++c) m[c].e = e[c];
+    Moments luma;
+    luma.e = Luma(e);
+    for (int l = 0; l < kBands; ++l) {
+      luma.at_n[l] = Luma({m[0].at_n[l], m[1].at_n[l], m[2].at_n[l]});
+      luma.at_r[l] = Luma({m[0].at_r[l], m[1].at_r[l], m[2].at_r[l]});
+    }
+    Bands p_mu{};
+    Legendre(mu, &p_mu);
+
+    pack.mu[row] = mu;
+    pack.albedo[row] = e;
+    double alpha = 1.0, residual = 0.0, sy = 0.0;
+    if (luma.e > 0.0) {
+      // The grid of the κ table, then golden-section refinement between its neighbours.
+      int best = 0;
+      double best_value = 0.0;
+      for (int a = 0; a < kAlphaGrid; ++a) {
+        const double value = Criterion(luma, table.kappa[a], p_mu, &sy);
+        if (a == 0 || value < best_value) {
+          best = a;
+          best_value = value;
+        }
+      }
+      double lo = table.log_alpha[std::max(0, best - 1)];
+      double hi = table.log_alpha[std::min(kAlphaGrid - 1, best + 1)];
+      const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+      auto value_at = [&](double la) {
+        return Criterion(luma, GgxPrefilterLegendre(std::exp(la)), p_mu, &sy);
+      };
+      double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo);
+      double f1 = value_at(x1), f2 = value_at(x2);
+      for (int it = 0; it < 24; ++it) {
+        if (f1 < f2) {
+          hi = x2;
+          x2 = x1;
+          f2 = f1;
+          x1 = hi - g * (hi - lo);
+          f1 = value_at(x1);
+        } else {
+          lo = x1;
+          x1 = x2;
+          f1 = f2;
+          x2 = lo + g * (hi - lo);
+          f2 = value_at(x2);
+        }
+      }
+      double la = 0.5 * (lo + hi);
+      double value = value_at(la);
+      if (best_value < value) {  // the grid's best was not bracketed (an end of the range)
+        la = table.log_alpha[best];
+        value = best_value;
+      }
+      alpha = std::exp(la);
+      double norm = 0.0;
+      for (int l = 1; l < kBands; ++l)
+        norm += (2.0 * l + 1.0) * (luma.at_n[l] * luma.at_n[l] + luma.at_r[l] * luma.at_r[l]);
+      residual = norm > 0.0 ? value / norm : 0.0;
+    }
+    const Bands kappa = GgxPrefilterLegendre(alpha);
+    for (int c = 0; c < 3; ++c) {
+      double sc = 0.0;
+      if (e[c] > 0.0) Criterion(m[c], kappa, p_mu, &sc);
+      pack.specular[row][c] = sc;
+      pack.diffuse[row][c] = std::max(0.0, e[c] - sc);
+    }
+    pack.alpha[row] = alpha;
+    pack.residual[row] = residual;
+  }
+  return pack;
+}
+
+std::string IblPackJson(const IblPack& pack) {
+  std::string out =
+      "{\"convention\": \"docs/engines.md, IBL pack: mu = cos(theta_view) at texel "
+      "centres (i + 0.5)/rows; radiance = diffuse_rgb * irradiance/pi + "
+      "specular_rgb * prefiltered(alpha_eq, reflect(-v, n)); albedo_rgb = "
+      "diffuse_rgb + specular_rgb\", \"rows\": ";
+  out += std::to_string(pack.mu.size());
+  char buf[96];
+  auto list = [&](const char* key, auto&& value) {
+    out += ", \"";
+    out += key;
+    out += "\": [";
+    for (std::size_t i = 0; i < pack.mu.size(); ++i) {
+      if (i) out += ", ";
+      out += value(i);
+    }
+    out += "]";
+  };
+  auto number = [&](double x) {
+    std::snprintf(buf, sizeof buf, "%.7g", x);
+    return std::string(buf);
+  };
+  auto rgb = [&](const Rgb& c) {
+    std::snprintf(buf, sizeof buf, "[%.7g, %.7g, %.7g]", c[0], c[1], c[2]);
+    return std::string(buf);
+  };
+  list("mu", [&](std::size_t i) { return number(pack.mu[i]); });
+  list("albedo_rgb", [&](std::size_t i) { return rgb(pack.albedo[i]); });
+  list("diffuse_rgb", [&](std::size_t i) { return rgb(pack.diffuse[i]); });
+  list("specular_rgb", [&](std::size_t i) { return rgb(pack.specular[i]); });
+  list("alpha_eq", [&](std::size_t i) { return number(pack.alpha[i]); });
+  list("fit_residual", [&](std::size_t i) { return number(pack.residual[i]); });
+  out += "}";
+  return out;
+}
+
+}  // namespace brdf
