@@ -195,7 +195,7 @@ std::string AtlasManifestJson(const Atlas& atlas, const std::vector<std::string>
   j["texel_convention"] = std::move(convention);
   j["values"] = "f_r in 1/sr, linear Rec.709 RGB, not multiplied by cos(theta); unused cells are 0";
   j["tool"] = {{"name", "brdf-toolchain"}, {"version", BrdfToolVersion()}};
-  j["payload"] = detail::PayloadJson(atlas.volume);
+  j["payload"] = detail::PayloadJson(detail::Summarize(atlas.volume));
   j["files"] = files;
   return j.dump(2) + "\n";
 }
