@@ -14,7 +14,16 @@
    the definition in docs/design.md §7 (max over channels of |d − r| / max(max r, 2^−14)),
    θout ≤ θb versus beyond, nearest-rank p99 and median.
 
-Usage: bc6h_check.py --brdf BRDF --dump BC6H_DUMP_FIXTURE --work DIR [--modes-only]
+4. With --gpu (ctest label browser): headless Chromium's WebGL 2 (SwiftShader) uploads both
+   KTX2 files as compressed 3D textures and texelFetches every texel (tests/node/bc6h_gpu.mjs);
+   the GPU's values must equal the hand-derived ones and the numpy decode bit for bit, and
+   `brdf eval` of the BC6H file at the directions of every texel of the 20° slice (θout ≤ 89°,
+   off the poles and the seam)
+   must read the same values (to 1e-5: its trilinear weights at texel centres are exact only up
+   to float rounding).
+
+Usage: bc6h_check.py --brdf BRDF --dump BC6H_DUMP_FIXTURE --work DIR [--gpu NODE_SCRIPT
+       [--chromium PATH]]
 """
 
 import argparse
@@ -163,6 +172,19 @@ def check_modes(args):
                                  f"{want[i].tolist()}")
     print(f"hand-made blocks: all {len(blocks)} modes decode to the hand-derived values "
           f"(numpy and library); {path}")
+    if args.gpu:
+        gpu = gpu_fetch(args, path, "bc6h_modes_gpu.raw").reshape(-1, 16, 3)
+        for i, mode in enumerate(bc.MODES):
+            if not np.array_equal(gpu[i], want[i]):
+                raise AssertionError(f"GPU, mode {mode}: {gpu[i].tolist()} != {want[i].tolist()}")
+        print("GPU: the hand-made blocks of all 14 modes fetch as the hand-derived values")
+
+
+def gpu_fetch(args, ktx2, name):
+    out = os.path.join(args.work, name)
+    subprocess.run([args.node, args.gpu, "--ktx2", ktx2, "--out", out, "--chromium", args.chromium],
+                   check=True, stderr=subprocess.DEVNULL if not args.verbose else None)
+    return np.fromfile(out, dtype="<f4")
 
 
 def nearest_rank(sorted_values, p):
@@ -194,6 +216,47 @@ def check_encoder(args):
         modes[m] = modes.get(m, 0) + 1
     print(f"encoder blocks: {len(level) // 16} blocks (modes {sorted(modes.items())}) decode "
           "identically in numpy and the library")
+    if args.gpu:
+        ktx2 = os.path.join(out, "gold.ktx2")
+        gpu = gpu_fetch(args, ktx2, "gold_gpu.raw").reshape(depth, height, width, 3)
+        if not np.array_equal(gpu.view(np.uint32), ours.view(np.uint32)):
+            bad = np.argwhere(gpu != ours)
+            raise AssertionError(f"{len(bad)} texels differ between the GPU and numpy, first "
+                                 f"{bad[0].tolist()}: {gpu[tuple(bad[0][:3])]} vs "
+                                 f"{ours[tuple(bad[0][:3])]}")
+        print(f"GPU: all {width * height * depth} texels fetch bit for bit as numpy decodes them")
+        # brdf eval at the direction of every texel of slice k = 1 (θin = 20°).
+        k = 1
+        theta_m = math.radians(20.0)
+        lines, where = [], []
+        # Directions name texels uniquely except at the poles (row 0 and 180: every φd is the
+        # same direction) and on the seam (columns 0 and 360 are both φd = 0, which eval may read
+        # from either; after compression the two columns need not be equal).
+        for j in range(1, height - 1):
+            for i in range(1, width - 1):
+                td, pd = math.radians(j), math.radians(i)
+                dx, dy, dz = math.sin(td) * math.cos(pd), math.sin(td) * math.sin(pd), math.cos(td)
+                ox = -math.cos(theta_m) * dx - math.sin(theta_m) * dz  # ω_out = S(θm)·ω_d
+                oy = -dy
+                oz = -math.sin(theta_m) * dx + math.cos(theta_m) * dz
+                theta_out = math.degrees(math.acos(max(-1.0, min(1.0, oz))))
+                if theta_out > 89.0:
+                    continue
+                phi_out = math.degrees(math.atan2(oy, ox)) % 360.0
+                lines.append(f"20 0 {theta_out:.12f} {phi_out:.12f}")
+                where.append((j, i))
+        r = subprocess.run([brdf, "eval", ktx2, "--pairs", "-"], input="\n".join(lines) + "\n",
+                           capture_output=True, text=True, check=True)
+        got = np.array([[float(x) for x in line.split()] for line in r.stdout.splitlines()])
+        want = np.array([gpu[k, j, i] for j, i in where], dtype=np.float64)
+        rel = np.abs(got - want).max(axis=1) / np.maximum(want.max(axis=1), 2.0 ** -14)
+        if rel.max() > 1e-5:
+            n = int(rel.argmax())
+            raise AssertionError(f"brdf eval at texel {where[n]} of slice {k}: {got[n]} vs the "
+                                 f"GPU's {want[n]}")
+        print(f"brdf eval of the BC6H file reads the GPU's values at all {len(where)} texels of "
+              f"the 20 deg slice with theta_out <= 89 deg (max relative difference "
+              f"{rel.max():.2e})")
 
     # Certified error, recomputed.
     import OpenImageIO as oiio
@@ -236,12 +299,14 @@ def main():
     ap.add_argument("--brdf", required=True)
     ap.add_argument("--dump", required=True)
     ap.add_argument("--work", required=True)
-    ap.add_argument("--modes-only", action="store_true")
+    ap.add_argument("--gpu", help="tests/node/bc6h_gpu.mjs: also decode on a real GPU")
+    ap.add_argument("--chromium", default="chromium")
+    ap.add_argument("--node", default="node")
+    ap.add_argument("--verbose", action="store_true")
     args = ap.parse_args()
     os.makedirs(args.work, exist_ok=True)
     check_modes(args)
-    if not args.modes_only:
-        check_encoder(args)
+    check_encoder(args)
 
 
 if __name__ == "__main__":
