@@ -105,8 +105,8 @@ ordered_json CertifiedErrorJson(const CertifiedError& e) {
       {"certified_error",
        {{"definition",
          "relative error of each texel of the payload as a GPU decodes it against the float "
-         "LUT: max over R, G, B of |decoded - reference| / max(largest reference channel, "
-         "2^-14)"},
+         "LUT clamped to [0, 65504]: max over R, G, B of |decoded - reference| / max(largest "
+         "reference channel, 1e-4 * the LUT's largest reference value, 2^-14)"},
         {"theta_b_deg", e.theta_b_deg},
         {"measured", StatisticsJson(e.measured)},
         {"filled", StatisticsJson(e.filled)}}}};

@@ -14,6 +14,7 @@ namespace {
 
 constexpr double kDegree = std::numbers::pi / 180.0;
 constexpr float kScaleFloor = 6.103515625e-05f;  // 2^−14
+constexpr float kRelativeFloor = 1e-4f;          // of the LUT's brightest value
 
 ErrorStatistics Statistics(std::vector<float>& errors) {
   ErrorStatistics s;
@@ -58,15 +59,21 @@ CertifiedError MeasureCompressionError(const Lut& reference, const std::vector<f
                                       decoded.size(), reference.texels.size()));
   CertifiedError e;
   e.theta_b_deg = theta_b_deg;
+  // The reference as the unsigned formats can hold it, and the scale floor.
+  const auto clamped = [](float v) { return std::clamp(v, 0.0f, kBc6hMaxValue); };
+  float brightest = 0.0f;
+  for (const float v : reference.texels) brightest = std::max(brightest, clamped(v));
+  const float floor = std::max(kScaleFloor, kRelativeFloor * brightest);
   std::vector<float> measured, filled;
   measured.reserve(reference.texels.size() / 3);
   for (int k = 0; k < reference.slices(); ++k)
     for (int j = 0; j < Lut::kHeight; ++j)
       for (int i = 0; i < Lut::kWidth; ++i) {
         const std::size_t at = reference.Index(k, j, i);
-        const float* r = &reference.texels[at];
+        const float r[3] = {clamped(reference.texels[at]), clamped(reference.texels[at + 1]),
+                            clamped(reference.texels[at + 2])};
         const float* d = &decoded[at];
-        const float scale = std::max({r[0], r[1], r[2], kScaleFloor});
+        const float scale = std::max({r[0], r[1], r[2], floor});
         const float err =
             std::max({std::abs(d[0] - r[0]), std::abs(d[1] - r[1]), std::abs(d[2] - r[2])}) / scale;
         // A hair of tolerance so that texels exactly at θb (θd = 0 rows of a slice at θb) count

@@ -11,8 +11,9 @@
 2. Blocks from our encoder: `brdf convert --compress bc6h` of a simulated capture; every texel
    decoded by numpy equals, bit for bit, what the library decodes (and so `brdf eval` reads).
 3. The certified error in the sidecar recomputed from the EXR's float LUT and the numpy decode:
-   the definition in docs/design.md §7 (max over channels of |d − r| / max(max r, 2^−14)),
-   θout ≤ θb versus beyond, nearest-rank p99 and median.
+   the definition in docs/design.md §7 (reference clamped to [0, 65504], max over channels of
+   |d − r| / max(max r, 1e-4 · the LUT's largest value, 2^−14)), θout ≤ θb versus beyond,
+   nearest-rank p99 and median.
 
 4. With --gpu (ctest label browser): headless Chromium's WebGL 2 (SwiftShader) uploads both
    KTX2 files as compressed 3D textures and texelFetches every texel (tests/node/bc6h_gpu.mjs);
@@ -270,8 +271,10 @@ def check_encoder(args):
     sidecar = json.load(open(os.path.join(out, "gold.json")))
     cert = sidecar["compression"]["certified_error"]
     theta_b = cert["theta_b_deg"]
-    ref64, ours64 = ref.astype(np.float64), ours.astype(np.float64)
-    scale = np.maximum(ref64.max(axis=3), 2.0 ** -14)
+    ref64 = np.clip(ref.astype(np.float64), 0.0, 65504.0)
+    ours64 = ours.astype(np.float64)
+    floor = max(2.0 ** -14, float(np.float32(1e-4)) * ref64.max())
+    scale = np.maximum(ref64.max(axis=3), floor)
     err = np.abs(ours64 - ref64).max(axis=3) / scale
     theta_in = np.radians(np.array(sidecar["theta_in_deg"], dtype=np.float64))[:, None, None]
     td = np.radians(np.arange(height, dtype=np.float64))[None, :, None]

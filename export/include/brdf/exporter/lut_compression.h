@@ -3,7 +3,8 @@
 //
 // A compressed LUT is encoded with EncodeBc6hVolume (bc6h.h), decoded again exactly as a GPU
 // samples it, and compared texel by texel with the float LUT it came from. The error of a texel
-// is e = max_c |d_c − r_c| / max(max_c r_c, 2^−14) (metadata.h's ErrorStatistics); texels are
+// is e = max_c |d_c − r_c| / max(max_c r_c, 10^−4·R, 2^−14) with r the LUT clamped to
+// [0, 65504] and R its largest value (metadata.h's ErrorStatistics); texels are
 // split by their outgoing polar angle θout (cos θout = cos θin·cos θd − sin θin·sin θd·cos φd,
 // the specular frame of docs/design.md §5 undone) into the measured range θout ≤ θb and the
 // filled range θout > θb (the extrapolation and the below-horizon edge extension). Max, p99 and

@@ -28,9 +28,12 @@ struct SaturatedCount {
 };
 
 // Relative errors of a compressed payload's texels against the float LUT it was made from, over
-// one range of texels (docs/design.md §7): for texel x with reference r and decoded value d,
-// e = max_c |d_c − r_c| / max(max_c r_c, 2^−14), the colour's largest channel as the scale
-// (2^−14, the smallest normal half float, keeps black texels from dividing by zero).
+// one range of texels (docs/design.md §7): for texel x with reference r (the float LUT clamped
+// to [0, 65504], what an unsigned texture can hold) and decoded value d,
+// e = max_c |d_c − r_c| / max(max_c r_c, 10^−4·R, 2^−14), the colour's largest channel as the
+// scale, with R the LUT's largest reference value: texels darker than 1/10,000 of the LUT's
+// brightest (the noise of a black backing) are judged on that absolute scale, and 2^−14, the
+// smallest normal half float, keeps an all-black LUT from dividing by zero.
 struct ErrorStatistics {
   double max = 0, p99 = 0, median = 0;
   std::uint64_t texels = 0;  // texels in the range
