@@ -57,10 +57,16 @@ void FinishLoadedTexture(LoadedTexture& t) {
   } else if (!t.atlas_manifest_json.empty()) {
     const AtlasManifest m = ParseAtlasManifest(
         t.atlas_manifest_json, beside ? t.metadata_file : t.file + " (embedded manifest)");
-    CheckRecordedPayload(t,
-                         beside ? "atlas manifest " + t.metadata_file : "embedded atlas manifest",
-                         m.texture_width, m.texture_height, static_cast<int>(m.theta_in_deg.size()),
-                         m.payload_bytes, m.payload_crc32);
+    const std::string what =
+        beside ? "atlas manifest " + t.metadata_file : "embedded atlas manifest";
+    const bool recorded_bc6h = m.payload_format == "bc6h_ufloat";
+    if (recorded_bc6h != (t.format == TexelFormat::kBc6hUfloat))
+      throw FormatError(t.file, what,
+                        std::string("a ") + (recorded_bc6h ? "BC6H_UF16" : "RGB9E5") +
+                            " texture as the manifest records",
+                        std::string("a ") + t.FormatName() + " texture");
+    CheckRecordedPayload(t, what, m.texture_width, m.texture_height,
+                         static_cast<int>(m.theta_in_deg.size()), m.payload_bytes, m.payload_crc32);
     t.theta_in_deg = m.theta_in_deg;
     t.theta_in_from_metadata = true;
   } else if (t.theta_in_deg.size() != static_cast<std::size_t>(t.volume.depth)) {

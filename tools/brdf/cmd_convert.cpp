@@ -92,6 +92,10 @@ int RunConvert(const ConvertOptions& options) {
   export_options.exr = ParseExrOptions(options.exr_type, options.exr_compression);
   export_options.compression = exporter::ParseLutCompression(options.compress);
   const engines::EngineSet engine_set = engines::ParseEngines(options.engines);
+  if (export_options.compression != exporter::LutCompression::kNone && engine_set.Any())
+    throw InvalidArgument(
+        "--compress bc6h: the engine hand-offs (--engine) are written as RGB9E5 only so far; "
+        "write them in a separate run without --compress");
   if (!options.engine_fits.empty()) {
     if (!engine_set.Any())
       throw InvalidArgument("--engine-fits: goes with --engine (the fits go into its manifests)");

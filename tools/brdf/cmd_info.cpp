@@ -336,6 +336,18 @@ std::string Hex32(std::uint32_t v) {
   return buf;
 }
 
+Json CertifiedErrorJson(const exporter::CertifiedError& e) {
+  const auto stats = [](const exporter::ErrorStatistics& s) {
+    return Json{{"max", s.max}, {"p99", s.p99}, {"median", s.median}, {"texels", s.texels}};
+  };
+  return {{"format", e.format},
+          {"bytes", e.bytes},
+          {"rgb9e5_bytes", e.rgb9e5_bytes},
+          {"theta_b_deg", e.theta_b_deg},
+          {"measured", stats(e.measured)},
+          {"filled", stats(e.filled)}};
+}
+
 // An exported LUT or atlas (.ktx2, .dds) or the sidecar / manifest describing one. Value ranges
 // are of the RGB9E5 values as stored (decoded exactly), per θin slice; for an atlas over the
 // cells that hold a material.
@@ -377,18 +389,8 @@ Json DescribeTexture(const std::string& path) {
     else
       j["extrapolation"] = nullptr;
     j["files"] = t.sidecar->files;
-    if (t.sidecar->certified_error) {
-      const exporter::CertifiedError& e = *t.sidecar->certified_error;
-      const auto stats = [](const exporter::ErrorStatistics& s) {
-        return Json{{"max", s.max}, {"p99", s.p99}, {"median", s.median}, {"texels", s.texels}};
-      };
-      j["certified_error"] = {{"format", e.format},
-                              {"bytes", e.bytes},
-                              {"rgb9e5_bytes", e.rgb9e5_bytes},
-                              {"theta_b_deg", e.theta_b_deg},
-                              {"measured", stats(e.measured)},
-                              {"filled", stats(e.filled)}};
-    }
+    if (t.sidecar->certified_error)
+      j["certified_error"] = CertifiedErrorJson(*t.sidecar->certified_error);
   }
   // Cells holding data: the whole texture for a LUT, the materials' cells for an atlas.
   std::vector<std::array<int, 2>> origins = {{0, 0}};
@@ -404,6 +406,8 @@ Json DescribeTexture(const std::string& path) {
                                 {"row", m.row},
                                 {"x0", m.x0},
                                 {"y0", m.y0}});
+      if (m.certified_error)
+        j["materials"].back()["certified_error"] = CertifiedErrorJson(*m.certified_error);
       origins.push_back({m.x0, m.y0});
     }
     cell_w = Lut::kWidth;
@@ -679,11 +683,20 @@ void PrintTextureText(const Json& j) {
                 j["tool_version"].get<std::string>().c_str());
   if (atlas && j.contains("materials")) {
     std::printf("  materials      %zu\n", j["materials"].size());
-    for (const Json& m : j["materials"])
+    for (const Json& m : j["materials"]) {
       std::printf("    %d %s: cell column %d, row %d (texel origin %d, %d), from %s\n",
                   m["index"].get<int>(), m["name"].get<std::string>().c_str(),
                   m["column"].get<int>(), m["row"].get<int>(), m["x0"].get<int>(),
                   m["y0"].get<int>(), m["source"].get<std::string>().c_str());
+      if (m.contains("certified_error")) {
+        const Json& e = m["certified_error"]["measured"];
+        std::printf(
+            "      certified BC6H error, measured range: max %.3g %%, p99 %.3g %%, median "
+            "%.3g %%\n",
+            100.0 * e["max"].get<double>(), 100.0 * e["p99"].get<double>(),
+            100.0 * e["median"].get<double>());
+      }
+    }
   }
   std::printf("  f_r (1/sr, r g b) per slice%s:\n", atlas ? " over the material cells" : "");
   for (const Json& r : j["value_ranges"])

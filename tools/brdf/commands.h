@@ -65,6 +65,7 @@ struct AtlasOptions {
   std::string extrapolate;
   std::string exr_type = "float";
   std::string exr_compression = "none";  // as convert's: one default for every EXR written
+  std::string compress = "none";         // as convert's
   int jobs = DefaultJobs();
   bool quiet = false;
   bool force = false;   // overwrite existing PREFIX.* files
