@@ -455,12 +455,12 @@ void FitLine(const BlockInput& in, std::uint16_t mask, int s, int anchor, float 
 }
 
 // Search effort: least-squares refinements per candidate, partitions tried in the two-subset
-// modes, modes tried per endpoint set, and how much lower a two-line estimate must be than the
-// one-subset error to try two subsets (benchmarks in docs/benchmarks/bc6h.md).
+// modes, modes tried per endpoint set, and the factor of the one-subset error a two-line
+// estimate must stay under to try two subsets (benchmarks in docs/benchmarks/bc6h.md).
 constexpr int kRefinements = 1;
 constexpr int kPartitionsTried = 2;
 constexpr int kModesTried = 1;
-constexpr double kTwoSubsetGain = 0.6;
+constexpr double kTwoSubsetGain = 1.0;
 
 // Estimated squared error of a two-line fit for every partition: per subset the scatter off
 // its principal axis plus the quantization of 8 levels along it (a uniform spread's variance
@@ -678,7 +678,7 @@ Bc6hBlock EncodeBc6hBlock(const float* rgb48) {
   double estimate = 0.0;
   const std::array<int, kPartitionsTried> ranked = RankPartitions(in, estimate);
   // Scatter that no line fits (noise) stays whatever the partition: only a two-line estimate
-  // well below the one-subset block's error is worth the two-subset modes. The estimate is in
+  // below the one-subset block's error is worth the two-subset modes. The estimate is in
   // the interpolation domain, (64/31)² times the half domain of `best.error`.
   if (estimate * (31.0 / 64.0) * (31.0 / 64.0) > kTwoSubsetGain * best.error) return best.block;
   for (int r = 0; r < kPartitionsTried; ++r) {

@@ -33,12 +33,14 @@
 //
 // What the encoder does (EncodeBc6hBlock). It works in the half-float bit domain, where equal
 // steps are nearly equal relative steps, so minimising squared error there minimises relative
-// error. Per block: a principal-axis fit of the 16 texels quantized in every one-subset mode;
-// if that is not already within kBc6hGoodEnoughHalfSteps of every texel, the 32 partitions are
-// ranked by a two-line fit estimate and the best few tried in every two-subset mode. Every
-// candidate gets least-squares endpoint refinement on its chosen indices, and candidates are
-// compared by the exact error of their packed block decoded with DecodeBc6hBlock. The result
-// depends only on the 16 input texels: the same bytes for any thread count.
+// error. Per block: a principal-axis fit of the 16 texels, quantized in the most precise
+// one-subset mode whose deltas hold it; if that leaves some texel more than
+// kBc6hGoodEnoughHalfSteps off, the 32 partitions are ranked by a two-line fit estimate and,
+// when the best estimate is below the one-subset error, the best two partitions are tried in the
+// most precise two-subset mode that holds their endpoints. Every candidate gets a least-squares
+// endpoint refinement on its chosen indices, and candidates are compared by their exact decoded
+// error (the palettes the decoder computes). The result depends only on the 16 input texels:
+// the same bytes for any thread count.
 #pragma once
 
 #include <array>
@@ -55,8 +57,8 @@ inline constexpr std::uint32_t kDxgiFormatBc6hUf16 = 95;        // DXGI_FORMAT_B
 // The largest value a BC6H_UF16 texel decodes to: half 0x7BFF.
 inline constexpr float kBc6hMaxValue = 65504.0f;
 // The encoder stops looking beyond one-subset modes for a block whose every texel channel is
-// within this many half-float steps (about 0.2–0.4 % relative) of its input.
-inline constexpr int kBc6hGoodEnoughHalfSteps = 3;
+// within this many half-float steps (about 0.4–0.8 % relative) of its input.
+inline constexpr int kBc6hGoodEnoughHalfSteps = 8;
 
 using Bc6hBlock = std::array<std::uint8_t, kBc6hBlockBytes>;
 // 16 texels (x fastest) × RGB, as half-float bit patterns.
