@@ -10,6 +10,9 @@
 #include <vector>
 
 #include "brdf/core/error.h"
+#include "brdf/exporter/dds.h"
+#include "brdf/exporter/ktx2.h"
+#include "brdf/exporter/texture_file.h"
 
 namespace brdf::exporter {
 namespace {
@@ -203,6 +206,64 @@ TEST(Bc6hVolume, RejectsWrongSizes) {
   EXPECT_THROW(DecodeBc6hVolume(v), InvalidArgument);
   const float rgb[3] = {1, 1, 1};
   EXPECT_THROW(EncodeBc6hVolume(rgb, 0, 1, 1), InvalidArgument);
+}
+
+// The containers: the KTX2 header fields and DFD the KTX 2.0 and Data Format specifications give
+// for VK_FORMAT_BC6H_UFLOAT_BLOCK, the DDS DXGI format 95, and the blocks read back unchanged.
+TEST(Bc6hContainers, Ktx2AndDdsHoldTheBlocks) {
+  const std::vector<float> rgb = SmoothVolume(361, 181, 2);
+  const Bc6hVolume v = EncodeBc6hVolume(rgb.data(), 361, 181, 2);
+  const std::string ktx2 = EncodeKtx2(v, {});
+  const auto u32 = [&](const std::string& b, std::size_t at) {
+    std::uint32_t x = 0;
+    for (int i = 0; i < 4; ++i) x |= std::uint32_t{static_cast<std::uint8_t>(b[at + i])} << (8 * i);
+    return x;
+  };
+  EXPECT_EQ(u32(ktx2, 12), 131u);  // vkFormat
+  EXPECT_EQ(u32(ktx2, 16), 1u);    // typeSize of a block-compressed format
+  EXPECT_EQ(u32(ktx2, 20), 361u);  // pixelWidth: the image, not the padded blocks
+  EXPECT_EQ(u32(ktx2, 24), 181u);
+  EXPECT_EQ(u32(ktx2, 28), 2u);
+  const std::uint32_t dfd = u32(ktx2, 48);
+  EXPECT_EQ(u32(ktx2, 52), 44u);                // dfdByteLength: one sample
+  EXPECT_EQ(u32(ktx2, dfd + 12) & 0xff, 131u);  // colorModel KHR_DF_MODEL_BC6H
+  EXPECT_EQ(u32(ktx2, dfd + 16), 0x0303u);      // texelBlockDimension 4 × 4 × 1
+  EXPECT_EQ(u32(ktx2, dfd + 20), 16u);          // bytesPlane0
+  EXPECT_EQ(u32(ktx2, dfd + 28), 0x807F0000u);  // bits 0..127, channel 0, FLOAT
+  EXPECT_EQ(u32(ktx2, dfd + 40), 0x3F800000u);  // sampleUpper 1.0f
+  const std::uint32_t level = u32(ktx2, 80);
+  EXPECT_EQ(level % 16, 0u);
+  EXPECT_EQ(u32(ktx2, 88), v.ByteSize());
+  const LoadedTexture k =
+      ParseKtx2(reinterpret_cast<const std::uint8_t*>(ktx2.data()), ktx2.size(), "t.ktx2");
+  EXPECT_EQ(k.format, TexelFormat::kBc6hUfloat);
+  EXPECT_EQ(k.bc6h.bytes, v.bytes);
+  ASSERT_TRUE(k.IsSingleLut());
+  EXPECT_EQ(k.lut.texels, DecodeBc6hVolume(v));
+
+  const std::string dds = EncodeDds(v);
+  EXPECT_EQ(u32(dds, 128), 95u);             // DXGI_FORMAT_BC6H_UF16
+  EXPECT_EQ(u32(dds, 20), 91u * 46u * 16u);  // linear size: one slice of blocks
+  const LoadedTexture d =
+      ParseDds(reinterpret_cast<const std::uint8_t*>(dds.data()), dds.size(), "t.dds");
+  EXPECT_EQ(d.format, TexelFormat::kBc6hUfloat);
+  EXPECT_EQ(d.bc6h.bytes, v.bytes);
+  EXPECT_EQ(d.TexelValue(200, 100, 1)[0], k.lut.Texel(1, 100, 200)[0]);
+
+  // A damaged DFD is named: the colour model word.
+  std::string bad = ktx2;
+  bad[dfd + 12] = 1;
+  try {
+    ParseKtx2(reinterpret_cast<const std::uint8_t*>(bad.data()), bad.size(), "bad.ktx2");
+    FAIL() << "accepted a BC6H file with an RGBSDA colour model";
+  } catch (const FormatError& e) {
+    EXPECT_NE(std::string(e.what()).find("colour model"), std::string::npos) << e.what();
+  }
+  // A truncated level is refused with the expected size.
+  std::string short_file = ktx2.substr(0, ktx2.size() - 16);
+  EXPECT_THROW(ParseKtx2(reinterpret_cast<const std::uint8_t*>(short_file.data()),
+                         short_file.size(), "short.ktx2"),
+               FormatError);
 }
 
 }  // namespace
