@@ -1,5 +1,6 @@
 #include "brdf/exporter/atlas.h"
 
+#include <array>
 #include <filesystem>
 #include <set>
 
@@ -86,6 +87,41 @@ Atlas BuildAtlas(const std::vector<AtlasMaterial>& materials) {
   return atlas;
 }
 
+void CompressAtlasBc6h(Atlas& atlas, const std::vector<AtlasMaterial>& materials, int jobs) {
+  const AtlasLayout& l = atlas.layout;
+  const int w = l.TextureWidth(), h = l.TextureHeight(), d = l.slices;
+  std::vector<float> texels(static_cast<std::size_t>(w) * h * d * 3, 0.0f);
+  const auto cell_origin = [&](std::size_t m) {
+    return std::array<int, 2>{l.cells.CellColumn(static_cast<int>(m)) * Lut::kWidth,
+                              l.cells.CellRow(static_cast<int>(m)) * Lut::kHeight};
+  };
+  for (std::size_t m = 0; m < materials.size(); ++m) {
+    const auto [x0, y0] = cell_origin(m);
+    for (int k = 0; k < d; ++k)
+      for (int j = 0; j < Lut::kHeight; ++j)
+        std::copy_n(materials[m].lut->Texel(k, j, 0), Lut::kWidth * 3,
+                    &texels[((static_cast<std::size_t>(k) * h + y0 + j) * w + x0) * 3]);
+  }
+  atlas.bc6h = EncodeBc6hVolume(texels.data(), w, h, d, jobs);
+  const std::vector<float> decoded = DecodeBc6hVolume(*atlas.bc6h);
+  atlas.certified_error.clear();
+  for (std::size_t m = 0; m < materials.size(); ++m) {
+    const auto [x0, y0] = cell_origin(m);
+    std::vector<float> cell(static_cast<std::size_t>(d) * Lut::kHeight * Lut::kWidth * 3);
+    for (int k = 0; k < d; ++k)
+      for (int j = 0; j < Lut::kHeight; ++j)
+        std::copy_n(&decoded[((static_cast<std::size_t>(k) * h + y0 + j) * w + x0) * 3],
+                    Lut::kWidth * 3,
+                    &cell[((static_cast<std::size_t>(k) * Lut::kHeight + j) * Lut::kWidth) * 3]);
+    const std::optional<ExtrapolationInfo>& x = materials[m].extrapolation;
+    CertifiedError e = MeasureCompressionError(*materials[m].lut, cell, x ? x->theta_b_deg : 90.0);
+    e.format = "bc6h_ufloat";
+    e.bytes = atlas.bc6h->ByteSize();
+    e.rgb9e5_bytes = atlas.volume.ByteSize();
+    atlas.certified_error.push_back(e);
+  }
+}
+
 FloatImage AtlasImage(const std::vector<AtlasMaterial>& materials) {
   const std::vector<double> theta = CheckMaterials(materials);
   const AtlasLayout layout =
@@ -161,6 +197,8 @@ std::string AtlasManifestJson(const Atlas& atlas, const std::vector<std::string>
     const auto i = static_cast<std::size_t>(m);
     if (i < atlas.extrapolation.size() && atlas.extrapolation[i])
       materials.back()["extrapolation"] = detail::ExtrapolationJson(*atlas.extrapolation[i]);
+    if (atlas.bc6h && i < atlas.certified_error.size())
+      materials.back()["compression"] = detail::CertifiedErrorJson(atlas.certified_error[i]);
     if (i < atlas.fitted_models_json.size() && !atlas.fitted_models_json[i].empty()) {
       ordered_json fitted = ordered_json::array();
       for (const std::string& text : atlas.fitted_models_json[i])
@@ -196,7 +234,8 @@ std::string AtlasManifestJson(const Atlas& atlas, const std::vector<std::string>
   j["texel_convention"] = std::move(convention);
   j["values"] = "f_r in 1/sr, linear Rec.709 RGB, not multiplied by cos(theta); unused cells are 0";
   j["tool"] = {{"name", "brdf-toolchain"}, {"version", BrdfToolVersion()}};
-  j["payload"] = detail::PayloadJson(atlas.volume);
+  j["payload"] = atlas.bc6h ? detail::PayloadJson(detail::Summarize(*atlas.bc6h))
+                            : detail::PayloadJson(detail::Summarize(atlas.volume));
   j["files"] = files;
   return j.dump(2) + "\n";
 }
@@ -207,16 +246,24 @@ std::vector<std::string> AtlasOutputPaths(const std::string& prefix) {
 
 std::vector<std::string> WriteAtlas(const std::string& prefix,
                                     const std::vector<AtlasMaterial>& materials,
-                                    const ExrOptions& exr_options) {
-  const Atlas atlas = BuildAtlas(materials);
+                                    const ExrOptions& exr_options, LutCompression compression,
+                                    int jobs) {
+  Atlas atlas = BuildAtlas(materials);
+  if (compression == LutCompression::kBc6h) CompressAtlasBc6h(atlas, materials, jobs);
   const std::string stem = std::filesystem::path(prefix).filename().string();
   const std::vector<std::string> files = {stem + ".ktx2", stem + ".dds", stem + ".exr",
                                           stem + ".json"};
   const std::string manifest = AtlasManifestJson(atlas, files);
   std::vector<std::string> written;
-  WriteKtx2(prefix + ".ktx2", atlas.volume, KeyValues{{"brdf.atlas", manifest}});
-  written.push_back(prefix + ".ktx2");
-  WriteDds(prefix + ".dds", atlas.volume);
+  if (atlas.bc6h) {
+    WriteKtx2(prefix + ".ktx2", *atlas.bc6h, KeyValues{{"brdf.atlas", manifest}});
+    written.push_back(prefix + ".ktx2");
+    WriteDds(prefix + ".dds", *atlas.bc6h);
+  } else {
+    WriteKtx2(prefix + ".ktx2", atlas.volume, KeyValues{{"brdf.atlas", manifest}});
+    written.push_back(prefix + ".ktx2");
+    WriteDds(prefix + ".dds", atlas.volume);
+  }
   written.push_back(prefix + ".dds");
   WriteExr(prefix + ".exr", AtlasImage(materials), exr_options,
            {{"brdf:atlas", manifest},
@@ -226,7 +273,8 @@ std::vector<std::string> WriteAtlas(const std::string& prefix,
                          "row-major, ascending theta_in, top-left first",
                          atlas.layout.composite.columns, atlas.layout.composite.rows,
                          atlas.layout.cells.columns, atlas.layout.cells.rows)},
-            {"brdf:payload_crc32", Hex32Text(atlas.volume.Crc32())}});
+            {"brdf:payload_crc32",
+             Hex32Text(atlas.bc6h ? atlas.bc6h->Crc32() : atlas.volume.Crc32())}});
   written.push_back(prefix + ".exr");
   WriteFileAtomically(prefix + ".json", manifest);
   written.push_back(prefix + ".json");
@@ -276,9 +324,15 @@ AtlasManifest ParseAtlasManifest(std::string_view json_text, const std::string& 
                           fitted.type_name());
       for (const ordered_json& x : fitted) entry.fitted_models_json.push_back(x.dump());
     }
+    if (list[i].contains("compression"))
+      entry.certified_error = detail::ParseCertifiedError(e.Object("compression"), file);
     m.materials.push_back(std::move(entry));
   }
   detail::JsonFields p(f.Object("payload"), file, "payload.");
+  if (f.Object("payload").contains("format")) m.payload_format = p.String("format");
+  if (m.payload_format != "rgb9e5" && m.payload_format != "bc6h_ufloat")
+    throw FormatError(file, "member 'payload.format'", "\"rgb9e5\" or \"bc6h_ufloat\"",
+                      "\"" + m.payload_format + "\"");
   m.payload_bytes = p.UInt64("bytes");
   detail::JsonFields c(p.Object("checksum"), file, "payload.checksum.");
   m.payload_crc32 = detail::ParseHex32(c.String("value"), file, "member 'payload.checksum.value'");

@@ -15,7 +15,7 @@ namespace {
 constexpr std::uint32_t kFourCcDx10 = 0x30315844;  // "DX10"
 constexpr std::uint32_t kDdsdCaps = 0x1, kDdsdHeight = 0x2, kDdsdWidth = 0x4, kDdsdPitch = 0x8,
                         kDdsdPixelFormat = 0x1000, kDdsdMipMapCount = 0x20000,
-                        kDdsdDepth = 0x800000;
+                        kDdsdLinearSize = 0x80000, kDdsdDepth = 0x800000;
 constexpr std::uint32_t kDdpfFourCc = 0x4;
 constexpr std::uint32_t kDdsCapsTexture = 0x1000;
 constexpr std::uint32_t kDdsCaps2Volume = 0x200000;
@@ -32,18 +32,21 @@ std::string FourCcText(std::uint32_t v) {
 
 }  // namespace
 
-std::string DdsVolumeHeader(int width, int height, int depth, std::uint32_t dxgi_format,
-                            int bytes_per_texel) {
+namespace {
+
+// DDS_HEADER + DDS_HEADER_DXT10 of a single-mip volume; `size_flag` is DDSD_PITCH (the row
+// pitch of an uncompressed texture) or DDSD_LINEARSIZE (the bytes of one compressed slice).
+std::string VolumeHeader(int width, int height, int depth, std::uint32_t dxgi_format,
+                         std::uint32_t size_flag, std::uint32_t pitch_or_linear_size) {
   std::string out;
   out.reserve(kDdsDataOffset);
   out.append(kDdsMagic.begin(), kDdsMagic.end());
   AppendU32(out, 124);  // dwSize
-  AppendU32(out, kDdsdCaps | kDdsdHeight | kDdsdWidth | kDdsdPitch | kDdsdPixelFormat |
+  AppendU32(out, kDdsdCaps | kDdsdHeight | kDdsdWidth | size_flag | kDdsdPixelFormat |
                      kDdsdMipMapCount | kDdsdDepth);
   AppendU32(out, static_cast<std::uint32_t>(height));
   AppendU32(out, static_cast<std::uint32_t>(width));
-  AppendU32(out, static_cast<std::uint32_t>(width) *
-                     static_cast<std::uint32_t>(bytes_per_texel));  // row pitch in bytes
+  AppendU32(out, pitch_or_linear_size);
   AppendU32(out, static_cast<std::uint32_t>(depth));
   AppendU32(out, 1);                               // dwMipMapCount
   for (int i = 0; i < 11; ++i) AppendU32(out, 0);  // dwReserved1
@@ -62,6 +65,32 @@ std::string DdsVolumeHeader(int width, int height, int depth, std::uint32_t dxgi
   AppendU32(out, 1);  // arraySize: 1 for a 3D texture
   AppendU32(out, 0);  // miscFlags2: DDS_ALPHA_MODE_UNKNOWN
   return out;
+}
+
+}  // namespace
+
+std::string DdsVolumeHeader(int width, int height, int depth, std::uint32_t dxgi_format,
+                            int bytes_per_texel) {
+  return VolumeHeader(
+      width, height, depth, dxgi_format, kDdsdPitch,
+      static_cast<std::uint32_t>(width) * static_cast<std::uint32_t>(bytes_per_texel));
+}
+
+std::string EncodeDds(const Bc6hVolume& volume) {
+  if (volume.width < 1 || volume.height < 1 || volume.depth < 1 ||
+      volume.bytes.size() != volume.BlockCount() * kBc6hBlockBytes)
+    throw InvalidArgument(fmt::format("DDS: inconsistent BC6H volume {} × {} × {} with {} bytes",
+                                      volume.width, volume.height, volume.depth,
+                                      volume.bytes.size()));
+  std::string out = VolumeHeader(
+      volume.width, volume.height, volume.depth, kDxgiFormatBc6hUf16, kDdsdLinearSize,
+      static_cast<std::uint32_t>(volume.BlocksWide() * volume.BlocksHigh() * kBc6hBlockBytes));
+  out.append(volume.bytes.begin(), volume.bytes.end());
+  return out;
+}
+
+void WriteDds(const std::string& path, const Bc6hVolume& volume) {
+  WriteFileAtomically(path, EncodeDds(volume));
 }
 
 std::string EncodeDds(const PackedVolume& volume) {
@@ -117,14 +146,8 @@ LoadedTexture ParseDds(const std::uint8_t* data, std::size_t size, const std::st
   const auto dimension = [&](const char* what) { return detail::ReadDimension(r, file, what); };
   t.volume.height = dimension("dwHeight");
   t.volume.width = dimension("dwWidth");
-  {
-    const std::uint64_t at = r.offset();
-    const std::uint32_t pitch = r.U32("dwPitchOrLinearSize");
-    if ((flags & kDdsdPitch) && pitch != static_cast<std::uint32_t>(t.volume.width) * 4)
-      throw FormatError(file, BytePosition(at),
-                        fmt::format("row pitch {} (width × 4 bytes)", t.volume.width * 4),
-                        std::to_string(pitch));
-  }
+  const std::uint64_t at_pitch = r.offset();
+  const std::uint32_t pitch = r.U32("dwPitchOrLinearSize");  // checked once the format is known
   t.volume.depth = dimension("dwDepth (a 3D texture: one slice per theta_in)");
   {
     const std::uint64_t at = r.offset();
@@ -161,10 +184,27 @@ LoadedTexture ParseDds(const std::uint8_t* data, std::size_t size, const std::st
   {
     const std::uint64_t at = r.offset();
     const std::uint32_t dxgi = r.U32("DDS_HEADER_DXT10.dxgiFormat");
-    if (dxgi != kDxgiFormatR9g9b9e5Sharedexp)
-      throw FormatError(file, BytePosition(at), "DXGI format 67 (DXGI_FORMAT_R9G9B9E5_SHAREDEXP)",
+    if (dxgi == kDxgiFormatBc6hUf16) {
+      t.format = TexelFormat::kBc6hUfloat;
+    } else if (dxgi != kDxgiFormatR9g9b9e5Sharedexp) {
+      throw FormatError(file, BytePosition(at),
+                        "DXGI format 67 (DXGI_FORMAT_R9G9B9E5_SHAREDEXP) or 95 "
+                        "(DXGI_FORMAT_BC6H_UF16)",
                         "unsupported DXGI format " + std::to_string(dxgi));
+    }
   }
+  const bool bc6h = t.format == TexelFormat::kBc6hUfloat;
+  if (bc6h) {
+    t.bc6h.width = t.volume.width, t.bc6h.height = t.volume.height, t.bc6h.depth = t.volume.depth;
+  }
+  // An uncompressed row is width × 4 bytes, a row of BC6H blocks ceil(width/4) × 16.
+  const std::uint32_t row_pitch = bc6h ? static_cast<std::uint32_t>(t.bc6h.BlocksWide() * 16)
+                                       : static_cast<std::uint32_t>(t.volume.width) * 4;
+  if ((flags & kDdsdPitch) && !(flags & kDdsdLinearSize) && pitch != row_pitch)
+    throw FormatError(file, BytePosition(at_pitch),
+                      bc6h ? fmt::format("row pitch {} (ceil(width/4) × 16 bytes)", row_pitch)
+                           : fmt::format("row pitch {} (width × 4 bytes)", row_pitch),
+                      std::to_string(pitch));
   expect(kResourceDimensionTexture3d, "resourceDimension", "D3D10_RESOURCE_DIMENSION_TEXTURE3D");
   r.U32("miscFlag");
   expect(1, "arraySize", "a 3D texture is never an array");
@@ -172,13 +212,21 @@ LoadedTexture ParseDds(const std::uint8_t* data, std::size_t size, const std::st
 
   const std::uint64_t texels = static_cast<std::uint64_t>(t.volume.width) * t.volume.height *
                                static_cast<std::uint64_t>(t.volume.depth);
-  if (r.remaining() != texels * 4)
-    throw FormatError(file, BytePosition(kDdsDataOffset),
-                      fmt::format("{} bytes of texel data ({} × {} × {} × 4)", texels * 4,
-                                  t.volume.width, t.volume.height, t.volume.depth),
-                      std::to_string(r.remaining()) + " bytes");
-  t.volume.words.resize(texels);
-  detail::CopyLittleEndianWords(data + kDdsDataOffset, t.volume.words);
+  const std::uint64_t expected = bc6h ? t.bc6h.BlockCount() * kBc6hBlockBytes : texels * 4;
+  if (r.remaining() != expected)
+    throw FormatError(
+        file, BytePosition(kDdsDataOffset),
+        bc6h ? fmt::format("{} bytes of BC6H blocks ({} × {} blocks × {} slices × 16)", expected,
+                           t.bc6h.BlocksWide(), t.bc6h.BlocksHigh(), t.bc6h.depth)
+             : fmt::format("{} bytes of texel data ({} × {} × {} × 4)", texels * 4, t.volume.width,
+                           t.volume.height, t.volume.depth),
+        std::to_string(r.remaining()) + " bytes");
+  if (bc6h) {
+    t.bc6h.bytes.assign(data + kDdsDataOffset, data + kDdsDataOffset + expected);
+  } else {
+    t.volume.words.resize(texels);
+    detail::CopyLittleEndianWords(data + kDdsDataOffset, t.volume.words);
+  }
   if (!theta_in_deg.empty()) {
     if (theta_in_deg.size() != static_cast<std::size_t>(t.volume.depth))
       throw InvalidArgument(fmt::format("{}: {} slices but {} θin values given", file,

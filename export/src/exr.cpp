@@ -86,15 +86,21 @@ void WriteExr(const std::string& path, const FloatImage& image, const ExrOptions
 
 void WriteExrComposite(const std::string& path, const Lut& lut, const PackedVolume& packed,
                        const TextureMetadata& metadata, const ExrOptions& options) {
+  WriteExrComposite(path, lut, SidecarJson(packed, lut.theta_in_deg, metadata), packed.Crc32(),
+                    options);
+}
+
+void WriteExrComposite(const std::string& path, const Lut& lut, const std::string& sidecar_json,
+                       std::uint32_t payload_crc32, const ExrOptions& options) {
   const GridLayout grid = SquareishGrid(lut.slices());
   WriteExr(path, CompositeImage(lut), options,
-           {{"brdf:sidecar", SidecarJson(packed, lut.theta_in_deg, metadata)},
+           {{"brdf:sidecar", sidecar_json},
             {"brdf:theta_in_deg", FormatThetaList(lut.theta_in_deg)},
             {"brdf:layout", fmt::format("{} x {} slices of 361 x 181, row-major, ascending "
                                         "theta_in, top-left first",
                                         grid.columns, grid.rows)},
             {"brdf:texel_convention", TexelCentreFormula()},
-            {"brdf:payload_crc32", Hex32Text(packed.Crc32())}});
+            {"brdf:payload_crc32", Hex32Text(payload_crc32)}});
 }
 
 void WriteExrComposite(const std::string& path, const Lut& lut, const TextureMetadata& metadata,

@@ -10,7 +10,15 @@
 
 namespace brdf::exporter::detail {
 
-ordered_json GridJson(const PackedVolume& payload, const std::vector<double>& theta_in_deg) {
+PayloadSummary Summarize(const PackedVolume& payload) {
+  return {false, payload.width, payload.height, payload.depth, payload.ByteSize(), payload.Crc32()};
+}
+
+PayloadSummary Summarize(const Bc6hVolume& payload) {
+  return {true, payload.width, payload.height, payload.depth, payload.ByteSize(), payload.Crc32()};
+}
+
+ordered_json GridJson(const PayloadSummary& payload, const std::vector<double>& theta_in_deg) {
   const double delta = theta_in_deg.size() >= 2 ? theta_in_deg[1] - theta_in_deg[0] : 0.0;
   return ordered_json{
       {"frame",
@@ -43,22 +51,77 @@ std::uint32_t ParseHex32(const std::string& text, const std::string& file,
   return static_cast<std::uint32_t>(std::stoul(text.substr(2), nullptr, 16));
 }
 
-ordered_json PayloadJson(const PackedVolume& payload) {
+ordered_json PayloadJson(const PayloadSummary& payload) {
+  ordered_json j;
+  if (payload.bc6h) {
+    j["format"] = "bc6h_ufloat";
+    j["encoding"] =
+        "BC6H_UF16 blocks per ARB_texture_compression_bptc (BPTC_FLOAT, unsigned): "
+        "VK_FORMAT_BC6H_UFLOAT_BLOCK (131), DXGI_FORMAT_BC6H_UF16 (95); 16 bytes per 4 x 4 "
+        "texels, each slice padded to ceil(width/4) x ceil(height/4) blocks with copies of its "
+        "nearest texels";
+    j["texel_order"] =
+        "blocks left to right, block rows top first, then z (theta_in slices, ascending)";
+  } else {
+    j["encoding"] =
+        "RGB9E5 per EXT_texture_shared_exponent (N=9, B=15, Emax=31): "
+        "VK_FORMAT_E5B9G9R9_UFLOAT_PACK32 (123), DXGI_FORMAT_R9G9B9E5_SHAREDEXP (67); "
+        "R bits 0-8, G 9-17, B 18-26, exponent 27-31";
+    j["texel_order"] =
+        "32-bit little-endian words; x (phi_d) fastest, then y (theta_d rows, top "
+        "first), then z (theta_in slices, ascending)";
+  }
+  j["bytes"] = payload.bytes;
+  j["checksum"] = {{"algorithm", "crc32"},
+                   {"definition",
+                    "CRC-32 (IEEE 802.3, polynomial 0xEDB88320 reflected, as zlib crc32) of "
+                    "the payload bytes as stored in the KTX2 level 0 image and the DDS data"},
+                   {"value", Hex32Text(payload.crc32)}};
+  return j;
+}
+
+namespace {
+
+ordered_json StatisticsJson(const ErrorStatistics& s) {
+  return ordered_json{{"max", s.max}, {"p99", s.p99}, {"median", s.median}, {"texels", s.texels}};
+}
+
+ErrorStatistics ParseStatistics(const ordered_json& object, const std::string& file,
+                                const std::string& prefix) {
+  JsonFields f(object, file, prefix);
+  return {f.Number("max"), f.Number("p99"), f.Number("median"), f.UInt64("texels")};
+}
+
+}  // namespace
+
+ordered_json CertifiedErrorJson(const CertifiedError& e) {
   return ordered_json{
-      {"encoding",
-       "RGB9E5 per EXT_texture_shared_exponent (N=9, B=15, Emax=31): "
-       "VK_FORMAT_E5B9G9R9_UFLOAT_PACK32 (123), DXGI_FORMAT_R9G9B9E5_SHAREDEXP (67); "
-       "R bits 0-8, G 9-17, B 18-26, exponent 27-31"},
-      {"texel_order",
-       "32-bit little-endian words; x (phi_d) fastest, then y (theta_d rows, top "
-       "first), then z (theta_in slices, ascending)"},
-      {"bytes", payload.ByteSize()},
-      {"checksum",
-       {{"algorithm", "crc32"},
-        {"definition",
-         "CRC-32 (IEEE 802.3, polynomial 0xEDB88320 reflected, as zlib crc32) of "
-         "the payload bytes as stored in the KTX2 level 0 image and the DDS data"},
-        {"value", Hex32Text(payload.Crc32())}}}};
+      {"format", e.format},
+      {"bytes", e.bytes},
+      {"rgb9e5_bytes", e.rgb9e5_bytes},
+      {"certified_error",
+       {{"definition",
+         "relative error of each texel of the payload as a GPU decodes it against the float "
+         "LUT clamped to [0, 65504]: max over R, G, B of |decoded - reference| / max(largest "
+         "reference channel, 1e-4 * the LUT's largest reference value, 2^-14)"},
+        {"theta_b_deg", e.theta_b_deg},
+        {"measured", StatisticsJson(e.measured)},
+        {"filled", StatisticsJson(e.filled)}}}};
+}
+
+CertifiedError ParseCertifiedError(const ordered_json& object, const std::string& file) {
+  JsonFields f(object, file, "compression.");
+  CertifiedError e;
+  e.format = f.String("format");
+  e.bytes = f.UInt64("bytes");
+  e.rgb9e5_bytes = f.UInt64("rgb9e5_bytes");
+  const ordered_json& c = f.Object("certified_error");
+  JsonFields cf(c, file, "compression.certified_error.");
+  e.theta_b_deg = cf.Number("theta_b_deg");
+  e.measured =
+      ParseStatistics(cf.Object("measured"), file, "compression.certified_error.measured.");
+  e.filled = ParseStatistics(cf.Object("filled"), file, "compression.certified_error.filled.");
+  return e;
 }
 
 ordered_json ParseEmbeddedJson(const std::string& text, const std::string& what) {

@@ -8,6 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include "brdf/exporter/bc6h.h"
 #include "brdf/exporter/metadata.h"
 #include "brdf/exporter/packed_volume.h"
 
@@ -15,12 +16,26 @@ namespace brdf::exporter::detail {
 
 using nlohmann::ordered_json;
 
+// What the metadata says about a stored payload, whatever its texel format.
+struct PayloadSummary {
+  bool bc6h = false;  // BC6H_UF16 blocks, else RGB9E5 words
+  int width = 0, height = 0, depth = 0;
+  std::uint64_t bytes = 0;
+  std::uint32_t crc32 = 0;
+};
+PayloadSummary Summarize(const PackedVolume& payload);
+PayloadSummary Summarize(const Bc6hVolume& payload);
+
 // {"frame": ..., "width": 361, "height": 181, "slices": K, "phi_d_deg": {...}, ...}
-ordered_json GridJson(const PackedVolume& payload, const std::vector<double>& theta_in_deg);
+ordered_json GridJson(const PayloadSummary& payload, const std::vector<double>& theta_in_deg);
 // {"centre_exact": TexelCentreFormula(), "published": PublishedFormula(), "glsl": snippet}
 ordered_json TexelConventionJson(const std::vector<double>& theta_in_deg);
 // {"encoding": ..., "texel_order": ..., "bytes": N, "checksum": {"algorithm": "crc32", ...}}
-ordered_json PayloadJson(const PackedVolume& payload);
+// With "format": "bc6h_ufloat" first for BC6H blocks (absent for RGB9E5, the original form).
+ordered_json PayloadJson(const PayloadSummary& payload);
+// The sidecar's "compression" member for a certified error.
+ordered_json CertifiedErrorJson(const CertifiedError& e);
+CertifiedError ParseCertifiedError(const ordered_json& object, const std::string& file);
 // "0x1234abcd" (as brdf::Hex32Text writes it) back to the number; throws FormatError naming
 // `file` and `position`.
 std::uint32_t ParseHex32(const std::string& text, const std::string& file,

@@ -132,6 +132,38 @@ void ValidateDfd(const std::uint8_t* data, std::size_t size, std::uint64_t base,
   }
 }
 
+// The BC6H descriptor has one fixed form (Data Format Specification §5.15, as libktx writes it);
+// every word but the sample position must match.
+void ValidateBc6hDfd(const std::uint8_t* data, std::size_t size, std::uint64_t base,
+                     const std::string& file) {
+  const std::vector<std::uint32_t> expected = Bc6hUfloatDataFormatDescriptor();
+  if (size != expected.size() * 4)
+    throw FormatError(
+        file, BytePosition(kHeaderEnd + 4),
+        fmt::format("dfdByteLength {} (one basic block with one BC6H sample)", expected.size() * 4),
+        std::to_string(size));
+  static constexpr const char* kWords[11] = {"DFD dfdTotalSize",
+                                             "DFD vendorId/descriptorType",
+                                             "DFD versionNumber/descriptorBlockSize",
+                                             "DFD colour model (131, BC6H), primaries, transfer",
+                                             "DFD texelBlockDimension (4 x 4 x 1)",
+                                             "DFD bytesPlane0 (16)",
+                                             "DFD bytesPlane4-7",
+                                             "DFD sample (bits 0-127, channel BC6H colour, FLOAT)",
+                                             "DFD sample position",
+                                             "DFD sampleLower (0.0)",
+                                             "DFD sampleUpper (1.0)"};
+  ByteReader r(data, size, file, base);
+  for (std::size_t w = 0; w < expected.size(); ++w) {
+    const std::uint64_t at = r.offset();
+    const std::uint32_t got = r.U32(kWords[w]);
+    if (w == 8) continue;  // any sample position is acceptable
+    if (got != expected[w])
+      throw FormatError(file, BytePosition(at), fmt::format("{} 0x{:08x}", kWords[w], expected[w]),
+                        fmt::format("0x{:08x}", got));
+  }
+}
+
 }  // namespace
 
 std::vector<std::uint32_t> E5b9g9r9DataFormatDescriptor() {
@@ -151,15 +183,15 @@ std::vector<std::uint32_t> E5b9g9r9DataFormatDescriptor() {
   return d;
 }
 
-std::string EncodeKtx2(const PackedVolume& volume, const KeyValues& key_values) {
-  if (volume.width < 1 || volume.height < 1 || volume.depth < 1 ||
-      volume.words.size() != static_cast<std::size_t>(volume.width) * volume.height * volume.depth)
-    throw InvalidArgument(fmt::format("KTX2: inconsistent volume {} × {} × {} with {} texels",
-                                      volume.width, volume.height, volume.depth,
-                                      volume.words.size()));
-  const std::vector<std::uint32_t> dfd = E5b9g9r9DataFormatDescriptor();
-  const KeyValues kvs = WithStandardKeys(key_values);
+namespace {
 
+// The container around any payload: `type_size` and the level alignment (lcm(texel block
+// size, 4); no supercompression) follow the format.
+std::string EncodeKtx2Payload(std::uint32_t vk_format, std::uint32_t type_size,
+                              std::size_t level_alignment, const std::vector<std::uint32_t>& dfd,
+                              int width, int height, int depth, const std::string& payload,
+                              const KeyValues& key_values) {
+  const KeyValues kvs = WithStandardKeys(key_values);
   std::string kvd;
   for (const auto& [key, value] : kvs) {
     const std::size_t length = key.size() + 1 + value.size() + 1;  // key\0value\0
@@ -174,17 +206,18 @@ std::string EncodeKtx2(const PackedVolume& volume, const KeyValues& key_values) 
   const std::size_t dfd_offset = kLevelIndexEnd;
   const std::size_t dfd_length = dfd.size() * 4;
   const std::size_t kvd_offset = dfd_offset + dfd_length;
-  // No supercompression global data, so the level only needs lcm(texel block size, 4) = 4.
-  const std::size_t level_offset = Align4(kvd_offset + kvd.size());
-  const std::size_t level_length = volume.ByteSize();
+  const std::size_t unaligned = kvd_offset + kvd.size();
+  const std::size_t level_offset =
+      (unaligned + level_alignment - 1) / level_alignment * level_alignment;
+  const std::size_t level_length = payload.size();
 
   std::string out(level_offset, '\0');
   std::memcpy(out.data(), kKtx2Identifier.data(), kKtx2Identifier.size());
-  const std::uint32_t header[9] = {kVkFormatE5b9g9r9UfloatPack32,
-                                   4,  // typeSize: _PACK32
-                                   static_cast<std::uint32_t>(volume.width),
-                                   static_cast<std::uint32_t>(volume.height),
-                                   static_cast<std::uint32_t>(volume.depth),
+  const std::uint32_t header[9] = {vk_format,
+                                   type_size,
+                                   static_cast<std::uint32_t>(width),
+                                   static_cast<std::uint32_t>(height),
+                                   static_cast<std::uint32_t>(depth),
                                    0,   // layerCount: not an array
                                    1,   // faceCount
                                    1,   // levelCount
@@ -201,8 +234,55 @@ std::string EncodeKtx2(const PackedVolume& volume, const KeyValues& key_values) 
   Put64(out, kIndexEnd + 16, level_length);  // uncompressedByteLength
   for (std::size_t i = 0; i < dfd.size(); ++i) Put32(out, dfd_offset + 4 * i, dfd[i]);
   std::memcpy(out.data() + kvd_offset, kvd.data(), kvd.size());
-  out += volume.Bytes();
+  out += payload;
   return out;
+}
+
+}  // namespace
+
+std::vector<std::uint32_t> Bc6hUfloatDataFormatDescriptor() {
+  constexpr std::uint32_t kBlockBytes = 24 + 16;   // one sample
+  constexpr std::uint32_t kModelBc6h = 131;        // KHR_DF_MODEL_BC6H
+  constexpr std::uint32_t kQualifierFloat = 0x80;  // KHR_DF_SAMPLE_DATATYPE_FLOAT
+  return {4 + kBlockBytes,
+          0,  // vendorId 0 (Khronos), descriptorType 0 (basic)
+          kDfVersion13 | (kBlockBytes << 16),
+          kModelBc6h | (kPrimariesBt709 << 8) | (kTransferLinear << 16),  // flags 0
+          3 | (3 << 8),  // texelBlockDimension 4 × 4 × 1 × 1 (stored minus one)
+          16,            // bytesPlane0: 16 bytes per block
+          0,
+          SampleWord0(0, 128, kQualifierFloat),  // channel 0 = KHR_DF_CHANNEL_BC6H_COLOR
+          0,                                     // sample position 0, 0, 0, 0
+          0,                                     // sampleLower 0.0f
+          0x3F800000u};                          // sampleUpper 1.0f
+}
+
+std::string EncodeKtx2(const PackedVolume& volume, const KeyValues& key_values) {
+  if (volume.width < 1 || volume.height < 1 || volume.depth < 1 ||
+      volume.words.size() != static_cast<std::size_t>(volume.width) * volume.height * volume.depth)
+    throw InvalidArgument(fmt::format("KTX2: inconsistent volume {} × {} × {} with {} texels",
+                                      volume.width, volume.height, volume.depth,
+                                      volume.words.size()));
+  // typeSize 4 (_PACK32); no supercompression global data, so the level only needs
+  // lcm(texel block size, 4) = 4.
+  return EncodeKtx2Payload(kVkFormatE5b9g9r9UfloatPack32, 4, 4, E5b9g9r9DataFormatDescriptor(),
+                           volume.width, volume.height, volume.depth, volume.Bytes(), key_values);
+}
+
+std::string EncodeKtx2(const Bc6hVolume& volume, const KeyValues& key_values) {
+  if (volume.width < 1 || volume.height < 1 || volume.depth < 1 ||
+      volume.bytes.size() != volume.BlockCount() * kBc6hBlockBytes)
+    throw InvalidArgument(fmt::format("KTX2: inconsistent BC6H volume {} × {} × {} with {} bytes",
+                                      volume.width, volume.height, volume.depth,
+                                      volume.bytes.size()));
+  // typeSize 1 for block-compressed formats; levels aligned to lcm(16-byte block, 4) = 16.
+  return EncodeKtx2Payload(kVkFormatBc6hUfloatBlock, 1, 16, Bc6hUfloatDataFormatDescriptor(),
+                           volume.width, volume.height, volume.depth,
+                           std::string(volume.bytes.begin(), volume.bytes.end()), key_values);
+}
+
+void WriteKtx2(const std::string& path, const Bc6hVolume& volume, const KeyValues& key_values) {
+  WriteFileAtomically(path, EncodeKtx2(volume, key_values));
 }
 
 void WriteKtx2(const std::string& path, const PackedVolume& volume, const KeyValues& key_values) {
@@ -229,11 +309,23 @@ LoadedTexture ParseKtx2(const std::uint8_t* data, std::size_t size, const std::s
         "the KTX 2.0 identifier ab 4b 54 58 20 32 30 bb 0d 0a 1a 0a («KTX 20»\\r\\n\\x1A\\n)", got);
   }
   r.Skip(12);
-  Expect32(r, kVkFormatE5b9g9r9UfloatPack32, "vkFormat", "VK_FORMAT_E5B9G9R9_UFLOAT_PACK32");
-  Expect32(r, 4, "typeSize");
   LoadedTexture t;
   t.file = file;
   t.container = TextureContainer::kKtx2;
+  {
+    const std::uint64_t at = r.offset();
+    const std::uint32_t vk_format = r.U32("vkFormat");
+    if (vk_format == kVkFormatBc6hUfloatBlock) {
+      t.format = TexelFormat::kBc6hUfloat;
+    } else if (vk_format != kVkFormatE5b9g9r9UfloatPack32) {
+      throw FormatError(file, BytePosition(at),
+                        "vkFormat 123 (VK_FORMAT_E5B9G9R9_UFLOAT_PACK32) or 131 "
+                        "(VK_FORMAT_BC6H_UFLOAT_BLOCK)",
+                        std::to_string(vk_format));
+    }
+  }
+  const bool bc6h = t.format == TexelFormat::kBc6hUfloat;
+  Expect32(r, bc6h ? 1 : 4, "typeSize", bc6h ? "1 for a block-compressed format" : "");
   const auto dimension = [&](const char* what) { return detail::ReadDimension(r, file, what); };
   t.volume.width = dimension("pixelWidth");
   t.volume.height = dimension("pixelHeight");
@@ -270,12 +362,15 @@ LoadedTexture ParseKtx2(const std::uint8_t* data, std::size_t size, const std::s
                         fmt::format("bytes {}..{}", offset, offset + length));
   };
   check_range(dfd_offset, dfd_length, kHeaderEnd, "the Data Format Descriptor");
-  if (dfd_length != 4 + kBasicBlockBytes)
+  if (bc6h) {
+    ValidateBc6hDfd(data + dfd_offset, dfd_length, dfd_offset, file);
+  } else if (dfd_length != 4 + kBasicBlockBytes)
     throw FormatError(
         file, BytePosition(kHeaderEnd + 4),
         fmt::format("dfdByteLength {} (one basic block of 6 samples)", 4 + kBasicBlockBytes),
         std::to_string(dfd_length));
-  ValidateDfd(data + dfd_offset, dfd_length, dfd_offset, file);
+  else
+    ValidateDfd(data + dfd_offset, dfd_length, dfd_offset, file);
 
   check_range(kvd_offset, kvd_length, kHeaderEnd + 8, "the key/value data");
   {
@@ -299,22 +394,36 @@ LoadedTexture ParseKtx2(const std::uint8_t* data, std::size_t size, const std::s
 
   const std::uint64_t texels = static_cast<std::uint64_t>(t.volume.width) * t.volume.height *
                                static_cast<std::uint64_t>(t.volume.depth);
-  if (level_length != texels * 4)
-    throw FormatError(file, BytePosition(kIndexEnd + 8),
-                      fmt::format("level 0 byteLength {} ({} × {} × {} texels × 4 bytes)",
-                                  texels * 4, t.volume.width, t.volume.height, t.volume.depth),
-                      std::to_string(level_length));
+  if (bc6h) {
+    t.bc6h.width = t.volume.width, t.bc6h.height = t.volume.height, t.bc6h.depth = t.volume.depth;
+  }
+  const std::uint64_t expected_length = bc6h ? t.bc6h.BlockCount() * kBc6hBlockBytes : texels * 4;
+  if (level_length != expected_length)
+    throw FormatError(
+        file, BytePosition(kIndexEnd + 8),
+        bc6h ? fmt::format("level 0 byteLength {} ({} × {} blocks of 4 × 4 texels × {} slices × 16 "
+                           "bytes)",
+                           expected_length, t.bc6h.BlocksWide(), t.bc6h.BlocksHigh(), t.bc6h.depth)
+             : fmt::format("level 0 byteLength {} ({} × {} × {} texels × 4 bytes)", texels * 4,
+                           t.volume.width, t.volume.height, t.volume.depth),
+        std::to_string(level_length));
   if (level_uncompressed != level_length)
     throw FormatError(file, BytePosition(kIndexEnd + 16),
                       fmt::format("uncompressedByteLength {} (no supercompression)", level_length),
                       std::to_string(level_uncompressed));
-  if (level_offset % 4 != 0)
-    throw FormatError(file, BytePosition(kIndexEnd), "a level byteOffset aligned to 4 bytes",
+  const std::uint64_t alignment = bc6h ? 16 : 4;
+  if (level_offset % alignment != 0)
+    throw FormatError(file, BytePosition(kIndexEnd),
+                      fmt::format("a level byteOffset aligned to {} bytes", alignment),
                       std::to_string(level_offset));
   check_range(level_offset, level_length, kIndexEnd, "the level 0 image");
 
-  t.volume.words.resize(texels);
-  detail::CopyLittleEndianWords(data + level_offset, t.volume.words);
+  if (bc6h) {
+    t.bc6h.bytes.assign(data + level_offset, data + level_offset + level_length);
+  } else {
+    t.volume.words.resize(texels);
+    detail::CopyLittleEndianWords(data + level_offset, t.volume.words);
+  }
 
   for (const auto& [key, value] : t.key_values) {
     if (key == "brdf.sidecar") t.sidecar_json = value;

@@ -4,6 +4,7 @@
 #include <utility>
 
 #include "brdf/core/error.h"
+#include "brdf/core/file_util.h"
 #include "brdf/exporter/dds.h"
 #include "brdf/exporter/ktx2.h"
 #include "brdf/exporter/sidecar.h"
@@ -71,18 +72,38 @@ LutExportResult ExportLut(const std::string& out_dir, const Lut& lut, const Pack
   const std::filesystem::path dir(out_dir);
   const auto path = [&](const char* ext) { return (dir / (name + ext)).string(); };
   LutExportResult result;
-  result.payload_bytes = packed.ByteSize();
-  result.payload_crc32 = packed.Crc32();
+  std::optional<CompressedLut> compressed;
+  if (options.compression == LutCompression::kBc6h) {
+    compressed = CompressLutBc6h(
+        lut, metadata.extrapolation ? metadata.extrapolation->theta_b_deg : 90.0, options.jobs);
+    metadata.certified_error = compressed->error;
+    result.certified_error = compressed->error;
+    result.payload_bytes = compressed->blocks.ByteSize();
+    result.payload_crc32 = compressed->blocks.Crc32();
+  } else {
+    result.payload_bytes = packed.ByteSize();
+    result.payload_crc32 = packed.Crc32();
+  }
+  const std::string sidecar = compressed
+                                  ? SidecarJson(compressed->blocks, lut.theta_in_deg, metadata)
+                                  : SidecarJson(packed, lut.theta_in_deg, metadata);
   if (f.ktx2) {
-    WriteKtx2(path(".ktx2"), packed, lut.theta_in_deg, metadata);
+    const KeyValues kvs{{"brdf.sidecar", sidecar}};
+    if (compressed)
+      WriteKtx2(path(".ktx2"), compressed->blocks, kvs);
+    else
+      WriteKtx2(path(".ktx2"), packed, kvs);
     result.written.push_back(path(".ktx2"));
   }
   if (f.dds) {
-    WriteDds(path(".dds"), packed);
+    if (compressed)
+      WriteDds(path(".dds"), compressed->blocks);
+    else
+      WriteDds(path(".dds"), packed);
     result.written.push_back(path(".dds"));
   }
   if (f.exr) {
-    WriteExrComposite(path(".exr"), lut, packed, metadata, options.exr);
+    WriteExrComposite(path(".exr"), lut, sidecar, result.payload_crc32, options.exr);
     result.written.push_back(path(".exr"));
   }
   if (f.png) {
@@ -90,7 +111,7 @@ LutExportResult ExportLut(const std::string& out_dir, const Lut& lut, const Pack
     result.written.push_back(path(".png"));
   }
   if (f.json) {
-    WriteSidecar(path(".json"), packed, lut.theta_in_deg, metadata);
+    WriteFileAtomically(path(".json"), sidecar);
     result.written.push_back(path(".json"));
   }
   return result;

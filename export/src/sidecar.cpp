@@ -15,8 +15,10 @@ namespace brdf::exporter {
 
 using nlohmann::ordered_json;
 
-std::string SidecarJson(const PackedVolume& payload, const std::vector<double>& theta_in_deg,
-                        const TextureMetadata& metadata) {
+namespace {
+
+std::string SidecarText(const detail::PayloadSummary& payload,
+                        const std::vector<double>& theta_in_deg, const TextureMetadata& metadata) {
   ordered_json j;
   j["kind"] = "brdf-lut-sidecar";
   j["format_version"] = 1;
@@ -41,11 +43,30 @@ std::string SidecarJson(const PackedVolume& payload, const std::vector<double>& 
       {"name", "brdf-toolchain"},
       {"version", metadata.tool_version.empty() ? BrdfToolVersion() : metadata.tool_version}};
   j["payload"] = detail::PayloadJson(payload);
+  if (metadata.certified_error)
+    j["compression"] = detail::CertifiedErrorJson(*metadata.certified_error);
   j["files"] = metadata.companion_files;
   return j.dump(2) + "\n";
 }
 
+}  // namespace
+
+std::string SidecarJson(const PackedVolume& payload, const std::vector<double>& theta_in_deg,
+                        const TextureMetadata& metadata) {
+  return SidecarText(detail::Summarize(payload), theta_in_deg, metadata);
+}
+
+std::string SidecarJson(const Bc6hVolume& payload, const std::vector<double>& theta_in_deg,
+                        const TextureMetadata& metadata) {
+  return SidecarText(detail::Summarize(payload), theta_in_deg, metadata);
+}
+
 void WriteSidecar(const std::string& path, const PackedVolume& payload,
+                  const std::vector<double>& theta_in_deg, const TextureMetadata& metadata) {
+  WriteFileAtomically(path, SidecarJson(payload, theta_in_deg, metadata));
+}
+
+void WriteSidecar(const std::string& path, const Bc6hVolume& payload,
                   const std::vector<double>& theta_in_deg, const TextureMetadata& metadata) {
   WriteFileAtomically(path, SidecarJson(payload, theta_in_deg, metadata));
 }
@@ -102,14 +123,30 @@ SidecarInfo ParseSidecarJson(std::string_view json_text, const std::string& file
   info.tool_version = t.String("version");
   detail::JsonFields p(f.Object("payload"), file, "payload.");
   info.payload_bytes = p.UInt64("bytes");
-  const std::uint64_t texels = static_cast<std::uint64_t>(std::max(info.width, 0)) *
-                               static_cast<std::uint64_t>(std::max(info.height, 0)) *
-                               static_cast<std::uint64_t>(std::max(info.slices, 0));
-  if (info.payload_bytes != texels * 4)
+  const ordered_json& payload = f.Object("payload");
+  if (payload.contains("format")) info.payload_format = p.String("format");
+  if (info.payload_format != "rgb9e5" && info.payload_format != "bc6h_ufloat")
+    throw FormatError(file, "member 'payload.format'", "\"rgb9e5\" or \"bc6h_ufloat\"",
+                      "\"" + info.payload_format + "\"");
+  const std::uint64_t w = static_cast<std::uint64_t>(std::max(info.width, 0)),
+                      h = static_cast<std::uint64_t>(std::max(info.height, 0)),
+                      d = static_cast<std::uint64_t>(std::max(info.slices, 0));
+  if (info.payload_format == "bc6h_ufloat") {
+    const std::uint64_t blocks = (w + 3) / 4 * ((h + 3) / 4) * d;
+    if (info.payload_bytes != blocks * 16)
+      throw FormatError(file, "member 'payload.bytes'",
+                        fmt::format("ceil(width/4) * ceil(height/4) * slices * 16 = {} * {} * {} "
+                                    "* 16 = {} (BC6H blocks)",
+                                    (w + 3) / 4, (h + 3) / 4, d, blocks * 16),
+                        std::to_string(info.payload_bytes));
+  } else if (info.payload_bytes != w * h * d * 4) {
     throw FormatError(file, "member 'payload.bytes'",
                       fmt::format("width * height * slices * 4 = {} * {} * {} * 4 = {}", info.width,
-                                  info.height, info.slices, texels * 4),
+                                  info.height, info.slices, w * h * d * 4),
                       std::to_string(info.payload_bytes));
+  }
+  if (j.contains("compression"))
+    info.certified_error = detail::ParseCertifiedError(f.Object("compression"), file);
   detail::JsonFields c(p.Object("checksum"), file, "payload.checksum.");
   if (c.String("algorithm") != "crc32")
     throw FormatError(file, "member 'payload.checksum.algorithm'", "\"crc32\"",

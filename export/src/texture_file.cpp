@@ -11,6 +11,7 @@
 #include "brdf/exporter/atlas.h"
 #include "brdf/exporter/dds.h"
 #include "brdf/exporter/ktx2.h"
+#include "brdf/exporter/rgb9e5.h"
 #include "brdf/exporter/sidecar.h"
 
 namespace brdf::exporter {
@@ -24,11 +25,11 @@ void CheckRecordedPayload(const LoadedTexture& t, const std::string& what, int w
         t.file, what,
         fmt::format("a {} × {} × {} texture as the metadata records", width, height, depth),
         fmt::format("{} × {} × {}", v.width, v.height, v.depth));
-  if (bytes != v.ByteSize())
+  if (bytes != t.PayloadBytes())
     throw FormatError(t.file, what,
                       fmt::format("a payload of {} bytes as the metadata records", bytes),
-                      std::to_string(v.ByteSize()) + " bytes");
-  const std::uint32_t actual = v.Crc32();
+                      std::to_string(t.PayloadBytes()) + " bytes");
+  const std::uint32_t actual = t.PayloadCrc32();
   if (actual != crc)
     throw FormatError(t.file, what, "payload CRC-32 " + Hex32Text(crc) + " as the metadata records",
                       Hex32Text(actual), "the texel data was changed or damaged");
@@ -42,17 +43,30 @@ void FinishLoadedTexture(LoadedTexture& t) {
   if (!t.sidecar_json.empty()) {
     const SidecarInfo info =
         ParseSidecarJson(t.sidecar_json, beside ? t.metadata_file : t.file + " (embedded sidecar)");
-    CheckRecordedPayload(t, beside ? "sidecar " + t.metadata_file : "embedded sidecar", info.width,
-                         info.height, info.slices, info.payload_bytes, info.payload_crc32);
+    const std::string what = beside ? "sidecar " + t.metadata_file : "embedded sidecar";
+    const bool recorded_bc6h = info.payload_format == "bc6h_ufloat";
+    if (recorded_bc6h != (t.format == TexelFormat::kBc6hUfloat))
+      throw FormatError(t.file, what,
+                        std::string("a ") + (recorded_bc6h ? "BC6H_UF16" : "RGB9E5") +
+                            " texture as the metadata records",
+                        std::string("a ") + t.FormatName() + " texture");
+    CheckRecordedPayload(t, what, info.width, info.height, info.slices, info.payload_bytes,
+                         info.payload_crc32);
     t.theta_in_deg = info.theta_in_deg;
     t.theta_in_from_metadata = true;
   } else if (!t.atlas_manifest_json.empty()) {
     const AtlasManifest m = ParseAtlasManifest(
         t.atlas_manifest_json, beside ? t.metadata_file : t.file + " (embedded manifest)");
-    CheckRecordedPayload(t,
-                         beside ? "atlas manifest " + t.metadata_file : "embedded atlas manifest",
-                         m.texture_width, m.texture_height, static_cast<int>(m.theta_in_deg.size()),
-                         m.payload_bytes, m.payload_crc32);
+    const std::string what =
+        beside ? "atlas manifest " + t.metadata_file : "embedded atlas manifest";
+    const bool recorded_bc6h = m.payload_format == "bc6h_ufloat";
+    if (recorded_bc6h != (t.format == TexelFormat::kBc6hUfloat))
+      throw FormatError(t.file, what,
+                        std::string("a ") + (recorded_bc6h ? "BC6H_UF16" : "RGB9E5") +
+                            " texture as the manifest records",
+                        std::string("a ") + t.FormatName() + " texture");
+    CheckRecordedPayload(t, what, m.texture_width, m.texture_height,
+                         static_cast<int>(m.theta_in_deg.size()), m.payload_bytes, m.payload_crc32);
     t.theta_in_deg = m.theta_in_deg;
     t.theta_in_from_metadata = true;
   } else if (t.theta_in_deg.size() != static_cast<std::size_t>(t.volume.depth)) {
@@ -62,8 +76,33 @@ void FinishLoadedTexture(LoadedTexture& t) {
     t.theta_in_from_metadata = false;
   }
   t.lut = Lut();
-  if (t.volume.width == Lut::kWidth && t.volume.height == Lut::kHeight)
-    t.lut = UnpackLut(t.volume, t.theta_in_deg);
+  if (t.volume.width == Lut::kWidth && t.volume.height == Lut::kHeight) {
+    if (t.format == TexelFormat::kBc6hUfloat) {
+      t.lut.theta_in_deg = t.theta_in_deg;
+      t.lut.texels = DecodeBc6hVolume(t.bc6h);
+    } else {
+      t.lut = UnpackLut(t.volume, t.theta_in_deg);
+    }
+  }
+}
+
+std::uint64_t LoadedTexture::PayloadBytes() const {
+  return format == TexelFormat::kBc6hUfloat ? bc6h.ByteSize() : volume.ByteSize();
+}
+
+std::uint32_t LoadedTexture::PayloadCrc32() const {
+  return format == TexelFormat::kBc6hUfloat ? bc6h.Crc32() : volume.Crc32();
+}
+
+std::array<float, 3> LoadedTexture::TexelValue(int x, int y, int z) const {
+  if (format == TexelFormat::kRgb9e5) return DecodeRgb9e5(volume.words[volume.Index(x, y, z)]);
+  const Bc6hHalfTexels block = DecodeBc6hBlock(bc6h.bytes.data() + bc6h.BlockOffset(x, y, z));
+  const auto& h = block[(y % 4) * 4 + x % 4];
+  return {HalfToFloat(h[0]), HalfToFloat(h[1]), HalfToFloat(h[2])};
+}
+
+const char* LoadedTexture::FormatName() const {
+  return format == TexelFormat::kBc6hUfloat ? "BC6H_UF16" : "RGB9E5";
 }
 
 LoadedTexture ReadTextureFile(const std::string& path) {

@@ -212,12 +212,13 @@ OpenedTexture OpenExportedTexture(const std::string& path) {
           "the size of " + out.texture_path + " (" + std::to_string(v.width) + " × " +
               std::to_string(v.height) + " × " + std::to_string(v.depth) + ")",
           std::to_string(width) + " × " + std::to_string(height) + " × " + std::to_string(depth));
-    const std::uint32_t actual = v.Crc32();
-    if (bytes != v.ByteSize() || crc != actual) {
+    const std::uint32_t actual = out.texture.PayloadCrc32();
+    if (bytes != out.texture.PayloadBytes() || crc != actual) {
       char want[64], got[64];
       std::snprintf(want, sizeof want, "%llu bytes, CRC-32 0x%08x",
                     static_cast<unsigned long long>(bytes), crc);
-      std::snprintf(got, sizeof got, "%zu bytes, CRC-32 0x%08x", v.ByteSize(), actual);
+      std::snprintf(got, sizeof got, "%llu bytes, CRC-32 0x%08x",
+                    static_cast<unsigned long long>(out.texture.PayloadBytes()), actual);
       throw FormatError(out.texture_path, "payload",
                         "the payload " + path + " records (" + want + ")", got,
                         "the texture and its JSON do not belong together, or one is damaged");

@@ -10,6 +10,7 @@
 #include "brdf/core/file_util.h"
 #include "brdf/exporter/dds.h"
 #include "brdf/exporter/ktx2.h"
+#include "brdf/exporter/lut_compression.h"
 #include "brdf/exporter/rgb9e5.h"
 #include "export_test_util.h"
 
@@ -93,6 +94,41 @@ TEST(Atlas, EachCellOfEveryContainerEqualsItsOwnLut) {
     // The library's own cell extraction agrees with the layout above.
     const Lut cell = ExtractAtlasCell(ktx2.volume, ComputeAtlasLayout(5, 4), m, lut.theta_in_deg);
     EXPECT_EQ(cell.texels, UnpackLut(PackLut(lut), lut.theta_in_deg).texels) << m;
+  }
+}
+
+// --compress bc6h for an atlas: the KTX2 and DDS hold the same blocks, the manifest describes
+// them and every material's certified error is the error of its own cell (recomputed here with
+// MeasureCompressionError on the cell cut out of the decoded texture).
+TEST(Atlas, Bc6hAtlasRecordsEachCellsError) {
+  const Five five;
+  const std::string dir = test::TestDir("atlas_bc6h");
+  WriteAtlas(dir + "/five", five.materials, {}, LutCompression::kBc6h, 2);
+  const LoadedTexture ktx2 = ReadKtx2(dir + "/five.ktx2");
+  const LoadedTexture dds = ReadTextureFile(dir + "/five.dds");
+  ASSERT_EQ(ktx2.format, TexelFormat::kBc6hUfloat);
+  ASSERT_EQ(dds.format, TexelFormat::kBc6hUfloat);
+  EXPECT_EQ(ktx2.bc6h.bytes, dds.bc6h.bytes);
+  EXPECT_EQ(ktx2.bc6h.ByteSize(), std::size_t{(3 * 361 + 3) / 4} * ((2 * 181 + 3) / 4) * 4 * 16);
+  const AtlasManifest m = ParseAtlasManifest(ktx2.atlas_manifest_json);
+  EXPECT_EQ(m.payload_format, "bc6h_ufloat");
+  const std::vector<float> decoded = DecodeBc6hVolume(ktx2.bc6h);
+  const int width = 3 * 361, height = 2 * 181;
+  for (int n = 0; n < 5; ++n) {
+    ASSERT_TRUE(m.materials[n].certified_error) << n;
+    const int x0 = (n % 3) * 361, y0 = (n / 3) * 181;
+    std::vector<float> cell;
+    for (int k = 0; k < 4; ++k)
+      for (int j = 0; j < 181; ++j)
+        for (int i = 0; i < 361 * 3; ++i)
+          cell.push_back(
+              decoded[((static_cast<std::size_t>(k) * height + y0 + j) * width + x0) * 3 + i]);
+    const CertifiedError want = MeasureCompressionError(five.luts[n], cell, 90.0);
+    const CertifiedError& got = *m.materials[n].certified_error;
+    EXPECT_EQ(got.measured.texels + got.filled.texels, 361u * 181u * 4u);
+    EXPECT_FLOAT_EQ(got.measured.max, want.measured.max) << n;
+    EXPECT_FLOAT_EQ(got.measured.p99, want.measured.p99) << n;
+    EXPECT_FLOAT_EQ(got.measured.median, want.measured.median) << n;
   }
 }
 

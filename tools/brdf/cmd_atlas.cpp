@@ -36,8 +36,13 @@ int RunAtlas(const AtlasOptions& options) {
   const exporter::ExrOptions exr_options =
       ParseExrOptions(options.exr_type, options.exr_compression);
   const engines::EngineSet engine_set = engines::ParseEngines(options.engines);
+  const exporter::LutCompression compression = exporter::ParseLutCompression(options.compress);
   if (options.jobs < 1)
     throw InvalidArgument("--jobs: expected at least 1, got " + std::to_string(options.jobs));
+  if (compression != exporter::LutCompression::kNone && engine_set.Any())
+    throw InvalidArgument(
+        "--compress bc6h: the engine hand-offs (--engine) are written as RGB9E5 only so far; "
+        "write them in a separate run without --compress");
 
   DiscoveredInputs found = DiscoverInputs(options.inputs, InputKinds{.exported_luts = true});
   if (found.inputs.empty() && found.failures.empty()) {
@@ -131,7 +136,8 @@ int RunAtlas(const AtlasOptions& options) {
   std::vector<std::string> written;
   try {
     // BuildAtlas inside WriteAtlas refuses different θin sets, naming both materials.
-    written = engines::WriteAtlasWithEngines(options.out, materials, exr_options, engine_set);
+    written = engines::WriteAtlasWithEngines(options.out, materials, exr_options, engine_set,
+                                             compression, options.jobs);
   } catch (...) {
     guard.RemoveNew();
     throw;

@@ -76,7 +76,12 @@ int RunConvert(const ConvertOptions& options) {
   exporter::LutExportOptions export_options;
   export_options.formats = exporter::ParseExportFormats(options.formats);
   export_options.exr = ParseExrOptions(options.exr_type, options.exr_compression);
+  export_options.compression = exporter::ParseLutCompression(options.compress);
   const engines::EngineSet engine_set = engines::ParseEngines(options.engines);
+  if (export_options.compression != exporter::LutCompression::kNone && engine_set.Any())
+    throw InvalidArgument(
+        "--compress bc6h: the engine hand-offs (--engine) are written as RGB9E5 only so far; "
+        "write them in a separate run without --compress");
   if (!options.engine_fits.empty()) {
     if (!engine_set.Any())
       throw InvalidArgument("--engine-fits: goes with --engine (the fits go into its manifests)");
@@ -136,6 +141,7 @@ int RunConvert(const ConvertOptions& options) {
                             static_cast<std::size_t>(options.jobs));
   processing::ResampleOptions resample;
   resample.parallel = alone && options.jobs > 1;
+  export_options.jobs = alone ? options.jobs : 1;  // the BC6H encoder, likewise
 
   Progress progress("convert", found.inputs.size(), !options.quiet);
   const std::vector<JobResult> results = RunJobs(

@@ -331,6 +331,18 @@ bool IsImportedFormat(const Json& j) {
          f == "merl";
 }
 
+Json CertifiedErrorJson(const exporter::CertifiedError& e) {
+  const auto stats = [](const exporter::ErrorStatistics& s) {
+    return Json{{"max", s.max}, {"p99", s.p99}, {"median", s.median}, {"texels", s.texels}};
+  };
+  return {{"format", e.format},
+          {"bytes", e.bytes},
+          {"rgb9e5_bytes", e.rgb9e5_bytes},
+          {"theta_b_deg", e.theta_b_deg},
+          {"measured", stats(e.measured)},
+          {"filled", stats(e.filled)}};
+}
+
 // An exported LUT or atlas (.ktx2, .dds) or the sidecar / manifest describing one. Value ranges
 // are of the RGB9E5 values as stored (decoded exactly), per θin slice; for an atlas over the
 // cells that hold a material.
@@ -342,9 +354,14 @@ Json DescribeTexture(const std::string& path) {
   j["file"] = path;
   j["format"] = t.manifest || !tex.IsSingleLut() ? "atlas" : "lut";
   j["texture_file"] = t.texture_path;
-  j["container"] = tex.container == exporter::TextureContainer::kKtx2
-                       ? "KTX2 (vkFormat 123, VK_FORMAT_E5B9G9R9_UFLOAT_PACK32)"
-                       : "DDS (DXGI_FORMAT_R9G9B9E5_SHAREDEXP, 67)";
+  const bool bc6h = tex.format == exporter::TexelFormat::kBc6hUfloat;
+  if (tex.container == exporter::TextureContainer::kKtx2)
+    j["container"] = bc6h ? "KTX2 (vkFormat 131, VK_FORMAT_BC6H_UFLOAT_BLOCK)"
+                          : "KTX2 (vkFormat 123, VK_FORMAT_E5B9G9R9_UFLOAT_PACK32)";
+  else
+    j["container"] =
+        bc6h ? "DDS (DXGI_FORMAT_BC6H_UF16, 95)" : "DDS (DXGI_FORMAT_R9G9B9E5_SHAREDEXP, 67)";
+  j["texel_format"] = tex.FormatName();
   j["file_bytes"] = std::filesystem::file_size(t.texture_path);
   if (!t.sidecar_path.empty()) j["json_file"] = t.sidecar_path;
   j["width"] = v.width;
@@ -352,8 +369,8 @@ Json DescribeTexture(const std::string& path) {
   j["slices"] = v.depth;
   j["theta_in_deg"] = tex.theta_in_deg;
   j["theta_in_from_metadata"] = tex.theta_in_from_metadata;
-  j["payload_bytes"] = v.ByteSize();
-  j["payload_crc32"] = Hex32Text(v.Crc32());
+  j["payload_bytes"] = tex.PayloadBytes();
+  j["payload_crc32"] = Hex32Text(tex.PayloadCrc32());
   j["checksum"] = t.checksum_verified ? "verified against the recorded CRC-32"
                                       : "not verified (no sidecar or manifest)";
   if (t.sidecar) {
@@ -367,6 +384,8 @@ Json DescribeTexture(const std::string& path) {
     else
       j["extrapolation"] = nullptr;
     j["files"] = t.sidecar->files;
+    if (t.sidecar->certified_error)
+      j["certified_error"] = CertifiedErrorJson(*t.sidecar->certified_error);
   }
   // Cells holding data: the whole texture for a LUT, the materials' cells for an atlas.
   std::vector<std::array<int, 2>> origins = {{0, 0}};
@@ -382,6 +401,8 @@ Json DescribeTexture(const std::string& path) {
                                 {"row", m.row},
                                 {"x0", m.x0},
                                 {"y0", m.y0}});
+      if (m.certified_error)
+        j["materials"].back()["certified_error"] = CertifiedErrorJson(*m.certified_error);
       origins.push_back({m.x0, m.y0});
     }
     cell_w = Lut::kWidth;
@@ -396,7 +417,7 @@ Json DescribeTexture(const std::string& path) {
     for (const auto& [x0, y0] : origins)
       for (int y = y0; y < std::min(y0 + cell_h, v.height); ++y)
         for (int x = x0; x < std::min(x0 + cell_w, v.width); ++x, ++n) {
-          const std::array<float, 3> rgb = exporter::DecodeRgb9e5(v.words[v.Index(x, y, k)]);
+          const std::array<float, 3> rgb = tex.TexelValue(x, y, k);
           for (int c = 0; c < 3; ++c) {
             lo[c] = std::min<double>(lo[c], rgb[c]);
             hi[c] = std::max<double>(hi[c], rgb[c]);
@@ -612,14 +633,37 @@ void PrintTextureText(const Json& j) {
     std::printf("  source         %s\n", j["source"].get<std::string>().c_str());
   std::string thetas;
   for (const auto& t : j["theta_in_deg"]) thetas += (thetas.empty() ? "" : ", ") + Fixed(t, "%g");
-  std::printf("  dimensions     %d × %d × %d texels (RGB9E5)\n", j["width"].get<int>(),
-              j["height"].get<int>(), j["slices"].get<int>());
+  std::printf("  dimensions     %d × %d × %d texels (%s)\n", j["width"].get<int>(),
+              j["height"].get<int>(), j["slices"].get<int>(),
+              j["texel_format"].get<std::string>().c_str());
   std::printf("  theta_in       %s deg%s\n", thetas.c_str(),
               j["theta_in_from_metadata"].get<bool>() ? "" : " (assumed: no metadata)");
   std::printf("  payload        %s bytes, CRC-32 %s, %s\n",
               std::to_string(j["payload_bytes"].get<std::uint64_t>()).c_str(),
               j["payload_crc32"].get<std::string>().c_str(),
               j["checksum"].get<std::string>().c_str());
+  if (j.contains("certified_error")) {
+    const Json& e = j["certified_error"];
+    const auto line = [&](const char* label, const Json& s) {
+      std::printf("  %s max %s %%, p99 %s %%, median %s %% over %s texels\n", label,
+                  Fixed(Json(100.0 * s["max"].get<double>()), "%.3g").c_str(),
+                  Fixed(Json(100.0 * s["p99"].get<double>()), "%.3g").c_str(),
+                  Fixed(Json(100.0 * s["median"].get<double>()), "%.3g").c_str(),
+                  std::to_string(s["texels"].get<std::uint64_t>()).c_str());
+    };
+    std::printf(
+        "  compression    %s, %s bytes (RGB9E5: %s, %.2fx smaller); certified relative "
+        "error against the float LUT:\n",
+        e["format"].get<std::string>().c_str(),
+        std::to_string(e["bytes"].get<std::uint64_t>()).c_str(),
+        std::to_string(e["rgb9e5_bytes"].get<std::uint64_t>()).c_str(),
+        e["bytes"].get<double>() > 0 ? e["rgb9e5_bytes"].get<double>() / e["bytes"].get<double>()
+                                     : 0.0);
+    line("  measured     ", e["measured"]);
+    line("  filled       ", e["filled"]);
+    std::printf("                 (measured: theta_out <= %s deg; filled: beyond it)\n",
+                Fixed(e["theta_b_deg"], "%g").c_str());
+  }
   if (j.contains("extrapolation")) {
     if (j["extrapolation"].is_null())
       std::printf("  extrapolation  none (measured up to the horizon)\n");
@@ -634,11 +678,20 @@ void PrintTextureText(const Json& j) {
                 j["tool_version"].get<std::string>().c_str());
   if (atlas && j.contains("materials")) {
     std::printf("  materials      %zu\n", j["materials"].size());
-    for (const Json& m : j["materials"])
+    for (const Json& m : j["materials"]) {
       std::printf("    %d %s: cell column %d, row %d (texel origin %d, %d), from %s\n",
                   m["index"].get<int>(), m["name"].get<std::string>().c_str(),
                   m["column"].get<int>(), m["row"].get<int>(), m["x0"].get<int>(),
                   m["y0"].get<int>(), m["source"].get<std::string>().c_str());
+      if (m.contains("certified_error")) {
+        const Json& e = m["certified_error"]["measured"];
+        std::printf(
+            "      certified BC6H error, measured range: max %.3g %%, p99 %.3g %%, median "
+            "%.3g %%\n",
+            100.0 * e["max"].get<double>(), 100.0 * e["p99"].get<double>(),
+            100.0 * e["median"].get<double>());
+      }
+    }
   }
   std::printf("  f_r (1/sr, r g b) per slice%s:\n", atlas ? " over the material cells" : "");
   for (const Json& r : j["value_ranges"])

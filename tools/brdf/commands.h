@@ -46,6 +46,8 @@ struct ConvertOptions {
   // measured (noisy) data by only ~20 % and costs more than everything else of a conversion
   // (docs/benchmarks.md).
   std::string exr_compression = "none";
+  // Texel format of the KTX2 and DDS: "none" (RGB9E5) or "bc6h" (exporter/lut_compression.h).
+  std::string compress = "none";
   int jobs = DefaultJobs();
   bool quiet = false;  // no progress bar
   bool force = false;  // overwrite existing outputs (brdf::CheckWritableOutputs)
@@ -63,6 +65,7 @@ struct AtlasOptions {
   std::string extrapolate;
   std::string exr_type = "float";
   std::string exr_compression = "none";  // as convert's: one default for every EXR written
+  std::string compress = "none";         // as convert's
   int jobs = DefaultJobs();
   bool quiet = false;
   bool force = false;   // overwrite existing PREFIX.* files

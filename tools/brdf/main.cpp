@@ -346,6 +346,13 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::IsMember({"zip", "none"}));
   convert_cmd
+      ->add_option("--compress", convert.compress,
+                   "Texel format of the KTX2 and DDS: none (RGB9E5) or bc6h (BC6H_UF16 blocks, "
+                   "4x smaller; the sidecar records the error against the float LUT: max, p99 "
+                   "and median over the measured and the filled range)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"none", "bc6h"}));
+  convert_cmd
       ->add_option("--jobs", convert.jobs,
                    "Inputs converted in parallel (default: hardware threads)")
       ->capture_default_str()
@@ -401,6 +408,12 @@ int main(int argc, char** argv) {
   atlas_cmd->add_option("--exr-compression", atlas.exr_compression, kExrCompressionHelp)
       ->capture_default_str()
       ->check(CLI::IsMember({"zip", "none"}));
+  atlas_cmd
+      ->add_option("--compress", atlas.compress,
+                   "Texel format of the KTX2 and DDS: none (RGB9E5) or bc6h (BC6H_UF16 blocks; "
+                   "the manifest records each material's error against its float LUT)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"none", "bc6h"}));
   atlas_cmd->add_option("--jobs", atlas.jobs, "Inputs resampled in parallel")
       ->capture_default_str()
       ->check(WholeNumberAtLeast(1));

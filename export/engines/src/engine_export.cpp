@@ -650,8 +650,10 @@ EngineExportResult ExportLutWithEngines(const std::string& out_dir, const Lut& l
 
 std::vector<std::string> WriteAtlasWithEngines(
     const std::string& prefix, const std::vector<exporter::AtlasMaterial>& materials,
-    const exporter::ExrOptions& exr_options, const EngineSet& engines) {
-  std::vector<std::string> written = exporter::WriteAtlas(prefix, materials, exr_options);
+    const exporter::ExrOptions& exr_options, const EngineSet& engines,
+    exporter::LutCompression compression, int jobs) {
+  std::vector<std::string> written =
+      exporter::WriteAtlas(prefix, materials, exr_options, compression, jobs);
   if (!engines.Any()) return written;
   const exporter::Atlas atlas = exporter::BuildAtlas(materials);
   const fs::path prefix_path(prefix);

@@ -20,7 +20,9 @@
 #include <vector>
 
 #include "brdf/core/lut.h"
+#include "brdf/exporter/bc6h.h"
 #include "brdf/exporter/exr.h"
+#include "brdf/exporter/lut_compression.h"
 #include "brdf/exporter/metadata.h"
 #include "brdf/exporter/packed_volume.h"
 
@@ -60,12 +62,22 @@ struct Atlas {
   std::vector<std::optional<ExtrapolationInfo>> extrapolation;                // per material
   std::vector<std::vector<std::string>> fitted_models_json;                   // per material
   PackedVolume volume;  // Cm·361 × Rm·181 × K, RGB9E5
+  // Set by CompressAtlasBc6h: the same texture as BC6H blocks (the KTX2 and DDS then hold these
+  // and the manifest describes them) and each material's certified error over its cell.
+  std::optional<Bc6hVolume> bc6h;
+  std::vector<CertifiedError> certified_error;  // per material, when bc6h is set
 };
 
 // Packs the materials. Throws InvalidArgument if there are none, a LUT is unexportable, names
 // repeat, or θin lists differ ("materials 'gold' (θin 0, 20, 40, 60) and 'felt' (θin 0, 30, 60)
 // have different θin sets; an atlas needs one θin list").
 Atlas BuildAtlas(const std::vector<AtlasMaterial>& materials);
+
+// Compresses the atlas texture as BC6H (bc6h.h) on `jobs` threads and measures every
+// material's cell against its float LUT (lut_compression.h; θb from its extrapolation, else
+// 90°). Blocks straddle cell borders (361 and 181 are not multiples of 4), so a block may mix two
+// materials; each cell's certified error includes that. Fills atlas.bc6h and certified_error.
+void CompressAtlasBc6h(Atlas& atlas, const std::vector<AtlasMaterial>& materials, int jobs = 1);
 
 // The flat float image of the atlas (EXR layout above), from the unquantised LUTs.
 FloatImage AtlasImage(const std::vector<AtlasMaterial>& materials);
@@ -80,9 +92,13 @@ std::vector<std::string> AtlasOutputPaths(const std::string& prefix);
 // Writes PREFIX.ktx2, PREFIX.dds, PREFIX.exr and PREFIX.json (the manifest), each atomically,
 // and returns the paths written. The manifest is also embedded in the KTX2 ("brdf.atlas") and
 // the EXR ("brdf:atlas"). Throws InvalidArgument / IoError.
+// With compression kBc6h the KTX2 and DDS hold the BC6H form (CompressAtlasBc6h) and the
+// manifest records it ("payload" of the blocks, a "compression" member per material).
 std::vector<std::string> WriteAtlas(const std::string& prefix,
                                     const std::vector<AtlasMaterial>& materials,
-                                    const ExrOptions& exr_options = {});
+                                    const ExrOptions& exr_options = {},
+                                    LutCompression compression = LutCompression::kNone,
+                                    int jobs = 1);
 
 // Material m's cell of an atlas volume, decoded into a LUT with the given θin list.
 Lut ExtractAtlasCell(const PackedVolume& atlas_volume, const AtlasLayout& layout, int m,
@@ -95,13 +111,15 @@ struct AtlasManifestEntry {
   // Absent: the manifest did not record them.
   std::optional<std::vector<SaturatedCount>> saturated_samples = std::nullopt;
   std::optional<ExtrapolationInfo> extrapolation = std::nullopt;
-  std::vector<std::string> fitted_models_json = {};  // each a compact JSON text
+  std::vector<std::string> fitted_models_json = {};              // each a compact JSON text
+  std::optional<CertifiedError> certified_error = std::nullopt;  // a compressed atlas's
 };
 struct AtlasManifest {
   std::vector<double> theta_in_deg;
   std::vector<AtlasManifestEntry> materials;
   AtlasLayout layout;
   int texture_width = 0, texture_height = 0;
+  std::string payload_format = "rgb9e5";  // or "bc6h_ufloat"
   std::uint64_t payload_bytes = 0;
   std::uint32_t payload_crc32 = 0;
 };

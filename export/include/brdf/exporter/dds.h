@@ -12,6 +12,12 @@
 //   miscFlags2 0; then the texels, byte for byte the same payload as the KTX2 level 0 image
 //   (slice by slice, rows top first), starting at byte 148.
 //
+// A compressed LUT (`--compress bc6h`, bc6h.h) has dxgiFormat 95 (DXGI_FORMAT_BC6H_UF16),
+// dwWidth/dwHeight the texel size (361 × 181, not rounded to blocks), DDSD_LINEARSIZE (0x80000)
+// instead of DDSD_PITCH with dwPitchOrLinearSize = the bytes of one slice's blocks
+// (ceil(w/4)·ceil(h/4)·16 = 66,976 for a LUT, as DirectXTex writes it), and the blocks of
+// Bc6hVolume from byte 148: the same bytes as the KTX2 level 0 image.
+//
 // DDS has no place for metadata: the θin list travels in the sidecar (sidecar.h) beside it.
 #pragma once
 
@@ -22,6 +28,7 @@
 #include <vector>
 
 #include "brdf/core/lut.h"
+#include "brdf/exporter/bc6h.h"
 #include "brdf/exporter/packed_volume.h"
 #include "brdf/exporter/texture_file.h"
 
@@ -45,11 +52,15 @@ std::string EncodeDds(const PackedVolume& volume);
 // Writes atomically (temporary sibling renamed into place). Throws InvalidArgument, IoError.
 void WriteDds(const std::string& path, const Lut& lut);
 void WriteDds(const std::string& path, const PackedVolume& volume);
+// The BC6H form (DXGI 95).
+std::string EncodeDds(const Bc6hVolume& volume);
+void WriteDds(const std::string& path, const Bc6hVolume& volume);
 
 // Reads and validates a DDS file of this format. θin comes from `theta_in_deg` when given
 // (must have depth entries), else k·20° (theta_in_from_metadata = false); ReadTextureFile
-// looks for the sidecar instead. Throws IoError / FormatError ("Unsupported DXGI format: 71
-// (expected 67, DXGI_FORMAT_R9G9B9E5_SHAREDEXP)").
+// looks for the sidecar instead. Throws IoError / FormatError ("expected DXGI format 67
+// (DXGI_FORMAT_R9G9B9E5_SHAREDEXP) or 95 (DXGI_FORMAT_BC6H_UF16), got unsupported DXGI format
+// 71").
 LoadedTexture ReadDds(const std::string& path, const std::vector<double>& theta_in_deg = {});
 LoadedTexture ParseDds(const std::uint8_t* data, std::size_t size, const std::string& file,
                        const std::vector<double>& theta_in_deg = {});

@@ -68,6 +68,9 @@ void WriteExrComposite(const std::string& path, const Lut& lut, const PackedVolu
                        const TextureMetadata& metadata, const ExrOptions& options = {});
 void WriteExrComposite(const std::string& path, const Lut& lut, const TextureMetadata& metadata,
                        const ExrOptions& options = {});
+// The same with the sidecar text and payload checksum already made (a compressed LUT's).
+void WriteExrComposite(const std::string& path, const Lut& lut, const std::string& sidecar_json,
+                       std::uint32_t payload_crc32, const ExrOptions& options = {});
 
 // The tone-mapped 8-bit sRGB PNG described above, written atomically.
 void WritePng(const std::string& path, const FloatImage& image);

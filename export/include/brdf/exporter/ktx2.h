@@ -19,6 +19,15 @@
 // in), "KTXwriter" = "brdf-toolchain <version>", and the project's metadata: "brdf.sidecar"
 // (the JSON sidecar text, sidecar.h) for a LUT or "brdf.atlas" (the manifest, atlas.h) for an
 // atlas. Values are NUL-terminated UTF-8.
+//
+// A compressed LUT (`--compress bc6h`, bc6h.h) is the same container with vkFormat 131
+// (VK_FORMAT_BC6H_UFLOAT_BLOCK), typeSize 1, pixelWidth/Height/Depth the texel size (361, 181,
+// K: not rounded to blocks), the level 0 image the blocks of Bc6hVolume (ceil(w/4)·ceil(h/4)
+// per slice, 16 bytes each, slice after slice) starting at a multiple of 16 bytes (lcm(block
+// size 16, 4)), and the DFD of the Data Format Specification's BC6H entry, as libktx writes it:
+// colour model 131 (KHR_DF_MODEL_BC6H), BT.709, linear, texelBlockDimension 4 × 4 × 1,
+// bytesPlane0 = 16, one sample covering bits 0–127 of channel 0 (BC6H colour) with qualifier
+// FLOAT, sampleLower 0.0f and sampleUpper 1.0f (44 bytes in all).
 #pragma once
 
 #include <array>
@@ -29,6 +38,7 @@
 #include <vector>
 
 #include "brdf/core/lut.h"
+#include "brdf/exporter/bc6h.h"
 #include "brdf/exporter/metadata.h"
 #include "brdf/exporter/packed_volume.h"
 #include "brdf/exporter/texture_file.h"
@@ -57,13 +67,18 @@ void WriteKtx2(const std::string& path, const PackedVolume& volume,
                const std::vector<double>& theta_in_deg, const TextureMetadata& metadata);
 // Writes any volume with the given key/value pairs (atlases).
 void WriteKtx2(const std::string& path, const PackedVolume& volume, const KeyValues& key_values);
+// The BC6H forms (vkFormat 131) of EncodeKtx2 and WriteKtx2.
+std::string EncodeKtx2(const Bc6hVolume& volume, const KeyValues& key_values);
+void WriteKtx2(const std::string& path, const Bc6hVolume& volume, const KeyValues& key_values);
 
-// Reads and validates a KTX2 file written by us or any conforming writer of this format.
+// Reads and validates a KTX2 file written by us or any conforming writer of these formats.
 LoadedTexture ReadKtx2(const std::string& path);
 // Parses KTX2 bytes already in memory; `file` names them in errors (also the fuzz entry).
 LoadedTexture ParseKtx2(const std::uint8_t* data, std::size_t size, const std::string& file);
 
 // The 124-byte DFD described above (dfdTotalSize word included), as 31 little-endian words.
 std::vector<std::uint32_t> E5b9g9r9DataFormatDescriptor();
+// The 44-byte BC6H_UFLOAT DFD described above, as 11 words.
+std::vector<std::uint32_t> Bc6hUfloatDataFormatDescriptor();
 
 }  // namespace brdf::exporter

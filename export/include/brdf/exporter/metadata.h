@@ -27,6 +27,28 @@ struct SaturatedCount {
   std::uint64_t count = 0;
 };
 
+// Relative errors of a compressed payload's texels against the float LUT it was made from, over
+// one range of texels (docs/design.md §7): for texel x with reference r (the float LUT clamped
+// to [0, 65504], what an unsigned texture can hold) and decoded value d,
+// e = max_c |d_c − r_c| / max(max_c r_c, 10^−4·R, 2^−14), the colour's largest channel as the
+// scale, with R the LUT's largest reference value: texels darker than 1/10,000 of the LUT's
+// brightest (the noise of a black backing) are judged on that absolute scale, and 2^−14, the
+// smallest normal half float, keeps an all-black LUT from dividing by zero.
+struct ErrorStatistics {
+  double max = 0, p99 = 0, median = 0;
+  std::uint64_t texels = 0;  // texels in the range
+};
+// The certified error a compressed LUT carries in its sidecar: the statistics over the measured
+// range (θout ≤ θb, where values come from the instrument) and over the filled range (θout > θb:
+// extrapolated and below-horizon texels) separately, and the sizes.
+struct CertifiedError {
+  std::string format;  // "bc6h_ufloat"
+  double theta_b_deg = 90;
+  ErrorStatistics measured, filled;
+  std::uint64_t bytes = 0;         // the compressed payload
+  std::uint64_t rgb9e5_bytes = 0;  // the same LUT as RGB9E5, for the ratio
+};
+
 struct TextureMetadata {
   std::string name;    // material name, usually the input file's stem
   std::string source;  // where the values came from: input path(s), device, material file
@@ -44,6 +66,8 @@ struct TextureMetadata {
   std::vector<std::string> companion_files;
   // Empty: this build's version (BrdfToolVersion()).
   std::string tool_version;
+  // Set for a compressed payload (`--compress bc6h`): written as the sidecar's "compression".
+  std::optional<CertifiedError> certified_error;
 };
 
 // "brdf-toolchain <version>" of this build (the KTXwriter value).

@@ -11,7 +11,9 @@
 // RGB9E5 payload bytes exactly as stored in the KTX2 level 0 image and the DDS data: 4 bytes
 // per texel, little-endian words, x fastest then y (rows, top first) then z (slices, θin
 // ascending). The payload size is recorded too: 361·181·K·4 bytes, 1,045,456 for K = 4
-// (docs/design.md §5).
+// (docs/design.md §5). For a BC6H payload (`--compress bc6h`) checksum and size are those of
+// the blocks as stored (91·46·K·16 bytes, 267,904 for K = 4), and "compression" records the
+// certified error of the decoded texels against the float LUT (docs/design.md §7).
 //
 // Example (abridged):
 //   { "kind": "brdf-lut-sidecar", "format_version": 1, "name": "gold", "source": "gold.bpc",
@@ -33,6 +35,7 @@
 #include <string_view>
 #include <vector>
 
+#include "brdf/exporter/bc6h.h"
 #include "brdf/exporter/metadata.h"
 #include "brdf/exporter/packed_volume.h"
 
@@ -41,9 +44,18 @@ namespace brdf::exporter {
 // The sidecar JSON text (2-space indent) for a payload and its θin list.
 std::string SidecarJson(const PackedVolume& payload, const std::vector<double>& theta_in_deg,
                         const TextureMetadata& metadata);
+// The same for a BC6H payload (`--compress bc6h`): "payload" then starts with "format":
+// "bc6h_ufloat", its bytes and checksum are the blocks', and metadata.certified_error is
+// written as "compression": { "format", "bytes", "rgb9e5_bytes", "certified_error": {
+// "definition", "theta_b_deg", "measured": { "max", "p99", "median", "texels" }, "filled": {…} } }
+// (fractions, not percent).
+std::string SidecarJson(const Bc6hVolume& payload, const std::vector<double>& theta_in_deg,
+                        const TextureMetadata& metadata);
 
 // Writes SidecarJson atomically to `path`. Throws IoError.
 void WriteSidecar(const std::string& path, const PackedVolume& payload,
+                  const std::vector<double>& theta_in_deg, const TextureMetadata& metadata);
+void WriteSidecar(const std::string& path, const Bc6hVolume& payload,
                   const std::vector<double>& theta_in_deg, const TextureMetadata& metadata);
 
 // What a sidecar says, parsed back.
@@ -51,8 +63,10 @@ struct SidecarInfo {
   std::string name, source;
   std::vector<double> theta_in_deg;
   int width = 0, height = 0, slices = 0;
+  std::string payload_format = "rgb9e5";  // or "bc6h_ufloat"
   std::uint64_t payload_bytes = 0;
   std::uint32_t payload_crc32 = 0;
+  std::optional<CertifiedError> certified_error;  // the "compression" member, when present
   std::optional<ExtrapolationInfo> extrapolation;
   std::optional<std::vector<SaturatedCount>> saturated_samples;  // absent: not recorded
   std::vector<std::string> fitted_models_json;                   // each model as compact JSON text

@@ -8,12 +8,14 @@
 // is capped at kMaxTextureFileBytes before anything is read.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <string>
 #include <utility>
 #include <vector>
 
 #include "brdf/core/lut.h"
+#include "brdf/exporter/bc6h.h"
 #include "brdf/exporter/packed_volume.h"
 
 namespace brdf::exporter {
@@ -22,11 +24,18 @@ namespace brdf::exporter {
 inline constexpr std::uint64_t kMaxTextureFileBytes = 2ull << 30;
 
 enum class TextureContainer { kKtx2, kDds };
+// What the texels are: RGB9E5 words (the default export) or BC6H_UF16 blocks (`--compress
+// bc6h`, bc6h.h).
+enum class TexelFormat { kRgb9e5, kBc6hUfloat };
 
 struct LoadedTexture {
   std::string file;
   TextureContainer container = TextureContainer::kKtx2;
-  PackedVolume volume;  // the RGB9E5 words exactly as stored
+  TexelFormat format = TexelFormat::kRgb9e5;
+  // The texture's size in texels, and for kRgb9e5 the words exactly as stored (for
+  // kBc6hUfloat `words` stays empty and the blocks are in `bc6h`).
+  PackedVolume volume;
+  Bc6hVolume bc6h;  // the BC6H blocks exactly as stored (kBc6hUfloat)
   // KTX2 key/value pairs in file order, values without their terminating NUL. Empty for DDS.
   std::vector<std::pair<std::string, std::string>> key_values;
   // Embedded metadata: the sidecar JSON of a single LUT ("brdf.sidecar") or the manifest of an
@@ -45,6 +54,13 @@ struct LoadedTexture {
   Lut lut;
 
   bool IsSingleLut() const { return lut.slices() > 0; }
+  // The stored payload, whatever the format: its size and CRC-32 (what metadata records).
+  std::uint64_t PayloadBytes() const;
+  std::uint32_t PayloadCrc32() const;
+  // Texel (x, y, z) decoded exactly as a GPU's texelFetch returns it.
+  std::array<float, 3> TexelValue(int x, int y, int z) const;
+  // "RGB9E5" or "BC6H_UF16", for messages.
+  const char* FormatName() const;
 };
 
 // Reads a .ktx2 or .dds file, recognised by its first bytes (not its extension). For a DDS

@@ -1,0 +1,91 @@
+// BC6H encoding and decoding of whole LUTs on one core (target: encode ≤ 50 ms per material,
+// docs/benchmarks/bc6h.md). One benchmark per float EXR composite in $BRDF_BC6H_LUTS (a folder
+// `brdf convert --exr-type float` wrote; bench/bc6h/run.sh makes one from the library materials
+// and the RGL files), beside RGB9E5 packing of the same LUT as the baseline:
+//   BRDF_BC6H_LUTS=DIR build/dev/bench/bench_bc6h --benchmark_repetitions=5
+//       --benchmark_report_aggregates_only=true
+#include <benchmark/benchmark.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "brdf/core/lut.h"
+#include "brdf/exporter/bc6h.h"
+#include "brdf/exporter/exr.h"
+#include "brdf/exporter/packed_volume.h"
+
+namespace {
+
+using namespace brdf;
+using namespace brdf::exporter;
+
+struct NamedLut {
+  std::string name;
+  Lut lut;
+};
+
+std::vector<NamedLut>& Luts() {
+  static std::vector<NamedLut> luts;
+  return luts;
+}
+
+void BM_EncodeBc6h(benchmark::State& state, const Lut* lut) {
+  for (auto _ : state) {
+    Bc6hVolume v =
+        EncodeBc6hVolume(lut->texels.data(), Lut::kWidth, Lut::kHeight, lut->slices(), 1);
+    benchmark::DoNotOptimize(v.bytes.data());
+  }
+  state.counters["blocks"] = static_cast<double>(91 * 46 * lut->slices());
+}
+
+void BM_DecodeBc6h(benchmark::State& state, const Lut* lut) {
+  const Bc6hVolume v =
+      EncodeBc6hVolume(lut->texels.data(), Lut::kWidth, Lut::kHeight, lut->slices(), 1);
+  for (auto _ : state) {
+    std::vector<float> texels = DecodeBc6hVolume(v);
+    benchmark::DoNotOptimize(texels.data());
+  }
+}
+
+void BM_PackRgb9e5(benchmark::State& state, const Lut* lut) {
+  for (auto _ : state) {
+    PackedVolume v = PackLut(*lut);
+    benchmark::DoNotOptimize(v.words.data());
+  }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const char* dir = std::getenv("BRDF_BC6H_LUTS");
+  if (dir == nullptr) {
+    std::fprintf(stderr,
+                 "bench_bc6h: set BRDF_BC6H_LUTS to a folder of float EXR composites "
+                 "(bench/bc6h/run.sh)\n");
+    return 2;
+  }
+  std::vector<std::filesystem::path> files;
+  for (const auto& e : std::filesystem::directory_iterator(dir))
+    if (e.path().extension() == ".exr") files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  for (const auto& f : files) {
+    const ExrFile exr = ReadExr(f.string());
+    Luts().push_back({f.stem().string(), LutFromComposite(exr.image, {0, 20, 40, 60})});
+  }
+  for (const NamedLut& l : Luts()) {
+    benchmark::RegisterBenchmark(("EncodeBc6h/" + l.name).c_str(), BM_EncodeBc6h, &l.lut)
+        ->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark(("DecodeBc6h/" + l.name).c_str(), BM_DecodeBc6h, &l.lut)
+        ->Unit(benchmark::kMillisecond);
+    benchmark::RegisterBenchmark(("PackRgb9e5/" + l.name).c_str(), BM_PackRgb9e5, &l.lut)
+        ->Unit(benchmark::kMillisecond);
+  }
+  benchmark::Initialize(&argc, argv);
+  benchmark::RunSpecifiedBenchmarks();
+  benchmark::Shutdown();
+  return 0;
+}

@@ -1,0 +1,752 @@
+#include "brdf/exporter/bc6h.h"
+
+#include <algorithm>
+#include <bit>
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "brdf/core/error.h"
+#include "brdf/core/file_util.h"
+#include "brdf/core/parallel.h"
+
+namespace brdf::exporter {
+namespace {
+
+// ---- The format (ARB_texture_compression_bptc, BPTC_FLOAT) ---------------------------------
+
+struct ModeInfo {
+  int number;  // the mode field's value
+  int subsets;
+  bool transformed;
+  int epb;                   // endpoint bits
+  std::array<int, 3> delta;  // bits of the transformed endpoints per channel (= epb if raw)
+  // Table.F: the block's bits from bit 0 up; two-subset modes end with the partition d[4:0].
+  const char* layout;
+};
+
+constexpr std::array<ModeInfo, 14> kModes = {{
+    {0,
+     2,
+     true,
+     10,
+     {5, 5, 5},
+     "m[1:0],g2[4],b2[4],b3[4],r0[9:0],g0[9:0],b0[9:0],r1[4:0],g3[4],g2[3:0],g1[4:0],b3[0],"
+     "g3[3:0],b1[4:0],b3[1],b2[3:0],r2[4:0],b3[2],r3[4:0],b3[3],d[4:0]"},
+    {1,
+     2,
+     true,
+     7,
+     {6, 6, 6},
+     "m[1:0],g2[5],g3[4],g3[5],r0[6:0],b3[0],b3[1],b2[4],g0[6:0],b2[5],b3[2],g2[4],b0[6:0],"
+     "b3[3],b3[5],b3[4],r1[5:0],g2[3:0],g1[5:0],g3[3:0],b1[5:0],b2[3:0],r2[5:0],r3[5:0],d[4:0]"},
+    {2,
+     2,
+     true,
+     11,
+     {5, 4, 4},
+     "m[4:0],r0[9:0],g0[9:0],b0[9:0],r1[4:0],r0[10],g2[3:0],g1[3:0],g0[10],b3[0],g3[3:0],"
+     "b1[3:0],b0[10],b3[1],b2[3:0],r2[4:0],b3[2],r3[4:0],b3[3],d[4:0]"},
+    {6,
+     2,
+     true,
+     11,
+     {4, 5, 4},
+     "m[4:0],r0[9:0],g0[9:0],b0[9:0],r1[3:0],r0[10],g3[4],g2[3:0],g1[4:0],g0[10],g3[3:0],"
+     "b1[3:0],b0[10],b3[1],b2[3:0],r2[3:0],b3[0],b3[2],r3[3:0],g2[4],b3[3],d[4:0]"},
+    {10,
+     2,
+     true,
+     11,
+     {4, 4, 5},
+     "m[4:0],r0[9:0],g0[9:0],b0[9:0],r1[3:0],r0[10],b2[4],g2[3:0],g1[3:0],g0[10],b3[0],"
+     "g3[3:0],b1[4:0],b0[10],b2[3:0],r2[3:0],b3[1],b3[2],r3[3:0],b3[4],b3[3],d[4:0]"},
+    {14,
+     2,
+     true,
+     9,
+     {5, 5, 5},
+     "m[4:0],r0[8:0],b2[4],g0[8:0],g2[4],b0[8:0],b3[4],r1[4:0],g3[4],g2[3:0],g1[4:0],b3[0],"
+     "g3[3:0],b1[4:0],b3[1],b2[3:0],r2[4:0],b3[2],r3[4:0],b3[3],d[4:0]"},
+    {18,
+     2,
+     true,
+     8,
+     {6, 5, 5},
+     "m[4:0],r0[7:0],g3[4],b2[4],g0[7:0],b3[2],g2[4],b0[7:0],b3[3],b3[4],r1[5:0],g2[3:0],"
+     "g1[4:0],b3[0],g3[3:0],b1[4:0],b3[1],b2[3:0],r2[5:0],r3[5:0],d[4:0]"},
+    {22,
+     2,
+     true,
+     8,
+     {5, 6, 5},
+     "m[4:0],r0[7:0],b3[0],b2[4],g0[7:0],g2[5],g2[4],b0[7:0],g3[5],b3[4],r1[4:0],g3[4],"
+     "g2[3:0],g1[5:0],g3[3:0],b1[4:0],b3[1],b2[3:0],r2[4:0],b3[2],r3[4:0],b3[3],d[4:0]"},
+    {26,
+     2,
+     true,
+     8,
+     {5, 5, 6},
+     "m[4:0],r0[7:0],b3[1],b2[4],g0[7:0],b2[5],g2[4],b0[7:0],b3[5],b3[4],r1[4:0],g3[4],"
+     "g2[3:0],g1[4:0],b3[0],g3[3:0],b1[5:0],b2[3:0],r2[4:0],b3[2],r3[4:0],b3[3],d[4:0]"},
+    {30,
+     2,
+     false,
+     6,
+     {6, 6, 6},
+     "m[4:0],r0[5:0],g3[4],b3[0],b3[1],b2[4],g0[5:0],g2[5],b2[5],b3[2],g2[4],b0[5:0],g3[5],"
+     "b3[3],b3[5],b3[4],r1[5:0],g2[3:0],g1[5:0],g3[3:0],b1[5:0],b2[3:0],r2[5:0],r3[5:0],d[4:0]"},
+    {3, 1, false, 10, {10, 10, 10}, "m[4:0],r0[9:0],g0[9:0],b0[9:0],r1[9:0],g1[9:0],b1[9:0]"},
+    {7,
+     1,
+     true,
+     11,
+     {9, 9, 9},
+     "m[4:0],r0[9:0],g0[9:0],b0[9:0],r1[8:0],r0[10],g1[8:0],g0[10],b1[8:0],b0[10]"},
+    {11,
+     1,
+     true,
+     12,
+     {8, 8, 8},
+     "m[4:0],r0[9:0],g0[9:0],b0[9:0],r1[7:0],r0[10:11],g1[7:0],g0[10:11],b1[7:0],b0[10:11]"},
+    {15,
+     1,
+     true,
+     16,
+     {4, 4, 4},
+     "m[4:0],r0[9:0],g0[9:0],b0[9:0],r1[3:0],r0[10:15],g1[3:0],g0[10:15],b1[3:0],b0[10:15]"},
+}};
+
+// The first 32 two-subset partitions of Table.P2: bit t set = texel t in subset 1.
+constexpr std::array<std::uint16_t, 32> kPartitions = {
+    0xcccc, 0x8888, 0xeeee, 0xecc8, 0xc880, 0xfeec, 0xfec8, 0xec80, 0xc800, 0xffec, 0xfe80,
+    0xe800, 0xffe8, 0xff00, 0xfff0, 0xf000, 0xf710, 0x008e, 0x7100, 0x08ce, 0x008c, 0x7310,
+    0x3100, 0x8cce, 0x088c, 0x3110, 0x6666, 0x366c, 0x17e8, 0x0ff0, 0x718e, 0x399c};
+// Table.A2: the anchor texel of subset 1.
+constexpr std::array<std::uint8_t, 32> kAnchor2 = {15, 15, 15, 15, 15, 15, 15, 15, 15, 15, 15,
+                                                   15, 15, 15, 15, 15, 15, 2,  8,  2,  2,  8,
+                                                   8,  15, 2,  8,  2,  2,  8,  8,  2,  2};
+constexpr std::array<int, 16> kWeights4 = {0,  4,  9,  13, 17, 21, 26, 30,
+                                           34, 38, 43, 47, 51, 55, 60, 64};
+constexpr std::array<int, 8> kWeights3 = {0, 9, 18, 27, 37, 46, 55, 64};
+
+// For every weight 0..64, the index whose table weight is nearest (the encoder's first guess).
+template <std::size_t N>
+constexpr std::array<std::uint8_t, 65> NearestWeightIndex(const std::array<int, N>& weights) {
+  std::array<std::uint8_t, 65> out{};
+  for (int w = 0; w <= 64; ++w) {
+    std::size_t best = 0;
+    for (std::size_t k = 1; k < N; ++k) {
+      const int d = weights[k] - w, db = weights[best] - w;
+      if (d * d < db * db) best = k;
+    }
+    out[w] = static_cast<std::uint8_t>(best);
+  }
+  return out;
+}
+constexpr std::array<std::uint8_t, 65> kNearest4 = NearestWeightIndex(kWeights4);
+constexpr std::array<std::uint8_t, 65> kNearest3 = NearestWeightIndex(kWeights3);
+
+// Variables of the layout strings: m = 0, endpoint e channel c = 1 + 3e + c, d = 13.
+constexpr int kVarMode = 0, kVarPartition = 13, kVarCount = 14;
+struct BitSource {
+  std::uint8_t var, bit;
+};
+struct Mode {
+  ModeInfo info;
+  std::vector<BitSource> bits;  // one entry per header bit, in block order
+};
+
+int VariableOf(std::string_view name) {
+  if (name == "m") return kVarMode;
+  if (name == "d") return kVarPartition;
+  const int channel = name[0] == 'r' ? 0 : name[0] == 'g' ? 1 : 2;
+  return 1 + 3 * (name[1] - '0') + channel;
+}
+
+// Expands a layout string: v[a:b] moves bits into v's bits b, b∓1, …, a in block order (a ≥ b
+// counts up from b; a < b is the specification's reversed form and counts down from b).
+std::vector<BitSource> ParseLayout(std::string_view layout) {
+  std::vector<BitSource> bits;
+  while (!layout.empty()) {
+    const std::size_t open = layout.find('['), close = layout.find(']');
+    const int var = VariableOf(layout.substr(0, open));
+    const std::string_view range = layout.substr(open + 1, close - open - 1);
+    const std::size_t colon = range.find(':');
+    const int a = std::stoi(std::string(range.substr(0, colon)));
+    const int b =
+        colon == std::string_view::npos ? a : std::stoi(std::string(range.substr(colon + 1)));
+    const int step = a >= b ? 1 : -1;
+    for (int bit = b;; bit += step) {
+      bits.push_back({static_cast<std::uint8_t>(var), static_cast<std::uint8_t>(bit)});
+      if (bit == a) break;
+    }
+    layout.remove_prefix(std::min(layout.size(), close + 2));  // "]," or "]"
+  }
+  return bits;
+}
+
+struct Tables {
+  std::array<Mode, 14> modes;
+  std::array<int, 32> index_of_number;  // mode number → index in modes, −1 reserved
+  Tables() {
+    index_of_number.fill(-1);
+    for (std::size_t i = 0; i < kModes.size(); ++i) {
+      modes[i].info = kModes[i];
+      modes[i].bits = ParseLayout(kModes[i].layout);
+      index_of_number[kModes[i].number] = static_cast<int>(i);
+    }
+  }
+};
+const Tables& GetTables() {
+  static const Tables tables;
+  return tables;
+}
+
+int ModeNumberOf(const std::uint8_t* block) {
+  return (block[0] & 3) < 2 ? block[0] & 3 : block[0] & 31;
+}
+
+int Unquantize(int x, int epb) {
+  if (epb >= 15) return x;
+  if (x == 0) return 0;
+  if (x == (1 << epb) - 1) return 0xFFFF;
+  return ((x << 16) + 0x8000) >> epb;
+}
+
+int SignExtend(int v, int bits) {
+  const int sign = 1 << (bits - 1);
+  return (v & (sign - 1)) - (v & sign);
+}
+
+int Interpolate(int a, int b, int w) { return ((64 - w) * a + w * b + 32) >> 6; }
+int FinishUnquantize(int c) { return (c * 31) >> 6; }
+
+bool IsAnchor(int texel, int subsets, int partition) {
+  return texel == 0 || (subsets == 2 && texel == kAnchor2[partition]);
+}
+
+// ---- Encoder -------------------------------------------------------------------------------
+
+// One block's input in the two domains the encoder works in: h, the value as a continuous
+// half-float bit pattern (what the decoded half should equal), and t = (h + 0.5)·64/31, the
+// interpolated value c whose (c·31) >> 6 is h.
+struct BlockInput {
+  float h[16][3];
+  float t[16][3];
+};
+
+float ContinuousHalf(float x) {
+  if (!(x > 0.0f)) return 0.0f;
+  if (x >= kBc6hMaxValue) return 31743.0f;           // 0x7BFF
+  if (x < 6.103515625e-05f) return x * 16777216.0f;  // denormals: steps of 2^−24
+  // x = (1 + m/2^23)·2^(E − 127): the half pattern (E − 127 + 15)·1024 + m/2^13, unrounded.
+  const std::uint32_t f = std::bit_cast<std::uint32_t>(x);
+  return static_cast<float>((static_cast<int>(f >> 23) - 112) * 1024) +
+         static_cast<float>(f & 0x7FFFFFu) * (1.0f / 8192.0f);
+}
+
+struct Endpoints {
+  float e[2][2][3];  // subset, end, channel (interp domain t)
+};
+
+int QuantizeEndpoint(float value, int epb) {
+  const float v = std::clamp(value, 0.0f, 65535.0f);
+  if (epb >= 15) return static_cast<int>(v + 0.5f);
+  // Inside the range Unquantize(q) is the centre of [q, q + 1)·2^(16 − EPB), so the bucket is
+  // nearest; 0 and 2^EPB − 1 map to the range's ends instead, so look next to them.
+  const int max = (1 << epb) - 1;
+  const int q = std::min(static_cast<int>(v * (1.0f / static_cast<float>(1 << (16 - epb)))), max);
+  if (q > 1 && q < max - 1) return q;
+  int best = q;
+  float best_d = std::abs(static_cast<float>(Unquantize(q, epb)) - v);
+  for (int c : {q - 1, q + 1}) {
+    if (c < 0 || c > max) continue;
+    const float d = std::abs(static_cast<float>(Unquantize(c, epb)) - v);
+    if (d < best_d) best = c, best_d = d;
+  }
+  return best;
+}
+
+struct Encoded {
+  float error = std::numeric_limits<float>::infinity();  // Σ (decoded − h)² in half steps
+  Bc6hBlock block{};
+};
+
+void WriteBits(Bc6hBlock& block, int& pos, std::uint32_t value, int count) {
+  for (int i = 0; i < count; ++i, ++pos)
+    if ((value >> i) & 1u) block[pos >> 3] |= static_cast<std::uint8_t>(1u << (pos & 7));
+}
+
+Bc6hBlock Pack(const Mode& mode, int partition, const int (&fields)[4][3],
+               const std::array<int, 16>& indices) {
+  int vars[kVarCount] = {};
+  vars[kVarMode] = mode.info.number;
+  vars[kVarPartition] = partition;
+  for (int e = 0; e < 2 * mode.info.subsets; ++e)
+    for (int c = 0; c < 3; ++c) vars[1 + 3 * e + c] = fields[e][c];
+  Bc6hBlock block{};
+  int pos = 0;
+  for (const BitSource& s : mode.bits) {
+    if ((vars[s.var] >> s.bit) & 1) block[pos >> 3] |= static_cast<std::uint8_t>(1u << (pos & 7));
+    ++pos;
+  }
+  const int index_bits = mode.info.subsets == 2 ? 3 : 4;
+  for (int t = 0; t < 16; ++t)
+    WriteBits(block, pos, static_cast<std::uint32_t>(indices[t]),
+              index_bits - (IsAnchor(t, mode.info.subsets, partition) ? 1 : 0));
+  return block;
+}
+
+// Quantizes the endpoints for `mode`, picks each texel's best index, packs the block and
+// refits the endpoints to the indices by least squares, `refinements` times; the best block
+// seen goes into `best`.
+void TryMode(const Mode& mode, int partition, Endpoints ends, const BlockInput& in, int refinements,
+             Encoded& best) {
+  const ModeInfo& info = mode.info;
+  const int subsets = info.subsets;
+  const std::uint16_t mask = subsets == 2 ? kPartitions[partition] : 0;
+  const int levels = subsets == 2 ? 8 : 16;
+  const int* weights = subsets == 2 ? kWeights3.data() : kWeights4.data();
+  const int wrap = (1 << info.epb) - 1;
+  for (int pass = 0; pass <= refinements; ++pass) {
+    int q[4][3], fields[4][3];
+    for (int s = 0; s < subsets; ++s)
+      for (int end = 0; end < 2; ++end)
+        for (int c = 0; c < 3; ++c)
+          q[2 * s + end][c] = QuantizeEndpoint(ends.e[s][end][c], info.epb);
+    for (int c = 0; c < 3; ++c) {
+      fields[0][c] = q[0][c];
+      for (int e = 1; e < 2 * subsets; ++e) {
+        if (!info.transformed) {
+          fields[e][c] = q[e][c];
+          continue;
+        }
+        // The delta modulo 2^EPB as a signed number, clamped to what the field holds.
+        int d = (q[e][c] - q[0][c]) & wrap;
+        if (d > wrap / 2) d -= wrap + 1;
+        const int limit = 1 << (info.delta[c] - 1);
+        d = std::clamp(d, -limit, limit - 1);
+        q[e][c] = (q[0][c] + d) & wrap;
+        fields[e][c] = d & ((1 << info.delta[c]) - 1);
+      }
+    }
+    // Decoded palettes, exactly as the decoder computes them.
+    int palette[2][16][3];
+    for (int s = 0; s < subsets; ++s)
+      for (int c = 0; c < 3; ++c) {
+        const int a = Unquantize(q[2 * s][c], info.epb), b = Unquantize(q[2 * s + 1][c], info.epb);
+        for (int k = 0; k < levels; ++k)
+          palette[s][k][c] = FinishUnquantize(Interpolate(a, b, weights[k]));
+      }
+    std::array<int, 16> indices{};
+    float error = 0.0f;
+    // Each texel's index: its projection on the subset's decoded segment gives a weight, the
+    // nearest weights' entries are compared exactly (the palette is monotonic per channel).
+    const std::uint8_t* nearest = subsets == 2 ? kNearest3.data() : kNearest4.data();
+    float dir[2][3], inv_len2[2];
+    for (int s = 0; s < subsets; ++s) {
+      float len2 = 0.0f;
+      for (int c = 0; c < 3; ++c) {
+        dir[s][c] = static_cast<float>(palette[s][levels - 1][c] - palette[s][0][c]);
+        len2 += dir[s][c] * dir[s][c];
+      }
+      inv_len2[s] = len2 > 0.0f ? 64.0f / len2 : 0.0f;
+    }
+    for (int t = 0; t < 16; ++t) {
+      const int s = (mask >> t) & 1;
+      const int allowed = IsAnchor(t, subsets, partition) ? levels / 2 : levels;
+      float p = 0.0f;
+      for (int c = 0; c < 3; ++c)
+        p += (in.h[t][c] - static_cast<float>(palette[s][0][c])) * dir[s][c];
+      const int w = std::clamp(static_cast<int>(p * inv_len2[s] + 0.5f), 0, 64);
+      const int centre = std::min<int>(nearest[w], allowed - 1);
+      float best_e = std::numeric_limits<float>::infinity();
+      for (int k = std::max(0, centre - 1); k <= std::min(allowed - 1, centre + 1); ++k) {
+        float e2 = 0.0f;
+        for (int c = 0; c < 3; ++c) {
+          const float d = static_cast<float>(palette[s][k][c]) - in.h[t][c];
+          e2 += d * d;
+        }
+        if (e2 < best_e) best_e = e2, indices[t] = k;
+      }
+      error += best_e;
+    }
+    if (error < best.error) {
+      best.error = error;
+      best.block = Pack(mode, partition, fields, indices);
+    }
+    if (pass == refinements) break;
+    // Least squares per subset and channel: min Σ ((1 − α)a + αb − t)² over the texels.
+    for (int s = 0; s < subsets; ++s) {
+      double aa = 0, ab = 0, bb = 0, at[3] = {}, bt[3] = {}, sum[3] = {};
+      int n = 0;
+      for (int t = 0; t < 16; ++t) {
+        if (((mask >> t) & 1) != s) continue;
+        const double alpha = weights[indices[t]] / 64.0, beta = 1.0 - alpha;
+        aa += beta * beta, ab += alpha * beta, bb += alpha * alpha, ++n;
+        for (int c = 0; c < 3; ++c) {
+          at[c] += beta * in.t[t][c], bt[c] += alpha * in.t[t][c], sum[c] += in.t[t][c];
+        }
+      }
+      const double det = aa * bb - ab * ab;
+      for (int c = 0; c < 3; ++c) {
+        if (std::abs(det) < 1e-9) {
+          ends.e[s][0][c] = ends.e[s][1][c] = static_cast<float>(sum[c] / std::max(n, 1));
+        } else {
+          ends.e[s][0][c] = static_cast<float>((bb * at[c] - ab * bt[c]) / det);
+          ends.e[s][1][c] = static_cast<float>((aa * bt[c] - ab * at[c]) / det);
+        }
+      }
+    }
+  }
+}
+
+// Principal axis of a 3 × 3 covariance (power iteration from its largest column).
+std::array<double, 3> PrincipalAxis(const double (&cov)[3][3]) {
+  int start = 0;
+  for (int c = 1; c < 3; ++c)
+    if (cov[c][c] > cov[start][start]) start = c;
+  std::array<double, 3> v = {cov[0][start], cov[1][start], cov[2][start]};
+  for (int it = 0; it < 8; ++it) {
+    std::array<double, 3> w{};
+    for (int r = 0; r < 3; ++r) w[r] = cov[r][0] * v[0] + cov[r][1] * v[1] + cov[r][2] * v[2];
+    const double norm = std::sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+    if (!(norm > 1e-30)) break;
+    for (int r = 0; r < 3; ++r) v[r] = w[r] / norm;
+  }
+  const double norm = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+  if (!(norm > 1e-30)) return {0.57735026918962584, 0.57735026918962584, 0.57735026918962584};
+  return {v[0] / norm, v[1] / norm, v[2] / norm};
+}
+
+// Endpoints of subset s (texels where ((mask >> t) & 1) == s) along its principal axis, end 0
+// on the side of the subset's anchor texel so that its index fits the shortened field.
+void FitLine(const BlockInput& in, std::uint16_t mask, int s, int anchor, float (&ends)[2][3]) {
+  double mean[3] = {};
+  int n = 0;
+  for (int t = 0; t < 16; ++t)
+    if (((mask >> t) & 1) == s) {
+      for (int c = 0; c < 3; ++c) mean[c] += in.t[t][c];
+      ++n;
+    }
+  for (double& m : mean) m /= std::max(n, 1);
+  double cov[3][3] = {};
+  for (int t = 0; t < 16; ++t)
+    if (((mask >> t) & 1) == s)
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) cov[r][c] += (in.t[t][r] - mean[r]) * (in.t[t][c] - mean[c]);
+  const std::array<double, 3> axis = PrincipalAxis(cov);
+  double lo = 0.0, hi = 0.0, anchor_p = 0.0;
+  for (int t = 0; t < 16; ++t) {
+    if (((mask >> t) & 1) != s) continue;
+    double p = 0.0;
+    for (int c = 0; c < 3; ++c) p += (in.t[t][c] - mean[c]) * axis[c];
+    lo = std::min(lo, p), hi = std::max(hi, p);
+    if (t == anchor) anchor_p = p;
+  }
+  if (anchor_p - lo > hi - anchor_p) std::swap(lo, hi);
+  for (int c = 0; c < 3; ++c) {
+    ends[0][c] = static_cast<float>(mean[c] + lo * axis[c]);
+    ends[1][c] = static_cast<float>(mean[c] + hi * axis[c]);
+  }
+}
+
+// Search effort: least-squares refinements per candidate, partitions tried in the two-subset
+// modes, modes tried per endpoint set, and the factor of the one-subset error a two-line
+// estimate must stay under to try two subsets (benchmarks in docs/benchmarks/bc6h.md).
+constexpr int kRefinements = 1;
+constexpr int kPartitionsTried = 2;
+constexpr int kModesTried = 1;
+constexpr double kTwoSubsetGain = 1.0;
+
+// Estimated squared error of a two-line fit for every partition: per subset the scatter off
+// its principal axis plus the quantization of 8 levels along it (a uniform spread's variance
+// /49), from running sums. Returns partitions ranked best first.
+std::array<int, kPartitionsTried> RankPartitions(const BlockInput& in, double& best_estimate) {
+  double total[9] = {};
+  double texel[16][9];
+  for (int t = 0; t < 16; ++t) {
+    const float* x = in.t[t];
+    double* p = texel[t];
+    p[0] = x[0], p[1] = x[1], p[2] = x[2];
+    p[3] = x[0] * double(x[0]), p[4] = x[0] * double(x[1]), p[5] = x[0] * double(x[2]);
+    p[6] = x[1] * double(x[1]), p[7] = x[1] * double(x[2]), p[8] = x[2] * double(x[2]);
+    for (int i = 0; i < 9; ++i) total[i] += p[i];
+  }
+  std::array<double, 3> axis;
+  {
+    double cov[3][3];
+    const int k[3][3] = {{3, 4, 5}, {4, 6, 7}, {5, 7, 8}};
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) cov[r][c] = total[k[r][c]] - total[r] * total[c] / 16.0;
+    axis = PrincipalAxis(cov);
+  }
+  std::array<double, 32> score{};
+  for (int part = 0; part < 32; ++part) {
+    double sub[2][9] = {};
+    int n1 = 0;
+    for (int t = 0; t < 16; ++t)
+      if ((kPartitions[part] >> t) & 1) {
+        for (int i = 0; i < 9; ++i) sub[1][i] += texel[t][i];
+        ++n1;
+      }
+    for (int i = 0; i < 9; ++i) sub[0][i] = total[i] - sub[1][i];
+    const int counts[2] = {16 - n1, n1};
+    double est = 0.0;
+    for (int s = 0; s < 2; ++s) {
+      const double n = counts[s];
+      const double* m = sub[s];
+      const double mx = m[0] / n, my = m[1] / n, mz = m[2] / n;
+      double cov[3][3];
+      cov[0][0] = m[3] - n * mx * mx, cov[0][1] = m[4] - n * mx * my,
+      cov[0][2] = m[5] - n * mx * mz;
+      cov[1][1] = m[6] - n * my * my, cov[1][2] = m[7] - n * my * mz,
+      cov[2][2] = m[8] - n * mz * mz;
+      cov[1][0] = cov[0][1], cov[2][0] = cov[0][2], cov[2][1] = cov[1][2];
+      // λmax ≈ the Rayleigh quotient after one power step from the block's axis.
+      double v[3];
+      for (int r = 0; r < 3; ++r)
+        v[r] = cov[r][0] * axis[0] + cov[r][1] * axis[1] + cov[r][2] * axis[2];
+      const double v2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+      double lambda = 0.0;
+      if (v2 > 1e-30) {
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c) lambda += v[r] * cov[r][c] * v[c];
+        lambda /= v2;
+      }
+      const double trace = std::max(0.0, cov[0][0] + cov[1][1] + cov[2][2]);
+      lambda = std::clamp(lambda, 0.0, trace);
+      est += (trace - lambda) + lambda / 49.0;
+    }
+    score[part] = est;
+  }
+  // The kPartitionsTried lowest scores, lower partition numbers first on ties.
+  std::array<int, kPartitionsTried> order;
+  std::array<bool, 32> taken{};
+  for (int r = 0; r < kPartitionsTried; ++r) {
+    int pick = -1;
+    for (int part = 0; part < 32; ++part)
+      if (!taken[part] && (pick < 0 || score[part] < score[pick])) pick = part;
+    order[r] = pick;
+    taken[pick] = true;
+  }
+  best_estimate = score[order[0]];
+  return order;
+}
+
+// True when the endpoints' quantized deltas fit the mode's fields without clamping.
+bool DeltasFit(const ModeInfo& info, const Endpoints& ends) {
+  if (!info.transformed) return true;
+  const int wrap = (1 << info.epb) - 1;
+  for (int c = 0; c < 3; ++c) {
+    const int base = QuantizeEndpoint(ends.e[0][0][c], info.epb);
+    const int limit = 1 << (info.delta[c] - 1);
+    for (int e = 1; e < 2 * info.subsets; ++e) {
+      int d = (QuantizeEndpoint(ends.e[e / 2][e % 2][c], info.epb) - base) & wrap;
+      if (d > wrap / 2) d -= wrap + 1;
+      if (d < -limit || d >= limit) return false;
+    }
+  }
+  return true;
+}
+
+// Tries the kModesTried most precise modes of `subsets` subsets whose deltas hold the
+// endpoints (modes are listed by endpoint precision within each kind, the raw ones last).
+void TryBestModes(int subsets, int partition, const Endpoints& ends, const BlockInput& in,
+                  Encoded& best) {
+  static const std::array<int, 14> order = [] {
+    std::array<int, 14> o{};
+    for (int i = 0; i < 14; ++i) o[i] = i;
+    std::stable_sort(o.begin(), o.end(),
+                     [](int a, int b) { return kModes[a].epb > kModes[b].epb; });
+    return o;
+  }();
+  int tried = 0;
+  for (int i : order) {
+    const Mode& mode = GetTables().modes[i];
+    if (mode.info.subsets != subsets || !DeltasFit(mode.info, ends)) continue;
+    TryMode(mode, partition, ends, in, kRefinements, best);
+    if (++tried == kModesTried) break;
+  }
+}
+
+int MaxHalfError(const Bc6hBlock& block, const BlockInput& in) {
+  const Bc6hHalfTexels decoded = DecodeBc6hBlock(block.data());
+  float worst = 0.0f;
+  for (int t = 0; t < 16; ++t)
+    for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(decoded[t][c] - in.h[t][c]));
+  return static_cast<int>(std::ceil(worst));
+}
+
+}  // namespace
+
+std::uint16_t FloatToHalfUnsigned(float value) {
+  if (!(value > 0.0f)) return 0;  // NaN, zero, negative
+  if (value >= kBc6hMaxValue) return 0x7BFF;
+  const std::uint32_t f = std::bit_cast<std::uint32_t>(value);
+  const int e = static_cast<int>(f >> 23) - 127;
+  const std::uint32_t mantissa = f & 0x7FFFFFu;
+  std::uint32_t half = 0, remainder = 0, halfway = 0;
+  if (e >= -14) {
+    half = (static_cast<std::uint32_t>(e + 15) << 10) | (mantissa >> 13);
+    remainder = mantissa & 0x1FFFu;
+    halfway = 0x1000u;
+  } else {
+    // A half denormal m·2^−24: the float's significand s·2^(e − 23) shifted right by −(e + 1).
+    const int shift = -(e + 1);
+    if (shift > 24) return 0;
+    const std::uint32_t significand = mantissa | (e > -127 ? 0x800000u : 0u);
+    half = significand >> shift;
+    remainder = significand & ((1u << shift) - 1u);
+    halfway = 1u << (shift - 1);
+  }
+  if (remainder > halfway || (remainder == halfway && (half & 1u))) ++half;  // nearest, ties even
+  return static_cast<std::uint16_t>(std::min<std::uint32_t>(half, 0x7BFFu));
+}
+
+float HalfToFloat(std::uint16_t half) {
+  const int e = (half >> 10) & 31, m = half & 1023;
+  const float sign = (half & 0x8000) ? -1.0f : 1.0f;
+  if (e == 0) return sign * std::ldexp(static_cast<float>(m), -24);
+  if (e == 31)
+    return m == 0 ? sign * std::numeric_limits<float>::infinity()
+                  : std::numeric_limits<float>::quiet_NaN();
+  return sign * std::ldexp(static_cast<float>(1024 + m), e - 25);
+}
+
+int Bc6hBlockMode(const std::uint8_t* block) { return ModeNumberOf(block); }
+
+Bc6hHalfTexels DecodeBc6hBlock(const std::uint8_t* block) {
+  Bc6hHalfTexels out{};
+  const Tables& tables = GetTables();
+  const int index = tables.index_of_number[ModeNumberOf(block)];
+  if (index < 0) return out;  // reserved mode: black
+  const Mode& mode = tables.modes[index];
+  const ModeInfo& info = mode.info;
+  int pos = 0;
+  const auto bit = [&]() {
+    const int b = (block[pos >> 3] >> (pos & 7)) & 1;
+    ++pos;
+    return b;
+  };
+  int vars[kVarCount] = {};
+  for (const BitSource& s : mode.bits) vars[s.var] |= bit() << s.bit;
+  const int endpoints = 2 * info.subsets;
+  int e[4][3];
+  for (int i = 0; i < endpoints; ++i)
+    for (int c = 0; c < 3; ++c) e[i][c] = vars[1 + 3 * i + c];
+  if (info.transformed) {
+    const int wrap = (1 << info.epb) - 1;
+    for (int i = 1; i < endpoints; ++i)
+      for (int c = 0; c < 3; ++c) e[i][c] = (e[0][c] + SignExtend(e[i][c], info.delta[c])) & wrap;
+  }
+  for (int i = 0; i < endpoints; ++i)
+    for (int c = 0; c < 3; ++c) e[i][c] = Unquantize(e[i][c], info.epb);
+  const int partition = vars[kVarPartition];
+  const std::uint16_t mask = info.subsets == 2 ? kPartitions[partition] : 0;
+  const int index_bits = info.subsets == 2 ? 3 : 4;
+  const int* weights = info.subsets == 2 ? kWeights3.data() : kWeights4.data();
+  for (int t = 0; t < 16; ++t) {
+    const int bits = index_bits - (IsAnchor(t, info.subsets, partition) ? 1 : 0);
+    int idx = 0;
+    for (int i = 0; i < bits; ++i) idx |= bit() << i;
+    const int s = (mask >> t) & 1;
+    for (int c = 0; c < 3; ++c)
+      out[t][c] = static_cast<std::uint16_t>(
+          FinishUnquantize(Interpolate(e[2 * s][c], e[2 * s + 1][c], weights[idx])));
+  }
+  return out;
+}
+
+Bc6hBlock EncodeBc6hBlock(const float* rgb48) {
+  BlockInput in;
+  for (int t = 0; t < 16; ++t)
+    for (int c = 0; c < 3; ++c) {
+      in.h[t][c] = ContinuousHalf(rgb48[3 * t + c]);
+      in.t[t][c] = (in.h[t][c] + 0.5f) * (64.0f / 31.0f);
+    }
+  Encoded best;
+  {
+    Endpoints ends{};
+    FitLine(in, 0, 0, 0, ends.e[0]);
+    TryBestModes(1, 0, ends, in, best);
+  }
+  if (MaxHalfError(best.block, in) <= kBc6hGoodEnoughHalfSteps) return best.block;
+  double estimate = 0.0;
+  const std::array<int, kPartitionsTried> ranked = RankPartitions(in, estimate);
+  // Scatter that no line fits (noise) stays whatever the partition: only a two-line estimate
+  // below the one-subset block's error is worth the two-subset modes. The estimate is in
+  // the interpolation domain, (64/31)² times the half domain of `best.error`.
+  if (estimate * (31.0 / 64.0) * (31.0 / 64.0) > kTwoSubsetGain * best.error) return best.block;
+  for (int r = 0; r < kPartitionsTried; ++r) {
+    const int part = ranked[r];
+    Endpoints ends{};
+    FitLine(in, kPartitions[part], 0, 0, ends.e[0]);
+    FitLine(in, kPartitions[part], 1, kAnchor2[part], ends.e[1]);
+    TryBestModes(2, part, ends, in, best);
+  }
+  return best.block;
+}
+
+std::uint32_t Bc6hVolume::Crc32() const { return brdf::Crc32(bytes.data(), bytes.size()); }
+
+Bc6hVolume EncodeBc6hVolume(const float* rgb, int width, int height, int depth, int jobs) {
+  for (const int d : {width, height, depth})
+    if (d < 1 || d > 65536)
+      throw InvalidArgument(fmt::format(
+          "BC6H: texture dimensions must be in 1..65536, got {} × {} × {}", width, height, depth));
+  Bc6hVolume v;
+  v.width = width, v.height = height, v.depth = depth;
+  v.bytes.assign(v.BlockCount() * kBc6hBlockBytes, 0);
+  const int bw = v.BlocksWide(), bh = v.BlocksHigh();
+  // One task per block row; each block's bytes depend on its texels only, so the result is the
+  // same for any number of threads.
+  ParallelChunks(
+      static_cast<std::size_t>(bh) * depth, 1, ResolveJobs(jobs), nullptr,
+      [&](std::size_t begin, std::size_t end) {
+        float texels[48];
+        for (std::size_t row = begin; row < end; ++row) {
+          const int z = static_cast<int>(row / bh), by = static_cast<int>(row % bh);
+          for (int bx = 0; bx < bw; ++bx) {
+            for (int t = 0; t < 16; ++t) {
+              const int x = std::min(4 * bx + t % 4, width - 1);
+              const int y = std::min(4 * by + t / 4, height - 1);
+              const float* src = rgb + ((static_cast<std::size_t>(z) * height + y) * width + x) * 3;
+              texels[3 * t] = src[0], texels[3 * t + 1] = src[1], texels[3 * t + 2] = src[2];
+            }
+            const Bc6hBlock block = EncodeBc6hBlock(texels);
+            std::memcpy(v.bytes.data() + v.BlockOffset(4 * bx, 4 * by, z), block.data(),
+                        kBc6hBlockBytes);
+          }
+        }
+      });
+  return v;
+}
+
+std::vector<float> DecodeBc6hVolume(const Bc6hVolume& v) {
+  if (v.width < 1 || v.height < 1 || v.depth < 1 ||
+      v.bytes.size() != v.BlockCount() * kBc6hBlockBytes)
+    throw InvalidArgument(
+        fmt::format("BC6H: {} bytes do not hold the {} blocks of a {} × {} × {} "
+                    "texture",
+                    v.bytes.size(), v.BlockCount(), v.width, v.height, v.depth));
+  std::vector<float> out(static_cast<std::size_t>(v.width) * v.height * v.depth * 3);
+  for (int z = 0; z < v.depth; ++z)
+    for (int by = 0; by < v.BlocksHigh(); ++by)
+      for (int bx = 0; bx < v.BlocksWide(); ++bx) {
+        const Bc6hHalfTexels texels =
+            DecodeBc6hBlock(v.bytes.data() + v.BlockOffset(4 * bx, 4 * by, z));
+        for (int t = 0; t < 16; ++t) {
+          const int x = 4 * bx + t % 4, y = 4 * by + t / 4;
+          if (x >= v.width || y >= v.height) continue;
+          float* dst = &out[((static_cast<std::size_t>(z) * v.height + y) * v.width + x) * 3];
+          for (int c = 0; c < 3; ++c) dst[c] = HalfToFloat(texels[t][c]);
+        }
+      }
+  return out;
+}
+
+}  // namespace brdf::exporter

@@ -1,0 +1,172 @@
+// A real GPU decodes our BC6H: headless Chromium (WebGL 2 on SwiftShader) uploads a KTX2 of
+// vkFormat 131 as a compressed 3D texture (EXT_texture_compression_bptc,
+// COMPRESSED_RGB_BPTC_UNSIGNED_FLOAT_EXT) and reads every texel of every slice back with
+// texelFetch into an RGBA32F render target. No three.js: the KTX2 is parsed here (header and
+// level index, KTX 2.0 §3) and handed to compressedTexImage3D as it is stored, at the size
+// padded to whole blocks (WebGL requires BPTC level 0 sizes to be multiples of 4).
+// Writes OUT as little-endian float32, depth × height × width × 3 (x fastest), for
+// tests/python/bc6h_gpu_check.py.
+// Usage: node bc6h_gpu.mjs --ktx2 FILE --out FILE [--chromium PATH]
+import { spawn } from 'node:child_process';
+import { createServer } from 'node:http';
+import { mkdtempSync, readFileSync, writeFileSync, existsSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join, resolve } from 'node:path';
+import WebSocket from 'ws';
+
+const args = {};
+for (let i = 2; i < process.argv.length; i += 2) args[process.argv[i].slice(2)] = process.argv[i + 1];
+for (const required of ['ktx2', 'out'])
+  if (!args[required]) { console.error(`bc6h_gpu: --${required} is required`); process.exit(2); }
+const ktx2 = readFileSync(resolve(args.ktx2));
+const chromium = args.chromium || 'chromium';
+const deadline = Date.now() + 240000;
+
+const page = `<!doctype html><canvas id="c" width="4" height="4"></canvas><script>
+window.readAll = async () => {
+  const bytes = new Uint8Array(await (await fetch('/texture.ktx2')).arrayBuffer());
+  const dv = new DataView(bytes.buffer);
+  const vkFormat = dv.getUint32(12, true), w = dv.getUint32(20, true), h = dv.getUint32(24, true),
+        d = dv.getUint32(28, true);
+  if (vkFormat !== 131) throw new Error('vkFormat ' + vkFormat + ', expected 131');
+  const offset = Number(dv.getBigUint64(80, true)), length = Number(dv.getBigUint64(88, true));
+  const gl = document.getElementById('c').getContext('webgl2');
+  const bptc = gl.getExtension('EXT_texture_compression_bptc');
+  if (!bptc) throw new Error('no EXT_texture_compression_bptc');
+  if (!gl.getExtension('EXT_color_buffer_float')) throw new Error('no EXT_color_buffer_float');
+  const tex = gl.createTexture();
+  gl.bindTexture(gl.TEXTURE_3D, tex);
+  gl.texParameteri(gl.TEXTURE_3D, gl.TEXTURE_MIN_FILTER, gl.NEAREST);
+  gl.texParameteri(gl.TEXTURE_3D, gl.TEXTURE_MAG_FILTER, gl.NEAREST);
+  // WebGL refuses BPTC level-0 sizes that are not multiples of 4; the file's blocks are exactly
+  // those of the padded size (ceil(w/4)·ceil(h/4) blocks per slice either way), so the texture
+  // is created at that size and only the w × h texels of the image are fetched.
+  const pw = Math.ceil(w / 4) * 4, ph = Math.ceil(h / 4) * 4;
+  gl.compressedTexImage3D(gl.TEXTURE_3D, 0, bptc.COMPRESSED_RGB_BPTC_UNSIGNED_FLOAT_EXT, pw, ph, d, 0,
+                          bytes.subarray(offset, offset + length));
+  const err = gl.getError();
+  if (err !== gl.NO_ERROR) throw new Error('compressedTexImage3D: GL error 0x' + err.toString(16));
+  const vs = '#version 300 es\\nin vec2 p; void main() { gl_Position = vec4(p, 0.0, 1.0); }';
+  const fs = '#version 300 es\\nprecision highp float; precision highp sampler3D;\\n' +
+    'uniform sampler3D lut; uniform int slice; out vec4 color;\\n' +
+    'void main() { color = vec4(texelFetch(lut, ivec3(int(gl_FragCoord.x), int(gl_FragCoord.y), slice), 0).rgb, 1.0); }';
+  const compile = (type, src) => { const s = gl.createShader(type); gl.shaderSource(s, src); gl.compileShader(s);
+    if (!gl.getShaderParameter(s, gl.COMPILE_STATUS)) throw new Error(gl.getShaderInfoLog(s)); return s; };
+  const prog = gl.createProgram();
+  gl.attachShader(prog, compile(gl.VERTEX_SHADER, vs));
+  gl.attachShader(prog, compile(gl.FRAGMENT_SHADER, fs));
+  gl.linkProgram(prog);
+  if (!gl.getProgramParameter(prog, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(prog));
+  gl.useProgram(prog);
+  const buf = gl.createBuffer();
+  gl.bindBuffer(gl.ARRAY_BUFFER, buf);
+  gl.bufferData(gl.ARRAY_BUFFER, new Float32Array([-1, -1, 3, -1, -1, 3]), gl.STATIC_DRAW);
+  const loc = gl.getAttribLocation(prog, 'p');
+  gl.enableVertexAttribArray(loc);
+  gl.vertexAttribPointer(loc, 2, gl.FLOAT, false, 0, 0);
+  const rt = gl.createTexture();
+  gl.bindTexture(gl.TEXTURE_2D, rt);
+  gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA32F, w, h);
+  const fb = gl.createFramebuffer();
+  gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
+  gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, rt, 0);
+  if (gl.checkFramebufferStatus(gl.FRAMEBUFFER) !== gl.FRAMEBUFFER_COMPLETE) throw new Error('incomplete RGBA32F target');
+  gl.viewport(0, 0, w, h);
+  gl.activeTexture(gl.TEXTURE0);
+  gl.bindTexture(gl.TEXTURE_3D, tex);
+  gl.uniform1i(gl.getUniformLocation(prog, 'lut'), 0);
+  const out = new Float32Array(w * h * d * 3), row = new Float32Array(w * h * 4);
+  for (let z = 0; z < d; z++) {
+    gl.uniform1i(gl.getUniformLocation(prog, 'slice'), z);
+    gl.drawArrays(gl.TRIANGLES, 0, 3);
+    gl.readPixels(0, 0, w, h, gl.RGBA, gl.FLOAT, row);
+    // gl_FragCoord.y = texel row y (texelFetch's t): row y of the texture is row y of the read.
+    for (let i = 0; i < w * h; i++)
+      for (let c = 0; c < 3; c++) out[(z * w * h + i) * 3 + c] = row[i * 4 + c];
+  }
+  const e2 = gl.getError();
+  if (e2 !== gl.NO_ERROR) throw new Error('GL error 0x' + e2.toString(16));
+  const u8 = new Uint8Array(out.buffer);
+  let s = '';
+  for (let i = 0; i < u8.length; i += 0x8000) s += String.fromCharCode.apply(null, u8.subarray(i, i + 0x8000));
+  return { w, h, d, renderer: gl.getParameter(gl.RENDERER), data: btoa(s) };
+};
+</script>`;
+
+const server = createServer((req, res) => {
+  if (req.url === '/texture.ktx2') { res.writeHead(200, { 'Content-Type': 'application/octet-stream' }); res.end(ktx2); }
+  else if (req.url === '/') { res.writeHead(200, { 'Content-Type': 'text/html' }); res.end(page); }
+  else { res.writeHead(404); res.end(); }
+});
+await new Promise((ok) => server.listen(0, '127.0.0.1', ok));
+const profile = mkdtempSync(join(tmpdir(), 'brdf-bc6h-'));
+const browser = spawn(chromium, [
+  '--headless', '--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
+  '--disable-gpu-sandbox', '--disable-background-networking', '--disable-component-update',
+  '--disable-sync', '--no-first-run', '--no-default-browser-check', '--mute-audio',
+  `--user-data-dir=${profile}`, '--remote-debugging-port=0', 'about:blank'],
+  { stdio: ['ignore', 'ignore', 'pipe'] });
+let browserLog = '';
+browser.stderr.on('data', (d) => { browserLog += d; });
+const cleanup = () => {
+  try { browser.kill('SIGKILL'); } catch { /* already gone */ }
+  server.close();
+  try { rmSync(profile, { recursive: true, force: true }); } catch { /* best effort */ }
+};
+const fail = (message) => {
+  console.error(`bc6h_gpu: ${message}`);
+  if (browserLog) console.error(browserLog.split('\n').slice(-15).join('\n'));
+  cleanup();
+  process.exit(1);
+};
+setTimeout(() => fail('timed out after 240 s'), deadline - Date.now()).unref();
+const sleep = (ms) => new Promise((ok) => setTimeout(ok, ms));
+let endpoint = null;
+while (!endpoint) {
+  if (Date.now() > deadline) fail('chromium did not open its DevTools port');
+  if (browser.exitCode !== null) fail(`chromium exited with code ${browser.exitCode}`);
+  const portFile = join(profile, 'DevToolsActivePort');
+  if (existsSync(portFile)) {
+    const [port, path] = readFileSync(portFile, 'utf8').split('\n');
+    if (port && path) endpoint = `ws://127.0.0.1:${port}${path}`;
+  }
+  if (!endpoint) await sleep(100);
+}
+const ws = new WebSocket(endpoint, { perMessageDeflate: false, maxPayload: 1 << 30 });
+await new Promise((ok, bad) => { ws.once('open', ok); ws.once('error', bad); });
+let nextId = 1;
+const pending = new Map();
+ws.on('message', (data) => {
+  const msg = JSON.parse(data.toString());
+  if (msg.id && pending.has(msg.id)) {
+    const { ok, bad } = pending.get(msg.id);
+    pending.delete(msg.id);
+    if (msg.error) bad(new Error(JSON.stringify(msg.error))); else ok(msg.result);
+  }
+});
+const send = (method, params = {}, sessionId) => new Promise((ok, bad) => {
+  const id = nextId++;
+  pending.set(id, { ok, bad });
+  ws.send(JSON.stringify({ id, method, params, ...(sessionId ? { sessionId } : {}) }));
+});
+try {
+  const { targetId } = await send('Target.createTarget', { url: 'about:blank' });
+  const { sessionId } = await send('Target.attachToTarget', { targetId, flatten: true });
+  await send('Page.enable', {}, sessionId);
+  await send('Page.navigate', { url: `http://127.0.0.1:${server.address().port}/` }, sessionId);
+  let result = null;
+  while (!result) {
+    if (Date.now() > deadline) fail('the page never loaded');
+    const r = await send('Runtime.evaluate', { expression: 'typeof window.readAll === "function" ? window.readAll() : null',
+                                               awaitPromise: true, returnByValue: true }, sessionId);
+    if (r.exceptionDetails) fail(r.exceptionDetails.exception?.description || r.exceptionDetails.text);
+    result = r.result.value;
+    if (!result) await sleep(100);
+  }
+  writeFileSync(resolve(args.out), Buffer.from(result.data, 'base64'));
+  console.log(`bc6h_gpu: ${result.w} x ${result.h} x ${result.d} texels fetched on ${result.renderer}`);
+} catch (e) {
+  fail(e.message);
+}
+cleanup();
+process.exit(0);
