@@ -413,7 +413,16 @@ def study(name, truth, n, methods):
     }
     truths = {k: truth(*v) for k, v in sets.items()}
     rows = {}
+    loo_of = {}
     for m in methods:
+        if m == "auto":
+            # Per material: the method whose leave-last-slice-out error (median, then p90) is
+            # lower, chosen from the capture alone.
+            pick = min(("clamp", "model"), key=lambda x: loo_of[x])
+            r = dict(rows[pick])
+            r["pick"] = pick
+            rows[m] = r
+            continue
         base_m, _, fine = m.partition("@")
         step = float(fine) if fine else DELTA
         top = 90.0 if step < DELTA else 80.0
@@ -426,6 +435,7 @@ def study(name, truth, n, methods):
         g = sample_angles(e3, t3, *sets["loo60"])
         e = rel_err(g, truths["loo60"])
         r["loo60"] = (np.median(e), np.percentile(e, 90))
+        loo_of[m] = (round(float(np.median(e)), 3), float(np.percentile(e, 90)))
         for k in ("both", "view", "inside"):
             e = rel_err(sample_angles(e4, t4, *sets[k]), truths[k])
             r[k] = np.median(e)
@@ -438,9 +448,9 @@ def study(name, truth, n, methods):
     print("%s  (GGX fit of 4 slices: %s)" % (name, json.dumps(p4)))
     for m, r in rows.items():
         print("  %-7s loo60 median %6.1f %%  p90 %6.1f %%  both %6.1f %%  view %6.1f %%  "
-              "inside %5.2f %%  measured kept %s" % (
+              "inside %5.2f %%  measured kept %s %s" % (
                   m, 100 * r["loo60"][0], 100 * r["loo60"][1], 100 * r["both"],
-                  100 * r["view"], 100 * r["inside"], r["kept"]))
+                  100 * r["view"], 100 * r["inside"], r["kept"], r.get("pick", "")))
     sys.stdout.flush()
     return rows
 

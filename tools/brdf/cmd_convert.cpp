@@ -149,6 +149,9 @@ int RunConvert(const ConvertOptions& options) {
                             static_cast<std::size_t>(options.jobs));
   processing::ResampleOptions resample;
   resample.parallel = alone && options.jobs > 1;
+  resample.beyond.method = processing::ParseBeyondMethod(options.beyond);
+  resample.beyond.subdivisions = options.beyond_subdivide;
+  resample.Validate();
 
   Progress progress("convert", found.inputs.size(), !options.quiet);
   const std::vector<JobResult> results = RunJobs(
@@ -169,6 +172,7 @@ int RunConvert(const ConvertOptions& options) {
         metadata.source = in.path;
         metadata.extrapolation = built.extrapolation;
         metadata.saturated_samples = built.saturated_samples;
+        if (built.beyond) metadata.beyond_json = processing::BeyondReportJson(*built.beyond);
         std::vector<std::string> outputs = OutputPaths(out_dir, in.name, export_options.formats);
         for (std::string& p : engines::EngineOutputPaths(out_dir.string(), in.name, engine_set))
           outputs.push_back(std::move(p));

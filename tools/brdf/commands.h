@@ -40,6 +40,9 @@ struct ConvertOptions {
   std::vector<std::string> inputs;  // files and folders
   std::string out;                  // output folder (created if missing)
   std::string extrapolate;          // "P,L"; empty: per-material JSON, else 1,0.5
+  // Blind-spot fill (brdf/processing/beyond.h): "clamp", "hold", "model" or "auto".
+  std::string beyond = "auto";
+  int beyond_subdivide = 2;  // the filled LUT's θin step is the measured one divided by this
   std::string formats = kAllLutFormats;
   std::string exr_type = "float";  // EXR pixel type: "float" or "half"
   // EXR compression: "none" or "zip". None by default: ZIP shrinks a float composite of
