@@ -57,10 +57,10 @@ def rms_of(output):
     return float(m.group(1))
 
 
-def eval_pairs(brdf, source, pairs, tmp):
+def eval_pairs(brdf, source, pairs, tmp, extra=()):
     path = os.path.join(tmp, "pairs.txt")
     np.savetxt(path, pairs, fmt="%.6f")
-    out = run([brdf, "eval", source, "--pairs", path])
+    out = run([brdf, "eval", source, "--pairs", path] + list(extra))
     return np.loadtxt(out.splitlines()).reshape(-1, 3)
 
 
@@ -76,12 +76,16 @@ def main():
     ap.add_argument("--size", type=int, default=96)
     ap.add_argument("--rgl", default="all")
     ap.add_argument("--convert-args", default="", help="extra `brdf convert` options")
+    ap.add_argument("--beyond", default=None,
+                    help="--beyond of convert and eval (default: the commands' own default)")
     ap.add_argument("--pairs", type=int, default=2000)
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--out", default=None, help="keep the files here (default: a temp folder)")
     a = ap.parse_args()
     brdf = a.brdf
     extra = shlex.split(a.convert_args)
+    beyond = ["--beyond", a.beyond] if a.beyond else []
+    extra += beyond
     tmp_obj = None
     if a.out:
         os.makedirs(a.out, exist_ok=True)
@@ -90,7 +94,7 @@ def main():
         tmp_obj = tempfile.TemporaryDirectory()
         tmp = tmp_obj.name
     rng = np.random.default_rng(18)
-    results = {"size": a.size, "convert_args": a.convert_args, "analytic": {}, "rgl": {}}
+    results = {"size": a.size, "convert_args": " ".join(extra), "analytic": {}, "rgl": {}}
 
     # 1. Analytic materials.
     metal = os.path.join(tmp, "metal_a02.json")
@@ -164,7 +168,8 @@ def main():
         out = run([brdf, "preview", os.path.join(lut_dir, stem + ".ktx2"), "--compare", src,
                    "--size", str(a.size), "--quiet", "--force", "--out",
                    os.path.join(tmp, stem + ".exr")])
-        e = rel_err(eval_pairs(brdf, bpc3, views, tmp), eval_pairs(brdf, bpc4, views, tmp))
+        e = rel_err(eval_pairs(brdf, bpc3, views, tmp, beyond),
+                    eval_pairs(brdf, bpc4, views, tmp, beyond))
         row = {"studio": rms_of(out), "loo60_median": float(np.median(e)) * 100,
                "loo60_p90": float(np.percentile(e, 90)) * 100}
         results["rgl"][f] = row

@@ -23,6 +23,8 @@ struct EvalOptions {
   double theta_in_deg = 0, phi_in_deg = 0;
   double theta_out_deg = 0, phi_out_deg = 0;
   std::string extrapolate;  // "P,L" for captures; empty: per-material JSON, else 1,0.5
+  std::string beyond = "auto";  // captures: blind-spot fill, as `brdf convert --beyond`
+  int beyond_subdivide = 2;     // captures: as `brdf convert --beyond-subdivide`
   // Many directions at once instead of --in/--out: a file ("-" = stdin) of lines
   // "THETA_IN PHI_IN THETA_OUT PHI_OUT" (degrees, blanks or commas between); one output line
   // each. Empty lines and lines starting with '#' are skipped.

@@ -176,6 +176,17 @@ int main(int argc, char** argv) {
                    "Captures: grazing extrapolation P,L (docs/design.md §6); default: the "
                    "per-material JSON beside the file, else 1,0.5")
       ->capture_default_str();
+  eval_cmd
+      ->add_option("--beyond", eval.beyond,
+                   "Captures: what fills the directions not measured, as 'brdf convert "
+                   "--beyond' (clamp, hold, model, auto)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"clamp", "hold", "model", "auto"}));
+  eval_cmd
+      ->add_option("--beyond-subdivide", eval.beyond_subdivide,
+                   "Captures: as 'brdf convert --beyond-subdivide'")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 20));
   eval_cmd->footer(
       "Captures are interpolated as 'brdf convert' resamples them; exported LUTs are sampled "
       "as a GPU samples the 3D texture (centre-exact coordinates, trilinear, clamp-to-edge). "

@@ -35,16 +35,23 @@ View TexelView(double theta_in_deg, int j, int i) {
   return {RadToDeg(ThetaOf(w)), RadToDeg(PhiOf(w))};
 }
 
-// GGX one-α parts at a geometry: f = kd/π + f0·a + b per channel.
-struct GgxParts {
-  double a = 0, b = 0;
+// A fill family at one geometry and shape: f = a·(1/π) + b·y + offset per channel, with a the
+// diffuse reflectance and b the family's second linear parameter (f0, ρs, ks), each from the
+// model's one definition (brdf/core/models.h).
+struct Parts {
+  double y = 0, offset = 0;
 };
-GgxParts Parts(const ShadingGeometry& g, double alpha) {
-  const double a2 = alpha * alpha;
-  const double s = models::GgxG1(g.n_dot_l, a2) * models::GgxG1(g.n_dot_v, a2) *
-                   models::GgxD(g.n_dot_h, a2) / (4.0 * g.n_dot_l * g.n_dot_v);
-  const double p5 = models::Pow5(1.0 - g.v_dot_h);
-  return {(1.0 - p5) * s, p5 * s};
+Parts PartsOf(Model family, const ShadingGeometry& g, double shape) {
+  switch (family) {
+    case Model::kWard:
+      return {models::Ward(g, 0.0, 1.0, shape), 0.0};
+    case Model::kLafortune:
+      return {models::Lafortune(g, 0.0, 1.0, shape), 0.0};
+    default: {
+      const double off = models::Ggx(g, 0.0, 0.0, shape);
+      return {models::Ggx(g, 0.0, 1.0, shape) - off, off};
+    }
+  }
 }
 
 ShadingGeometry GeometryAt(double theta_in_deg, double theta_out_deg, double phi_out_deg) {
@@ -82,22 +89,27 @@ double SolveBounded(const Normal& n, double* kd, double* f0) {
   return best;
 }
 
-double FitAtAlpha(const std::vector<FitPoint>& pts, const std::array<double, 3>& eps, double alpha,
-                  FillModel* out) {
+struct Candidate {
+  std::array<double, 3> a{}, b{};
+  double shape = 0;
+};
+
+double FitAtShape(Model family, const std::vector<FitPoint>& pts, const std::array<double, 3>& eps,
+                  double shape, Candidate* out) {
   std::array<Normal, 3> n{};
   for (const FitPoint& p : pts) {
-    const GgxParts q = Parts(p.g, alpha);
+    const Parts q = PartsOf(family, p.g, shape);
     const double x = kInvPi;
     for (int c = 0; c < 3; ++c) {
       const double w = 1.0 / ((p.f[c] + eps[c]) * (p.f[c] + eps[c]));
-      const double y = p.f[c] - q.b;
-      n[c].saa += w * x * x, n[c].sab += w * x * q.a, n[c].sbb += w * q.a * q.a;
-      n[c].sa += w * x * y, n[c].sb += w * q.a * y, n[c].s += w * y * y;
+      const double y = p.f[c] - q.offset;
+      n[c].saa += w * x * x, n[c].sab += w * x * q.y, n[c].sbb += w * q.y * q.y;
+      n[c].sa += w * x * y, n[c].sb += w * q.y * y, n[c].s += w * y * y;
     }
   }
   double total = 0;
-  for (int c = 0; c < 3; ++c) total += SolveBounded(n[c], &out->kd[c], &out->f0[c]);
-  out->alpha = alpha;
+  for (int c = 0; c < 3; ++c) total += SolveBounded(n[c], &out->a[c], &out->b[c]);
+  out->shape = shape;
   return total;
 }
 
@@ -304,6 +316,10 @@ LeaveLastSliceOut Validate(const Lut& measured, double theta_b, const Lut& fille
   return v;
 }
 
+// Which validation is better: the lower p90 relative error, then the lower median (the tail is
+// where glossy peaks and grazing growth sit, which a median over mostly diffuse texels misses).
+std::pair<double, double> Key(const LeaveLastSliceOut& v) { return {v.p90, v.median}; }
+
 bool Uniform(const Lut& lut) {
   const double delta = lut.DeltaInDeg();
   if (lut.slices() < 2 || !(delta > 0) || std::fabs(lut.theta_in_deg[0]) > 1e-9) return false;
@@ -348,10 +364,8 @@ void BeyondOptions::Validate() const {
 std::array<double, 3> FillModel::Eval(double theta_in_deg, double theta_out_deg,
                                       double phi_out_deg) const {
   const ShadingGeometry g = GeometryAt(theta_in_deg, theta_out_deg, phi_out_deg);
-  const GgxParts q = Parts(g, alpha);
-  std::array<double, 3> f{};
-  for (int c = 0; c < 3; ++c) f[c] = kd[c] * kInvPi + f0[c] * q.a + q.b;
-  return f;
+  const Rgb f = models::EvaluateRgb(material.model, g, material.values.data());
+  return {f[0], f[1], f[2]};
 }
 
 std::string BeyondReportJson(const BeyondReport& r) {
@@ -374,11 +388,8 @@ std::string BeyondReportJson(const BeyondReport& r) {
   j["leave_last_slice_out_hold"] = loo(r.validation_hold);
   j["leave_last_slice_out_model"] = loo(r.validation_model);
   if (r.model) {
-    j["model"] = {{"model", "ggx"},
-                  {"kd", r.model->kd},
-                  {"f0", r.model->f0},
-                  {"alpha", r.model->alpha},
-                  {"median_relative_error", r.model->median_relative_error}};
+    j["model"] = ordered_json::parse(MaterialToJson(r.model->material));
+    j["model"]["median_relative_error"] = r.model->median_relative_error;
   } else {
     j["model"] = nullptr;
   }
@@ -386,7 +397,7 @@ std::string BeyondReportJson(const BeyondReport& r) {
   return j.dump();
 }
 
-FillModel FitFillModel(const Lut& lut, double theta_b) {
+FillModel FitFillModel(const Lut& lut, double theta_b, Model family) {
   if (lut.slices() == 0 || lut.texels.empty())
     throw InvalidArgument("FitFillModel: the LUT has no slices");
   std::vector<FitPoint> pts;
@@ -411,51 +422,57 @@ FillModel FitFillModel(const Lut& lut, double theta_b) {
   std::array<double, 3> eps{};
   const double all = (mean[0] + mean[1] + mean[2]) / (3.0 * std::max<std::size_t>(pts.size(), 1));
   for (int c = 0; c < 3; ++c) eps[c] = 0.02 * all + 1e-6;
-  FillModel best, trial;
+  const bool lafortune = family == Model::kLafortune;
+  const double lo = std::log(lafortune ? 1.0 : 0.005), hi = std::log(lafortune ? 20000.0 : 1.5);
+  Candidate best, trial;
   double best_cost = HUGE_VAL;
-  const int n_grid = 36;
-  const double lo = std::log(0.005), hi = std::log(1.5);
+  const int n_grid = 24;
   int best_n = 0;
   for (int n = 0; n < n_grid; ++n) {
-    const double c = FitAtAlpha(pts, eps, std::exp(lo + (hi - lo) * n / (n_grid - 1)), &trial);
+    const double c =
+        FitAtShape(family, pts, eps, std::exp(lo + (hi - lo) * n / (n_grid - 1)), &trial);
     if (c < best_cost) best_cost = c, best = trial, best_n = n;
   }
-  // Golden section in log α between the grid neighbours.
+  // Golden section in log(shape) between the grid neighbours.
   double a = lo + (hi - lo) * std::max(0, best_n - 1) / (n_grid - 1);
   double b = lo + (hi - lo) * std::min(n_grid - 1, best_n + 1) / (n_grid - 1);
   const double g = 0.5 * (std::sqrt(5.0) - 1.0);
   double x1 = b - g * (b - a), x2 = a + g * (b - a);
-  FillModel m1, m2;
-  double f1 = FitAtAlpha(pts, eps, std::exp(x1), &m1), f2 = FitAtAlpha(pts, eps, std::exp(x2), &m2);
-  for (int it = 0; it < 24; ++it) {
+  Candidate m1, m2;
+  double f1 = FitAtShape(family, pts, eps, std::exp(x1), &m1);
+  double f2 = FitAtShape(family, pts, eps, std::exp(x2), &m2);
+  for (int it = 0; it < 16; ++it) {
     if (f1 < f2) {
       b = x2, x2 = x1, f2 = f1, m2 = m1;
       x1 = b - g * (b - a);
-      f1 = FitAtAlpha(pts, eps, std::exp(x1), &m1);
+      f1 = FitAtShape(family, pts, eps, std::exp(x1), &m1);
     } else {
       a = x1, x1 = x2, f1 = f2, m1 = m2;
       x2 = a + g * (b - a);
-      f2 = FitAtAlpha(pts, eps, std::exp(x2), &m2);
+      f2 = FitAtShape(family, pts, eps, std::exp(x2), &m2);
     }
   }
   if (f1 < best_cost) best = m1, best_cost = f1;
   if (f2 < best_cost) best = m2, best_cost = f2;
+  FillModel out;
+  out.material =
+      Material::Make(family,
+                     {Rgb{best.a[0], best.a[1], best.a[2]}, Rgb{best.b[0], best.b[1], best.b[2]},
+                      Rgb{best.shape, best.shape, best.shape}},
+                     "blind-spot fill");
   std::vector<double> rel;
   rel.reserve(pts.size() * 3);
   for (const FitPoint& p : pts) {
-    const GgxParts q = Parts(p.g, best.alpha);
-    for (int c = 0; c < 3; ++c) {
-      const double m = best.kd[c] * kInvPi + best.f0[c] * q.a + q.b;
-      rel.push_back(std::fabs(m - p.f[c]) / std::max(p.f[c], 1e-3));
-    }
+    const Rgb m = models::EvaluateRgb(family, p.g, out.material.values.data());
+    for (int c = 0; c < 3; ++c) rel.push_back(std::fabs(m[c] - p.f[c]) / std::max(p.f[c], 1e-3));
   }
   if (!rel.empty()) {
     std::nth_element(rel.begin(), rel.begin() + static_cast<std::ptrdiff_t>(rel.size() / 2),
                      rel.end());
-    best.median_relative_error = rel[rel.size() / 2];
+    out.median_relative_error = rel[rel.size() / 2];
   }
-  best.texels = pts.size();
-  return best;
+  out.texels = pts.size();
+  return out;
 }
 
 Lut ExtendBeyondMeasured(const Lut& measured, double theta_b, const BeyondOptions& options,
@@ -477,7 +494,6 @@ Lut ExtendBeyondMeasured(const Lut& measured, double theta_b, const BeyondOption
   // Validation: the fill from all slices but the last, read at the last one.
   const bool validate = measured.slices() >= 3;
   Lut head;
-  FillModel head_model;
   if (validate) {
     head.theta_in_deg.assign(measured.theta_in_deg.begin(), measured.theta_in_deg.end() - 1);
     head.texels.assign(
@@ -493,21 +509,28 @@ Lut ExtendBeyondMeasured(const Lut& measured, double theta_b, const BeyondOption
   BeyondMethod use = options.method;
   if (validate && (use == BeyondMethod::kHold || use == BeyondMethod::kAuto))
     r.validation_hold = validate_with(Ratio{});
+  // kModel: the family whose fill predicts the left-out slice best (GGX without validation).
+  Model family = Model::kGgx;
   if (validate && (use == BeyondMethod::kModel || use == BeyondMethod::kAuto)) {
-    head_model = FitFillModel(head, theta_b);
-    r.validation_model = validate_with(Ratio{&head_model});
+    for (Model m : {Model::kGgx, Model::kWard, Model::kLafortune}) {
+      const FillModel head_model = FitFillModel(head, theta_b, m);
+      const LeaveLastSliceOut v = validate_with(Ratio{&head_model});
+      if (!r.validation_model || Key(v) < Key(*r.validation_model)) {
+        r.validation_model = v;
+        family = m;
+      }
+    }
   }
   if (use == BeyondMethod::kAuto) {
     use = BeyondMethod::kModel;
-    if (r.validation_hold && r.validation_model) {
-      const auto key = [](const LeaveLastSliceOut& v) { return std::pair(v.median, v.p90); };
-      if (key(*r.validation_hold) < key(*r.validation_model)) use = BeyondMethod::kHold;
-    }
+    if (r.validation_hold && r.validation_model &&
+        Key(*r.validation_hold) < Key(*r.validation_model))
+      use = BeyondMethod::kHold;
   }
   r.used = use;
   r.validation = use == BeyondMethod::kModel ? r.validation_model : r.validation_hold;
   if (use == BeyondMethod::kModel) {
-    r.model = FitFillModel(measured, theta_b);
+    r.model = FitFillModel(measured, theta_b, family);
     return Fill(measured, theta_b, options.max_theta_in_deg, fill_step, Ratio{&*r.model}, &r);
   }
   return Fill(measured, theta_b, options.max_theta_in_deg, fill_step, Ratio{}, &r);

@@ -18,8 +18,9 @@
 //                      view in the slice below), so a glossy peak keeps its measured shape and
 //                      takes the model's change with θin;
 //      in between linear in θout, so the two meet without a step.
-//  M is the fill model: GGX with Schlick Fresnel (docs/design.md §9, `ggx`, one α for the
-//  three channels) fitted to the measured texels by relative least squares (FitFillModel);
+//  M is the fill model: a docs/design.md §9 `ggx`, `ward` or `lafortune` material (one shape
+//  parameter for the three channels) fitted to the measured texels by relative least squares
+//  (FitFillModel), the family whose fill validates best (below);
 //  kHold uses M ≡ 1 (the measured values carried on unchanged, reciprocity still applied).
 //  Ratios are limited to [1/16, 16]; directions at or below the horizon read the model at
 //  89.5°. Then, per filled slice and channel, the directional albedo ∫ f cosθout dω is
@@ -27,8 +28,9 @@
 //
 // Validation (leave the last slice out): the same fill built from slices 0 … K−2 alone (the
 // model fitted to those), read at the measured slice θL's texels with θout ≤ θb, against that
-// slice. kAuto builds both kHold and kModel this way and uses the one with the lower median
-// relative error (then p90); with fewer than three slices it uses kModel.
+// slice. kModel validates each family this way and keeps the best; kAuto also validates kHold
+// and uses whichever is better: lower p90 relative error, then lower median. With fewer than
+// three slices nothing is validated and kModel (GGX) is used.
 //
 // Slices inserted between measured ones (subdivisions > 1), at θ between measured θa < θb with
 // t = (θ − θa)/(θb − θa), texel (θd, φd): (1 − t)·f(θa)·M(θ)/M(θa) + t·f(θb)·M(θ)/M(θb), each
@@ -47,6 +49,7 @@
 #include <vector>
 
 #include "brdf/core/lut.h"
+#include "brdf/core/models.h"
 
 namespace brdf::processing {
 
@@ -80,21 +83,22 @@ struct BeyondOptions {
   void Validate() const;
 };
 
-// The fill model: docs/design.md §9 `ggx` with these parameters.
+// The fill model: a docs/design.md §9 material (ggx, ward or lafortune).
 struct FillModel {
-  std::array<double, 3> kd{}, f0{};
-  double alpha = 0.1;
+  Material material;
   double median_relative_error = 0;  // over the texels fitted
   std::size_t texels = 0;            // fitted
 
   std::array<double, 3> Eval(double theta_in_deg, double theta_out_deg, double phi_out_deg) const;
 };
 
-// GGX fitted to the texels of `lut` with θout ≤ theta_b_deg (a strided subset, denser near the
-// specular peak): for each α of a log-spaced grid, kd and f0 ∈ [0, 1] per channel by linear
-// least squares weighted by 1/(f + ε)² (ε = 2 % of the mean value), then α refined by golden
-// section. Throws InvalidArgument for an empty LUT.
-FillModel FitFillModel(const Lut& lut, double theta_b_deg);
+// `family` (kGgx, kWard or kLafortune) fitted to the texels of `lut` with θout ≤ theta_b_deg (a
+// strided subset, denser near the specular peak): each is linear in its two reflectances
+// (kd, f0 / ρd, ρs / kd, ks) for a fixed shape (α, α, n), so for each shape of a log-spaced
+// grid those are solved in [0, 1] per channel by least squares weighted by 1/(f + ε)² (ε = 2 %
+// of the mean value), then the shape (one for the three channels) refined by golden section.
+// Throws InvalidArgument for an empty LUT.
+FillModel FitFillModel(const Lut& lut, double theta_b_deg, Model family = Model::kGgx);
 
 // The record of a fill for a sidecar or manifest: {"method", "requested", "measured_theta_in",
 // "extrapolated_theta_in", "subdivisions", "leave_last_slice_out": {...} or null, "model": {...}
