@@ -16,7 +16,20 @@ namespace {
 
 constexpr double kGrazingDeg = 89.5;  // the model is read here at and below the horizon
 constexpr double kBlendDeg = 5.0;     // half width of the reciprocity/continuation seam
-constexpr double kMaxRatio = 16.0;
+constexpr double kMaxRatio = 8.0;
+// The ratio M(new)/M(old) is read with the fitted lobe widened to at least this (α ≥ 0.1 for
+// ggx and ward, n ≤ 200 for lafortune): the ratio is meant to carry the smooth change with
+// θin (Fresnel, shadowing, the 1/cos factors), and a lobe a degree wide, as the fit gives for
+// sharp measured highlights, turns a sub-degree misplacement into a factor of 8.
+constexpr double kMinRatioAlpha = 0.1, kMaxRatioExponent = 200.0;
+
+FillModel Widened(FillModel m) {
+  for (int c = 6; c < 9; ++c)
+    m.material.values[c] = m.material.model == Model::kLafortune
+                               ? std::min(m.material.values[c], kMaxRatioExponent)
+                               : std::max(m.material.values[c], kMinRatioAlpha);
+  return m;
+}
 
 // Runs body(j) for every texel row j, on TBB's workers (within any enclosing arena's limit).
 template <class Body>
@@ -513,7 +526,7 @@ Lut ExtendBeyondMeasured(const Lut& measured, double theta_b, const BeyondOption
   Model family = Model::kGgx;
   if (validate && (use == BeyondMethod::kModel || use == BeyondMethod::kAuto)) {
     for (Model m : {Model::kGgx, Model::kWard, Model::kLafortune}) {
-      const FillModel head_model = FitFillModel(head, theta_b, m);
+      const FillModel head_model = Widened(FitFillModel(head, theta_b, m));
       const LeaveLastSliceOut v = validate_with(Ratio{&head_model});
       if (!r.validation_model || Key(v) < Key(*r.validation_model)) {
         r.validation_model = v;
@@ -531,7 +544,8 @@ Lut ExtendBeyondMeasured(const Lut& measured, double theta_b, const BeyondOption
   r.validation = use == BeyondMethod::kModel ? r.validation_model : r.validation_hold;
   if (use == BeyondMethod::kModel) {
     r.model = FitFillModel(measured, theta_b, family);
-    return Fill(measured, theta_b, options.max_theta_in_deg, fill_step, Ratio{&*r.model}, &r);
+    const FillModel ratio_model = Widened(*r.model);
+    return Fill(measured, theta_b, options.max_theta_in_deg, fill_step, Ratio{&ratio_model}, &r);
   }
   return Fill(measured, theta_b, options.max_theta_in_deg, fill_step, Ratio{}, &r);
 }
