@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <memory>
 #include <string>
 
 #include "brdf/core/error.h"
@@ -127,18 +129,44 @@ double FitAtShape(Model family, const std::vector<FitPoint>& pts, const std::arr
 }
 
 // A fill "model" of kHold is M ≡ 1; of kModel the fitted GGX.
+std::array<double, 3> RatioOf(const std::array<double, 3>& a, const std::array<double, 3>& b) {
+  std::array<double, 3> r{};
+  for (int c = 0; c < 3; ++c)
+    r[c] = b[c] > 1e-30 ? std::clamp(a[c] / b[c], 1.0 / kMaxRatio, kMaxRatio) : 1.0;
+  return r;
+}
+
+// Every texel's view in the slice at one θin, and the model there (computed once per θin).
+struct SliceGrid {
+  std::vector<View> view;                // index j·361 + i
+  std::vector<std::array<double, 3>> m;  // empty for M ≡ 1
+};
+
+// M(new)/M(old) at texels; kHold's model is null (M ≡ 1).
 struct Ratio {
   const FillModel* model = nullptr;
-  std::array<double, 3> operator()(double ti_new, const View& v_new, double ti_old,
-                                   const View& v_old) const {
-    if (model == nullptr) return {1.0, 1.0, 1.0};
-    const auto a = model->Eval(ti_new, v_new.theta_deg, v_new.phi_deg);
-    const auto b = model->Eval(ti_old, v_old.theta_deg, v_old.phi_deg);
-    std::array<double, 3> r{};
-    for (int c = 0; c < 3; ++c)
-      r[c] = b[c] > 1e-30 ? std::clamp(a[c] / b[c], 1.0 / kMaxRatio, kMaxRatio) : 1.0;
-    return r;
+  // The grid of the slice at `theta_in_deg`, computed on first use. Not thread-safe: call it
+  // outside the parallel loops, which then only read the grids.
+  const SliceGrid& Prepare(double theta_in_deg) const {
+    const long key = std::lround(theta_in_deg * 1e6);
+    if (auto it = grids->find(key); it != grids->end()) return it->second;
+    SliceGrid g;
+    g.view.resize(static_cast<std::size_t>(Lut::kHeight) * Lut::kWidth);
+    if (model) g.m.resize(g.view.size());
+    ForRows([&](int j) {
+      for (int i = 0; i < Lut::kWidth; ++i) {
+        const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
+        g.view[n] = TexelView(theta_in_deg, j, i);
+        if (model) g.m[n] = model->Eval(theta_in_deg, g.view[n].theta_deg, g.view[n].phi_deg);
+      }
+    });
+    return grids->emplace(key, std::move(g)).first->second;
   }
+  std::array<double, 3> Between(const SliceGrid& now, const SliceGrid& old, std::size_t n) const {
+    if (model == nullptr) return {1.0, 1.0, 1.0};
+    return RatioOf(now.m[n], old.m[n]);
+  }
+  std::shared_ptr<std::map<long, SliceGrid>> grids = std::make_shared<std::map<long, SliceGrid>>();
 };
 
 // Slices every `step` degrees from 0 to the last measured one (which are kept as they are).
@@ -164,11 +192,14 @@ Lut Densify(const Lut& measured, double step, const Ratio& ratio) {
     const int b = a + 1;
     const double t = static_cast<double>(k % per) / per;
     const double ta = measured.theta_in_deg[a], tb = measured.theta_in_deg[b];
+    const SliceGrid& g = ratio.Prepare(theta);
+    const SliceGrid& ga = ratio.Prepare(ta);
+    const SliceGrid& gb = ratio.Prepare(tb);
     ForRows([&](int j) {
       for (int i = 0; i < Lut::kWidth; ++i) {
-        const View v = TexelView(theta, j, i);
-        const auto ra = ratio(theta, v, ta, TexelView(ta, j, i));
-        const auto rb = ratio(theta, v, tb, TexelView(tb, j, i));
+        const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
+        const auto ra = ratio.Between(g, ga, n);
+        const auto rb = ratio.Between(g, gb, n);
         const float* fa = measured.Texel(a, j, i);
         const float* fb = measured.Texel(b, j, i);
         float* dst = out.Texel(k, j, i);
@@ -183,18 +214,17 @@ Lut Densify(const Lut& measured, double step, const Ratio& ratio) {
 // Directional albedo per channel of slice k (its upper-hemisphere texels, column 360 left out),
 // and the part of it from texels for which `filled` is true.
 template <class Filled>
-void Albedo(const Lut& lut, int k, Filled filled, std::array<double, 3>* total,
+void Albedo(const Lut& lut, int k, const SliceGrid& g, Filled filled, std::array<double, 3>* total,
             std::array<double, 3>* fill) {
   *total = {0, 0, 0};
   *fill = {0, 0, 0};
-  const double t = lut.theta_in_deg[k];
   for (int j = 0; j < Lut::kHeight; ++j) {
     // The texel's cell: θd ∈ [j − ½, j + ½]° (clipped at the poles), φd ∈ [i − ½, i + ½]°.
     const double dw = (std::cos(DegToRad(std::max(j - 0.5, 0.0))) -
                        std::cos(DegToRad(std::min(j + 0.5, 180.0)))) *
                       DegToRad(Lut::kTexelDeg);
     for (int i = 0; i < Lut::kWidth - 1; ++i) {
-      const View v = TexelView(t, j, i);
+      const View v = g.view[static_cast<std::size_t>(j) * Lut::kWidth + i];
       if (v.theta_deg >= 90.0) continue;
       const double w = dw * std::cos(DegToRad(v.theta_deg));
       const float* f = lut.Texel(k, j, i);
@@ -209,16 +239,17 @@ void Albedo(const Lut& lut, int k, Filled filled, std::array<double, 3>* total,
 
 // Scales the filled texels of slice k so that its albedo is at most 1 per channel.
 template <class Filled>
-void LimitAlbedo(Lut* lut, int k, Filled filled, BeyondReport* report) {
+void LimitAlbedo(Lut* lut, int k, const SliceGrid& g, Filled filled, BeyondReport* report) {
   std::array<double, 3> total, fill;
-  Albedo(*lut, k, filled, &total, &fill);
+  Albedo(*lut, k, g, filled, &total, &fill);
   for (int c = 0; c < 3; ++c) {
     double albedo = total[c];
     if (total[c] > 1.0 && fill[c] > 0) {
       const double s = std::max(0.0, (1.0 - (total[c] - fill[c])) / fill[c]);
       for (int j = 0; j < Lut::kHeight; ++j)
         for (int i = 0; i < Lut::kWidth; ++i)
-          if (filled(j, i, TexelView(lut->theta_in_deg[k], j, i))) lut->Texel(k, j, i)[c] *= s;
+          if (filled(j, i, g.view[static_cast<std::size_t>(j) * Lut::kWidth + i]))
+            lut->Texel(k, j, i)[c] *= s;
       albedo = total[c] - fill[c] + fill[c] * s;
       ++report->albedo_scaled_channels;
     }
@@ -236,17 +267,19 @@ Lut Fill(const Lut& measured_in, double theta_b, double max_theta_in, double ste
   for (int k = 0; k < k_meas; ++k) {
     const double t = measured_in.theta_in_deg[k];
     if (ratio.model == nullptr) break;  // M ≡ 1: the band stays as it is
+    const SliceGrid& g = ratio.Prepare(t);
     ForRows([&](int j) {
       for (int i = 0; i < Lut::kWidth; ++i) {
-        const View v = TexelView(t, j, i);
+        const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
+        const View v = g.view[n];
         if (v.theta_deg <= theta_b) continue;
-        const auto r = ratio(t, v, t, View{theta_b, v.phi_deg});
+        const auto r = RatioOf(g.m[n], ratio.model->Eval(t, theta_b, v.phi_deg));
         float* f = out.Texel(k, j, i);
         for (int c = 0; c < 3; ++c) f[c] = static_cast<float>(f[c] * r[c]);
       }
     });
     LimitAlbedo(
-        &out, k, [&](int, int, const View& v) { return v.theta_deg > theta_b; }, report);
+        &out, k, g, [&](int, int, const View& v) { return v.theta_deg > theta_b; }, report);
   }
   // 2. Slices between the measured ones, when the step is finer.
   if (step > 0) {
@@ -265,9 +298,12 @@ Lut Fill(const Lut& measured_in, double theta_b, double max_theta_in, double ste
     const double t = k * delta;
     out.theta_in_deg.push_back(t);
     out.texels.resize(static_cast<std::size_t>(k + 1) * Lut::kHeight * Lut::kWidth * 3);
+    const SliceGrid& g = ratio.Prepare(t);
+    const SliceGrid& g_below = ratio.Prepare(t - delta);
     ForRows([&](int j) {
       for (int i = 0; i < Lut::kWidth; ++i) {
-        const View v = TexelView(t, j, i);
+        const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
+        const View v = g.view[n];
         const double to = std::min(v.theta_deg, 90.0);
         const double w = std::clamp((to - (last - kBlendDeg)) / (2 * kBlendDeg), 0.0, 1.0);
         std::array<double, 3> value{};
@@ -276,8 +312,7 @@ Lut Fill(const Lut& measured_in, double theta_b, double max_theta_in, double ste
           for (int c = 0; c < 3; ++c) value[c] = (1.0 - w) * f[c];
         }
         if (w > 0.0) {
-          const View below = TexelView(t - delta, j, i);
-          const auto r = ratio(t, v, t - delta, below);
+          const auto r = ratio.Between(g, g_below, n);
           const float* f = out.Texel(k - 1, j, i);
           for (int c = 0; c < 3; ++c) value[c] += w * f[c] * r[c];
         }
@@ -289,7 +324,7 @@ Lut Fill(const Lut& measured_in, double theta_b, double max_theta_in, double ste
     for (int j = 0; j < Lut::kHeight; ++j)
       std::copy_n(out.Texel(k, j, 0), 3, out.Texel(k, j, Lut::kWidth - 1));
     LimitAlbedo(
-        &out, k, [](int, int, const View&) { return true; }, report);
+        &out, k, g, [](int, int, const View&) { return true; }, report);
     report->extrapolated_theta_in_deg.push_back(t);
   }
   return out;
@@ -418,10 +453,11 @@ FillModel FitFillModel(const Lut& lut, double theta_b, Model family) {
   for (int k = 0; k < lut.slices(); ++k) {
     const double t = lut.theta_in_deg[k];
     for (int j = 0; j < Lut::kHeight; ++j) {
-      // Every texel row near the peak, every third row and column elsewhere.
+      // Every texel row near the peak (every third column), every fourth row and column
+      // elsewhere.
       const bool near = j <= 20;
-      if (!near && j % 3 != 0) continue;
-      for (int i = 0; i < Lut::kWidth - 1; i += near ? 2 : 3) {
+      if (!near && j % 4 != 0) continue;
+      for (int i = 0; i < Lut::kWidth - 1; i += near ? 3 : 4) {
         const View v = TexelView(t, j, i);
         if (v.theta_deg > theta_b) continue;
         FitPoint p;
@@ -439,7 +475,7 @@ FillModel FitFillModel(const Lut& lut, double theta_b, Model family) {
   const double lo = std::log(lafortune ? 1.0 : 0.005), hi = std::log(lafortune ? 20000.0 : 1.5);
   Candidate best, trial;
   double best_cost = HUGE_VAL;
-  const int n_grid = 24;
+  const int n_grid = 16;
   int best_n = 0;
   for (int n = 0; n < n_grid; ++n) {
     const double c =
@@ -454,7 +490,7 @@ FillModel FitFillModel(const Lut& lut, double theta_b, Model family) {
   Candidate m1, m2;
   double f1 = FitAtShape(family, pts, eps, std::exp(x1), &m1);
   double f2 = FitAtShape(family, pts, eps, std::exp(x2), &m2);
-  for (int it = 0; it < 16; ++it) {
+  for (int it = 0; it < 12; ++it) {
     if (f1 < f2) {
       b = x2, x2 = x1, f2 = f1, m2 = m1;
       x1 = b - g * (b - a);
