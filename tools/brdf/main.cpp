@@ -338,8 +338,9 @@ int main(int argc, char** argv) {
                    "What fills the light beyond the last measured slice and the view beyond "
                    "the last measured theta_out (docs/design.md §5): clamp (the nearest slice, "
                    "no extra slice), hold (extra slices up to 80 deg by reciprocity and the "
-                   "held measured values), model (extra slices and band from a GGX fitted to "
-                   "the capture, as a ratio on the measured values) or auto (hold or model, "
+                   "held measured values), model (extra slices and band from a ggx, ward or "
+                   "lafortune material fitted to the capture, as a ratio on the measured "
+                   "values; the family that predicts the last slice best from the others) or auto (hold or model, "
                    "whichever predicts the capture's last slice better from the others)")
       ->capture_default_str()
       ->check(CLI::IsMember({"clamp", "hold", "model", "auto"}));
