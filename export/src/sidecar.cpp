@@ -39,6 +39,8 @@ std::string SidecarText(const detail::PayloadSummary& payload,
   j["fitted_models"] = ordered_json::array();
   for (const std::string& text : metadata.fitted_models_json)
     j["fitted_models"].push_back(detail::ParseEmbeddedJson(text, "fitted model"));
+  if (!metadata.beyond_json.empty())
+    j["beyond"] = detail::ParseEmbeddedJson(metadata.beyond_json, "blind-spot fill record");
   j["tool"] = {
       {"name", "brdf-toolchain"},
       {"version", metadata.tool_version.empty() ? BrdfToolVersion() : metadata.tool_version}};

@@ -271,6 +271,11 @@ std::optional<std::string> OpenedSource::BeyondMeasuredWarning(double theta_in_d
   const double light = exchanged ? theta_out_deg : theta_in_deg;
   if (inside(light)) return std::nullopt;  // reciprocity: a measured slice answers
   const double nearest = light < lo ? lo : hi;
+  if (lut && lut->lut().theta_in_deg.back() > hi + kTolDeg)
+    return path + ": warning: θin " + Deg(theta_in_deg) + "° is outside the measured range " +
+           Deg(lo) + "°–" + Deg(hi) + "° and so is θout " + Deg(theta_out_deg) +
+           "°: the value is extrapolated from the measured slices (docs/design.md §5, "
+           "\"Beyond the measured slices\"), not measured";
   return path + ": warning: θin " + Deg(theta_in_deg) + "° is outside the measured range " +
          Deg(lo) + "°–" + Deg(hi) + "° and so is θout " + Deg(theta_out_deg) +
          "°: the value is the θin " + Deg(nearest) +
@@ -281,10 +286,25 @@ std::optional<std::string> OpenedSource::SphereCoverageNote(const std::string& p
   if (measured_theta_in_deg.empty()) return std::nullopt;
   const double hi = measured_theta_in_deg.back();
   if (hi >= kSphereCoverageThetaInDeg - Lut::kThetaInToleranceDeg) return std::nullopt;
+  const auto* lut = dynamic_cast<const LutBrdf*>(brdf.get());
+  if (lut && lut->lut().theta_in_deg.back() > hi + Lut::kThetaInToleranceDeg)
+    return path + ": note: θin measured up to " + Deg(hi) +
+           "°: where the sphere is both lit and seen more than " + Deg(hi) +
+           "° from its normal (towards its rim) the picture shows values extrapolated from the "
+           "measured slices up to " +
+           Deg(lut->lut().theta_in_deg.back()) +
+           "°, not measured ones (docs/preview.md, \"Captures\")";
   return path + ": note: θin measured up to " + Deg(hi) +
          "°: where the sphere is both lit and seen more than " + Deg(hi) +
          "° from its normal (towards its rim) the picture shows the " + Deg(hi) +
          "° slice's values, not measured ones (docs/preview.md, \"Captures\")";
+}
+
+processing::ResampleOptions DefaultResampleOptions() {
+  processing::ResampleOptions r;
+  r.beyond.method = processing::kDefaultBeyondMethod;
+  r.beyond.subdivisions = processing::kDefaultBeyondSubdivisions;
+  return r;
 }
 
 namespace {
@@ -339,7 +359,9 @@ OpenedSource OpenBrdf(const std::string& path_or_name, const OpenOptions& option
       out.warnings = std::move(p.warnings);
       auto brdf = std::make_unique<LutBrdf>(processing::MeasurementAsBrdf(
           p.measurement, p.extrapolation.params, options.resample, OutputNameOf(path)));
-      out.measured_theta_in_deg = brdf->lut().theta_in_deg;
+      for (const Slice& s : p.measurement.slices)
+        out.measured_theta_in_deg.push_back(s.theta_in_deg);
+      std::sort(out.measured_theta_in_deg.begin(), out.measured_theta_in_deg.end());
       out.extrapolation = p.extrapolation;
       out.evaluation = Evaluation::kResampledLut;
       out.brdf = std::move(brdf);
@@ -429,6 +451,7 @@ InputLut LutFromInput(const std::string& path, FileKind kind,
   out.saturated_samples = CountSaturated(p.measurement);
   processing::ResampleReport report;
   out.lut = processing::BuildLut(p.measurement, p.extrapolation.params, resample_options, &report);
+  if (report.beyond.used != processing::BeyondMethod::kClamp) out.beyond = report.beyond;
   if (report.theta_b_deg < 90.0)
     out.extrapolation = exporter::ExtrapolationInfo{p.extrapolation.params.p,
                                                     p.extrapolation.params.l, report.theta_b_deg};

@@ -80,7 +80,7 @@ int RunAtlas(const AtlasOptions& options) {
 
   tbb::global_control limit(tbb::global_control::max_allowed_parallelism,
                             static_cast<std::size_t>(options.jobs));
-  processing::ResampleOptions resample;
+  processing::ResampleOptions resample = sources::DefaultResampleOptions();
   resample.parallel = found.inputs.size() == 1 && options.jobs > 1;
   std::vector<Lut> luts(found.inputs.size());
   std::vector<std::optional<std::vector<exporter::SaturatedCount>>> saturated(found.inputs.size());

@@ -142,6 +142,9 @@ int RunConvert(const ConvertOptions& options) {
   processing::ResampleOptions resample;
   resample.parallel = alone && options.jobs > 1;
   export_options.jobs = alone ? options.jobs : 1;  // the BC6H encoder, likewise
+  resample.beyond.method = processing::ParseBeyondMethod(options.beyond);
+  resample.beyond.subdivisions = options.beyond_subdivide;
+  resample.Validate();
 
   Progress progress("convert", found.inputs.size(), !options.quiet);
   const std::vector<JobResult> results = RunJobs(
@@ -162,6 +165,7 @@ int RunConvert(const ConvertOptions& options) {
         metadata.source = in.path;
         metadata.extrapolation = built.extrapolation;
         metadata.saturated_samples = built.saturated_samples;
+        if (built.beyond) metadata.beyond_json = processing::BeyondReportJson(*built.beyond);
         std::vector<std::string> outputs =
             exporter::LutExportPaths(out_dir.string(), in.name, export_options.formats);
         for (std::string& p : engines::EngineOutputPaths(out_dir.string(), in.name, engine_set))

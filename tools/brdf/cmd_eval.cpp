@@ -87,6 +87,8 @@ int RunEval(const EvalOptions& options) {
   if (!options.extrapolate.empty()) extrapolate = ParseExtrapolationOption(options.extrapolate);
   sources::OpenOptions open_options;
   open_options.extrapolation = extrapolate;
+  open_options.resample.beyond.method = processing::ParseBeyondMethod(options.beyond);
+  open_options.resample.beyond.subdivisions = options.beyond_subdivide;
   const sources::OpenedSource source = sources::OpenBrdf(options.file, open_options);
   for (const std::string& w : source.warnings) std::fprintf(stderr, "%s\n", w.c_str());
   std::set<double> warned_theta_in;  // one warning per θin beyond the measured range

@@ -23,6 +23,9 @@ struct EvalOptions {
   double theta_in_deg = 0, phi_in_deg = 0;
   double theta_out_deg = 0, phi_out_deg = 0;
   std::string extrapolate;  // "P,L" for captures; empty: per-material JSON, else 1,0.5
+  // Captures: blind-spot fill, as `brdf convert --beyond` (processing::kDefaultBeyondMethod).
+  std::string beyond = "clamp";
+  int beyond_subdivide = 2;     // captures: as `brdf convert --beyond-subdivide`
   // Many directions at once instead of --in/--out: a file ("-" = stdin) of lines
   // "THETA_IN PHI_IN THETA_OUT PHI_OUT" (degrees, blanks or commas between); one output line
   // each. Empty lines and lines starting with '#' are skipped.
@@ -40,6 +43,10 @@ struct ConvertOptions {
   std::vector<std::string> inputs;  // files and folders
   std::string out;                  // output folder (created if missing)
   std::string extrapolate;          // "P,L"; empty: per-material JSON, else 1,0.5
+  // Blind-spot fill (brdf/processing/beyond.h): "clamp", "hold", "model" or "auto"; the default
+  // is processing::kDefaultBeyondMethod.
+  std::string beyond = "clamp";
+  int beyond_subdivide = 2;  // the filled LUT's θin step is the measured one divided by this
   std::string formats = kAllLutFormats;
   std::string exr_type = "float";  // EXR pixel type: "float" or "half"
   // EXR compression: "none" or "zip". None by default: ZIP shrinks a float composite of

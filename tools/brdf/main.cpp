@@ -182,6 +182,17 @@ int main(int argc, char** argv) {
                    "Captures: grazing extrapolation P,L (docs/design.md §6); default: the "
                    "per-material JSON beside the file, else 1,0.5")
       ->capture_default_str();
+  eval_cmd
+      ->add_option("--beyond", eval.beyond,
+                   "Captures: what fills the directions not measured, as 'brdf convert "
+                   "--beyond' (clamp, hold, model, auto)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"clamp", "hold", "model", "auto"}));
+  eval_cmd
+      ->add_option("--beyond-subdivide", eval.beyond_subdivide,
+                   "Captures: as 'brdf convert --beyond-subdivide'")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 20));
   eval_cmd->footer(
       "Captures are interpolated as 'brdf convert' resamples them; exported LUTs are sampled "
       "as a GPU samples the 3D texture (centre-exact coordinates, trilinear, clamp-to-edge). "
@@ -337,6 +348,24 @@ int main(int argc, char** argv) {
                    "default 1,0.5 (clamping); 'auto' fits GGX to each input and chooses P,L "
                    "that follow its fall-off to 90 deg (recorded in the sidecar)")
       ->capture_default_str();
+  convert_cmd
+      ->add_option("--beyond", convert.beyond,
+                   "What fills the light beyond the last measured slice and the view beyond "
+                   "the last measured theta_out (docs/design.md §5): clamp (the nearest slice, "
+                   "no extra slice), hold (extra slices up to 80 deg by reciprocity and the "
+                   "held measured values), model (extra slices and band from a ggx, ward or "
+                   "lafortune material fitted to the capture, as a ratio on the measured "
+                   "values; the family that predicts the last slice best from the others) or auto (hold or model, "
+                   "whichever predicts the capture's last slice better from the others)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"clamp", "hold", "model", "auto"}));
+  convert_cmd
+      ->add_option("--beyond-subdivide", convert.beyond_subdivide,
+                   "With hold, model or auto: the filled LUT's theta_in step is the measured "
+                   "one divided by this (2: 10 deg slices 0-80 for the reference instrument, "
+                   "filtering follows grazing highlights; 1: the measured step)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 20));
   convert_cmd->add_option("--formats", convert.formats, "Comma-separated outputs to write")
       ->capture_default_str();
   convert_cmd->add_option("--exr-type", convert.exr_type, kExrTypeHelp)

@@ -79,6 +79,7 @@ std::string_view InterpolationMethodName(InterpolationMethod method) {
 }
 
 void ResampleOptions::Validate() const {
+  beyond.Validate();
   if (neighbours < 4 || neighbours > 64)
     throw InvalidArgument("resample option neighbours must be in [4, 64], got " +
                           std::to_string(neighbours));
@@ -292,6 +293,12 @@ Lut BuildLut(const Measurement& measurement, const ExtrapolationParams& params,
     report->extrapolation = params;
     report->slices.clear();
     for (const auto& s : slices) report->slices.push_back(s->report());
+  }
+  if (options.beyond.method != BeyondMethod::kClamp)
+    return ExtendBeyondMeasured(lut, theta_b, options.beyond, report ? &report->beyond : nullptr);
+  if (report) {
+    report->beyond = BeyondReport{};
+    report->beyond.measured_theta_in_deg = lut.theta_in_deg;
   }
   return lut;
 }

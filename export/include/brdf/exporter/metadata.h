@@ -61,6 +61,9 @@ struct TextureMetadata {
   // Fitted analytic models (docs/design.md §9 material JSON objects, each a complete JSON text), if
   // any. Written verbatim into the sidecar's "fitted_models" array; must be valid JSON.
   std::vector<std::string> fitted_models_json;
+  // What filled the directions the instrument did not measure (processing::BeyondReportJson: a
+  // JSON object text), written as the sidecar's "beyond"; empty: not recorded (no fill).
+  std::string beyond_json;
   // File names (no folder) of the other outputs of the same conversion ("gold.ktx2", ...),
   // recorded in the sidecar so `brdf info`/`brdf eval` can find the textures from it.
   std::vector<std::string> companion_files;

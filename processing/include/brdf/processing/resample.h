@@ -43,6 +43,7 @@
 
 #include "brdf/core/lut.h"
 #include "brdf/core/measurement.h"
+#include "brdf/processing/beyond.h"
 #include "brdf/processing/extrapolation.h"
 
 namespace brdf::processing {
@@ -67,6 +68,11 @@ struct ResampleOptions {
   // and Lut::SampleAngles interpolates between neighbouring slices the same way. Such a LUT is
   // for evaluation only; the exported textures need θin,k = k·Δin.
   bool require_uniform_theta_in = true;
+  // What fills the directions the instrument did not measure (light beyond the last slice,
+  // view beyond θb): ExtendBeyondMeasured (beyond.h) after resampling, so the LUT carries
+  // extra slices k·Δin up to beyond.max_theta_in_deg. kClamp builds the LUT as before (the
+  // measured slices only, §6 band). Not applied to a θin list that is not k·Δin.
+  BeyondOptions beyond;
 
   // Throws InvalidArgument naming the bad option.
   void Validate() const;
@@ -89,7 +95,8 @@ struct ResampleReport {
   double theta_b_deg = 0;   // last measured polar angle, start of the extrapolated band
   double delta_in_deg = 0;  // Δin (0 for a single slice)
   ExtrapolationParams extrapolation;
-  std::vector<SliceResampleReport> slices;  // ascending θin, one per LUT slice
+  std::vector<SliceResampleReport> slices;  // ascending θin, one per measured slice
+  BeyondReport beyond;                      // what filled the blind spots
 };
 
 // One reason BuildLut refuses a measurement (or, for kDegenerateRange, would build a LUT with no

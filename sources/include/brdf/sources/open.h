@@ -101,12 +101,17 @@ struct OpenedTexture {
 // that texture. Throws IoError / FormatError / InvalidArgument (another kind of file).
 OpenedTexture OpenExportedTexture(const std::string& path);
 
+// ResampleOptions as the commands use them unless told otherwise: the blind-spot fill
+// processing::kDefaultBeyondMethod with kDefaultBeyondSubdivisions.
+processing::ResampleOptions DefaultResampleOptions();
+
 struct OpenOptions {
   // §6 parameters from the command line (captures and tables; ignored with a warning for
   // exported LUTs, where the extrapolation is baked in).
   std::optional<processing::ExtrapolationParams> extrapolation;
-  // How captures are resampled (the same options `brdf convert` uses by default).
-  processing::ResampleOptions resample;
+  // How captures are resampled (the same options `brdf convert` uses by default, the
+  // blind-spot fill of brdf/processing/beyond.h included).
+  processing::ResampleOptions resample = DefaultResampleOptions();
 };
 
 // How OpenBrdf evaluates the file.
@@ -186,6 +191,8 @@ struct InputLut {
   Lut lut;
   std::optional<exporter::ExtrapolationInfo> extrapolation;  // what filled θout > θb
   std::optional<std::vector<exporter::SaturatedCount>> saturated_samples;  // absent: unknown
+  // What filled the blind spots (a resampled input with a fill other than clamp).
+  std::optional<processing::BeyondReport> beyond;
   std::vector<std::string> warnings;
 };
 InputLut LutFromInput(const std::string& path, FileKind kind,

@@ -1,0 +1,589 @@
+#include "brdf/processing/beyond.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <memory>
+#include <string>
+
+#include "brdf/core/error.h"
+#include "brdf/core/geometry.h"
+#include "brdf/core/models.h"
+
+#include <tbb/parallel_for.h>
+#include <nlohmann/json.hpp>
+
+namespace brdf::processing {
+namespace {
+
+constexpr double kGrazingDeg = 89.5;  // the model is read here at and below the horizon
+constexpr double kBlendDeg = 5.0;     // half width of the reciprocity/continuation seam
+constexpr double kMaxRatio = 8.0;
+// The ratio M(new)/M(old) is read with the fitted lobe widened to at least this (α ≥ 0.1 for
+// ggx and ward, n ≤ 200 for lafortune): the ratio is meant to carry the smooth change with
+// θin (Fresnel, shadowing, the 1/cos factors), and a lobe a degree wide, as the fit gives for
+// sharp measured highlights, turns a sub-degree misplacement into a factor of 8.
+constexpr double kMinRatioAlpha = 0.1, kMaxRatioExponent = 200.0;
+
+FillModel Widened(FillModel m) {
+  for (int c = 6; c < 9; ++c)
+    m.material.values[c] = m.material.model == Model::kLafortune
+                               ? std::min(m.material.values[c], kMaxRatioExponent)
+                               : std::max(m.material.values[c], kMinRatioAlpha);
+  return m;
+}
+
+// Runs body(j) for every texel row j, on TBB's workers (within any enclosing arena's limit).
+template <class Body>
+void ForRows(const Body& body) {
+  tbb::parallel_for(0, Lut::kHeight, [&](int j) { body(j); });
+}
+
+struct View {
+  double theta_deg, phi_deg;
+};
+
+// The view (θout, φout) of texel (j, i) of the slice at θin (θout up to 180°).
+View TexelView(double theta_in_deg, int j, int i) {
+  const Vec3 w = SpecularFrame::FromThetaInDeg(theta_in_deg)
+                     .FromSpecular(SphericalDirectionDeg(j * Lut::kTexelDeg, i * Lut::kTexelDeg));
+  return {RadToDeg(ThetaOf(w)), RadToDeg(PhiOf(w))};
+}
+
+// A fill family at one geometry and shape: f = a·(1/π) + b·y + offset per channel, with a the
+// diffuse reflectance and b the family's second linear parameter (f0, ρs, ks), each from the
+// model's one definition (brdf/core/models.h).
+struct Parts {
+  double y = 0, offset = 0;
+};
+Parts PartsOf(Model family, const ShadingGeometry& g, double shape) {
+  switch (family) {
+    case Model::kWard:
+      return {models::Ward(g, 0.0, 1.0, shape), 0.0};
+    case Model::kLafortune:
+      return {models::Lafortune(g, 0.0, 1.0, shape), 0.0};
+    default: {
+      const double off = models::Ggx(g, 0.0, 0.0, shape);
+      return {models::Ggx(g, 0.0, 1.0, shape) - off, off};
+    }
+  }
+}
+
+ShadingGeometry GeometryAt(double theta_in_deg, double theta_out_deg, double phi_out_deg) {
+  const Vec3 l = SphericalDirectionDeg(std::min(theta_in_deg, kGrazingDeg), 0.0);
+  const Vec3 v = SphericalDirectionDeg(std::min(theta_out_deg, kGrazingDeg), phi_out_deg);
+  return ShadingGeometry::Of(l, v);
+}
+
+struct FitPoint {
+  ShadingGeometry g;
+  std::array<double, 3> f;
+};
+
+// Weighted least squares of kd, f0 ∈ [0, 1] for one channel: Σ w (kd/π + f0·a + b − f)².
+struct Normal {
+  double saa = 0, sab = 0, sbb = 0, sa = 0, sb = 0, s = 0;  // Σw·(x_k x_l), Σw·x_k·y, Σw·y²
+};
+double SolveBounded(const Normal& n, double* kd, double* f0) {
+  // Unknowns x = (kd/π coefficient 1/π, f0 coefficient a); cost = xᵀAx − 2xᵀr + s.
+  const auto cost = [&](double x, double y) {
+    return n.saa * x * x + 2 * n.sab * x * y + n.sbb * y * y - 2 * (n.sa * x + n.sb * y) + n.s;
+  };
+  double best = HUGE_VAL;
+  const auto consider = [&](double x, double y) {
+    x = std::clamp(x, 0.0, 1.0);
+    y = std::clamp(y, 0.0, 1.0);
+    const double c = cost(x, y);
+    if (c < best) best = c, *kd = x, *f0 = y;
+  };
+  const double det = n.saa * n.sbb - n.sab * n.sab;
+  if (det > 1e-300)
+    consider((n.sa * n.sbb - n.sb * n.sab) / det, (n.sb * n.saa - n.sa * n.sab) / det);
+  for (double x : {0.0, 1.0}) consider(x, n.sbb > 0 ? (n.sb - n.sab * x) / n.sbb : 0.0);
+  for (double y : {0.0, 1.0}) consider(n.saa > 0 ? (n.sa - n.sab * y) / n.saa : 0.0, y);
+  return best;
+}
+
+struct Candidate {
+  std::array<double, 3> a{}, b{};
+  double shape = 0;
+};
+
+double FitAtShape(Model family, const std::vector<FitPoint>& pts, const std::array<double, 3>& eps,
+                  double shape, Candidate* out) {
+  std::array<Normal, 3> n{};
+  for (const FitPoint& p : pts) {
+    const Parts q = PartsOf(family, p.g, shape);
+    const double x = kInvPi;
+    for (int c = 0; c < 3; ++c) {
+      const double w = 1.0 / ((p.f[c] + eps[c]) * (p.f[c] + eps[c]));
+      const double y = p.f[c] - q.offset;
+      n[c].saa += w * x * x, n[c].sab += w * x * q.y, n[c].sbb += w * q.y * q.y;
+      n[c].sa += w * x * y, n[c].sb += w * q.y * y, n[c].s += w * y * y;
+    }
+  }
+  double total = 0;
+  for (int c = 0; c < 3; ++c) total += SolveBounded(n[c], &out->a[c], &out->b[c]);
+  out->shape = shape;
+  return total;
+}
+
+// A fill "model" of kHold is M ≡ 1; of kModel the fitted GGX.
+std::array<double, 3> RatioOf(const std::array<double, 3>& a, const std::array<double, 3>& b) {
+  std::array<double, 3> r{};
+  for (int c = 0; c < 3; ++c)
+    r[c] = b[c] > 1e-30 ? std::clamp(a[c] / b[c], 1.0 / kMaxRatio, kMaxRatio) : 1.0;
+  return r;
+}
+
+// Every texel's view in the slice at one θin, and the model there (computed once per θin).
+struct SliceGrid {
+  std::vector<View> view;                // index j·361 + i
+  std::vector<std::array<double, 3>> m;  // empty for M ≡ 1
+};
+
+// M(new)/M(old) at texels; kHold's model is null (M ≡ 1).
+struct Ratio {
+  const FillModel* model = nullptr;
+  // The grid of the slice at `theta_in_deg`, computed on first use. Not thread-safe: call it
+  // outside the parallel loops, which then only read the grids.
+  const SliceGrid& Prepare(double theta_in_deg) const {
+    const long key = std::lround(theta_in_deg * 1e6);
+    if (auto it = grids->find(key); it != grids->end()) return it->second;
+    SliceGrid g;
+    g.view.resize(static_cast<std::size_t>(Lut::kHeight) * Lut::kWidth);
+    if (model) g.m.resize(g.view.size());
+    ForRows([&](int j) {
+      for (int i = 0; i < Lut::kWidth; ++i) {
+        const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
+        g.view[n] = TexelView(theta_in_deg, j, i);
+        if (model) g.m[n] = model->Eval(theta_in_deg, g.view[n].theta_deg, g.view[n].phi_deg);
+      }
+    });
+    return grids->emplace(key, std::move(g)).first->second;
+  }
+  std::array<double, 3> Between(const SliceGrid& now, const SliceGrid& old, std::size_t n) const {
+    if (model == nullptr) return {1.0, 1.0, 1.0};
+    return RatioOf(now.m[n], old.m[n]);
+  }
+  std::shared_ptr<std::map<long, SliceGrid>> grids = std::make_shared<std::map<long, SliceGrid>>();
+};
+
+// Slices every `step` degrees from 0 to the last measured one (which are kept as they are).
+// A slice θ between measured slices θa < θb, weight t = (θ − θa)/(θb − θa), texel (θd, φd):
+//   (1 − t)·f(θa)·M(θ)/M(θa) + t·f(θb)·M(θ)/M(θb)
+// with M at each slice's own view of that texel: linear in θin at equal (θd, φd) for M ≡ 1,
+// and following the model's change with θin otherwise.
+Lut Densify(const Lut& measured, double step, const Ratio& ratio) {
+  const double delta = measured.DeltaInDeg();
+  const int per = static_cast<int>(std::lround(delta / step));
+  if (per <= 1) return measured;
+  Lut out;
+  out.Resize(static_cast<std::size_t>((measured.slices() - 1) * per + 1));
+  for (int k = 0; k < out.slices(); ++k) {
+    const double theta = k * step;
+    out.theta_in_deg[k] = theta;
+    const int a = k / per;
+    if (k % per == 0) {
+      std::copy_n(measured.Texel(a, 0, 0), static_cast<std::size_t>(Lut::kHeight) * Lut::kWidth * 3,
+                  out.Texel(k, 0, 0));
+      continue;
+    }
+    const int b = a + 1;
+    const double t = static_cast<double>(k % per) / per;
+    const double ta = measured.theta_in_deg[a], tb = measured.theta_in_deg[b];
+    const SliceGrid& g = ratio.Prepare(theta);
+    const SliceGrid& ga = ratio.Prepare(ta);
+    const SliceGrid& gb = ratio.Prepare(tb);
+    ForRows([&](int j) {
+      for (int i = 0; i < Lut::kWidth; ++i) {
+        const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
+        const auto ra = ratio.Between(g, ga, n);
+        const auto rb = ratio.Between(g, gb, n);
+        const float* fa = measured.Texel(a, j, i);
+        const float* fb = measured.Texel(b, j, i);
+        float* dst = out.Texel(k, j, i);
+        for (int c = 0; c < 3; ++c)
+          dst[c] = static_cast<float>((1.0 - t) * fa[c] * ra[c] + t * fb[c] * rb[c]);
+      }
+    });
+  }
+  return out;
+}
+
+// Directional albedo per channel of slice k (its upper-hemisphere texels, column 360 left out),
+// and the part of it from texels for which `filled` is true.
+template <class Filled>
+void Albedo(const Lut& lut, int k, const SliceGrid& g, Filled filled, std::array<double, 3>* total,
+            std::array<double, 3>* fill) {
+  *total = {0, 0, 0};
+  *fill = {0, 0, 0};
+  for (int j = 0; j < Lut::kHeight; ++j) {
+    // The texel's cell: θd ∈ [j − ½, j + ½]° (clipped at the poles), φd ∈ [i − ½, i + ½]°.
+    const double dw = (std::cos(DegToRad(std::max(j - 0.5, 0.0))) -
+                       std::cos(DegToRad(std::min(j + 0.5, 180.0)))) *
+                      DegToRad(Lut::kTexelDeg);
+    for (int i = 0; i < Lut::kWidth - 1; ++i) {
+      const View v = g.view[static_cast<std::size_t>(j) * Lut::kWidth + i];
+      if (v.theta_deg >= 90.0) continue;
+      const double w = dw * std::cos(DegToRad(v.theta_deg));
+      const float* f = lut.Texel(k, j, i);
+      const bool is_fill = filled(j, i, v);
+      for (int c = 0; c < 3; ++c) {
+        (*total)[c] += w * f[c];
+        if (is_fill) (*fill)[c] += w * f[c];
+      }
+    }
+  }
+}
+
+// Scales the filled texels of slice k so that its albedo is at most 1 per channel.
+template <class Filled>
+void LimitAlbedo(Lut* lut, int k, const SliceGrid& g, Filled filled, BeyondReport* report) {
+  std::array<double, 3> total, fill;
+  Albedo(*lut, k, g, filled, &total, &fill);
+  for (int c = 0; c < 3; ++c) {
+    double albedo = total[c];
+    if (total[c] > 1.0 && fill[c] > 0) {
+      const double s = std::max(0.0, (1.0 - (total[c] - fill[c])) / fill[c]);
+      for (int j = 0; j < Lut::kHeight; ++j)
+        for (int i = 0; i < Lut::kWidth; ++i)
+          if (filled(j, i, g.view[static_cast<std::size_t>(j) * Lut::kWidth + i]))
+            lut->Texel(k, j, i)[c] *= s;
+      albedo = total[c] - fill[c] + fill[c] * s;
+      ++report->albedo_scaled_channels;
+    }
+    report->max_albedo = std::max(report->max_albedo, albedo);
+  }
+}
+
+// The fill of `measured` by `ratio` (no validation, no method choice).
+Lut Fill(const Lut& measured_in, double theta_b, double max_theta_in, double step,
+         const Ratio& ratio, BeyondReport* report) {
+  Lut out = measured_in;
+  const int k_meas = measured_in.slices();
+  const double last = measured_in.theta_in_deg.back();
+  // 1. The θout band of the measured slices.
+  for (int k = 0; k < k_meas; ++k) {
+    const double t = measured_in.theta_in_deg[k];
+    if (ratio.model == nullptr) break;  // M ≡ 1: the band stays as it is
+    const SliceGrid& g = ratio.Prepare(t);
+    ForRows([&](int j) {
+      for (int i = 0; i < Lut::kWidth; ++i) {
+        const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
+        const View v = g.view[n];
+        if (v.theta_deg <= theta_b) continue;
+        const auto r = RatioOf(g.m[n], ratio.model->Eval(t, theta_b, v.phi_deg));
+        float* f = out.Texel(k, j, i);
+        for (int c = 0; c < 3; ++c) f[c] = static_cast<float>(f[c] * r[c]);
+      }
+    });
+    LimitAlbedo(
+        &out, k, g, [&](int, int, const View& v) { return v.theta_deg > theta_b; }, report);
+  }
+  // 2. Slices between the measured ones, when the step is finer.
+  if (step > 0) {
+    out = Densify(out, step, ratio);
+    for (double t : out.theta_in_deg)
+      if (std::none_of(measured_in.theta_in_deg.begin(), measured_in.theta_in_deg.end(),
+                       [&](double m) { return std::fabs(m - t) < 1e-6; }))
+        report->inserted_theta_in_deg.push_back(t);
+  }
+  const int k_meas_step = out.slices();
+  const double delta = out.DeltaInDeg();
+  const Lut banded = out;  // measured slices with their band: what reciprocity reads
+  // 3. New slices beyond the last measured one.
+  const int k_total = static_cast<int>(std::floor(max_theta_in / delta + 1e-9)) + 1;
+  for (int k = k_meas_step; k < k_total; ++k) {
+    const double t = k * delta;
+    out.theta_in_deg.push_back(t);
+    out.texels.resize(static_cast<std::size_t>(k + 1) * Lut::kHeight * Lut::kWidth * 3);
+    const SliceGrid& g = ratio.Prepare(t);
+    const SliceGrid& g_below = ratio.Prepare(t - delta);
+    ForRows([&](int j) {
+      for (int i = 0; i < Lut::kWidth; ++i) {
+        const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
+        const View v = g.view[n];
+        const double to = std::min(v.theta_deg, 90.0);
+        const double w = std::clamp((to - (last - kBlendDeg)) / (2 * kBlendDeg), 0.0, 1.0);
+        std::array<double, 3> value{};
+        if (w < 1.0) {
+          const auto f = banded.SampleTexture(std::min(to, last), std::min(t, 90.0), -v.phi_deg);
+          for (int c = 0; c < 3; ++c) value[c] = (1.0 - w) * f[c];
+        }
+        if (w > 0.0) {
+          const auto r = ratio.Between(g, g_below, n);
+          const float* f = out.Texel(k - 1, j, i);
+          for (int c = 0; c < 3; ++c) value[c] += w * f[c] * r[c];
+        }
+        float* dst = out.Texel(k, j, i);
+        for (int c = 0; c < 3; ++c) dst[c] = static_cast<float>(value[c]);
+      }
+    });
+    // Column 360 repeats column 0 (docs/design.md §5).
+    for (int j = 0; j < Lut::kHeight; ++j)
+      std::copy_n(out.Texel(k, j, 0), 3, out.Texel(k, j, Lut::kWidth - 1));
+    LimitAlbedo(
+        &out, k, g, [](int, int, const View&) { return true; }, report);
+    report->extrapolated_theta_in_deg.push_back(t);
+  }
+  return out;
+}
+
+LeaveLastSliceOut Validate(const Lut& measured, double theta_b, const Lut& filled) {
+  LeaveLastSliceOut v;
+  const int k = measured.slices() - 1;
+  v.theta_in_deg = measured.theta_in_deg[k];
+  const int kf = static_cast<int>(
+      std::find_if(filled.theta_in_deg.begin(), filled.theta_in_deg.end(),
+                   [&](double t) { return std::fabs(t - v.theta_in_deg) < 1e-6; }) -
+      filled.theta_in_deg.begin());
+  std::vector<double> got, want;
+  for (int j = 0; j < Lut::kHeight; ++j)
+    for (int i = 0; i < Lut::kWidth - 1; ++i) {
+      if (TexelView(v.theta_in_deg, j, i).theta_deg > theta_b) continue;
+      const float* a = filled.Texel(kf, j, i);
+      const float* b = measured.Texel(k, j, i);
+      got.push_back(double(a[0]) + a[1] + a[2]);
+      want.push_back(double(b[0]) + b[1] + b[2]);
+    }
+  const double floor = 1e-3 * *std::max_element(want.begin(), want.end());
+  std::vector<double> e(got.size());
+  for (std::size_t n = 0; n < e.size(); ++n)
+    e[n] = std::fabs(got[n] - want[n]) / std::max(want[n], floor);
+  v.texels = e.size();
+  const auto at = [&](double q) {
+    std::vector<double> s = e;
+    const std::size_t n =
+        std::min(s.size() - 1, static_cast<std::size_t>(q * (s.size() - 1) + 0.5));
+    std::nth_element(s.begin(), s.begin() + static_cast<std::ptrdiff_t>(n), s.end());
+    return s[n];
+  };
+  v.median = at(0.5);
+  v.p90 = at(0.9);
+  return v;
+}
+
+// Which validation is better: the lower p90 relative error, then the lower median (the tail is
+// where glossy peaks and grazing growth sit, which a median over mostly diffuse texels misses).
+std::pair<double, double> Key(const LeaveLastSliceOut& v) { return {v.p90, v.median}; }
+
+bool Uniform(const Lut& lut) {
+  const double delta = lut.DeltaInDeg();
+  if (lut.slices() < 2 || !(delta > 0) || std::fabs(lut.theta_in_deg[0]) > 1e-9) return false;
+  for (int k = 0; k < lut.slices(); ++k)
+    if (std::fabs(lut.theta_in_deg[k] - k * delta) > 1e-6) return false;
+  return true;
+}
+
+}  // namespace
+
+std::string_view BeyondMethodName(BeyondMethod method) {
+  switch (method) {
+    case BeyondMethod::kClamp:
+      return "clamp";
+    case BeyondMethod::kHold:
+      return "hold";
+    case BeyondMethod::kModel:
+      return "model";
+    case BeyondMethod::kAuto:
+      return "auto";
+  }
+  return "clamp";
+}
+
+BeyondMethod ParseBeyondMethod(std::string_view text) {
+  for (BeyondMethod m :
+       {BeyondMethod::kClamp, BeyondMethod::kHold, BeyondMethod::kModel, BeyondMethod::kAuto})
+    if (text == BeyondMethodName(m)) return m;
+  throw InvalidArgument("--beyond: expected clamp, hold, model or auto, got '" + std::string(text) +
+                        "'");
+}
+
+void BeyondOptions::Validate() const {
+  if (!(max_theta_in_deg > 0.0 && max_theta_in_deg <= 90.0))
+    throw InvalidArgument("beyond: the largest extrapolated θin must be in (0°, 90°], got " +
+                          std::to_string(max_theta_in_deg));
+  if (subdivisions < 1 || subdivisions > 20)
+    throw InvalidArgument("beyond: subdivisions of the measured θin step must be in [1, 20], got " +
+                          std::to_string(subdivisions));
+}
+
+std::array<double, 3> FillModel::Eval(double theta_in_deg, double theta_out_deg,
+                                      double phi_out_deg) const {
+  const ShadingGeometry g = GeometryAt(theta_in_deg, theta_out_deg, phi_out_deg);
+  const Rgb f = models::EvaluateRgb(material.model, g, material.values.data());
+  return {f[0], f[1], f[2]};
+}
+
+std::string BeyondReportJson(const BeyondReport& r) {
+  using nlohmann::ordered_json;
+  ordered_json j;
+  j["method"] = std::string(BeyondMethodName(r.used));
+  j["requested"] = std::string(BeyondMethodName(r.requested));
+  j["measured_theta_in"] = r.measured_theta_in_deg;
+  j["extrapolated_theta_in"] = r.extrapolated_theta_in_deg;
+  j["inserted_theta_in"] = r.inserted_theta_in_deg;
+  j["subdivisions"] = r.subdivisions;
+  const auto loo = [](const std::optional<LeaveLastSliceOut>& v) {
+    if (!v) return ordered_json(nullptr);
+    return ordered_json{{"theta_in", v->theta_in_deg},
+                        {"median_relative_error", v->median},
+                        {"p90_relative_error", v->p90},
+                        {"texels", v->texels}};
+  };
+  j["leave_last_slice_out"] = loo(r.validation);
+  j["leave_last_slice_out_hold"] = loo(r.validation_hold);
+  j["leave_last_slice_out_model"] = loo(r.validation_model);
+  if (r.model) {
+    j["model"] = ordered_json::parse(MaterialToJson(r.model->material));
+    j["model"]["median_relative_error"] = r.model->median_relative_error;
+  } else {
+    j["model"] = nullptr;
+  }
+  j["max_albedo"] = r.max_albedo;
+  return j.dump();
+}
+
+FillModel FitFillModel(const Lut& lut, double theta_b, Model family) {
+  if (lut.slices() == 0 || lut.texels.empty())
+    throw InvalidArgument("FitFillModel: the LUT has no slices");
+  std::vector<FitPoint> pts;
+  std::array<double, 3> mean{};
+  for (int k = 0; k < lut.slices(); ++k) {
+    const double t = lut.theta_in_deg[k];
+    for (int j = 0; j < Lut::kHeight; ++j) {
+      // Every texel row near the peak (every third column), every fourth row and column
+      // elsewhere.
+      const bool near = j <= 20;
+      if (!near && j % 4 != 0) continue;
+      for (int i = 0; i < Lut::kWidth - 1; i += near ? 3 : 4) {
+        const View v = TexelView(t, j, i);
+        if (v.theta_deg > theta_b) continue;
+        FitPoint p;
+        p.g = GeometryAt(t, v.theta_deg, v.phi_deg);
+        const float* f = lut.Texel(k, j, i);
+        for (int c = 0; c < 3; ++c) p.f[c] = f[c], mean[c] += f[c];
+        pts.push_back(p);
+      }
+    }
+  }
+  std::array<double, 3> eps{};
+  const double all = (mean[0] + mean[1] + mean[2]) / (3.0 * std::max<std::size_t>(pts.size(), 1));
+  for (int c = 0; c < 3; ++c) eps[c] = 0.02 * all + 1e-6;
+  const bool lafortune = family == Model::kLafortune;
+  const double lo = std::log(lafortune ? 1.0 : 0.005), hi = std::log(lafortune ? 20000.0 : 1.5);
+  Candidate best, trial;
+  double best_cost = HUGE_VAL;
+  const int n_grid = 16;
+  int best_n = 0;
+  for (int n = 0; n < n_grid; ++n) {
+    const double c =
+        FitAtShape(family, pts, eps, std::exp(lo + (hi - lo) * n / (n_grid - 1)), &trial);
+    if (c < best_cost) best_cost = c, best = trial, best_n = n;
+  }
+  // Golden section in log(shape) between the grid neighbours.
+  double a = lo + (hi - lo) * std::max(0, best_n - 1) / (n_grid - 1);
+  double b = lo + (hi - lo) * std::min(n_grid - 1, best_n + 1) / (n_grid - 1);
+  const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+  double x1 = b - g * (b - a), x2 = a + g * (b - a);
+  Candidate m1, m2;
+  double f1 = FitAtShape(family, pts, eps, std::exp(x1), &m1);
+  double f2 = FitAtShape(family, pts, eps, std::exp(x2), &m2);
+  for (int it = 0; it < 12; ++it) {
+    if (f1 < f2) {
+      b = x2, x2 = x1, f2 = f1, m2 = m1;
+      x1 = b - g * (b - a);
+      f1 = FitAtShape(family, pts, eps, std::exp(x1), &m1);
+    } else {
+      a = x1, x1 = x2, f1 = f2, m1 = m2;
+      x2 = a + g * (b - a);
+      f2 = FitAtShape(family, pts, eps, std::exp(x2), &m2);
+    }
+  }
+  if (f1 < best_cost) best = m1, best_cost = f1;
+  if (f2 < best_cost) best = m2, best_cost = f2;
+  FillModel out;
+  out.material =
+      Material::Make(family,
+                     {Rgb{best.a[0], best.a[1], best.a[2]}, Rgb{best.b[0], best.b[1], best.b[2]},
+                      Rgb{best.shape, best.shape, best.shape}},
+                     "blind-spot fill");
+  std::vector<double> rel;
+  rel.reserve(pts.size() * 3);
+  for (const FitPoint& p : pts) {
+    const Rgb m = models::EvaluateRgb(family, p.g, out.material.values.data());
+    for (int c = 0; c < 3; ++c) rel.push_back(std::fabs(m[c] - p.f[c]) / std::max(p.f[c], 1e-3));
+  }
+  if (!rel.empty()) {
+    std::nth_element(rel.begin(), rel.begin() + static_cast<std::ptrdiff_t>(rel.size() / 2),
+                     rel.end());
+    out.median_relative_error = rel[rel.size() / 2];
+  }
+  out.texels = pts.size();
+  return out;
+}
+
+Lut ExtendBeyondMeasured(const Lut& measured, double theta_b, const BeyondOptions& options,
+                         BeyondReport* report) {
+  options.Validate();
+  BeyondReport local;
+  BeyondReport& r = report ? *report : local;
+  r = BeyondReport{};
+  r.requested = options.method;
+  r.measured_theta_in_deg = measured.theta_in_deg;
+  const double last = measured.theta_in_deg.empty() ? 0.0 : measured.theta_in_deg.back();
+  const double step = measured.DeltaInDeg() / options.subdivisions;
+  if (options.method == BeyondMethod::kClamp || !Uniform(measured) ||
+      !(options.max_theta_in_deg >= last + step - 1e-9))
+    return measured;
+  r.subdivisions = options.subdivisions;
+  const double fill_step = options.subdivisions > 1 ? step : 0.0;
+
+  // Validation: the fill from all slices but the last, read at the last one.
+  const bool validate = measured.slices() >= 3;
+  Lut head;
+  if (validate) {
+    head.theta_in_deg.assign(measured.theta_in_deg.begin(), measured.theta_in_deg.end() - 1);
+    head.texels.assign(
+        measured.texels.begin(),
+        measured.texels.begin() +
+            static_cast<std::ptrdiff_t>(head.theta_in_deg.size() * Lut::kHeight * Lut::kWidth * 3));
+  }
+  const auto validate_with = [&](const Ratio& ratio) {
+    BeyondReport scratch;
+    const Lut f = Fill(head, theta_b, last, fill_step, ratio, &scratch);
+    return Validate(measured, theta_b, f);
+  };
+  BeyondMethod use = options.method;
+  if (validate && (use == BeyondMethod::kHold || use == BeyondMethod::kAuto))
+    r.validation_hold = validate_with(Ratio{});
+  // kModel: the family whose fill predicts the left-out slice best (GGX without validation).
+  Model family = Model::kGgx;
+  if (validate && (use == BeyondMethod::kModel || use == BeyondMethod::kAuto)) {
+    for (Model m : {Model::kGgx, Model::kWard, Model::kLafortune}) {
+      const FillModel head_model = Widened(FitFillModel(head, theta_b, m));
+      const LeaveLastSliceOut v = validate_with(Ratio{&head_model});
+      if (!r.validation_model || Key(v) < Key(*r.validation_model)) {
+        r.validation_model = v;
+        family = m;
+      }
+    }
+  }
+  if (use == BeyondMethod::kAuto) {
+    use = BeyondMethod::kModel;
+    if (r.validation_hold && r.validation_model &&
+        Key(*r.validation_hold) < Key(*r.validation_model))
+      use = BeyondMethod::kHold;
+  }
+  r.used = use;
+  r.validation = use == BeyondMethod::kModel ? r.validation_model : r.validation_hold;
+  if (use == BeyondMethod::kModel) {
+    r.model = FitFillModel(measured, theta_b, family);
+    const FillModel ratio_model = Widened(*r.model);
+    return Fill(measured, theta_b, options.max_theta_in_deg, fill_step, Ratio{&ratio_model}, &r);
+  }
+  return Fill(measured, theta_b, options.max_theta_in_deg, fill_step, Ratio{}, &r);
+}
+
+}  // namespace brdf::processing
