@@ -265,16 +265,16 @@ std::vector<std::string> WriteAtlas(const std::string& prefix,
     WriteDds(prefix + ".dds", atlas.volume);
   }
   written.push_back(prefix + ".dds");
-  WriteExr(prefix + ".exr", AtlasImage(materials), exr_options,
-           {{"brdf:atlas", manifest},
-            {"brdf:theta_in_deg", FormatThetaList(atlas.theta_in_deg)},
-            {"brdf:layout",
-             fmt::format("{} x {} slice grids of {} x {} material cells (361 x 181 each), "
-                         "row-major, ascending theta_in, top-left first",
-                         atlas.layout.composite.columns, atlas.layout.composite.rows,
-                         atlas.layout.cells.columns, atlas.layout.cells.rows)},
-            {"brdf:payload_crc32",
-             Hex32Text(atlas.bc6h ? atlas.bc6h->Crc32() : atlas.volume.Crc32())}});
+  WriteExr(
+      prefix + ".exr", AtlasImage(materials), exr_options,
+      {{"brdf:atlas", manifest},
+       {"brdf:theta_in_deg", FormatThetaList(atlas.theta_in_deg)},
+       {"brdf:layout",
+        fmt::format("{} x {} slice grids of {} x {} material cells (361 x 181 each), "
+                    "row-major, ascending theta_in, top-left first",
+                    atlas.layout.composite.columns, atlas.layout.composite.rows,
+                    atlas.layout.cells.columns, atlas.layout.cells.rows)},
+       {"brdf:payload_crc32", Hex32Text(atlas.bc6h ? atlas.bc6h->Crc32() : atlas.volume.Crc32())}});
   written.push_back(prefix + ".exr");
   WriteFileAtomically(prefix + ".json", manifest);
   written.push_back(prefix + ".json");

@@ -9,6 +9,7 @@
 #include "brdf/core/file_util.h"
 #include "brdf/core/merl.h"
 #include "brdf/core/rgl.h"
+#include "brdf/core/text_format.h"
 #include "brdf/core/virtual_capture.h"
 #include "brdf/exporter/packed_volume.h"
 #include "brdf/processing/measurement_brdf.h"
@@ -214,11 +215,9 @@ OpenedTexture OpenExportedTexture(const std::string& path) {
           std::to_string(width) + " × " + std::to_string(height) + " × " + std::to_string(depth));
     const std::uint32_t actual = out.texture.PayloadCrc32();
     if (bytes != out.texture.PayloadBytes() || crc != actual) {
-      char want[64], got[64];
-      std::snprintf(want, sizeof want, "%llu bytes, CRC-32 0x%08x",
-                    static_cast<unsigned long long>(bytes), crc);
-      std::snprintf(got, sizeof got, "%llu bytes, CRC-32 0x%08x",
-                    static_cast<unsigned long long>(out.texture.PayloadBytes()), actual);
+      const std::string want = std::to_string(bytes) + " bytes, CRC-32 " + Hex32Text(crc);
+      const std::string got =
+          std::to_string(out.texture.PayloadBytes()) + " bytes, CRC-32 " + Hex32Text(actual);
       throw FormatError(out.texture_path, "payload",
                         "the payload " + path + " records (" + want + ")", got,
                         "the texture and its JSON do not belong together, or one is damaged");

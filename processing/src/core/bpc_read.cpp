@@ -17,8 +17,8 @@
 #include "bpc_chunks.h"
 #include "brdf/core/bpc.h"
 #include "brdf/core/error.h"
-#include "brdf/core/text_format.h"
 #include "brdf/core/file_util.h"
+#include "brdf/core/text_format.h"
 
 namespace brdf {
 
@@ -77,8 +77,9 @@ class BpcParser {
         const std::uint64_t region = next - pos;
         AddProblem(BpcProblemKind::kCorrupt, pos, region, slice,
                    "chunk header CRC-32 " + Hex32Text(h.header_crc),
-                   Hex32Text(Crc32(p, 20)) + " (tag " + TagText(p) + "); " + std::to_string(region) +
-                       " bytes skipped" + (next == size_ ? " to the end of the file" : ""));
+                   Hex32Text(Crc32(p, 20)) + " (tag " + TagText(p) + "); " +
+                       std::to_string(region) + " bytes skipped" +
+                       (next == size_ ? " to the end of the file" : ""));
         if (slice >= 0) ++expected_slice;
         prefix_intact = false;
         pos = next;
@@ -196,7 +197,8 @@ class BpcParser {
     const std::size_t n = static_cast<std::size_t>(h.payload_size);
     const std::uint8_t* payload = p + kChunkHeaderSize;
     if (const std::uint32_t crc = Crc32(payload, n); crc != h.payload_crc)
-      FailHeader(pos + kChunkHeaderSize, "header JSON CRC-32 " + Hex32Text(h.payload_crc), Hex32Text(crc));
+      FailHeader(pos + kChunkHeaderSize, "header JSON CRC-32 " + Hex32Text(h.payload_crc),
+                 Hex32Text(crc));
     const Json j = ParseJsonPayload(payload, n, file_, pos + kChunkHeaderSize, "header");
     // The preamble's version is outside any CRC; the JSON repeats it, so a damaged version
     // field is caught rather than silently accepted.

@@ -1,4 +1,5 @@
 #include "brdf/core/models.h"
+#include "brdf/core/text_format.h"
 
 #include <cmath>
 #include <cstdio>
@@ -90,14 +91,8 @@ std::string Abbreviate(const nlohmann::json& value) {
   return text;
 }
 
-std::string Number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
-}
-
 std::string RangeText(const ParameterInfo& p) {
-  return "a finite number in [" + Number(p.min) + ", " + Number(p.max) + "]";
+  return "a finite number in [" + ShortNumberText(p.min) + ", " + ShortNumberText(p.max) + "]";
 }
 
 // Reads one parameter into `out` (Count() values), checking finiteness and range.
@@ -273,9 +268,10 @@ std::vector<std::string> PhysicalProblems(const Material& material) {
       if (!std::isfinite(v))
         problems.push_back(where + " is not a finite number");
       else if (v < p.min)
-        problems.push_back(where + (p.min == 0 ? " is negative" : " is below " + Number(p.min)));
+        problems.push_back(where +
+                           (p.min == 0 ? " is negative" : " is below " + ShortNumberText(p.min)));
       else if (v > p.max)
-        problems.push_back(where + " exceeds " + Number(p.max));
+        problems.push_back(where + " exceeds " + ShortNumberText(p.max));
     }
   }
   // Energy: the diffuse and specular reflectances of the legacy models share one budget.

@@ -1,15 +1,10 @@
 // Helpers shared by the RGL reader's translation units (not part of the public API).
 #pragma once
 
-#include <string_view>
-
 namespace brdf {
 
 // The 12 bytes an RGL tensor file (.bsdf) starts with: "tensor_file" and a NUL.
 inline constexpr char kTensorFileMagic[12] = {'t', 'e', 'n', 's', 'o', 'r',
                                               '_', 'f', 'i', 'l', 'e', '\0'};
-
-// Strict UTF-8 (RFC 3629): no overlong forms, no surrogates, nothing above U+10FFFF.
-bool IsValidUtf8(std::string_view s);
 
 }  // namespace brdf

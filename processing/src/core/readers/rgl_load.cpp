@@ -17,6 +17,7 @@
 #include "brdf/core/rgl.h"
 #include "readers/rgl_eval.h"
 #include "readers/rgl_internal.h"
+#include "readers/text_util.h"
 
 namespace brdf {
 
@@ -153,7 +154,7 @@ RglBrdf RglBrdf::FromTensorFile(const TensorFile& tf, std::string name) {
                         TensorDtypeName(d->dtype) + " with shape " + d->ShapeString());
     const auto bytes = tf.Data(*d);
     info.description.assign(reinterpret_cast<const char*>(bytes.data()), bytes.size());
-    if (!IsValidUtf8(info.description))
+    if (!detail::IsValidUtf8(info.description))
       throw FormatError(tf.file(), BytePosition(d->data_offset) + " (field 'description')",
                         "UTF-8 text", "invalid UTF-8 bytes");
   }

@@ -10,6 +10,7 @@
 #include "brdf/core/file_util.h"
 #include "brdf/core/rgl.h"
 #include "readers/rgl_internal.h"
+#include "readers/text_util.h"
 
 namespace brdf {
 namespace {
@@ -132,7 +133,7 @@ TensorFile TensorFile::Parse(std::vector<std::uint8_t> bytes, std::string file) 
     const std::uint16_t name_len = r.U16(which + " name length");
     const std::uint64_t name_at = r.offset();
     f.name = r.String(name_len, which + " name");
-    if (!IsValidUtf8(f.name))
+    if (!detail::IsValidUtf8(f.name))
       throw FormatError(out.file_, BytePosition(name_at), "a UTF-8 field name",
                         "invalid UTF-8 bytes in field " + std::to_string(k) + "'s name");
     if (names.contains(f.name))
@@ -253,43 +254,4 @@ std::string EncodeTensorFile(std::span<const TensorFieldData> fields) {
 
 }  // namespace brdf
 
-namespace brdf {
-
-bool IsValidUtf8(std::string_view s) {
-  std::size_t i = 0;
-  const std::size_t n = s.size();
-  while (i < n) {
-    const auto c = static_cast<unsigned char>(s[i]);
-    if (c < 0x80) {
-      ++i;
-      continue;
-    }
-    int len = 0;
-    std::uint32_t cp = 0;
-    if (c >= 0xC2 && c <= 0xDF) {
-      len = 2;
-      cp = c & 0x1Fu;
-    } else if (c >= 0xE0 && c <= 0xEF) {
-      len = 3;
-      cp = c & 0x0Fu;
-    } else if (c >= 0xF0 && c <= 0xF4) {
-      len = 4;
-      cp = c & 0x07u;
-    } else {
-      return false;  // continuation byte, overlong lead C0/C1, or F5..FF
-    }
-    if (n - i < static_cast<std::size_t>(len)) return false;
-    for (int k = 1; k < len; ++k) {
-      const auto cc = static_cast<unsigned char>(s[i + static_cast<std::size_t>(k)]);
-      if ((cc & 0xC0u) != 0x80u) return false;
-      cp = (cp << 6) | (cc & 0x3Fu);
-    }
-    if ((len == 3 && cp < 0x800) || (len == 4 && (cp < 0x10000 || cp > 0x10FFFF)) ||
-        (cp >= 0xD800 && cp <= 0xDFFF))
-      return false;
-    i += static_cast<std::size_t>(len);
-  }
-  return true;
-}
-
-}  // namespace brdf
+namespace brdf {}  // namespace brdf
