@@ -7,12 +7,10 @@
 // Writes OUT as little-endian float32, depth × height × width × 3 (x fastest), for
 // tests/python/bc6h_gpu_check.py.
 // Usage: node bc6h_gpu.mjs --ktx2 FILE --out FILE [--chromium PATH]
-import { spawn } from 'node:child_process';
 import { createServer } from 'node:http';
-import { mkdtempSync, readFileSync, writeFileSync, existsSync, rmSync } from 'node:fs';
-import { tmpdir } from 'node:os';
-import { join, resolve } from 'node:path';
-import WebSocket from 'ws';
+import { readFileSync, writeFileSync } from 'node:fs';
+import { resolve } from 'node:path';
+import { startChromium } from './headless_chromium.mjs';
 
 const args = {};
 for (let i = 2; i < process.argv.length; i += 2) args[process.argv[i].slice(2)] = process.argv[i + 1];
@@ -99,56 +97,8 @@ const server = createServer((req, res) => {
   else { res.writeHead(404); res.end(); }
 });
 await new Promise((ok) => server.listen(0, '127.0.0.1', ok));
-const profile = mkdtempSync(join(tmpdir(), 'brdf-bc6h-'));
-const browser = spawn(chromium, [
-  '--headless', '--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
-  '--disable-gpu-sandbox', '--disable-background-networking', '--disable-component-update',
-  '--disable-sync', '--no-first-run', '--no-default-browser-check', '--mute-audio',
-  `--user-data-dir=${profile}`, '--remote-debugging-port=0', 'about:blank'],
-  { stdio: ['ignore', 'ignore', 'pipe'] });
-let browserLog = '';
-browser.stderr.on('data', (d) => { browserLog += d; });
-const cleanup = () => {
-  try { browser.kill('SIGKILL'); } catch { /* already gone */ }
-  server.close();
-  try { rmSync(profile, { recursive: true, force: true }); } catch { /* best effort */ }
-};
-const fail = (message) => {
-  console.error(`bc6h_gpu: ${message}`);
-  if (browserLog) console.error(browserLog.split('\n').slice(-15).join('\n'));
-  cleanup();
-  process.exit(1);
-};
-setTimeout(() => fail('timed out after 240 s'), deadline - Date.now()).unref();
+const { send, fail, cleanup } = await startChromium({ chromium, name: 'bc6h_gpu', deadline, server });
 const sleep = (ms) => new Promise((ok) => setTimeout(ok, ms));
-let endpoint = null;
-while (!endpoint) {
-  if (Date.now() > deadline) fail('chromium did not open its DevTools port');
-  if (browser.exitCode !== null) fail(`chromium exited with code ${browser.exitCode}`);
-  const portFile = join(profile, 'DevToolsActivePort');
-  if (existsSync(portFile)) {
-    const [port, path] = readFileSync(portFile, 'utf8').split('\n');
-    if (port && path) endpoint = `ws://127.0.0.1:${port}${path}`;
-  }
-  if (!endpoint) await sleep(100);
-}
-const ws = new WebSocket(endpoint, { perMessageDeflate: false, maxPayload: 1 << 30 });
-await new Promise((ok, bad) => { ws.once('open', ok); ws.once('error', bad); });
-let nextId = 1;
-const pending = new Map();
-ws.on('message', (data) => {
-  const msg = JSON.parse(data.toString());
-  if (msg.id && pending.has(msg.id)) {
-    const { ok, bad } = pending.get(msg.id);
-    pending.delete(msg.id);
-    if (msg.error) bad(new Error(JSON.stringify(msg.error))); else ok(msg.result);
-  }
-});
-const send = (method, params = {}, sessionId) => new Promise((ok, bad) => {
-  const id = nextId++;
-  pending.set(id, { ok, bad });
-  ws.send(JSON.stringify({ id, method, params, ...(sessionId ? { sessionId } : {}) }));
-});
 try {
   const { targetId } = await send('Target.createTarget', { url: 'about:blank' });
   const { sessionId } = await send('Target.attachToTarget', { targetId, flatten: true });

@@ -18,13 +18,11 @@
 // Usage: node render_web.mjs --web DIR --material NAME --out DIR [--size N] [--pairs FILE]
 //        [--exact FILE] [--sidecar FILE.json] [--es-harness NAME=FILE,...]
 //        [--cell NAME (an atlas material)] [--bench] [--chromium PATH]
-import { spawn } from 'node:child_process';
 import { createServer } from 'node:http';
-import { mkdtempSync, readFileSync, writeFileSync, existsSync, rmSync, statSync } from 'node:fs';
-import { tmpdir } from 'node:os';
+import { readFileSync, writeFileSync, existsSync, statSync } from 'node:fs';
 import { join, extname, resolve, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
-import WebSocket from 'ws';
+import { startChromium } from './headless_chromium.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
 const args = {};
@@ -64,63 +62,9 @@ const server = createServer((req, res) => {
 await new Promise((ok) => server.listen(0, '127.0.0.1', ok));
 const base = `http://127.0.0.1:${server.address().port}`;
 
-const profile = mkdtempSync(join(tmpdir(), 'brdf-chromium-'));
-const browser = spawn(chromium, [
-  '--headless', '--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
-  '--disable-gpu-sandbox', '--disable-background-networking', '--disable-component-update',
-  '--disable-sync', '--no-first-run', '--no-default-browser-check', '--mute-audio',
-  `--user-data-dir=${profile}`, '--remote-debugging-port=0', '--window-size=1100,1100',
-  'about:blank'], { stdio: ['ignore', 'ignore', 'pipe'] });
-let browserLog = '';
-browser.stderr.on('data', (d) => { browserLog += d; });
-const cleanup = () => {
-  try { browser.kill('SIGKILL'); } catch { /* already gone */ }
-  server.close();
-  try { rmSync(profile, { recursive: true, force: true }); } catch { /* best effort */ }
-};
-const fail = (message) => {
-  console.error(`render_web: ${message}`);
-  if (browserLog) console.error(browserLog.split('\n').slice(-15).join('\n'));
-  cleanup();
-  process.exit(1);
-};
-const timer = setTimeout(() => fail('timed out after 240 s'), deadline - Date.now());
-
+const { send, fail, cleanup, consoleLines } = await startChromium({
+  chromium, name: 'render_web', deadline, server, extraArgs: ['--window-size=1100,1100'] });
 const sleep = (ms) => new Promise((ok) => setTimeout(ok, ms));
-let endpoint = null;
-while (!endpoint) {
-  if (Date.now() > deadline) fail('chromium did not open its DevTools port');
-  if (browser.exitCode !== null) fail(`chromium exited with code ${browser.exitCode}`);
-  const portFile = join(profile, 'DevToolsActivePort');
-  if (existsSync(portFile)) {
-    const [port, path] = readFileSync(portFile, 'utf8').split('\n');
-    if (port && path) endpoint = `ws://127.0.0.1:${port}${path}`;
-  }
-  if (!endpoint) await sleep(100);
-}
-
-const ws = new WebSocket(endpoint, { perMessageDeflate: false, maxPayload: 1 << 30 });
-await new Promise((ok, bad) => { ws.once('open', ok); ws.once('error', bad); });
-let nextId = 1;
-const pending = new Map();
-const consoleLines = [];
-ws.on('message', (data) => {
-  const msg = JSON.parse(data.toString());
-  if (msg.id && pending.has(msg.id)) {
-    const { ok, bad } = pending.get(msg.id);
-    pending.delete(msg.id);
-    if (msg.error) bad(new Error(JSON.stringify(msg.error))); else ok(msg.result);
-  } else if (msg.method === 'Runtime.consoleAPICalled') {
-    consoleLines.push(msg.params.args.map((a) => a.value ?? a.description).join(' '));
-  } else if (msg.method === 'Runtime.exceptionThrown') {
-    consoleLines.push('exception: ' + msg.params.exceptionDetails.exception?.description);
-  }
-});
-const send = (method, params = {}, sessionId) => new Promise((ok, bad) => {
-  const id = nextId++;
-  pending.set(id, { ok, bad });
-  ws.send(JSON.stringify({ id, method, params, ...(sessionId ? { sessionId } : {}) }));
-});
 
 async function openPage(url) {
   const { targetId } = await send('Target.createTarget', { url: 'about:blank' });
@@ -347,8 +291,6 @@ try {
     writeFileSync(join(outDir, 'bench.json'), JSON.stringify(result, null, 2));
   }
   console.log(JSON.stringify({ ok: true, three: info.revision, renderer: info.renderer, probes: n }));
-  clearTimeout(timer);
-  ws.close();
   cleanup();
 } catch (e) {
   fail(`${e.stack || e}\n${consoleLines.join('\n')}`);

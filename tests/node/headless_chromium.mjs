@@ -1,0 +1,79 @@
+// Headless Chromium (WebGL 2 on SwiftShader) driven through the DevTools protocol, shared by
+// the browser tests (render_web.mjs, bc6h_gpu.mjs). startChromium() launches the browser with
+// a private profile folder, waits for its DevTools port and returns
+//   send(method, params, sessionId)  one DevTools call, resolved with its result
+//   fail(message)                    prints `name: message` and the browser's last log lines,
+//                                    cleans up and exits 1
+//   cleanup()                        closes the DevTools connection, kills the browser, closes
+//                                    `server`, removes the profile
+//   consoleLines                     the pages' console output and uncaught exceptions
+// Every step is bounded by `deadline` (a Date.now() value): past it the script fails.
+import { spawn } from 'node:child_process';
+import { mkdtempSync, readFileSync, existsSync, rmSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import WebSocket from 'ws';
+
+export async function startChromium({ chromium, name, deadline, server, extraArgs = [] }) {
+  const profile = mkdtempSync(join(tmpdir(), `brdf-${name}-`));
+  const browser = spawn(chromium, [
+    '--headless', '--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader',
+    '--disable-gpu-sandbox', '--disable-background-networking', '--disable-component-update',
+    '--disable-sync', '--no-first-run', '--no-default-browser-check', '--mute-audio',
+    `--user-data-dir=${profile}`, '--remote-debugging-port=0', ...extraArgs, 'about:blank'],
+    { stdio: ['ignore', 'ignore', 'pipe'] });
+  let browserLog = '';
+  let ws = null;
+  browser.stderr.on('data', (d) => { browserLog += d; });
+  const cleanup = () => {
+    if (ws) ws.close();
+    try { browser.kill('SIGKILL'); } catch { /* already gone */ }
+    if (server) server.close();
+    try { rmSync(profile, { recursive: true, force: true }); } catch { /* best effort */ }
+  };
+  const fail = (message) => {
+    console.error(`${name}: ${message}`);
+    if (browserLog) console.error(browserLog.split('\n').slice(-15).join('\n'));
+    cleanup();
+    process.exit(1);
+  };
+  const seconds = Math.round((deadline - Date.now()) / 1000);
+  setTimeout(() => fail(`timed out after ${seconds} s`), deadline - Date.now()).unref();
+
+  const sleep = (ms) => new Promise((ok) => setTimeout(ok, ms));
+  let endpoint = null;
+  while (!endpoint) {
+    if (Date.now() > deadline) fail('chromium did not open its DevTools port');
+    if (browser.exitCode !== null) fail(`chromium exited with code ${browser.exitCode}`);
+    const portFile = join(profile, 'DevToolsActivePort');
+    if (existsSync(portFile)) {
+      const [port, path] = readFileSync(portFile, 'utf8').split('\n');
+      if (port && path) endpoint = `ws://127.0.0.1:${port}${path}`;
+    }
+    if (!endpoint) await sleep(100);
+  }
+
+  ws = new WebSocket(endpoint, { perMessageDeflate: false, maxPayload: 1 << 30 });
+  await new Promise((ok, bad) => { ws.once('open', ok); ws.once('error', bad); });
+  let nextId = 1;
+  const pending = new Map();
+  const consoleLines = [];
+  ws.on('message', (data) => {
+    const msg = JSON.parse(data.toString());
+    if (msg.id && pending.has(msg.id)) {
+      const { ok, bad } = pending.get(msg.id);
+      pending.delete(msg.id);
+      if (msg.error) bad(new Error(JSON.stringify(msg.error))); else ok(msg.result);
+    } else if (msg.method === 'Runtime.consoleAPICalled') {
+      consoleLines.push(msg.params.args.map((a) => a.value ?? a.description).join(' '));
+    } else if (msg.method === 'Runtime.exceptionThrown') {
+      consoleLines.push('exception: ' + msg.params.exceptionDetails.exception?.description);
+    }
+  });
+  const send = (method, params = {}, sessionId) => new Promise((ok, bad) => {
+    const id = nextId++;
+    pending.set(id, { ok, bad });
+    ws.send(JSON.stringify({ id, method, params, ...(sessionId ? { sessionId } : {}) }));
+  });
+  return { send, fail, cleanup, consoleLines };
+}
