@@ -80,7 +80,13 @@ FitReport ReportFromJson(const Json& fit, const std::string& file, Model materia
     bool known = false;
     for (Model m : AllModels())
       if (ModelName(m) == v->get<std::string>()) r.model = m, known = true;
-    if (!known) in.Fail("model", "'" + v->get<std::string>() + "'", "a model name");
+    if (!known) {
+      // Appended piece by piece: GCC 12's -Wrestrict misreads "'" + std::string&& at -O2.
+      std::string quoted = "'";
+      quoted += v->get<std::string>();
+      quoted += '\'';
+      in.Fail("model", quoted, "a model name");
+    }
   }
   if (const Json* v = in.Find("loss", false)) {
     bool known = false;
