@@ -107,3 +107,11 @@ def test_large_batch_on_threads_equals_small_batches():
     pieces = np.concatenate([s.eval_deg(*(a[i:i + 1000] for a in args))
                              for i in range(0, n, 1000)])
     assert np.array_equal(whole, pieces)
+
+
+def test_exported_lut_matches_cli(brdf_tool, tmp_path):
+    out = tmp_path / "lut"
+    code, _, err = run_cli(brdf_tool, "convert", "copper", "--out", out)
+    assert code == 0, err
+    s, _, _ = assert_same_as_cli(brdf_tool, str(out / "copper.ktx2"), tmp_path, seed=5)
+    assert s.evaluation == "exported_lut"
