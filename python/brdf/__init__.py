@@ -10,7 +10,17 @@ brdf.InvalidArgument (ValueErrors) for bad content, shapes and dtypes, with the 
 message the command-line tool prints after "brdf: error: ".
 """
 
+import os as _os
+
 import numpy as _np
+
+from . import _paths
+
+# An installed package finds the material library relative to itself (the interpreter is not
+# installed beside it), through the variable the library reads; a value the user set wins.
+if _paths.MATERIALS_FROM_PACKAGE is not None and not _os.environ.get("BRDF_MATERIALS_DIR"):
+    _os.environ["BRDF_MATERIALS_DIR"] = _os.path.normpath(
+        _os.path.join(_os.path.dirname(_os.path.abspath(__file__)), _paths.MATERIALS_FROM_PACKAGE))
 
 from ._brdf import Error, FormatError, InvalidArgument, IoError
 from ._brdf import Source as _Source
