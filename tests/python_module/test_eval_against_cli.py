@@ -115,3 +115,17 @@ def test_exported_lut_matches_cli(brdf_tool, tmp_path):
     assert code == 0, err
     s, _, _ = assert_same_as_cli(brdf_tool, str(out / "copper.ktx2"), tmp_path, seed=5)
     assert s.evaluation == "exported_lut"
+
+
+def test_strided_and_empty_inputs():
+    s = brdf.open("gold")
+    rng = np.random.default_rng(6)
+    wi = directions(rng.uniform(0, 89, 50), rng.uniform(0, 360, 50))
+    wo = directions(rng.uniform(0, 89, 50), rng.uniform(0, 360, 50))
+    contiguous = s.eval(wi, wo)
+    # Fortran order and a strided view (every other row of a larger array) read the same values.
+    assert np.array_equal(s.eval(np.asfortranarray(wi), np.asfortranarray(wo)), contiguous)
+    doubled = np.repeat(wi, 2, axis=0)
+    assert np.array_equal(s.eval(doubled[::2], wo), contiguous)
+    assert s.eval(np.zeros((0, 3)), np.zeros((0, 3))).shape == (0, 3)
+    assert s.eval_deg(np.zeros(0), 0, 0, 0).shape == (0, 3)
