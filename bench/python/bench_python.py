@@ -62,10 +62,12 @@ def main():
             s = brdf.open(path)
             s.eval_deg(*(a[:1000] for a in args))  # warm-up
             t_py = median_seconds(lambda: s.eval_deg(*args), 5)
+            t_one = median_seconds(lambda: s.eval_deg(*args, jobs=1), 5)
             t_cli = median_seconds(
                 lambda: subprocess.run([tool, "eval", path, "--pairs", pairs], check=True,
                                        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL), 3)
-            print(f"{label}: eval_deg {n / t_py / 1e6:.2f} M/s ({n} pairs, median of 5); "
+            print(f"{label}: eval_deg {n / t_py / 1e6:.2f} M/s ({n} pairs, median of 5; "
+                  f"jobs=1: {n / t_one / 1e6:.2f} M/s); "
                   f"brdf eval --pairs {n_cli / t_cli / 1e6:.3f} M/s ({n_cli} pairs incl. "
                   f"start-up and text, median of 3); ratio {(n / t_py) / (n_cli / t_cli):.0f}x")
 

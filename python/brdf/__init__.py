@@ -60,19 +60,21 @@ class Source:
         """The measured light polar angles of a capture or LUT (empty for other sources)."""
         return list(self._source.measured_theta_in_deg)
 
-    def eval(self, wi, wo):
+    def eval(self, wi, wo, jobs=0):
         """f_r (1/sr, RGB, not multiplied by cos) for N pairs of unit vectors.
 
         wi, wo: float64 arrays of shape (N, 3) in the local frame (z = normal); wi points towards
         the light, wo towards the viewer. Returns a float64 array of shape (N, 3).
+        jobs: threads for batches of 16,384 pairs or more (0: one per core), as `--jobs`.
         """
-        return self._source.eval(_np.asarray(wi), _np.asarray(wo))
+        return self._source.eval(_np.asarray(wi), _np.asarray(wo), int(jobs))
 
-    def eval_deg(self, theta_in, phi_in, theta_out, phi_out):
+    def eval_deg(self, theta_in, phi_in, theta_out, phi_out, jobs=0):
         """f_r (1/sr, RGB) for angles in degrees, as `brdf eval --in T,P --out T,P` gives it.
 
         The four arguments are numbers or arrays broadcast against each other (numpy rules);
         polar angles in [0, 90], azimuths finite. Returns float64 of shape broadcast + (3,).
+        jobs: threads for batches of 16,384 pairs or more (0: one per core).
         """
         names = ("theta_in", "phi_in", "theta_out", "phi_out")
         arrays = []
@@ -91,7 +93,7 @@ class Source:
             ) from None
         shape = broadcast[0].shape
         flat = [_np.ascontiguousarray(a, dtype=_np.float64).reshape(-1) for a in broadcast]
-        return self._source._eval_deg_flat(*flat).reshape(shape + (3,))
+        return self._source._eval_deg_flat(*flat, int(jobs)).reshape(shape + (3,))
 
     def __repr__(self):
         return f"brdf.Source({self.path!r}, evaluation={self.evaluation!r})"

@@ -51,11 +51,15 @@ const char* EvaluationName(sources::Evaluation e) {
   return "unknown";
 }
 
-// Runs f(i) for i in [0, n) without the GIL, on the library's threads for large batches.
+// Runs f(i) for i in [0, n) without the GIL, on the library's threads for large batches:
+// `jobs` threads (0: one per core, brdf::ResolveJobs), one below kParallelThreshold pairs.
 template <class F>
-void ForEachPair(std::size_t n, F f) {
+void ForEachPair(std::size_t n, int jobs_option, F f) {
+  if (jobs_option < 0)
+    throw InvalidArgument("jobs: expected 0 (one thread per core) or a positive count, got " +
+                          std::to_string(jobs_option));
   const py::gil_scoped_release release;
-  const int jobs = n >= kParallelThreshold ? ResolveJobs(0) : 1;
+  const int jobs = n >= kParallelThreshold ? ResolveJobs(jobs_option) : 1;
   ParallelChunks(n, kChunk, jobs, nullptr, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) f(i);
   });
@@ -90,7 +94,7 @@ class Source {
   std::vector<double> measured_theta_in_deg() const { return opened_.measured_theta_in_deg; }
 
   // wi, wo: N×3 unit vectors (z = normal, wi towards the light). Returns N×3 f_r in 1/sr.
-  py::array_t<double> Eval(const py::array& wi_arg, const py::array& wo_arg) const {
+  py::array_t<double> Eval(const py::array& wi_arg, const py::array& wo_arg, int jobs) const {
     const auto wi = VectorsArgument(wi_arg, "wi");
     const auto wo = VectorsArgument(wo_arg, "wo");
     if (wi.shape(0) != wo.shape(0))
@@ -109,7 +113,7 @@ class Source {
     py::array_t<double> out({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(3)});
     double* f = out.mutable_data();
     const BrdfSource& brdf = *opened_.brdf;
-    ForEachPair(n, [&](std::size_t i) {
+    ForEachPair(n, jobs, [&](std::size_t i) {
       const Rgb r =
           brdf.Eval({a[3 * i], a[3 * i + 1], a[3 * i + 2]}, {b[3 * i], b[3 * i + 1], b[3 * i + 2]});
       f[3 * i] = r[0];
@@ -123,7 +127,8 @@ class Source {
   py::array_t<double> EvalDegFlat(const py::array_t<double, py::array::c_style>& ti,
                                   const py::array_t<double, py::array::c_style>& pi,
                                   const py::array_t<double, py::array::c_style>& to,
-                                  const py::array_t<double, py::array::c_style>& po) const {
+                                  const py::array_t<double, py::array::c_style>& po,
+                                  int jobs) const {
     const auto n = static_cast<std::size_t>(ti.size());
     if (pi.size() != ti.size() || to.size() != ti.size() || po.size() != ti.size())
       throw InvalidArgument("eval_deg: the four angle arrays must have one length");
@@ -143,7 +148,7 @@ class Source {
     py::array_t<double> out({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(3)});
     double* f = out.mutable_data();
     const BrdfSource& brdf = *opened_.brdf;
-    ForEachPair(n, [&](std::size_t i) {
+    ForEachPair(n, jobs, [&](std::size_t i) {
       const Rgb r = brdf.Eval(SphericalDirectionDeg(t_in[i], p_in[i]),
                               SphericalDirectionDeg(t_out[i], p_out[i]));
       f[3 * i] = r[0];
@@ -178,7 +183,7 @@ PYBIND11_MODULE(_brdf, m) {
       .def_property_readonly("evaluation", &Source::evaluation)
       .def_property_readonly("warnings", &Source::warnings)
       .def_property_readonly("measured_theta_in_deg", &Source::measured_theta_in_deg)
-      .def("eval", &Source::Eval, py::arg("wi"), py::arg("wo"))
+      .def("eval", &Source::Eval, py::arg("wi"), py::arg("wo"), py::arg("jobs") = 0)
       .def("_eval_deg_flat", &Source::EvalDegFlat, py::arg("theta_in"), py::arg("phi_in"),
-           py::arg("theta_out"), py::arg("phi_out"));
+           py::arg("theta_out"), py::arg("phi_out"), py::arg("jobs") = 0);
 }

@@ -107,6 +107,10 @@ def test_large_batch_on_threads_equals_small_batches():
     pieces = np.concatenate([s.eval_deg(*(a[i:i + 1000] for a in args))
                              for i in range(0, n, 1000)])
     assert np.array_equal(whole, pieces)
+    assert np.array_equal(s.eval_deg(*args, jobs=1), whole)
+    assert np.array_equal(s.eval_deg(*args, jobs=3), whole)
+    with pytest.raises(ValueError, match=r"^jobs: expected 0 \(one thread per core\) or a positive count, got -1$"):
+        s.eval_deg(*args, jobs=-1)
 
 
 def test_exported_lut_matches_cli(brdf_tool, tmp_path):
