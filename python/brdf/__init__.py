@@ -25,7 +25,7 @@ if _paths.MATERIALS_FROM_PACKAGE is not None and not _os.environ.get("BRDF_MATER
 from ._brdf import Error, FormatError, InvalidArgument, IoError
 from ._brdf import Source as _Source
 
-__all__ = ["open", "Source", "Error", "FormatError", "InvalidArgument", "IoError"]
+__all__ = ["open", "read_capture", "Source", "Error", "FormatError", "InvalidArgument", "IoError"]
 
 
 class Source:
@@ -103,3 +103,18 @@ def open(path_or_name):  # noqa: A001 (the module's entry point, like io.open)
     """Opens any file `brdf eval` evaluates (material .json, .bpc capture, .ktx2/.dds LUT or
     sidecar, RGL .bsdf, MERL .binary, tables) or a library material name ("gold")."""
     return Source(path_or_name)
+
+
+def read_capture(path):
+    """The samples of a .bpc capture as numpy arrays, read as `brdf export-csv` reads it
+    (damage is refused with the CLI's message; an interrupted slice is kept, flagged).
+
+    Returns a dict: "theta_in_deg", "phi_in_deg", "theta_out_deg", "phi_out_deg" (float32, N),
+    "rgb" and "sigma" (float32, N×3, f_r and its one-sigma uncertainty in 1/sr; sigma 0 where
+    the slice records none), "flags" (uint8, N: bit 0 saturated, 1 below the noise floor,
+    2 interpolated, 3 invalid), "slice" (int32, N: index into "slices"), "slices" (one dict per
+    slice: theta_in_deg, phi_in_deg, has_sigma, complete, samples), "metadata" (the file's
+    metadata, "extra" for any other key) and "warnings".
+    """
+    from ._brdf import read_capture as _read_capture
+    return _read_capture(str(path))

@@ -25,6 +25,9 @@
 #include "brdf/core/error.h"
 #include "brdf/core/geometry.h"
 #include "brdf/core/parallel.h"
+#include "brdf/sources/capture.h"
+#include "brdf/sources/detect.h"
+#include "brdf/sources/material_library.h"
 #include "brdf/sources/open.h"
 
 namespace py = pybind11;
@@ -163,6 +166,83 @@ class Source {
   sources::OpenedSource opened_;
 };
 
+// A capture's samples as numpy arrays, read by the rule of `brdf export-csv`
+// (sources::LoadCaptureForCopy: damage refused with its message, incomplete slices kept).
+// The same steps as tools/brdf/cmd_export_csv.cpp, so the same file gives the same message:
+// a library name resolved, the kind told by content, then the capture rule.
+py::dict ReadCapture(const std::string& path_or_name) {
+  const std::string path = sources::ResolveSource(path_or_name);
+  const sources::FileKind kind = sources::DetectFileKind(path);
+  if (kind != sources::FileKind::kCapture)
+    throw InvalidArgument(path + ": a " + sources::FileKindName(kind) +
+                          "; read_capture reads .bpc captures (bring other formats in with "
+                          "`brdf import` first)");
+  std::vector<std::string> warnings;
+  const Measurement m = sources::LoadCaptureForCopy(path, &warnings);
+  const auto n = static_cast<py::ssize_t>(m.SampleCount());
+  py::array_t<float> t_in(n), p_in(n), t_out(n), p_out(n), rgb({n, py::ssize_t{3}}),
+      sigma({n, py::ssize_t{3}});
+  py::array_t<std::uint8_t> flags(n);
+  py::array_t<std::int32_t> slice(n);
+  float *ti = t_in.mutable_data(), *pi = p_in.mutable_data(), *to = t_out.mutable_data(),
+        *po = p_out.mutable_data(), *c = rgb.mutable_data(), *e = sigma.mutable_data();
+  std::uint8_t* fl = flags.mutable_data();
+  std::int32_t* si = slice.mutable_data();
+  py::list slices;
+  std::size_t k = 0;
+  for (std::size_t s = 0; s < m.slices.size(); ++s) {
+    const Slice& sl = m.slices[s];
+    py::dict d;
+    d["theta_in_deg"] = sl.theta_in_deg;
+    d["phi_in_deg"] = sl.phi_in_deg;
+    d["has_sigma"] = sl.has_sigma;
+    d["complete"] = sl.complete;
+    d["samples"] = sl.samples.size();
+    slices.append(d);
+    for (const Sample& x : sl.samples) {
+      ti[k] = x.theta_in_deg;
+      pi[k] = x.phi_in_deg;
+      to[k] = x.theta_out_deg;
+      po[k] = x.phi_out_deg;
+      for (int ch = 0; ch < 3; ++ch) {
+        c[3 * k + ch] = x.rgb[ch];
+        e[3 * k + ch] = x.sigma[ch];
+      }
+      fl[k] = x.flags;
+      si[k] = static_cast<std::int32_t>(s);
+      ++k;
+    }
+  }
+  const Metadata& md = m.metadata;
+  py::dict meta;
+  meta["sample_name"] = md.sample_name;
+  meta["instrument_model"] = md.instrument_model;
+  meta["instrument_serial"] = md.instrument_serial;
+  meta["firmware_version"] = md.firmware_version;
+  meta["protocol_version"] = md.protocol_version;
+  meta["calibration_reference"] = md.calibration_reference;
+  meta["calibration_time"] = md.calibration_time;
+  meta["capture_start"] = md.capture_start;
+  meta["capture_end"] = md.capture_end;
+  meta["operator_notes"] = md.operator_notes;
+  meta["units"] = md.units;
+  meta["software_version"] = md.software_version;
+  meta["extra"] = md.extra;
+  py::dict out;
+  out["theta_in_deg"] = t_in;
+  out["phi_in_deg"] = p_in;
+  out["theta_out_deg"] = t_out;
+  out["phi_out_deg"] = p_out;
+  out["rgb"] = rgb;
+  out["sigma"] = sigma;
+  out["flags"] = flags;
+  out["slice"] = slice;
+  out["slices"] = slices;
+  out["metadata"] = meta;
+  out["warnings"] = warnings;
+  return out;
+}
+
 }  // namespace
 
 }  // namespace brdf::python
@@ -175,6 +255,8 @@ PYBIND11_MODULE(_brdf, m) {
   py::register_exception<brdf::FormatError>(m, "FormatError", PyExc_ValueError);
   py::register_exception<brdf::InvalidArgument>(m, "InvalidArgument", PyExc_ValueError);
   py::register_exception<brdf::IoError>(m, "IoError", PyExc_OSError);
+
+  m.def("read_capture", &brdf::python::ReadCapture, py::arg("path"));
 
   py::class_<Source>(m, "Source")
       .def(py::init<const std::string&>(), py::arg("path_or_name"))
