@@ -41,6 +41,8 @@ def test_samples_equal_the_independent_reader(brdf_tool, tmp_path, material, ext
     if "sigma_r" in records.dtype.names:
         sigma = np.stack([records["sigma_" + c] for c in "rgb"], axis=1).astype("<f4")
         assert np.array_equal(got["sigma"].view(np.uint32), sigma.view(np.uint32))
+        if "--noise" not in extra:  # the noisy detector records non-zero uncertainties
+            assert np.any(sigma > 0)
     else:
         assert not np.any(got["sigma"])
     assert np.array_equal(got["flags"], records["flags"])
