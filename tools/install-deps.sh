@@ -20,6 +20,7 @@ packages=(
   xvfb xauth
   clang libclang-rt-14-dev
   python3 python3-numpy python3-scipy
+  python3-dev pybind11-dev python3-pybind11 python3-pytest  # the Python module (python/), its tests
   nodejs
   # Engine hand-off tests (tests/engines): real clients for the shipped files.
   chromium glslang-tools spirv-cross mono-mcs python3-openimageio

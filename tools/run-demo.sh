@@ -19,7 +19,7 @@ else
   "$root/tools/install-deps.sh"
   cmake -S "$root" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release \
     -DBRDF_BUILD_TESTS=OFF -DBRDF_BUILD_BENCH=OFF >/dev/null
-  cmake --build "$build" -j "$(nproc)" --target brdf brdf-view
+  cmake --build "$build" -j "$(nproc)" --target brdf brdf-view brdf_python_module
   tools="$build/tools"
 fi
 brdf="$tools/brdf"

@@ -1,0 +1,271 @@
+// The compiled part of the Python module `brdf` (python/brdf/__init__.py wraps it): a file or a
+// library material opened by brdf::sources::OpenBrdf, evaluated for arrays of direction pairs.
+//
+// Bit-identical with `brdf eval --pairs`: eval_deg turns each angle pair into directions with
+// SphericalDirectionDeg and calls BrdfSource::Eval, exactly as tools/brdf/cmd_eval.cpp does, and
+// checks the polar angles by the same rule ([0, 90] degrees, finite azimuths).
+//
+// Batches release the GIL and are shared out by brdf::ParallelChunks (brdf/core/parallel.h);
+// BrdfSource::Eval is const and used concurrently by the previewer the same way.
+//
+// Errors: brdf::IoError becomes brdf.IoError (an OSError), brdf::FormatError and
+// brdf::InvalidArgument brdf.FormatError / brdf.InvalidArgument (ValueErrors), any other
+// brdf::Error brdf.Error (a RuntimeError); the message is the library's one line, the text
+// after "brdf: error: " in what the CLI prints.
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cmath>
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "brdf/core/brdf_source.h"
+#include "brdf/core/error.h"
+#include "brdf/core/geometry.h"
+#include "brdf/core/parallel.h"
+#include "brdf/sources/capture.h"
+#include "brdf/sources/detect.h"
+#include "brdf/sources/material_library.h"
+#include "brdf/sources/open.h"
+
+namespace py = pybind11;
+
+namespace brdf::python {
+
+namespace {
+
+// Below this many pairs a batch runs on the calling thread (starting threads costs more).
+constexpr std::size_t kParallelThreshold = 16384;
+constexpr std::size_t kChunk = 4096;
+
+const char* EvaluationName(sources::Evaluation e) {
+  switch (e) {
+    case sources::Evaluation::kAnalytic:
+      return "analytic";
+    case sources::Evaluation::kMeasuredDatabase:
+      return "measured_database";
+    case sources::Evaluation::kResampledLut:
+      return "resampled_lut";
+    case sources::Evaluation::kExportedLut:
+      return "exported_lut";
+  }
+  return "unknown";
+}
+
+// Runs f(i) for i in [0, n) without the GIL, on the library's threads for large batches:
+// `jobs` threads (0: one per core, brdf::ResolveJobs), one below kParallelThreshold pairs.
+template <class F>
+void ForEachPair(std::size_t n, int jobs_option, F f) {
+  if (jobs_option < 0)
+    throw InvalidArgument("jobs: expected 0 (one thread per core) or a positive count, got " +
+                          std::to_string(jobs_option));
+  const py::gil_scoped_release release;
+  const int jobs = n >= kParallelThreshold ? ResolveJobs(jobs_option) : 1;
+  ParallelChunks(n, kChunk, jobs, nullptr, [&](std::size_t begin, std::size_t end) {
+    for (std::size_t i = begin; i < end; ++i) f(i);
+  });
+}
+
+// An N×3 float64 array, C-contiguous (a copy only when the caller's array is strided).
+py::array_t<double, py::array::c_style> VectorsArgument(const py::array& a, const char* name) {
+  if (a.dtype().kind() != 'f' || a.itemsize() != 8)
+    throw InvalidArgument(std::string(name) + ": expected an N×3 array of float64, got dtype " +
+                          std::string(py::str(a.dtype())));
+  if (a.ndim() != 2 || a.shape(1) != 3) {
+    std::string shape = "(";
+    for (py::ssize_t d = 0; d < a.ndim(); ++d)
+      shape += (d ? ", " : "") + std::to_string(a.shape(d));
+    if (a.ndim() == 1) shape += ",";
+    shape += ")";
+    throw InvalidArgument(std::string(name) + ": expected an N×3 array of float64, got shape " +
+                          shape);
+  }
+  return py::array_t<double, py::array::c_style>::ensure(a);
+}
+
+class Source {
+ public:
+  explicit Source(const std::string& path_or_name)
+      : path_(path_or_name), opened_(sources::OpenBrdf(path_or_name)) {}
+
+  std::string path() const { return path_; }
+  std::string name() const { return opened_.brdf->Name(); }
+  std::string evaluation() const { return EvaluationName(opened_.evaluation); }
+  std::vector<std::string> warnings() const { return opened_.warnings; }
+  std::vector<double> measured_theta_in_deg() const { return opened_.measured_theta_in_deg; }
+
+  // wi, wo: N×3 unit vectors (z = normal, wi towards the light). Returns N×3 f_r in 1/sr.
+  py::array_t<double> Eval(const py::array& wi_arg, const py::array& wo_arg, int jobs) const {
+    const auto wi = VectorsArgument(wi_arg, "wi");
+    const auto wo = VectorsArgument(wo_arg, "wo");
+    if (wi.shape(0) != wo.shape(0))
+      throw InvalidArgument("wi, wo: expected the same number of directions, got " +
+                            std::to_string(wi.shape(0)) + " and " + std::to_string(wo.shape(0)));
+    const auto n = static_cast<std::size_t>(wi.shape(0));
+    const double* a = wi.data();
+    const double* b = wo.data();
+    for (std::size_t i = 0; i < n; ++i)
+      for (const auto& [v, which] : {std::pair{a + 3 * i, "wi"}, std::pair{b + 3 * i, "wo"}}) {
+        const double len = std::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        if (!(std::abs(len - 1.0) <= 1e-6))
+          throw InvalidArgument(std::string(which) + "[" + std::to_string(i) +
+                                "]: expected a unit vector, got length " + NumberText(len));
+      }
+    py::array_t<double> out({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(3)});
+    double* f = out.mutable_data();
+    const BrdfSource& brdf = *opened_.brdf;
+    ForEachPair(n, jobs, [&](std::size_t i) {
+      const Rgb r =
+          brdf.Eval({a[3 * i], a[3 * i + 1], a[3 * i + 2]}, {b[3 * i], b[3 * i + 1], b[3 * i + 2]});
+      f[3 * i] = r[0];
+      f[3 * i + 1] = r[1];
+      f[3 * i + 2] = r[2];
+    });
+    return out;
+  }
+
+  // Four 1-D float64 arrays of one length (brdf/__init__.py broadcasts); returns N×3.
+  py::array_t<double> EvalDegFlat(const py::array_t<double, py::array::c_style>& ti,
+                                  const py::array_t<double, py::array::c_style>& pi,
+                                  const py::array_t<double, py::array::c_style>& to,
+                                  const py::array_t<double, py::array::c_style>& po,
+                                  int jobs) const {
+    const auto n = static_cast<std::size_t>(ti.size());
+    if (pi.size() != ti.size() || to.size() != ti.size() || po.size() != ti.size())
+      throw InvalidArgument("eval_deg: the four angle arrays must have one length");
+    const double *t_in = ti.data(), *p_in = pi.data(), *t_out = to.data(), *p_out = po.data();
+    // The rule of `brdf eval` (cmd_eval.cpp): polar angles in [0, 90], finite azimuths.
+    for (std::size_t i = 0; i < n; ++i) {
+      for (const auto& [t, which] :
+           {std::pair{t_in[i], "theta_in"}, std::pair{t_out[i], "theta_out"}})
+        if (!(t >= 0.0 && t <= 90.0))
+          throw InvalidArgument(std::string(which) + "[" + std::to_string(i) +
+                                "]: polar angle must be in [0, 90] degrees, got " + NumberText(t));
+      for (const auto& [p, which] : {std::pair{p_in[i], "phi_in"}, std::pair{p_out[i], "phi_out"}})
+        if (!std::isfinite(p))
+          throw InvalidArgument(std::string(which) + "[" + std::to_string(i) +
+                                "]: azimuth must be finite, got " + NumberText(p));
+    }
+    py::array_t<double> out({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(3)});
+    double* f = out.mutable_data();
+    const BrdfSource& brdf = *opened_.brdf;
+    ForEachPair(n, jobs, [&](std::size_t i) {
+      const Rgb r = brdf.Eval(SphericalDirectionDeg(t_in[i], p_in[i]),
+                              SphericalDirectionDeg(t_out[i], p_out[i]));
+      f[3 * i] = r[0];
+      f[3 * i + 1] = r[1];
+      f[3 * i + 2] = r[2];
+    });
+    return out;
+  }
+
+ private:
+  std::string path_;
+  sources::OpenedSource opened_;
+};
+
+// A capture's samples as numpy arrays, read by the rule of `brdf export-csv`
+// (sources::LoadCaptureForCopy: damage refused with its message, incomplete slices kept).
+// The same steps as tools/brdf/cmd_export_csv.cpp, so the same file gives the same message:
+// a library name resolved, the kind told by content, then the capture rule.
+py::dict ReadCapture(const std::string& path_or_name) {
+  const std::string path = sources::ResolveSource(path_or_name);
+  const sources::FileKind kind = sources::DetectFileKind(path);
+  if (kind != sources::FileKind::kCapture)
+    throw InvalidArgument(path + ": a " + sources::FileKindName(kind) +
+                          "; read_capture reads .bpc captures (bring other formats in with "
+                          "`brdf import` first)");
+  std::vector<std::string> warnings;
+  const Measurement m = sources::LoadCaptureForCopy(path, &warnings);
+  const auto n = static_cast<py::ssize_t>(m.SampleCount());
+  py::array_t<float> t_in(n), p_in(n), t_out(n), p_out(n), rgb({n, py::ssize_t{3}}),
+      sigma({n, py::ssize_t{3}});
+  py::array_t<std::uint8_t> flags(n);
+  py::array_t<std::int32_t> slice(n);
+  float *ti = t_in.mutable_data(), *pi = p_in.mutable_data(), *to = t_out.mutable_data(),
+        *po = p_out.mutable_data(), *c = rgb.mutable_data(), *e = sigma.mutable_data();
+  std::uint8_t* fl = flags.mutable_data();
+  std::int32_t* si = slice.mutable_data();
+  py::list slices;
+  std::size_t k = 0;
+  for (std::size_t s = 0; s < m.slices.size(); ++s) {
+    const Slice& sl = m.slices[s];
+    py::dict d;
+    d["theta_in_deg"] = sl.theta_in_deg;
+    d["phi_in_deg"] = sl.phi_in_deg;
+    d["has_sigma"] = sl.has_sigma;
+    d["complete"] = sl.complete;
+    d["samples"] = sl.samples.size();
+    slices.append(d);
+    for (const Sample& x : sl.samples) {
+      ti[k] = x.theta_in_deg;
+      pi[k] = x.phi_in_deg;
+      to[k] = x.theta_out_deg;
+      po[k] = x.phi_out_deg;
+      for (int ch = 0; ch < 3; ++ch) {
+        c[3 * k + ch] = x.rgb[ch];
+        e[3 * k + ch] = x.sigma[ch];
+      }
+      fl[k] = x.flags;
+      si[k] = static_cast<std::int32_t>(s);
+      ++k;
+    }
+  }
+  const Metadata& md = m.metadata;
+  py::dict meta;
+  meta["sample_name"] = md.sample_name;
+  meta["instrument_model"] = md.instrument_model;
+  meta["instrument_serial"] = md.instrument_serial;
+  meta["firmware_version"] = md.firmware_version;
+  meta["protocol_version"] = md.protocol_version;
+  meta["calibration_reference"] = md.calibration_reference;
+  meta["calibration_time"] = md.calibration_time;
+  meta["capture_start"] = md.capture_start;
+  meta["capture_end"] = md.capture_end;
+  meta["operator_notes"] = md.operator_notes;
+  meta["units"] = md.units;
+  meta["software_version"] = md.software_version;
+  meta["extra"] = md.extra;
+  py::dict out;
+  out["theta_in_deg"] = t_in;
+  out["phi_in_deg"] = p_in;
+  out["theta_out_deg"] = t_out;
+  out["phi_out_deg"] = p_out;
+  out["rgb"] = rgb;
+  out["sigma"] = sigma;
+  out["flags"] = flags;
+  out["slice"] = slice;
+  out["slices"] = slices;
+  out["metadata"] = meta;
+  out["warnings"] = warnings;
+  return out;
+}
+
+}  // namespace
+
+}  // namespace brdf::python
+
+PYBIND11_MODULE(_brdf, m) {
+  using brdf::python::Source;
+  m.doc() = "Compiled core of the brdf module (use `import brdf`).";
+  // Later registrations are tried first: the subclasses before brdf::Error.
+  py::register_exception<brdf::Error>(m, "Error", PyExc_RuntimeError);
+  py::register_exception<brdf::FormatError>(m, "FormatError", PyExc_ValueError);
+  py::register_exception<brdf::InvalidArgument>(m, "InvalidArgument", PyExc_ValueError);
+  py::register_exception<brdf::IoError>(m, "IoError", PyExc_OSError);
+
+  m.def("read_capture", &brdf::python::ReadCapture, py::arg("path"));
+
+  py::class_<Source>(m, "Source")
+      .def(py::init<const std::string&>(), py::arg("path_or_name"))
+      .def_property_readonly("path", &Source::path)
+      .def_property_readonly("name", &Source::name)
+      .def_property_readonly("evaluation", &Source::evaluation)
+      .def_property_readonly("warnings", &Source::warnings)
+      .def_property_readonly("measured_theta_in_deg", &Source::measured_theta_in_deg)
+      .def("eval", &Source::Eval, py::arg("wi"), py::arg("wo"), py::arg("jobs") = 0)
+      .def("_eval_deg_flat", &Source::EvalDegFlat, py::arg("theta_in"), py::arg("phi_in"),
+           py::arg("theta_out"), py::arg("phi_out"), py::arg("jobs") = 0);
+}
