@@ -254,7 +254,7 @@ int RunCapture(const CaptureOptions& o) {
   request.operator_notes = o.operator_notes;
   if (sim) {
     request.settings = SettingsOf(o, source->Name());
-    request.notes["material_file"] = material_path;
+    request.notes["material_file"] = sources::RecordedSourceName(material_path);
   } else {
     request.settings["device"] = o.device;
   }
