@@ -236,3 +236,31 @@ TEST_F(FitCommand, ExportedLutsAndCsvTablesAreFittedAndNameCollisionsRefused) {
 
 }  // namespace
 }  // namespace brdf::tooltest
+
+namespace brdf::tooltest {
+namespace {
+
+// A fit the solver cannot carry out (one sample at −1e30 makes ln(1 + f cos) undefined under
+// --loss log): one line naming the file, exit code 1, no material file written, and none of the
+// solver library's own log lines on the terminal.
+TEST_F(FitCommand, AFailedFitWritesNothingAndExitsOne) {
+  Measurement m = CaptureOf(Ggx03(), {0, 20, 40, 60});
+  m.slices[1].samples[7].rgb[0] = -1e30f;
+  const fs::path bad = dir_ / "bad.bpc", out = dir_ / "bad.ggx.json";
+  WriteBpc(bad.string(), m);
+  const ToolRun r =
+      RunTool("fit " + Quote(bad) + " --model ggx --loss log --out " + Quote(out), dir_);
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_FALSE(fs::exists(out)) << "a failed fit is not a material file";
+  for (const char* glog : {"InitGoogleLogging", "trust_region", ".cc:", "Jacobian"}) {
+    EXPECT_EQ(r.err.find(glog), std::string::npos) << r.err;
+    EXPECT_EQ(r.out.find(glog), std::string::npos) << r.out;
+  }
+  const std::vector<std::string> lines = r.ErrLines();
+  ASSERT_EQ(lines.size(), 1u) << r.err;
+  EXPECT_EQ(lines[0].rfind(bad.string() + ": ", 0), 0u) << lines[0];
+  EXPECT_NE(lines[0].find("ggx"), std::string::npos) << lines[0];
+}
+
+}  // namespace
+}  // namespace brdf::tooltest
