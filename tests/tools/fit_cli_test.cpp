@@ -264,3 +264,33 @@ TEST_F(FitCommand, AFailedFitWritesNothingAndExitsOne) {
 
 }  // namespace
 }  // namespace brdf::tooltest
+
+namespace brdf::tooltest {
+namespace {
+
+// A fit is a function of its input and options: `--jobs 1` and `--jobs 2` write the same bytes,
+// and so do two runs (no wall time in the result). Engine (joint channels) and legacy (per
+// channel) models both.
+TEST_F(FitCommand, ResultsDoNotDependOnJobsOrOnTheRun) {
+  const fs::path cap = dir_ / "cap.bpc";
+  WriteBpc(cap.string(), CaptureOf(Ggx03(), {0, 20, 40, 60}));
+  for (const char* model : {"ggx", "unity-hdrp-lit"}) {
+    SCOPED_TRACE(model);
+    std::vector<std::string> files;
+    for (const char* jobs : {"1", "2", "2"}) {
+      const fs::path out = dir_ / (std::string("fit") + std::to_string(files.size()) + ".json");
+      const ToolRun r = RunTool("fit " + Quote(cap) + " --model " + model + " --jobs " + jobs +
+                                    " --out " + Quote(out) + " --quiet",
+                                dir_);
+      ASSERT_EQ(r.exit_code, 0) << r.err;
+      files.push_back(ReadAll(out));
+      fs::remove(out);
+    }
+    EXPECT_EQ(files[0], files[1]) << "--jobs 1 and --jobs 2 differ";
+    EXPECT_EQ(files[1], files[2]) << "two runs differ";
+    EXPECT_EQ(files[0].find("\"seconds\""), std::string::npos) << files[0];
+  }
+}
+
+}  // namespace
+}  // namespace brdf::tooltest
