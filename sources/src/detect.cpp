@@ -170,4 +170,8 @@ FileKind FileKindOf(ImportFormat format) {
 
 std::string OutputNameOf(const std::string& path) { return fs::path(path).stem().string(); }
 
+std::string RecordedSourceName(const std::string& path) {
+  return fs::path(path).filename().string();
+}
+
 }  // namespace brdf::sources

@@ -44,9 +44,9 @@ std::string ExtrapolationIgnored(const std::string& path) {
 Measurement CaptureFile(const BrdfSource& source, const std::string& path, FileKind kind) {
   Measurement m = CaptureNoiseFree(source);
   if (m.metadata.sample_name.empty()) m.metadata.sample_name = OutputNameOf(path);
-  m.metadata.extra["source_file"] = path;
+  m.metadata.extra["source_file"] = RecordedSourceName(path);
   if (kind == FileKind::kMaterial) {
-    m.metadata.extra["material_file"] = path;
+    m.metadata.extra["material_file"] = RecordedSourceName(path);
   } else if (const auto format = ImportFormatOf(kind)) {
     m.metadata.extra["source_format"] = ImportFormatName(*format);
   }

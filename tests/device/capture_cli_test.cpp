@@ -259,15 +259,16 @@ TEST_F(CaptureCli, RefusesToOverwriteAnExistingFileWithoutForce) {
   EXPECT_TRUE(ReadBpc(out).finished);
 }
 
-// Ctrl-C and SIGTERM during a capture: the scan is aborted on the instrument, the completed
-// slices stay in a valid, unfinished file, and --resume completes it to the uninterrupted
-// result. The simulated firmware is paced (5 ms per row) so the signal lands mid-capture.
+// Ctrl-C, SIGTERM and SIGHUP (a closed SSH session) during a capture: the scan is aborted on the
+// instrument, the completed slices stay in a valid, unfinished file, the resume line is printed,
+// and --resume completes it to the uninterrupted result. The simulated firmware is paced (5 ms per
+// row) so the signal lands mid-capture.
 TEST_F(CaptureCli, SignalAbortsTheScanAndLeavesAResumableFile) {
   const std::string common = " --material gold --sample g --seed 3" + kCoarse + " --sim-pace-ms 5";
   const std::string whole = Path("whole.bpc");
   ASSERT_EQ(Run("capture --quiet --out " + whole + common).exit_code, 0);
   const Measurement expected = LoadBpc(whole);
-  for (int sig : {SIGINT, SIGTERM}) {
+  for (int sig : {SIGINT, SIGTERM, SIGHUP}) {
     SCOPED_TRACE(sig);
     const std::string out = Path("sig.bpc"), err = Path("sig.err");
     fs::remove(out);

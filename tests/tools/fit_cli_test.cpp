@@ -236,3 +236,61 @@ TEST_F(FitCommand, ExportedLutsAndCsvTablesAreFittedAndNameCollisionsRefused) {
 
 }  // namespace
 }  // namespace brdf::tooltest
+
+namespace brdf::tooltest {
+namespace {
+
+// A fit the solver cannot carry out (one sample at −1e30 makes ln(1 + f cos) undefined under
+// --loss log): one line naming the file, exit code 1, no material file written, and none of the
+// solver library's own log lines on the terminal.
+TEST_F(FitCommand, AFailedFitWritesNothingAndExitsOne) {
+  Measurement m = CaptureOf(Ggx03(), {0, 20, 40, 60});
+  m.slices[1].samples[7].rgb[0] = -1e30f;
+  const fs::path bad = dir_ / "bad.bpc", out = dir_ / "bad.ggx.json";
+  WriteBpc(bad.string(), m);
+  const ToolRun r =
+      RunTool("fit " + Quote(bad) + " --model ggx --loss log --out " + Quote(out), dir_);
+  EXPECT_EQ(r.exit_code, 1) << r.out << r.err;
+  EXPECT_FALSE(fs::exists(out)) << "a failed fit is not a material file";
+  for (const char* glog : {"InitGoogleLogging", "trust_region", ".cc:", "Jacobian"}) {
+    EXPECT_EQ(r.err.find(glog), std::string::npos) << r.err;
+    EXPECT_EQ(r.out.find(glog), std::string::npos) << r.out;
+  }
+  const std::vector<std::string> lines = r.ErrLines();
+  ASSERT_EQ(lines.size(), 1u) << r.err;
+  EXPECT_EQ(lines[0].rfind(bad.string() + ": ", 0), 0u) << lines[0];
+  EXPECT_NE(lines[0].find("ggx"), std::string::npos) << lines[0];
+}
+
+}  // namespace
+}  // namespace brdf::tooltest
+
+namespace brdf::tooltest {
+namespace {
+
+// A fit is a function of its input and options: `--jobs 1` and `--jobs 2` write the same bytes,
+// and so do two runs (no wall time in the result). Engine (joint channels) and legacy (per
+// channel) models both.
+TEST_F(FitCommand, ResultsDoNotDependOnJobsOrOnTheRun) {
+  const fs::path cap = dir_ / "cap.bpc";
+  WriteBpc(cap.string(), CaptureOf(Ggx03(), {0, 20, 40, 60}));
+  for (const char* model : {"ggx", "unity-hdrp-lit"}) {
+    SCOPED_TRACE(model);
+    std::vector<std::string> files;
+    for (const char* jobs : {"1", "2", "2"}) {
+      const fs::path out = dir_ / (std::string("fit") + std::to_string(files.size()) + ".json");
+      const ToolRun r = RunTool("fit " + Quote(cap) + " --model " + model + " --jobs " + jobs +
+                                    " --out " + Quote(out) + " --quiet",
+                                dir_);
+      ASSERT_EQ(r.exit_code, 0) << r.err;
+      files.push_back(ReadAll(out));
+      fs::remove(out);
+    }
+    EXPECT_EQ(files[0], files[1]) << "--jobs 1 and --jobs 2 differ";
+    EXPECT_EQ(files[1], files[2]) << "two runs differ";
+    EXPECT_EQ(files[0].find("\"seconds\""), std::string::npos) << files[0];
+  }
+}
+
+}  // namespace
+}  // namespace brdf::tooltest

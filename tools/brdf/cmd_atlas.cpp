@@ -129,7 +129,8 @@ int RunAtlas(const AtlasOptions& options) {
 
   std::vector<exporter::AtlasMaterial> materials;
   for (std::size_t i = 0; i < luts.size(); ++i)
-    materials.push_back({found.inputs[i].name, &luts[i], found.inputs[i].path, saturated[i],
+    materials.push_back({found.inputs[i].name, &luts[i],
+                         sources::RecordedSourceName(found.inputs[i].path), saturated[i],
                          extrapolation[i], fitted[i]});
   CreateOutputFolder(fs::path(options.out).parent_path().string());
   const OutputGuard guard(outputs);

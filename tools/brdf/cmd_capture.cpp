@@ -129,8 +129,10 @@ std::string Eta(double seconds) {
   return buf;
 }
 
-// Ctrl-C and SIGTERM ask the session to abort the scan; a second signal is not special (the
-// abort itself is bounded by the reply timeout).
+// Ctrl-C, SIGTERM and SIGHUP (the terminal or SSH session closed) ask the session to abort the
+// scan; a second signal is not special (the abort itself is bounded by the reply timeout).
+// SIGPIPE is ignored meanwhile: once the session's stderr pipe is gone, progress lines fail
+// quietly instead of killing the tool with the scan still running.
 std::atomic<bool> g_cancel{false};
 extern "C" void OnSignal(int) { g_cancel.store(true); }
 
@@ -142,17 +144,24 @@ class SignalScope {
     sigemptyset(&sa.sa_mask);
     sigaction(SIGINT, &sa, &old_int_);
     sigaction(SIGTERM, &sa, &old_term_);
+    sigaction(SIGHUP, &sa, &old_hup_);
+    struct sigaction ignore {};
+    ignore.sa_handler = SIG_IGN;
+    sigemptyset(&ignore.sa_mask);
+    sigaction(SIGPIPE, &ignore, &old_pipe_);
   }
   ~SignalScope() {
     sigaction(SIGINT, &old_int_, nullptr);
     sigaction(SIGTERM, &old_term_, nullptr);
+    sigaction(SIGHUP, &old_hup_, nullptr);
+    sigaction(SIGPIPE, &old_pipe_, nullptr);
   }
   SignalScope(const SignalScope&) = delete;
   SignalScope& operator=(const SignalScope&) = delete;
 
  private:
   struct sigaction old_int_ {
-  }, old_term_{};
+  }, old_term_{}, old_hup_{}, old_pipe_{};
 };
 
 // The session's next step in this tool's words (options by their flag names).
@@ -254,7 +263,7 @@ int RunCapture(const CaptureOptions& o) {
   request.operator_notes = o.operator_notes;
   if (sim) {
     request.settings = SettingsOf(o, source->Name());
-    request.notes["material_file"] = material_path;
+    request.notes["material_file"] = sources::RecordedSourceName(material_path);
   } else {
     request.settings["device"] = o.device;
   }

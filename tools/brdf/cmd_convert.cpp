@@ -162,7 +162,7 @@ int RunConvert(const ConvertOptions& options) {
         exporter::TextureMetadata metadata;
         if (automatic) metadata.fitted_models_json.push_back(automatic->record_json);
         metadata.name = in.name;
-        metadata.source = in.path;
+        metadata.source = sources::RecordedSourceName(in.path);
         metadata.extrapolation = built.extrapolation;
         metadata.saturated_samples = built.saturated_samples;
         if (built.beyond) metadata.beyond_json = processing::BeyondReportJson(*built.beyond);

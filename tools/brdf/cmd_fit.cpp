@@ -83,6 +83,19 @@ std::string SliceErrors(const processing::FitReport& r) {
   return out;
 }
 
+// Why a fit failed, in the user's terms (the solver's own sentence names its internals).
+std::string FailedFitReason(const processing::FitReport& r, Model m) {
+  const std::string model(ModelName(m));
+  const std::string loss(FitLossName(r.loss));
+  if (r.message.find("evaluation failed") != std::string::npos)
+    return "the " + model + " fit failed: its error under --loss " + loss +
+           " is not a finite number on these samples (a value no surface has, e.g. a negative "
+           "or enormous f_r?); no material file written";
+  return "the " + model +
+         " fit failed (the solver stopped before a result); no material file "
+         "written";
+}
+
 }  // namespace
 
 std::optional<AutoExtrapolationChoice> AutoExtrapolationFor(const std::string& path,
@@ -223,6 +236,9 @@ int RunFit(const FitCommandOptions& options) {
           o.model = m;
           processing::FitResult r = processing::FitMaterial(meas, o);
           r.material.name = inputs[i].name;
+          // A failed fit is no material: nothing is written, the input counts as failed.
+          if (r.report.status == processing::FitStatus::kFailed)
+            throw Error(FailedFitReason(r.report, m));
           WriteFileAtomically(output_of(inputs[i], m), FittedMaterialToJson(r));
           char done[96];
           std::snprintf(done, sizeof done, " %s (%s, %.2f s)", std::string(ModelName(m)).c_str(),

@@ -355,7 +355,8 @@ int main(int argc, char** argv) {
                    "no extra slice), hold (extra slices up to 80 deg by reciprocity and the "
                    "held measured values), model (extra slices and band from a ggx, ward or "
                    "lafortune material fitted to the capture, as a ratio on the measured "
-                   "values; the family that predicts the last slice best from the others) or auto (hold or model, "
+                   "values; the family that predicts the last slice best from the others) or auto "
+                   "(hold or model, "
                    "whichever predicts the capture's last slice better from the others)")
       ->capture_default_str()
       ->check(CLI::IsMember({"clamp", "hold", "model", "auto"}));
@@ -570,8 +571,10 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(WholeNumberAtLeast(1));
   fit_cmd
-      ->add_option("--jobs", fit.jobs,
-                   "Threads: inputs fitted in parallel, or Ceres threads for a single input")
+      ->add_option(
+          "--jobs", fit.jobs,
+          "Threads: inputs fitted in parallel, or for a single input its colour channels and "
+          "the two fixed halves its samples are summed in (results do not depend on --jobs)")
       ->capture_default_str()
       ->check(WholeNumberAtLeast(1));
   fit_cmd->add_flag("--force", fit.force, "Overwrite existing output files");

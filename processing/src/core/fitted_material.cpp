@@ -202,7 +202,6 @@ std::string FitReportJson(const FitReport& report) {
   j["slices"] = slices;
   j["iterations"] = report.iterations;
   j["starts"] = report.starts;
-  j["seconds"] = report.seconds;
   j["samples_used"] = report.samples_used;
   j["excluded"] = {{"invalid", report.excluded_invalid},
                    {"saturated", report.excluded_saturated},

@@ -2,8 +2,11 @@
 // samples prepared (fit_data.cpp), the model's multi-start run (kernel_fit.h) and the report.
 #include "brdf/fit/fit.h"
 
+#include <glog/logging.h>
+
 #include <chrono>
 #include <cstdio>
+#include <mutex>
 #include <optional>
 #include <string>
 
@@ -22,6 +25,20 @@ std::string Format(const char* fmt, double a, double b = 0, double c = 0, double
   char buf[256];
   std::snprintf(buf, sizeof buf, fmt, a, b, c, d);
   return buf;
+}
+
+// Ceres reports through glog, whose lines ("Logging before InitGoogleLogging()", "E...
+// trust_region_minimizer.cc:71] Terminating: ...") are a library's diary, not a message for the
+// user: the outcome is in the report. glog is initialised once (unless the host program did) and
+// only fatal messages pass; a host that wants Ceres' log sets FLAGS_minloglevel after fitting.
+void SilenceSolverLogging() {
+  static std::once_flag once;
+  std::call_once(once, [] {
+    if (!google::IsGoogleLoggingInitialized()) google::InitGoogleLogging("brdf");
+    FLAGS_logtostderr = false;
+    FLAGS_minloglevel = google::GLOG_FATAL;
+    FLAGS_stderrthreshold = google::GLOG_FATAL;
+  });
 }
 
 }  // namespace
@@ -44,6 +61,7 @@ FitReport EvaluateFit(const Measurement& measurement, const Material& material,
 
 FitResult FitMaterial(const Measurement& measurement, const FitOptions& options) {
   const auto t0 = Clock::now();
+  SilenceSolverLogging();
   if (options.starts < 1)
     throw InvalidArgument("fit: the number of starts must be at least 1, got " +
                           std::to_string(options.starts));

@@ -342,9 +342,13 @@ class KernelFit {
       out.x[i] = std::clamp(out.x[i], lo[i], hi[i]);
     }
     ceres::Problem problem;
-    // One residual block per thread (CompressedCost explains why not one per sample).
+    // Two residual blocks, whatever the thread count (CompressedCost explains why not one per
+    // sample). The split is fixed so the sums are too: Ceres adds its threads' partial costs
+    // and gradients, and with two blocks every assignment of blocks to threads adds the same two
+    // numbers (a + b = b + a exactly), so the result does not depend on --jobs. More blocks
+    // would let more threads help but make the sum's order depend on scheduling.
     const std::size_t n = data_.samples.size();
-    const std::size_t parts = static_cast<std::size_t>(std::max(1, threads));
+    constexpr std::size_t parts = 2;
     auto make_cost = [&](std::size_t begin, std::size_t end,
                          const std::array<bool, kN>* held) -> SummedCost<kN>* {
       if constexpr (kHasLinear)

@@ -66,6 +66,11 @@ FileKind FileKindOf(ImportFormat format);
 // The output name of an input: its file name without the extension ("gold.bpc" → "gold").
 std::string OutputNameOf(const std::string& path);
 
+// What a written file records as its source: the input's file name alone ("/home/ana/gold.bpc"
+// → "gold.bpc"). Sidecars, manifests and captures are shipped and shared, so they never carry
+// the converting machine's folders (docs/robustness.md).
+std::string RecordedSourceName(const std::string& path);
+
 // The suffix of per-material extrapolation files, ".extrapolate.json".
 inline constexpr const char* kExtrapolationSuffix = ".extrapolate.json";
 
