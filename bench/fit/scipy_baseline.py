@@ -84,8 +84,9 @@ def unreal(d, x):
     return [base[c] * (1 - metallic) / np.pi + dist * vis * (f90 * fc + (1 - fc) * f0[c]) for c in range(3)]
 
 
-def hdrp(d, x):
-    base, metallic, smoothness = x[0:3], x[3], x[4]
+def hdrp_terms(d, smoothness):
+    """The terms HDRP Lit's two parameterisations share: GGX D, the height-correlated visibility,
+    the Disney diffuse (renormalised) and the Schlick weight (1 - l·h)^5."""
     perceptual = 1 - smoothness
     alpha = max(perceptual * perceptual, 1e-4)
     a2 = alpha * alpha
@@ -97,10 +98,16 @@ def hdrp(d, x):
     fd90 = 0.5 + perceptual * (1 + lov)
     disney = (1 + (fd90 - 1) * pow5(1 - nol)) * (1 + (fd90 - 1) * pow5(1 - nov)) / (1.03571 * np.pi)
     fc = pow5(1 - loh)
+    return dist * vis, disney, fc
+
+
+def hdrp(d, x):
+    base, metallic, smoothness = x[0:3], x[3], x[4]
+    spec_dv, disney, fc = hdrp_terms(d, smoothness)
     out = []
     for c in range(3):
         f0 = 0.04 + (base[c] - 0.04) * metallic
-        out.append(base[c] * (1 - metallic) * disney + (f0 + (1 - f0) * fc) * dist * vis)
+        out.append(base[c] * (1 - metallic) * disney + (f0 + (1 - f0) * fc) * spec_dv)
     return out
 
 
@@ -119,19 +126,9 @@ def urp(d, x):
 def hdrp_specular(d, x):
     """HDRP Lit, specular colour: fresnel0 = specularColor, diffuseColor = baseColor·(1 − max(specularColor))."""
     base, spec, smoothness = x[0:3], x[3:6], x[6]
-    perceptual = 1 - smoothness
-    alpha = max(perceptual * perceptual, 1e-4)
-    a2 = alpha * alpha
-    nol, noh, lov, loh = d["n_dot_l"], d["n_dot_h"], d["l_dot_v"], d["v_dot_h"]
-    nov = np.maximum(d["n_dot_v"], 1e-4)
-    s = (noh * a2 - noh) * noh + 1
-    dist = a2 / (np.pi * s * s)
-    vis = 0.5 / (nol * np.sqrt((-nov * a2 + nov) * nov + a2) + nov * np.sqrt((-nol * a2 + nol) * nol + a2))
-    fd90 = 0.5 + perceptual * (1 + lov)
-    disney = (1 + (fd90 - 1) * pow5(1 - nol)) * (1 + (fd90 - 1) * pow5(1 - nov)) / (1.03571 * np.pi)
-    fc = pow5(1 - loh)
+    spec_dv, disney, fc = hdrp_terms(d, smoothness)
     keep = 1 - max(spec)
-    return [base[c] * keep * disney + (spec[c] + (1 - spec[c]) * fc) * dist * vis for c in range(3)]
+    return [base[c] * keep * disney + (spec[c] + (1 - spec[c]) * fc) * spec_dv for c in range(3)]
 
 
 def urp_specular(d, x):
