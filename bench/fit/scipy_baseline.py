@@ -111,14 +111,20 @@ def hdrp(d, x):
     return out
 
 
-def urp(d, x):
-    albedo, metallic, smoothness = x[0:3], x[3], x[4]
+def urp_specular_term(d, smoothness):
+    """URP Lit's specular lobe (its minimalist GGX, DirectBRDFSpecular) for a smoothness."""
     perceptual = 1 - smoothness
     roughness = max(perceptual * perceptual, 2.0 ** -7)
     r2 = max(roughness * roughness, 2.0 ** -14)
     noh, loh = d["n_dot_h"], d["v_dot_h"]
     dd = noh * noh * (r2 - 1) + 1.00001
     term = r2 / (dd * dd * np.maximum(0.1, loh * loh) * (4 * roughness + 2))
+    return term
+
+
+def urp(d, x):
+    albedo, metallic, smoothness = x[0:3], x[3], x[4]
+    term = urp_specular_term(d, smoothness)
     return [(albedo[c] * (0.96 - 0.96 * metallic) + term * (0.04 + (albedo[c] - 0.04) * metallic)) / np.pi
             for c in range(3)]
 
@@ -134,12 +140,7 @@ def hdrp_specular(d, x):
 def urp_specular(d, x):
     """URP Lit, specular setup: diffuse = albedo·(1 − specular) per channel, specular = specular colour."""
     albedo, spec, smoothness = x[0:3], x[3:6], x[6]
-    perceptual = 1 - smoothness
-    roughness = max(perceptual * perceptual, 2.0 ** -7)
-    r2 = max(roughness * roughness, 2.0 ** -14)
-    noh, loh = d["n_dot_h"], d["v_dot_h"]
-    dd = noh * noh * (r2 - 1) + 1.00001
-    term = r2 / (dd * dd * np.maximum(0.1, loh * loh) * (4 * roughness + 2))
+    term = urp_specular_term(d, smoothness)
     return [(albedo[c] * (1 - spec[c]) + term * spec[c]) / np.pi for c in range(3)]
 
 
