@@ -13,10 +13,10 @@
 #include "brdf/core/brdf_source.h"
 #include "brdf/core/models.h"
 #include "brdf/device/driver.h"
-#include "brdf/device_emulation/emulated_usb.h"
 #include "brdf/device/protocol.h"
 #include "brdf/device/simulator.h"
 #include "brdf/device/usb_transport.h"
+#include "brdf/device_emulation/emulated_usb.h"
 
 namespace {
 

@@ -29,8 +29,8 @@
 #include "brdf/core/brdf_source.h"
 #include "brdf/core/lut_brdf.h"
 #include "brdf/core/rgl.h"
-#include "brdf/processing/measurement_brdf.h"
 #include "brdf/preview/preview.h"
+#include "brdf/processing/measurement_brdf.h"
 
 namespace {
 

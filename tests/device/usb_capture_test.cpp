@@ -16,8 +16,8 @@
 
 #include "brdf/core/bpc.h"
 #include "brdf/device/capture_session.h"
-#include "brdf/device_emulation/emulated_usb.h"
 #include "brdf/device/usb_transport.h"
+#include "brdf/device_emulation/emulated_usb.h"
 #include "device_test_support.h"
 
 namespace brdf::device {

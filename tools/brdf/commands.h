@@ -25,7 +25,7 @@ struct EvalOptions {
   std::string extrapolate;  // "P,L" for captures; empty: per-material JSON, else 1,0.5
   // Captures: blind-spot fill, as `brdf convert --beyond` (processing::kDefaultBeyondMethod).
   std::string beyond = "clamp";
-  int beyond_subdivide = 2;     // captures: as `brdf convert --beyond-subdivide`
+  int beyond_subdivide = 2;  // captures: as `brdf convert --beyond-subdivide`
   // Many directions at once instead of --in/--out: a file ("-" = stdin) of lines
   // "THETA_IN PHI_IN THETA_OUT PHI_OUT" (degrees, blanks or commas between); one output line
   // each. Empty lines and lines starting with '#' are skipped.

@@ -24,10 +24,10 @@
 //            MeasuredBrdf*.es300.glsl and MeasuredBrdf*.450.glsl (the lookup as GLSL files)
 //   each     NAME.manifest.json   axes and ranges, texel-centre mapping, units, colour space,
 //                                 probe texels (index → RGB f_r), the IBL pack under "ibl"
-//                                 (brdf/core/ibl_pack.h; null for atlases), and under "engines" each
-//                                 folder's files, texture format, orientation per import
-//                                 path and import settings (one text, hard-linked into every
-//                                 engine folder of the conversion)
+//                                 (brdf/core/ibl_pack.h; null for atlases), and under "engines"
+//                                 each folder's files, texture format, orientation per import path
+//                                 and import settings (one text, hard-linked into every engine
+//                                 folder of the conversion)
 // Shader files carry the LUT layout in their constants; they are named MeasuredBrdf.* for the
 // reference layout (θin 0, 20, 40, 60, one material) and MeasuredBrdf_<tag>.* otherwise, so
 // materials of one layout share one file and different layouts never overwrite each other.
