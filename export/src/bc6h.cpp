@@ -585,36 +585,9 @@ int MaxHalfError(const Bc6hBlock& block, const BlockInput& in) {
 
 std::uint16_t FloatToHalfUnsigned(float value) {
   if (!(value > 0.0f)) return 0;  // NaN, zero, negative
-  if (value >= kBc6hMaxValue) return 0x7BFF;
-  const std::uint32_t f = std::bit_cast<std::uint32_t>(value);
-  const int e = static_cast<int>(f >> 23) - 127;
-  const std::uint32_t mantissa = f & 0x7FFFFFu;
-  std::uint32_t half = 0, remainder = 0, halfway = 0;
-  if (e >= -14) {
-    half = (static_cast<std::uint32_t>(e + 15) << 10) | (mantissa >> 13);
-    remainder = mantissa & 0x1FFFu;
-    halfway = 0x1000u;
-  } else {
-    // A half denormal m·2^−24: the float's significand s·2^(e − 23) shifted right by −(e + 1).
-    const int shift = -(e + 1);
-    if (shift > 24) return 0;
-    const std::uint32_t significand = mantissa | (e > -127 ? 0x800000u : 0u);
-    half = significand >> shift;
-    remainder = significand & ((1u << shift) - 1u);
-    halfway = 1u << (shift - 1);
-  }
-  if (remainder > halfway || (remainder == halfway && (half & 1u))) ++half;  // nearest, ties even
-  return static_cast<std::uint16_t>(std::min<std::uint32_t>(half, 0x7BFFu));
-}
-
-float HalfToFloat(std::uint16_t half) {
-  const int e = (half >> 10) & 31, m = half & 1023;
-  const float sign = (half & 0x8000) ? -1.0f : 1.0f;
-  if (e == 0) return sign * std::ldexp(static_cast<float>(m), -24);
-  if (e == 31)
-    return m == 0 ? sign * std::numeric_limits<float>::infinity()
-                  : std::numeric_limits<float>::quiet_NaN();
-  return sign * std::ldexp(static_cast<float>(1024 + m), e - 25);
+  // Positive halves order like their bit patterns, so the clamp to 65504 is a min on bits
+  // (FloatToHalf gives +inf, 0x7C00, from 65520 up).
+  return std::min<std::uint16_t>(FloatToHalf(value), 0x7BFF);
 }
 
 int Bc6hBlockMode(const std::uint8_t* block) { return ModeNumberOf(block); }

@@ -49,6 +49,8 @@
 #include <string>
 #include <vector>
 
+#include "brdf/exporter/half.h"
+
 namespace brdf::exporter {
 
 inline constexpr std::size_t kBc6hBlockBytes = 16;
@@ -64,11 +66,9 @@ using Bc6hBlock = std::array<std::uint8_t, kBc6hBlockBytes>;
 // 16 texels (x fastest) × RGB, as half-float bit patterns.
 using Bc6hHalfTexels = std::array<std::array<std::uint16_t, 3>, 16>;
 
-// IEEE 754 binary16 helpers for the unsigned format. FloatToHalfUnsigned rounds to nearest
-// even and clamps to [0, 65504] (NaN and negative values → 0, +∞ → 65504), as the format
-// cannot hold anything else. HalfToFloat is exact.
+// Binary16 for the unsigned format: FloatToHalf (brdf/exporter/half.h) clamped to [0, 65504]
+// (NaN and negative values → 0, +∞ → 65504), as the format cannot hold anything else.
 std::uint16_t FloatToHalfUnsigned(float value);
-float HalfToFloat(std::uint16_t half);
 
 // Decodes one block bit-exactly as the specification (and so a GPU) does; texels x fastest.
 Bc6hHalfTexels DecodeBc6hBlock(const std::uint8_t* block);

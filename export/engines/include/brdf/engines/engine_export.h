@@ -52,6 +52,7 @@
 #include "brdf/core/fitted_material.h"
 #include "brdf/core/lut.h"
 #include "brdf/exporter/atlas.h"
+#include "brdf/exporter/half.h"
 #include "brdf/exporter/lut_export.h"
 #include "brdf/exporter/metadata.h"
 #include "brdf/exporter/packed_volume.h"
@@ -149,7 +150,7 @@ std::string EncodeRgba16fDds(const exporter::PackedVolume& volume);
 // significant bits and lies in [2^−24, 65408], which half represents without rounding
 // (subnormals below 2^−14).
 std::uint16_t Rgb9e5ChannelToHalf(std::uint32_t mantissa, std::uint32_t exponent);
-// IEEE 754 binary16 from any float, round to nearest even (overflow → ±inf, NaN kept quiet).
-std::uint16_t FloatToHalf(float value);
+// IEEE 754 binary16 from any float (brdf/exporter/half.h), also used for the RGBA16F volumes.
+using exporter::FloatToHalf;
 
 }  // namespace brdf::engines
