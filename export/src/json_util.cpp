@@ -18,6 +18,17 @@ PayloadSummary Summarize(const Bc6hVolume& payload) {
   return {true, payload.width, payload.height, payload.depth, payload.ByteSize(), payload.Crc32()};
 }
 
+PayloadSummary Summarize(const CompactLut& payload) {
+  PayloadSummary s{false,
+                   Lut::kWidth,
+                   Lut::kHeight,
+                   payload.slices(),
+                   payload.PayloadBytes(),
+                   CompactPayloadCrc32(payload)};
+  s.compact = true;
+  return s;
+}
+
 ordered_json GridJson(const PayloadSummary& payload, const std::vector<double>& theta_in_deg) {
   const double delta = theta_in_deg.size() >= 2 ? theta_in_deg[1] - theta_in_deg[0] : 0.0;
   return ordered_json{
@@ -53,7 +64,15 @@ std::uint32_t ParseHex32(const std::string& text, const std::string& file,
 
 ordered_json PayloadJson(const PayloadSummary& payload) {
   ordered_json j;
-  if (payload.bc6h) {
+  if (payload.compact) {
+    j["format"] = "compact_log_grid";
+    j["encoding"] =
+        "per theta_in slice a grid of kept theta_d rows and phi_d columns holding half floats "
+        "g = log2(f/S + eps), read bilinearly in g (docs/formats/compact.md)";
+    j["texel_order"] =
+        "the .brdfc container: header, theta_in list, per-slice row and column lists, then "
+        "each slice's grid row by row, columns fastest, R, G, B";
+  } else if (payload.bc6h) {
     j["format"] = "bc6h_ufloat";
     j["encoding"] =
         "BC6H_UF16 blocks per ARB_texture_compression_bptc (BPTC_FLOAT, unsigned): "
@@ -75,7 +94,8 @@ ordered_json PayloadJson(const PayloadSummary& payload) {
   j["checksum"] = {{"algorithm", "crc32"},
                    {"definition",
                     "CRC-32 (IEEE 802.3, polynomial 0xEDB88320 reflected, as zlib crc32) of "
-                    "the payload bytes as stored in the KTX2 level 0 image and the DDS data"},
+                    "the payload bytes as stored in the KTX2 level 0 image and the DDS data (of a "
+                    ".brdfc file: its bytes from offset 36 to the end of the grid values)"},
                    {"value", Hex32Text(payload.crc32)}};
   return j;
 }

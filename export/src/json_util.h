@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "brdf/exporter/bc6h.h"
+#include "brdf/exporter/compact_lut.h"
 #include "brdf/exporter/metadata.h"
 #include "brdf/exporter/packed_volume.h"
 
@@ -22,9 +23,11 @@ struct PayloadSummary {
   int width = 0, height = 0, depth = 0;
   std::uint64_t bytes = 0;
   std::uint32_t crc32 = 0;
+  bool compact = false;  // the compact log grid (compact_lut.h), else as bc6h says
 };
 PayloadSummary Summarize(const PackedVolume& payload);
 PayloadSummary Summarize(const Bc6hVolume& payload);
+PayloadSummary Summarize(const CompactLut& payload);
 
 // {"frame": ..., "width": 361, "height": 181, "slices": K, "phi_d_deg": {...}, ...}
 ordered_json GridJson(const PayloadSummary& payload, const std::vector<double>& theta_in_deg);

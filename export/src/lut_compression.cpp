@@ -40,8 +40,9 @@ ErrorStatistics Statistics(std::vector<float>& errors) {
 LutCompression ParseLutCompression(std::string_view text) {
   if (text == "none") return LutCompression::kNone;
   if (text == "bc6h") return LutCompression::kBc6h;
+  if (text == "compact") return LutCompression::kCompact;
   throw InvalidArgument("--compress: unknown compression '" + std::string(text) +
-                        "' (known: none, bc6h)");
+                        "' (known: none, bc6h, compact)");
 }
 
 double TexelThetaOutDeg(double theta_in_deg, int j, int i) {

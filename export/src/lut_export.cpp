@@ -40,15 +40,50 @@ LutExportFormats ParseExportFormats(std::string_view list) {
 }
 
 std::vector<std::string> LutExportPaths(const std::string& out_dir, const std::string& name,
-                                        const LutExportFormats& formats) {
+                                        const LutExportFormats& formats, LutCompression compression,
+                                        bool any_representation) {
   std::vector<std::string> paths;
   const std::filesystem::path dir(out_dir);
-  for (const auto& [on, ext] : {std::pair{formats.ktx2, ".ktx2"}, std::pair{formats.dds, ".dds"},
-                                std::pair{formats.exr, ".exr"}, std::pair{formats.png, ".png"},
-                                std::pair{formats.json, ".json"}})
+  const bool blocks = any_representation || compression != LutCompression::kCompact;
+  const bool compact = (any_representation || compression == LutCompression::kCompact) &&
+                       (formats.ktx2 || formats.dds);
+  for (const auto& [on, ext] :
+       {std::pair{blocks && formats.ktx2, ".ktx2"}, std::pair{blocks && formats.dds, ".dds"},
+        std::pair{compact, ".brdfc"}, std::pair{formats.exr, ".exr"},
+        std::pair{formats.png, ".png"}, std::pair{formats.json, ".json"}})
     if (on) paths.push_back((dir / (name + ext)).string());
   return paths;
 }
+
+std::vector<std::string> LutExportPaths(const std::string& out_dir, const std::string& name,
+                                        const LutExportOptions& options) {
+  return LutExportPaths(out_dir, name, options.formats, options.compression, options.max_error > 0);
+}
+
+const char* LutCompressionName(LutCompression compression) {
+  switch (compression) {
+    case LutCompression::kBc6h:
+      return "BC6H";
+    case LutCompression::kCompact:
+      return "compact";
+    case LutCompression::kNone:
+      break;
+  }
+  return "RGB9E5";
+}
+
+namespace {
+
+// The certified error of the RGB9E5 words themselves (for --max-error's comparison).
+CertifiedError Rgb9e5Error(const Lut& lut, const PackedVolume& packed, double theta_b_deg) {
+  CertifiedError e =
+      MeasureCompressionError(lut, UnpackLut(packed, lut.theta_in_deg).texels, theta_b_deg);
+  e.format = "rgb9e5";
+  e.bytes = e.rgb9e5_bytes = packed.ByteSize();
+  return e;
+}
+
+}  // namespace
 
 LutExportResult ExportLut(const std::string& out_dir, const Lut& lut, TextureMetadata metadata,
                           const LutExportOptions& options) {
@@ -63,20 +98,56 @@ LutExportResult ExportLut(const std::string& out_dir, const Lut& lut, const Pack
     throw InvalidArgument("LUT export: the output name must be a plain file name, got '" + name +
                           "'");
   const LutExportFormats& f = options.formats;
+  const double theta_b = metadata.extrapolation ? metadata.extrapolation->theta_b_deg : 90.0;
+  LutExportResult result;
+  std::optional<CompressedLut> compressed;
+  std::optional<CompactBuild> compact;
+  LutCompression chosen = options.compression;
+  if (options.max_error > 0) {
+    // The smallest representation meeting the bound: compact, else BC6H, else RGB9E5.
+    const double bound = options.max_error;
+    compact = BuildCompactLut(lut, theta_b, bound, options.jobs);
+    const std::uint64_t bc6h_bytes = static_cast<std::uint64_t>((Lut::kWidth + 3) / 4) *
+                                     ((Lut::kHeight + 3) / 4) * 16 * lut.slices();
+    if (compact->met_target && compact->error.bytes < bc6h_bytes) {
+      chosen = LutCompression::kCompact;
+    } else {
+      compressed = CompressLutBc6h(lut, theta_b, options.jobs);
+      if (compressed->error.measured.max <= bound) {
+        chosen = LutCompression::kBc6h;
+        compact.reset();
+      } else if (compact->met_target) {
+        chosen = LutCompression::kCompact;
+        compressed.reset();
+      } else {
+        chosen = LutCompression::kNone;
+        compressed.reset(), compact.reset();
+        result.certified_error = Rgb9e5Error(lut, packed, theta_b);
+        result.met_max_error = result.certified_error->measured.max <= bound;
+      }
+    }
+  } else if (chosen == LutCompression::kCompact) {
+    compact = BuildCompactLut(lut, theta_b, kCompactDefaultMaxError, options.jobs);
+    result.met_max_error = compact->met_target;
+  } else if (chosen == LutCompression::kBc6h) {
+    compressed = CompressLutBc6h(lut, theta_b, options.jobs);
+  }
+  result.chosen = chosen;
+  const bool blocks = chosen != LutCompression::kCompact;
   metadata.companion_files.clear();
-  if (f.ktx2) metadata.companion_files.push_back(name + ".ktx2");
-  if (f.dds) metadata.companion_files.push_back(name + ".dds");
+  if (blocks && f.ktx2) metadata.companion_files.push_back(name + ".ktx2");
+  if (blocks && f.dds) metadata.companion_files.push_back(name + ".dds");
+  if (!blocks && (f.ktx2 || f.dds)) metadata.companion_files.push_back(name + ".brdfc");
   if (f.exr) metadata.companion_files.push_back(name + ".exr");
   if (f.png) metadata.companion_files.push_back(name + ".png");
 
   const std::filesystem::path dir(out_dir);
   const auto path = [&](const char* ext) { return (dir / (name + ext)).string(); };
-  LutExportResult result;
-  std::optional<CompressedLut> compressed;
-  if (options.compression == LutCompression::kBc6h) {
-    compressed = CompressLutBc6h(
-        lut, metadata.extrapolation ? metadata.extrapolation->theta_b_deg : 90.0, options.jobs);
-    metadata.certified_error = compressed->error;
+  if (compact) {
+    result.certified_error = compact->error;
+    result.payload_bytes = compact->compact.PayloadBytes();
+    result.payload_crc32 = CompactPayloadCrc32(compact->compact);
+  } else if (compressed) {
     result.certified_error = compressed->error;
     result.payload_bytes = compressed->blocks.ByteSize();
     result.payload_crc32 = compressed->blocks.Crc32();
@@ -84,10 +155,12 @@ LutExportResult ExportLut(const std::string& out_dir, const Lut& lut, const Pack
     result.payload_bytes = packed.ByteSize();
     result.payload_crc32 = packed.Crc32();
   }
-  const std::string sidecar = compressed
+  metadata.certified_error = result.certified_error;
+  const std::string sidecar = compact ? SidecarJson(compact->compact, metadata)
+                              : compressed
                                   ? SidecarJson(compressed->blocks, lut.theta_in_deg, metadata)
                                   : SidecarJson(packed, lut.theta_in_deg, metadata);
-  if (f.ktx2) {
+  if (blocks && f.ktx2) {
     const KeyValues kvs{{"brdf.sidecar", sidecar}};
     if (compressed)
       WriteKtx2(path(".ktx2"), compressed->blocks, kvs);
@@ -95,12 +168,16 @@ LutExportResult ExportLut(const std::string& out_dir, const Lut& lut, const Pack
       WriteKtx2(path(".ktx2"), packed, kvs);
     result.written.push_back(path(".ktx2"));
   }
-  if (f.dds) {
+  if (blocks && f.dds) {
     if (compressed)
       WriteDds(path(".dds"), compressed->blocks);
     else
       WriteDds(path(".dds"), packed);
     result.written.push_back(path(".dds"));
+  }
+  if (!blocks && (f.ktx2 || f.dds)) {
+    WriteCompactLut(path(".brdfc"), compact->compact, sidecar);
+    result.written.push_back(path(".brdfc"));
   }
   if (f.exr) {
     WriteExrComposite(path(".exr"), lut, sidecar, result.payload_crc32, options.exr);

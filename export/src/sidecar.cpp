@@ -63,6 +63,10 @@ std::string SidecarJson(const Bc6hVolume& payload, const std::vector<double>& th
   return SidecarText(detail::Summarize(payload), theta_in_deg, metadata);
 }
 
+std::string SidecarJson(const CompactLut& payload, const TextureMetadata& metadata) {
+  return SidecarText(detail::Summarize(payload), payload.theta_in_deg, metadata);
+}
+
 void WriteSidecar(const std::string& path, const PackedVolume& payload,
                   const std::vector<double>& theta_in_deg, const TextureMetadata& metadata) {
   WriteFileAtomically(path, SidecarJson(payload, theta_in_deg, metadata));
@@ -127,13 +131,17 @@ SidecarInfo ParseSidecarJson(std::string_view json_text, const std::string& file
   info.payload_bytes = p.UInt64("bytes");
   const ordered_json& payload = f.Object("payload");
   if (payload.contains("format")) info.payload_format = p.String("format");
-  if (info.payload_format != "rgb9e5" && info.payload_format != "bc6h_ufloat")
-    throw FormatError(file, "member 'payload.format'", "\"rgb9e5\" or \"bc6h_ufloat\"",
+  if (info.payload_format != "rgb9e5" && info.payload_format != "bc6h_ufloat" &&
+      info.payload_format != "compact_log_grid")
+    throw FormatError(file, "member 'payload.format'",
+                      "\"rgb9e5\", \"bc6h_ufloat\" or \"compact_log_grid\"",
                       "\"" + info.payload_format + "\"");
   const std::uint64_t w = static_cast<std::uint64_t>(std::max(info.width, 0)),
                       h = static_cast<std::uint64_t>(std::max(info.height, 0)),
                       d = static_cast<std::uint64_t>(std::max(info.slices, 0));
-  if (info.payload_format == "bc6h_ufloat") {
+  if (info.payload_format == "compact_log_grid") {
+    // Any size: the grid adapts to the data (the container checks itself).
+  } else if (info.payload_format == "bc6h_ufloat") {
     const std::uint64_t blocks = (w + 3) / 4 * ((h + 3) / 4) * d;
     if (info.payload_bytes != blocks * 16)
       throw FormatError(file, "member 'payload.bytes'",

@@ -12,6 +12,8 @@
 #include <optional>
 #include <set>
 
+#include <fmt/format.h>
+
 #include "batch.h"
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
@@ -32,7 +34,7 @@ namespace {
 // Refuses inputs whose outputs would collide with another input's outputs or overwrite an
 // input (a material "gold.json" converted into its own folder would be replaced by the sidecar
 // "gold.json"). Such inputs move from `inputs` to `failures`.
-void RefuseCollisions(const fs::path& out_dir, const exporter::LutExportFormats& formats,
+void RefuseCollisions(const fs::path& out_dir, const exporter::LutExportOptions& formats,
                       std::vector<BatchInput>& inputs, std::vector<BatchFailure>& failures) {
   std::set<std::string> input_paths;
   for (const BatchInput& in : inputs) input_paths.insert(Identity(in.path));
@@ -69,6 +71,26 @@ void RefuseCollisions(const fs::path& out_dir, const exporter::LutExportFormats&
   inputs = std::move(kept);
 }
 
+// The one line per input --max-error and --compress compact print: which representation, its
+// bytes and the error it achieved.
+std::optional<std::string> RepresentationLine(const std::string& name,
+                                              const exporter::LutExportOptions& options,
+                                              const exporter::LutExportResult& result) {
+  if (!(options.max_error > 0) && options.compression != exporter::LutCompression::kCompact)
+    return std::nullopt;
+  const double bound =
+      options.max_error > 0 ? options.max_error : exporter::kCompactDefaultMaxError;
+  const exporter::CertifiedError& e = *result.certified_error;
+  return fmt::format(
+      "{}: {} {} bytes ({:.1f}x smaller than RGB9E5), measured max {:.2f} % (p99 "
+      "{:.2f} %, median {:.3f} %){}",
+      name, exporter::LutCompressionName(result.chosen), e.bytes,
+      static_cast<double>(e.rgb9e5_bytes) / static_cast<double>(e.bytes), 100 * e.measured.max,
+      100 * e.measured.p99, 100 * e.measured.median,
+      result.met_max_error ? fmt::format(" <= {:g} %", 100 * bound)
+                           : fmt::format(" - WARNING: above the bound {:g} %", 100 * bound));
+}
+
 }  // namespace
 
 int RunConvert(const ConvertOptions& options) {
@@ -77,11 +99,13 @@ int RunConvert(const ConvertOptions& options) {
   export_options.formats = exporter::ParseExportFormats(options.formats);
   export_options.exr = ParseExrOptions(options.exr_type, options.exr_compression);
   export_options.compression = exporter::ParseLutCompression(options.compress);
+  export_options.max_error = options.max_error;
   const engines::EngineSet engine_set = engines::ParseEngines(options.engines);
-  if (export_options.compression != exporter::LutCompression::kNone && engine_set.Any())
-    throw InvalidArgument(
-        "--compress bc6h: the engine hand-offs (--engine) are written as RGB9E5 only so far; "
-        "write them in a separate run without --compress");
+  if ((export_options.compression != exporter::LutCompression::kNone || options.max_error > 0) &&
+      engine_set.Any())
+    throw InvalidArgument(std::string(options.max_error > 0 ? "--max-error" : "--compress") +
+                          ": the engine hand-offs (--engine) are written as RGB9E5 only so far; "
+                          "write them in a separate run without it");
   if (!options.engine_fits.empty()) {
     if (!engine_set.Any())
       throw InvalidArgument("--engine-fits: goes with --engine (the fits go into its manifests)");
@@ -109,13 +133,12 @@ int RunConvert(const ConvertOptions& options) {
   if (!fs::is_directory(out_dir))
     throw IoError(options.out + ": cannot create the output folder" +
                   (ec ? ": " + ec.message() : std::string()));
-  RefuseCollisions(out_dir, export_options.formats, found.inputs, found.failures);
+  RefuseCollisions(out_dir, export_options, found.inputs, found.failures);
   {
     // The overwrite rule, for every output of the run before any work is done.
     std::vector<std::string> outputs, names;
     for (const BatchInput& in : found.inputs) {
-      for (std::string& p :
-           exporter::LutExportPaths(out_dir.string(), in.name, export_options.formats))
+      for (std::string& p : exporter::LutExportPaths(out_dir.string(), in.name, export_options))
         outputs.push_back(std::move(p));
       names.push_back(in.name);
     }
@@ -167,15 +190,18 @@ int RunConvert(const ConvertOptions& options) {
         metadata.saturated_samples = built.saturated_samples;
         if (built.beyond) metadata.beyond_json = processing::BeyondReportJson(*built.beyond);
         std::vector<std::string> outputs =
-            exporter::LutExportPaths(out_dir.string(), in.name, export_options.formats);
+            exporter::LutExportPaths(out_dir.string(), in.name, export_options);
         for (std::string& p : engines::EngineOutputPaths(out_dir.string(), in.name, engine_set))
           outputs.push_back(std::move(p));
         const OutputGuard guard(std::move(outputs));
         try {
-          engines::ExportLutWithEngines(
+          const engines::EngineExportResult exported = engines::ExportLutWithEngines(
               out_dir.string(), built.lut, metadata, export_options, engine_set,
               options.engine_fits.empty() ? std::vector<FittedMaterial>{}
                                           : engines::ReadFitResults(options.engine_fits, in.name));
+          if (const std::optional<std::string> line =
+                  RepresentationLine(in.name, export_options, exported.lut))
+            result.warnings.push_back(*line);
         } catch (...) {
           // No partial set: remove what this conversion already renamed into place (the
           // writer that failed removed its own temporary file).

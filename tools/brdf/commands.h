@@ -53,8 +53,12 @@ struct ConvertOptions {
   // measured (noisy) data by only ~20 % and costs more than everything else of a conversion
   // (docs/benchmarks.md).
   std::string exr_compression = "none";
-  // Texel format of the KTX2 and DDS: "none" (RGB9E5) or "bc6h" (exporter/lut_compression.h).
+  // Texel format of the KTX2 and DDS: "none" (RGB9E5) or "bc6h" (exporter/lut_compression.h),
+  // or "compact" (a .brdfc in their place, exporter/compact_lut.h).
   std::string compress = "none";
+  // --max-error E (a fraction; 0: not given): the smallest of compact, BC6H and RGB9E5 meeting
+  // it on the measured range, per input (exporter::LutExportOptions::max_error).
+  double max_error = 0;
   int jobs = DefaultJobs();
   bool quiet = false;  // no progress bar
   bool force = false;  // overwrite existing outputs (brdf::CheckWritableOutputs)

@@ -21,9 +21,11 @@
 
 namespace brdf::exporter {
 
-enum class LutCompression { kNone, kBc6h };
+// kNone: RGB9E5 KTX2/DDS; kBc6h: BC6H KTX2/DDS; kCompact: the compact form (compact_lut.h), one
+// .brdfc file in place of the KTX2 and DDS.
+enum class LutCompression { kNone, kBc6h, kCompact };
 
-// "none" or "bc6h". Throws InvalidArgument naming the value and the known ones.
+// "none", "bc6h" or "compact". Throws InvalidArgument naming the value and the known ones.
 LutCompression ParseLutCompression(std::string_view text);
 
 // θout in degrees of LUT texel (row j = θd in degrees, column i = φd in degrees) of the slice at

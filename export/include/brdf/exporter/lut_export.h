@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "brdf/core/lut.h"
+#include "brdf/exporter/compact_lut.h"
 #include "brdf/exporter/exr.h"
 #include "brdf/exporter/lut_compression.h"
 #include "brdf/exporter/metadata.h"
@@ -37,20 +38,36 @@ struct LutExportOptions {
   LutExportFormats formats;
   ExrOptions exr;
   LutCompression compression = LutCompression::kNone;
-  int jobs = 1;  // threads for the BC6H encoder (0 = one per core)
+  int jobs = 1;  // threads for the BC6H encoder and the compact build (0 = one per core)
+  // `--max-error E` (a fraction; 0 = not given): `compression` is ignored and the smallest of
+  // the compact form, BC6H and RGB9E5 whose certified measured-range max error is at most E is
+  // written (RGB9E5, the most precise, when none is); the choice goes into the result and the
+  // sidecar. With kCompact alone, the compact form's target (default kCompactDefaultMaxError).
+  double max_error = 0;
 };
 
 struct LutExportResult {
   std::vector<std::string> written;  // paths, in the order ktx2, dds, exr, png, json
   std::uint64_t payload_bytes = 0;   // RGB9E5 (or BC6H) bytes in each of the KTX2 and DDS files
   std::uint32_t payload_crc32 = 0;   // the sidecar's checksum
-  std::optional<CertifiedError> certified_error;  // set when compressed
+  std::optional<CertifiedError> certified_error;  // set when compressed or chosen by max_error
+  LutCompression chosen = LutCompression::kNone;  // the representation written
+  bool met_max_error = true;  // false: even the chosen one misses max_error (or the compact target)
 };
 
 // The files ExportLut writes for `name` into `out_dir` with `formats`, in its order (ktx2, dds,
-// exr, png, json): the list a caller's overwrite check covers before any work.
+// brdfc, exr, png, json): the list a caller's overwrite check covers before any work. With
+// kCompact the .brdfc takes the place of the KTX2 and DDS (written when either is selected);
+// with `any_representation` (max_error given) every file either could be is listed.
 std::vector<std::string> LutExportPaths(const std::string& out_dir, const std::string& name,
-                                        const LutExportFormats& formats);
+                                        const LutExportFormats& formats,
+                                        LutCompression compression = LutCompression::kNone,
+                                        bool any_representation = false);
+// The same for the options ExportLut is given.
+std::vector<std::string> LutExportPaths(const std::string& out_dir, const std::string& name,
+                                        const LutExportOptions& options);
+// "RGB9E5", "BC6H" or "compact", for messages.
+const char* LutCompressionName(LutCompression compression);
 
 // `metadata.name` names the files (must be non-empty and a plain file name);
 // `metadata.companion_files` is filled in here. The folder must exist.

@@ -36,6 +36,7 @@
 #include <vector>
 
 #include "brdf/exporter/bc6h.h"
+#include "brdf/exporter/compact_lut.h"
 #include "brdf/exporter/metadata.h"
 #include "brdf/exporter/packed_volume.h"
 
@@ -52,6 +53,11 @@ std::string SidecarJson(const PackedVolume& payload, const std::vector<double>& 
 std::string SidecarJson(const Bc6hVolume& payload, const std::vector<double>& theta_in_deg,
                         const TextureMetadata& metadata);
 
+// The same for a compact LUT (`--compress compact`, compact_lut.h): "payload" starts with
+// "format": "compact_log_grid"; bytes and checksum are CompactLut::PayloadBytes and
+// CompactPayloadCrc32.
+std::string SidecarJson(const CompactLut& payload, const TextureMetadata& metadata);
+
 // Writes SidecarJson atomically to `path`. Throws IoError.
 void WriteSidecar(const std::string& path, const PackedVolume& payload,
                   const std::vector<double>& theta_in_deg, const TextureMetadata& metadata);
@@ -63,7 +69,7 @@ struct SidecarInfo {
   std::string name, source;
   std::vector<double> theta_in_deg;
   int width = 0, height = 0, slices = 0;
-  std::string payload_format = "rgb9e5";  // or "bc6h_ufloat"
+  std::string payload_format = "rgb9e5";  // or "bc6h_ufloat", "compact_log_grid"
   std::uint64_t payload_bytes = 0;
   std::uint32_t payload_crc32 = 0;
   std::optional<CertifiedError> certified_error;  // the "compression" member, when present
