@@ -24,6 +24,9 @@ constexpr std::size_t kHeaderBytes = 36;
 constexpr int kMaxSlices = 181;
 constexpr float kScaleFloor = 6.103515625e-05f;  // 2^−14, as lut_compression.cpp
 constexpr float kRelativeFloor = 1e-4f;
+// The extrapolated band (θb < θout ≤ 90°) is built to 4× the target: visible at grazing views,
+// but not measured.
+constexpr float kFilledWeight = 0.25f;
 
 // The grid coordinate of x (degrees, inside [0, kept.back()]) for a kept list: p + (x −
 // a_p)/(a_{p+1} − a_p) on the gap [a_p, a_{p+1}] holding x.
@@ -68,12 +71,15 @@ class SliceBuilder {
                float floor_value)
       : lut_(lut), k_(k), mirrored_(mirrored), scale_(scale), floor_(floor_value) {
     const int n = Lut::kHeight * Lut::kWidth;
-    measured_.resize(n);
+    weight_.resize(n);
     logs_.resize(static_cast<std::size_t>(n) * 3);
     for (int j = 0; j < Lut::kHeight; ++j)
       for (int i = 0; i < Lut::kWidth; ++i) {
         const int at = j * Lut::kWidth + i;
-        measured_[at] = TexelThetaOutDeg(lut.theta_in_deg[k], j, i) <= theta_b_deg + 1e-9;
+        const double theta_out = TexelThetaOutDeg(lut.theta_in_deg[k], j, i);
+        weight_[at] = theta_out <= theta_b_deg + 1e-9 ? 1.0f
+                      : theta_out <= 90.0             ? kFilledWeight
+                                                      : 0.0f;
         for (int c = 0; c < 3; ++c)
           logs_[at * 3 + c] = FloatToHalf(
               scale > 0 ? std::log2(Clamped(lut.Texel(k, j, i)[c]) / scale + kCompactEpsilon)
@@ -183,13 +189,14 @@ class SliceBuilder {
     for (int j = std::max(j0, 0); j < std::min(j1, Lut::kHeight); ++j)
       for (int i = std::max(i0, 0); i < std::min(i1, Lut::kWidth); ++i) {
         const int at = j * Lut::kWidth + i;
-        if (!measured_[at]) continue;
+        if (weight_[at] == 0.0f) continue;
         const std::array<float, 3> d =
             ReadGrid(grid.data(), nr, nc, rmap[j], cmap[i], scale_, kCompactEpsilon);
         const float* ref = lut_.Texel(k_, j, i);
         const float r[3] = {Clamped(ref[0]), Clamped(ref[1]), Clamped(ref[2])};
         const float s = std::max({r[0], r[1], r[2], floor_});
         errors[at] =
+            weight_[at] *
             std::max({std::abs(d[0] - r[0]), std::abs(d[1] - r[1]), std::abs(d[2] - r[2])}) / s;
       }
   }
@@ -198,7 +205,7 @@ class SliceBuilder {
   int k_;
   bool mirrored_;
   float scale_, floor_;
-  std::vector<bool> measured_;
+  std::vector<float> weight_;  // 1 measured, kFilledWeight above the horizon beyond θb, else 0
   std::vector<std::uint16_t> logs_;  // every texel's g as a half, the grid's candidates
   std::vector<std::uint16_t> rows_, cols_;
   std::vector<float> errors_;

@@ -138,6 +138,60 @@ FLOAT3 MeasuredBrdf(@LUT_PARAM@FLOAT3 n, FLOAT3 l, FLOAT3 v) {
 }
 )~~";
 
+// The compact decoder's fetch (compact_lut.h): the grid position from the LUT coordinates, two
+// slices read bilinearly in log2 and blended linearly, as CompactLut::SampleAngles.
+constexpr std::string_view kCompactFetch = R"~~(
+// Compact form decoder (docs/formats/compact.md): per slice, log2(f/S + eps) on a grid of kept
+// theta_d rows and phi_d columns; whole-degree maps from degrees to grid coordinates.
+uniform highp sampler2D measured_brdf_compact_grid;
+uniform highp sampler2D measured_brdf_compact_rows;
+uniform highp sampler2D measured_brdf_compact_cols;
+uniform float measured_brdf_compact_scale;
+uniform float measured_brdf_compact_epsilon;
+
+// A map table (entries at whole degrees, channel 0) read linearly at x degrees.
+float MeasuredBrdfCompactMap(highp sampler2D map, float x, int last, int k) {
+  int x0 = min(int(floor(x)), last - 1);
+  float t = x - float(x0);
+  float a = texelFetch(map, ivec2(x0, k), 0).r;
+  float b = texelFetch(map, ivec2(x0 + 1, k), 0).r;
+  return a + (b - a) * t;
+}
+
+vec3 MeasuredBrdfCompactSlice(int k, float theta_d, float phi_d) {
+  float mr = MeasuredBrdfCompactMap(measured_brdf_compact_rows, clamp(theta_d, 0.0, 180.0), 180, k);
+  float mc = MeasuredBrdfCompactMap(measured_brdf_compact_cols, clamp(phi_d, 0.0, 360.0), 360, k);
+  vec4 info = texelFetch(measured_brdf_compact_rows, ivec2(0, k), 0);
+  int r0 = min(int(floor(mr)), int(info.b) - 1);
+  int c0 = min(int(floor(mc)), int(info.a) - 1);
+  float tr = mr - float(r0);
+  float tc = mc - float(c0);
+  int y = int(info.g) + r0;
+  vec3 g00 = texelFetch(measured_brdf_compact_grid, ivec2(c0, y), 0).rgb;
+  vec3 g01 = texelFetch(measured_brdf_compact_grid, ivec2(c0 + 1, y), 0).rgb;
+  vec3 g10 = texelFetch(measured_brdf_compact_grid, ivec2(c0, y + 1), 0).rgb;
+  vec3 g11 = texelFetch(measured_brdf_compact_grid, ivec2(c0 + 1, y + 1), 0).rgb;
+  vec3 top = g00 + (g01 - g00) * tc;
+  vec3 bottom = g10 + (g11 - g10) * tc;
+  vec3 l = top + (bottom - top) * tr;
+  return measured_brdf_compact_scale * max(exp2(l) - measured_brdf_compact_epsilon, vec3(0.0));
+}
+
+// uvw as MeasuredBrdfCoords returns it (single LUT, cell 0, 0).
+vec3 MeasuredBrdfCompactFetch(vec3 uvw) {
+  float phi_d = uvw.x * MEASURED_BRDF_TEXELS_U - 0.5;
+  float theta_d = uvw.y * MEASURED_BRDF_TEXELS_V - 0.5;
+  float x = uvw.z * MEASURED_BRDF_SLICES - 0.5;
+  float fl = floor(x);
+  int last = int(MEASURED_BRDF_SLICES) - 1;
+  int k0 = clamp(int(fl), 0, last);
+  int k1 = clamp(int(fl) + 1, 0, last);
+  vec3 a = MeasuredBrdfCompactSlice(k0, theta_d, phi_d);
+  vec3 b = MeasuredBrdfCompactSlice(k1, theta_d, phi_d);
+  return a + (b - a) * (x - fl);
+}
+)~~";
+
 // A float literal every language accepts ("20.0", "2.5", "0.000001" never in exponent form).
 std::string ShaderFloat(double v) {
   std::string s = fmt::format("{:.9f}", v);
@@ -206,6 +260,22 @@ std::string MeasuredBrdfShaderCode(ShaderLanguage language, const ShaderLutLayou
       break;
   }
   return code;
+}
+
+std::string CompactBrdfGlslFile(const ShaderLutLayout& layout) {
+  if (layout.texture_width != 361 || layout.texture_height != 181)
+    throw InvalidArgument("shader code: the compact decoder reads single LUTs (361 x 181)");
+  std::string code = MeasuredBrdfShaderCode(ShaderLanguage::kGlsl, layout);
+  // The fetch needs the constants, so it goes right after them.
+  const std::string anchor = "const float MEASURED_BRDF_DEG_PER_RAD = 57.295779513082323;\n";
+  const std::size_t at = code.find(anchor);
+  if (at == std::string::npos) throw InvalidArgument("shader code: template without constants");
+  code.insert(at + anchor.size(), kCompactFetch);
+  ReplaceAll(code, "highp sampler3D lut, ", "");
+  ReplaceAll(code, "lut, FLOAT2", "FLOAT2");
+  ReplaceAll(code, "lut, vec2", "vec2");
+  ReplaceAll(code, "textureLod(lut, uvw, 0.0).rgb", "MeasuredBrdfCompactFetch(uvw)");
+  return "#version 300 es\n// The compact form's decoder (docs/formats/compact.md).\n" + code;
 }
 
 std::string MeasuredBrdfGlslFile(GlslVersion version, const ShaderLutLayout& layout) {

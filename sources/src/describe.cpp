@@ -26,8 +26,10 @@
 #include "brdf/core/rgl.h"
 #include "brdf/core/text_format.h"
 #include "brdf/core/zemax.h"
+#include "brdf/exporter/compact_lut.h"
 #include "brdf/exporter/packed_volume.h"
 #include "brdf/exporter/rgb9e5.h"
+#include "brdf/exporter/sidecar.h"
 #include "brdf/processing/resample.h"
 #include "brdf/sources/capture.h"
 #include "brdf/sources/detect.h"
@@ -442,6 +444,69 @@ Json DescribeTexture(const std::string& path) {
   return j;
 }
 
+// A compact LUT (.brdfc): the same members as DescribeTexture's for a LUT, from the container
+// and its embedded sidecar; value ranges of the decoded texel centres.
+Json DescribeCompact(const std::string& path) {
+  const exporter::LoadedCompact c = exporter::ReadCompactLutFile(path);
+  const exporter::CompactLut& lut = c.compact;
+  Json j;
+  j["file"] = path;
+  j["format"] = "lut";
+  j["texture_file"] = path;
+  j["container"] = std::string("compact LUT (BRDFCLUT, log2 grid, ") +
+                   (lut.mirrored ? "mirrored phi_d 0-180" : "phi_d 0-360") + ")";
+  j["texel_format"] = "compact log grid";
+  j["file_bytes"] = std::filesystem::file_size(path);
+  j["width"] = Lut::kWidth;
+  j["height"] = Lut::kHeight;
+  j["slices"] = lut.slices();
+  j["theta_in_deg"] = lut.theta_in_deg;
+  j["theta_in_from_metadata"] = true;
+  j["payload_bytes"] = lut.PayloadBytes();
+  j["payload_crc32"] = Hex32Text(exporter::CompactPayloadCrc32(lut));
+  j["checksum"] = "verified against the recorded CRC-32";
+  j["grid"] = Json::array();
+  for (int k = 0; k < lut.slices(); ++k)
+    j["grid"].push_back({{"theta_in_deg", lut.theta_in_deg[k]},
+                         {"rows", lut.rows[k].size()},
+                         {"columns", lut.cols[k].size()}});
+  if (!c.sidecar_json.empty()) {
+    const exporter::SidecarInfo info = exporter::ParseSidecarJson(c.sidecar_json, path);
+    j["name"] = info.name;
+    j["source"] = info.source;
+    j["tool_version"] = info.tool_version;
+    if (info.extrapolation)
+      j["extrapolation"] = {{"p", info.extrapolation->p},
+                            {"l", info.extrapolation->l},
+                            {"theta_b_deg", info.extrapolation->theta_b_deg}};
+    else
+      j["extrapolation"] = nullptr;
+    j["files"] = info.files;
+    if (info.certified_error) j["certified_error"] = CertifiedErrorJson(*info.certified_error);
+  }
+  const std::vector<float> texels = lut.DecodeTexels();
+  j["value_ranges"] = Json::array();
+  const std::size_t per_slice = static_cast<std::size_t>(Lut::kHeight) * Lut::kWidth;
+  for (int k = 0; k < lut.slices(); ++k) {
+    std::array<double, 3> lo{}, hi{}, sum{};
+    lo.fill(std::numeric_limits<double>::infinity());
+    hi.fill(-std::numeric_limits<double>::infinity());
+    for (std::size_t t = 0; t < per_slice; ++t)
+      for (int ch = 0; ch < 3; ++ch) {
+        const double v = texels[(k * per_slice + t) * 3 + ch];
+        lo[ch] = std::min(lo[ch], v), hi[ch] = std::max(hi[ch], v), sum[ch] += v;
+      }
+    std::array<double, 3> mean{};
+    for (int ch = 0; ch < 3; ++ch) mean[ch] = sum[ch] / static_cast<double>(per_slice);
+    j["value_ranges"].push_back({{"theta_in_deg", Number(lut.theta_in_deg[k])},
+                                 {"rgb_min", Triple(lo)},
+                                 {"rgb_max", Triple(hi)},
+                                 {"rgb_mean", Triple(mean)}});
+  }
+  j["warnings"] = Json::array();
+  return j;
+}
+
 }  // namespace
 
 std::string DescribeFile(const std::string& file_or_name, const RemedyPhrasing& phrase) {
@@ -456,14 +521,17 @@ std::string DescribeFile(const std::string& file_or_name, const RemedyPhrasing& 
     j = DescribeMaterial(file);
   } else if (IsExportedLut(kind)) {
     j = DescribeTexture(file);
+  } else if (kind == FileKind::kCompactLut) {
+    j = DescribeCompact(file);
   } else if (const std::optional<ImportFormat> format = ImportFormatOf(kind)) {
     j = DescribeImported(file, *format, say);
   } else {
-    throw InvalidArgument(file + ": a " + std::string(FileKindName(kind)) +
-                          "; a description covers captures (.bpc), material files, exported "
-                          "LUTs (.ktx2, .dds, sidecar and atlas manifest .json), RGL .bsdf, MERL "
-                          ".binary, Zemax and LightTools BSDF tables, CSV point clouds and "
-                          "goniometer tables");
+    throw InvalidArgument(
+        file + ": a " + std::string(FileKindName(kind)) +
+        "; a description covers captures (.bpc), material files, exported "
+        "LUTs (.ktx2, .dds, .brdfc, sidecar and atlas manifest .json), RGL .bsdf, MERL "
+        ".binary, Zemax and LightTools BSDF tables, CSV point clouds and "
+        "goniometer tables");
   }
   return j.dump(2, ' ', false, Json::error_handler_t::replace);
 }

@@ -12,6 +12,7 @@
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
 #include "brdf/core/json_error.h"
+#include "brdf/exporter/compact_lut.h"
 #include "brdf/exporter/dds.h"
 #include "brdf/exporter/ktx2.h"
 
@@ -71,6 +72,8 @@ const char* FileKindName(FileKind kind) {
       return "KTX2 texture";
     case FileKind::kDds:
       return "DDS texture";
+    case FileKind::kCompactLut:
+      return "compact LUT (.brdfc)";
     case FileKind::kSidecar:
       return "LUT sidecar";
     case FileKind::kAtlasManifest:
@@ -112,6 +115,8 @@ FileKind DetectFileKind(const std::string& path) {
   if (StartsWith(head, kBpcMagic)) return FileKind::kCapture;
   if (StartsWith(head, exporter::kKtx2Identifier)) return FileKind::kKtx2;
   if (StartsWith(head, exporter::kDdsMagic)) return FileKind::kDds;
+  if (exporter::IsCompactLutFile(reinterpret_cast<const std::uint8_t*>(head.data()), head.size()))
+    return FileKind::kCompactLut;
   const ImportFormat binary = DetectImportFormatFromHead(head, size, ext);
   if (binary == ImportFormat::kRgl || binary == ImportFormat::kMerl) return FileKindOf(binary);
 
@@ -124,6 +129,7 @@ FileKind DetectFileKind(const std::string& path) {
   if (ext == ".bpc") return FileKind::kCapture;
   if (ext == ".ktx2") return FileKind::kKtx2;
   if (ext == ".dds") return FileKind::kDds;
+  if (ext == ".brdfc") return FileKind::kCompactLut;
 
   // 4. Text tables.
   return FileKindOf(binary);

@@ -11,6 +11,7 @@
 #include "brdf/core/rgl.h"
 #include "brdf/core/text_format.h"
 #include "brdf/core/virtual_capture.h"
+#include "brdf/exporter/compact_lut.h"
 #include "brdf/exporter/packed_volume.h"
 #include "brdf/processing/measurement_brdf.h"
 #include "brdf/sources/capture.h"
@@ -374,6 +375,14 @@ OpenedSource OpenBrdf(const std::string& path_or_name, const OpenOptions& option
       out.measured_theta_in_deg = t.texture.lut.theta_in_deg;
       out.evaluation = Evaluation::kExportedLut;
       out.brdf = std::make_unique<LutBrdf>(std::move(t.texture.lut), OutputNameOf(path));
+      return out;
+    }
+    case FileKind::kCompactLut: {
+      // Reconstructed exactly as the shipped compact GLSL decoder does it.
+      exporter::LoadedCompact c = exporter::ReadCompactLutFile(path);
+      out.measured_theta_in_deg = c.compact.theta_in_deg;
+      out.evaluation = Evaluation::kExportedLut;
+      out.brdf = std::make_unique<exporter::CompactBrdf>(std::move(c.compact), OutputNameOf(path));
       return out;
     }
     default:

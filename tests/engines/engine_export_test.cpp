@@ -234,9 +234,10 @@ TEST_F(EngineExport, WritesEveryEngineFolderWithTheContainersAsBytes) {
                         "web/package.json",
                         "web/felt.manifest.json",
                         "web/MeasuredBrdf.es300.glsl",
-                        "web/MeasuredBrdf.450.glsl"})
+                        "web/MeasuredBrdf.450.glsl",
+                        "web/MeasuredBrdf.compact.es300.glsl"})
     EXPECT_TRUE(fs::is_regular_file(dir_ / f)) << f;
-  EXPECT_EQ(r.written.size(), 21u);
+  EXPECT_EQ(r.written.size(), 22u);
   const std::string ktx2 = Read(dir_ / "felt.ktx2");
   EXPECT_EQ(Read(dir_ / "unity/felt.brdf3d"), ktx2);
   EXPECT_EQ(Read(dir_ / "web/felt.ktx2"), ktx2);

@@ -134,6 +134,8 @@ TEST_F(ShaderCompile, ShippedWebGlslFilesCompile) {
   const fs::path out = ExportAll({0, 20, 40, 60});
   ExpectCompiles("-S frag " + (out / "web/MeasuredBrdf.es300.glsl").string(), "web es300 file");
   ExpectCompiles("-S frag " + (out / "web/MeasuredBrdf.450.glsl").string(), "web 450 file");
+  ExpectCompiles("-S frag " + (out / "web/MeasuredBrdf.compact.es300.glsl").string(),
+                 "web compact decoder (GLSL ES 3.00)");
   // The ES module embeds the same GLSL body.
   const std::string js = Read(out / "web/measured_brdf.js");
   const std::string body =

@@ -451,6 +451,10 @@ std::vector<std::string> StageEngineFolder(Engine e, const fs::path& dir, const 
       });
       shared(detail::ShaderStem(h.layout) + ".450.glsl",
              [&] { return exporter::MeasuredBrdfGlslFile(exporter::GlslVersion::k450, h.layout); });
+      // The decoder of the compact form (`--compress compact`, .brdfc) of a single LUT.
+      if (h.layout.texture_width == Lut::kWidth && h.layout.texture_height == Lut::kHeight)
+        shared(detail::ShaderStem(h.layout) + ".compact.es300.glsl",
+               [&] { return exporter::CompactBrdfGlslFile(h.layout); });
       break;
   }
   // The manifest: written into the first folder, hard-linked (from its temporary name) into

@@ -76,4 +76,18 @@ enum class GlslVersion { kEs300, k450 };
 // #version line, drop the first line.
 std::string MeasuredBrdfGlslFile(GlslVersion version, const ShaderLutLayout& layout);
 
+// The decoder of the compact form (compact_lut.h, docs/formats/compact.md) as a complete GLSL ES
+// 3.00 file: the same template with its fetch replaced by MeasuredBrdfCompactFetch(uvw), which
+// reads the uniforms it declares (no sampler parameter: MeasuredBrdf(n, l, v),
+// MeasuredBrdfTangent(cell, l, v), ... take no `lut`):
+//   measured_brdf_compact_grid   sampler2D RGB16F, width the largest column count, one texel row
+//                                per kept row, slices stacked (slice k from row row0_k)
+//   measured_brdf_compact_rows   sampler2D RGBA32F, 181 × K: (row map m(θd = x°), row0_k,
+//                                rows_k − 1, cols_k − 1)
+//   measured_brdf_compact_cols   sampler2D R32F, 361 × K: column map m(φd = x°), mirrored
+//                                lists folded
+//   measured_brdf_compact_scale, measured_brdf_compact_epsilon   S and ε of the file
+// All read with texelFetch (no filtering, any sampler state), exactly as CompactLut::SampleAngles.
+std::string CompactBrdfGlslFile(const ShaderLutLayout& layout);
+
 }  // namespace brdf::exporter

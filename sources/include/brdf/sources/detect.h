@@ -41,6 +41,7 @@ enum class FileKind {
   kLightTools,     // LightTools BSDF table
   kCsv,            // CSV point cloud
   kGonio,          // spectral goniometer table
+  kCompactLut,     // exported compact LUT (.brdfc, brdf/exporter/compact_lut.h)
   kUnknown,        // none of the above
 };
 
