@@ -1,5 +1,6 @@
 // 8-bit RGB PNG through libpng, see brdf/image_io/image_io.h.
 #include <png.h>
+#include <zlib.h>
 
 #include <csetjmp>
 #include <cstdio>
@@ -40,7 +41,7 @@ void IgnoreWarning(png_structp, png_const_charp) {}
 // Encodes into `state->bytes`. Only trivially destructible locals live in this frame, because
 // libpng leaves it with longjmp on error. Returns false on error (message in state).
 bool Encode(EncodeState* state, int width, int height, png_bytepp rows, png_textp text,
-            int text_count, int zlib_level) {
+            int text_count, int zlib_level, bool fast) {
   png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, state, KeepError, IgnoreWarning);
   if (png == nullptr) return false;
   png_infop info = png_create_info_struct(png);
@@ -54,6 +55,10 @@ bool Encode(EncodeState* state, int width, int height, png_bytepp rows, png_text
   }
   png_set_write_fn(png, state, AppendBytes, NoFlush);
   png_set_compression_level(png, zlib_level);
+  if (fast) {
+    png_set_filter(png, PNG_FILTER_TYPE_BASE, PNG_FILTER_SUB);
+    png_set_compression_strategy(png, Z_RLE);
+  }
   png_set_IHDR(png, info, static_cast<png_uint_32>(width), static_cast<png_uint_32>(height), 8,
                PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT,
                PNG_FILTER_TYPE_DEFAULT);
@@ -67,8 +72,8 @@ bool Encode(EncodeState* state, int width, int height, png_bytepp rows, png_text
 }  // namespace
 
 void WritePng8(const std::string& path, int width, int height,
-               const std::vector<unsigned char>& rgb8, int zlib_level,
-               const StringAttributes& text) {
+               const std::vector<unsigned char>& rgb8, int zlib_level, const StringAttributes& text,
+               bool fast) {
   if (width < 1 || height < 1 || rgb8.size() != static_cast<std::size_t>(width) * height * 3)
     throw InvalidArgument(fmt::format("{}: PNG: inconsistent image {} × {} with {} bytes", path,
                                       width, height, rgb8.size()));
@@ -98,7 +103,7 @@ void WritePng8(const std::string& path, int width, int height,
   std::vector<unsigned char> bytes;
   EncodeState state{&bytes, "libpng could not allocate its state"};
   if (!Encode(&state, width, height, rows.data(), chunks.data(), static_cast<int>(chunks.size()),
-              zlib_level))
+              zlib_level, fast))
     throw IoError(path + ": encoding the PNG failed: " + state.message);
   WriteFileAtomically(path,
                       std::string_view(reinterpret_cast<const char*>(bytes.data()), bytes.size()));

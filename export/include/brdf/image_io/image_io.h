@@ -82,9 +82,12 @@ ExrImage ReadExrImage(const std::string& path);
 
 // Writes 8-bit RGB (`rgb8`: width·height·3 bytes, row 0 at the top) as a PNG with zlib
 // compression `zlib_level` (0–9) and one tEXt chunk per entry of `text` (keywords of 1–79
-// Latin-1 characters). Atomic like WriteExrImage.
+// Latin-1 characters). Atomic like WriteExrImage. `fast`: every row with the Sub filter and
+// zlib's run-length strategy instead of libpng's per-row filter choice and the default
+// strategy (the batch's contact images: less encoding time for files a few percent larger,
+// docs/benchmarks/batch.md).
 void WritePng8(const std::string& path, int width, int height,
-               const std::vector<unsigned char>& rgb8, int zlib_level,
-               const StringAttributes& text);
+               const std::vector<unsigned char>& rgb8, int zlib_level, const StringAttributes& text,
+               bool fast = false);
 
 }  // namespace brdf::image_io
