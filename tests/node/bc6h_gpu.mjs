@@ -10,7 +10,7 @@
 import { createServer } from 'node:http';
 import { readFileSync, writeFileSync } from 'node:fs';
 import { resolve } from 'node:path';
-import { startChromium } from './headless_chromium.mjs';
+import { runPageFunction, startChromium } from './headless_chromium.mjs';
 
 const args = {};
 for (let i = 2; i < process.argv.length; i += 2) args[process.argv[i].slice(2)] = process.argv[i + 1];
@@ -98,21 +98,9 @@ const server = createServer((req, res) => {
 });
 await new Promise((ok) => server.listen(0, '127.0.0.1', ok));
 const { send, fail, cleanup } = await startChromium({ chromium, name: 'bc6h_gpu', deadline, server });
-const sleep = (ms) => new Promise((ok) => setTimeout(ok, ms));
 try {
-  const { targetId } = await send('Target.createTarget', { url: 'about:blank' });
-  const { sessionId } = await send('Target.attachToTarget', { targetId, flatten: true });
-  await send('Page.enable', {}, sessionId);
-  await send('Page.navigate', { url: `http://127.0.0.1:${server.address().port}/` }, sessionId);
-  let result = null;
-  while (!result) {
-    if (Date.now() > deadline) fail('the page never loaded');
-    const r = await send('Runtime.evaluate', { expression: 'typeof window.readAll === "function" ? window.readAll() : null',
-                                               awaitPromise: true, returnByValue: true }, sessionId);
-    if (r.exceptionDetails) fail(r.exceptionDetails.exception?.description || r.exceptionDetails.text);
-    result = r.result.value;
-    if (!result) await sleep(100);
-  }
+  const result = await runPageFunction({ send, fail, url: `http://127.0.0.1:${server.address().port}/`,
+                                         fnName: 'readAll', deadline });
   writeFileSync(resolve(args.out), Buffer.from(result.data, 'base64'));
   console.log(`bc6h_gpu: ${result.w} x ${result.h} x ${result.d} texels fetched on ${result.renderer}`);
 } catch (e) {

@@ -9,7 +9,7 @@
 import { createServer } from 'node:http';
 import { readFileSync, writeFileSync } from 'node:fs';
 import { resolve } from 'node:path';
-import { startChromium } from './headless_chromium.mjs';
+import { runPageFunction, startChromium } from './headless_chromium.mjs';
 
 const args = {};
 for (let i = 2; i < process.argv.length; i += 2) args[process.argv[i].slice(2)] = process.argv[i + 1];
@@ -165,21 +165,9 @@ const server = createServer((req, res) => {
 });
 await new Promise((ok) => server.listen(0, '127.0.0.1', ok));
 const { send, fail, cleanup } = await startChromium({ chromium, name: 'compact_gpu', deadline, server });
-const sleep = (ms) => new Promise((ok) => setTimeout(ok, ms));
 try {
-  const { targetId } = await send('Target.createTarget', { url: 'about:blank' });
-  const { sessionId } = await send('Target.attachToTarget', { targetId, flatten: true });
-  await send('Page.enable', {}, sessionId);
-  await send('Page.navigate', { url: `http://127.0.0.1:${server.address().port}/` }, sessionId);
-  let result = null;
-  while (!result) {
-    if (Date.now() > deadline) fail('the page never loaded');
-    const r = await send('Runtime.evaluate', { expression: 'typeof window.runAll === "function" ? window.runAll() : null',
-                                               awaitPromise: true, returnByValue: true }, sessionId);
-    if (r.exceptionDetails) fail(r.exceptionDetails.exception?.description || r.exceptionDetails.text);
-    result = r.result.value;
-    if (!result) await sleep(100);
-  }
+  const result = await runPageFunction({ send, fail, url: `http://127.0.0.1:${server.address().port}/`,
+                                         fnName: 'runAll', deadline });
   writeFileSync(resolve(args.out), Buffer.from(result.data, 'base64'));
   console.log(`compact_gpu: ${result.n} pairs over ${result.K} slices evaluated on ${result.renderer}`);
 } catch (e) {

@@ -1,5 +1,5 @@
 // Headless Chromium (WebGL 2 on SwiftShader) driven through the DevTools protocol, shared by
-// the browser tests (render_web.mjs, bc6h_gpu.mjs). startChromium() launches the browser with
+// the browser tests (render_web.mjs, bc6h_gpu.mjs, compact_gpu.mjs). startChromium() launches the browser with
 // a private profile folder, waits for its DevTools port and returns
 //   send(method, params, sessionId)  one DevTools call, resolved with its result
 //   fail(message)                    prints `name: message` and the browser's last log lines,
@@ -76,4 +76,23 @@ export async function startChromium({ chromium, name, deadline, server, extraArg
     ws.send(JSON.stringify({ id, method, params, ...(sessionId ? { sessionId } : {}) }));
   });
   return { send, fail, cleanup, consoleLines };
+}
+
+// Opens `url` in a new tab of the browser `send` drives and returns what the page's async
+// function window[fnName]() resolves to (by value), polling every 100 ms until the page has
+// defined it. An exception in the page, or `deadline` passing, fails through `fail`.
+export async function runPageFunction({ send, fail, url, fnName, deadline }) {
+  const { targetId } = await send('Target.createTarget', { url: 'about:blank' });
+  const { sessionId } = await send('Target.attachToTarget', { targetId, flatten: true });
+  await send('Page.enable', {}, sessionId);
+  await send('Page.navigate', { url }, sessionId);
+  for (;;) {
+    if (Date.now() > deadline) fail('the page never loaded');
+    const r = await send('Runtime.evaluate', {
+      expression: `typeof window.${fnName} === "function" ? window.${fnName}() : null`,
+      awaitPromise: true, returnByValue: true }, sessionId);
+    if (r.exceptionDetails) fail(r.exceptionDetails.exception?.description || r.exceptionDetails.text);
+    if (r.result.value) return r.result.value;
+    await new Promise((ok) => setTimeout(ok, 100));
+  }
 }
