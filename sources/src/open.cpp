@@ -325,7 +325,7 @@ OpenedTexture OpenTextureToEvaluate(const std::string& path, const OpenOptions& 
 
 [[noreturn]] void RefuseUnevaluable(const std::string& path, FileKind kind) {
   throw InvalidArgument(path + ": cannot evaluate a " + std::string(FileKindName(kind)) +
-                        " (evaluable: material .json, .bpc capture, .ktx2 / .dds LUT, LUT "
+                        " (evaluable: material .json, .bpc capture, .ktx2 / .dds / .brdfc LUT, LUT "
                         "sidecar .json, RGL .bsdf, MERL .binary, Zemax or LightTools BSDF "
                         "table, CSV point cloud, goniometer table)");
 }

@@ -159,12 +159,13 @@ int main(int argc, char** argv) {
       "Print f_r (1/sr, linear RGB) of a material, capture or exported LUT for a pair of "
       "directions (or many, with --pairs)");
   eval_cmd
-      ->add_option("file", eval.file,
-                   "Material file (.json), capture (.bpc), exported LUT (.ktx2, .dds), LUT "
-                   "sidecar (.json), or measured data: RGL .bsdf, MERL .binary, or a table "
-                   "interpolated like a capture (Zemax or LightTools .bsdf, CSV point cloud, "
-                   "goniometer table; detected by content), or a library material name" +
-                       std::string(kLibraryNames))
+      ->add_option(
+          "file", eval.file,
+          "Material file (.json), capture (.bpc), exported LUT (.ktx2, .dds, compact "
+          ".brdfc), LUT sidecar (.json), or measured data: RGL .bsdf, MERL .binary, or a table "
+          "interpolated like a capture (Zemax or LightTools .bsdf, CSV point cloud, "
+          "goniometer table; detected by content), or a library material name" +
+              std::string(kLibraryNames))
       ->required();
   auto* eval_in_opt = eval_cmd->add_option("--in", eval_in, "Light direction THETA,PHI in degrees")
                           ->check(AnglePairValidator());
@@ -315,13 +316,14 @@ int main(int argc, char** argv) {
       "info",
       "Describe a file: a .bpc capture (slices, samples, ranges, statistics, flags, "
       "metadata, damage), a material .json (model and parameters), an exported LUT or atlas "
-      "(.ktx2, .dds) or its sidecar / manifest .json (dimensions, θin, payload, checksum, "
+      "(.ktx2, .dds, compact .brdfc) or its sidecar / manifest .json (dimensions, θin, payload, "
+      "checksum, "
       "extrapolation, value ranges), or a third-party measurement (Zemax or LightTools .bsdf "
       "with the integrated TIS per incidence, CSV point cloud, goniometer table, RGL .bsdf, "
       "MERL .binary)");
   info_cmd
       ->add_option("file", info.file,
-                   "File to describe (.bpc, .json, .ktx2, .dds, .bsdf, .csv, .binary) or a "
+                   "File to describe (.bpc, .json, .ktx2, .dds, .brdfc, .bsdf, .csv, .binary) or a "
                    "library material name" +
                        std::string(kLibraryNames))
       ->required();
