@@ -115,7 +115,7 @@ ErrorStatistics ParseStatistics(const ordered_json& object, const std::string& f
 }  // namespace
 
 ordered_json CertifiedErrorJson(const CertifiedError& e) {
-  return ordered_json{
+  ordered_json j{
       {"format", e.format},
       {"bytes", e.bytes},
       {"rgb9e5_bytes", e.rgb9e5_bytes},
@@ -127,6 +127,11 @@ ordered_json CertifiedErrorJson(const CertifiedError& e) {
         {"theta_b_deg", e.theta_b_deg},
         {"measured", StatisticsJson(e.measured)},
         {"filled", StatisticsJson(e.filled)}}}};
+  if (e.max_error_bound > 0) {
+    j["max_error_bound"] = e.max_error_bound;
+    j["max_error_met"] = e.max_error_met;
+  }
+  return j;
 }
 
 CertifiedError ParseCertifiedError(const ordered_json& object, const std::string& file) {
@@ -141,6 +146,10 @@ CertifiedError ParseCertifiedError(const ordered_json& object, const std::string
   e.measured =
       ParseStatistics(cf.Object("measured"), file, "compression.certified_error.measured.");
   e.filled = ParseStatistics(cf.Object("filled"), file, "compression.certified_error.filled.");
+  if (object.contains("max_error_bound")) {
+    e.max_error_bound = f.Number("max_error_bound");
+    e.max_error_met = e.measured.max <= e.max_error_bound;
+  }
   return e;
 }
 

@@ -155,6 +155,10 @@ LutExportResult ExportLut(const std::string& out_dir, const Lut& lut, const Pack
     result.payload_bytes = packed.ByteSize();
     result.payload_crc32 = packed.Crc32();
   }
+  if (options.max_error > 0 && result.certified_error) {
+    result.certified_error->max_error_bound = options.max_error;
+    result.certified_error->max_error_met = result.met_max_error;
+  }
   metadata.certified_error = result.certified_error;
   const std::string sidecar = compact ? SidecarJson(compact->compact, metadata)
                               : compressed

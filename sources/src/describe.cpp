@@ -342,12 +342,17 @@ Json CertifiedErrorJson(const exporter::CertifiedError& e) {
   const auto stats = [](const exporter::ErrorStatistics& s) {
     return Json{{"max", s.max}, {"p99", s.p99}, {"median", s.median}, {"texels", s.texels}};
   };
-  return {{"format", e.format},
-          {"bytes", e.bytes},
-          {"rgb9e5_bytes", e.rgb9e5_bytes},
-          {"theta_b_deg", e.theta_b_deg},
-          {"measured", stats(e.measured)},
-          {"filled", stats(e.filled)}};
+  Json j{{"format", e.format},
+         {"bytes", e.bytes},
+         {"rgb9e5_bytes", e.rgb9e5_bytes},
+         {"theta_b_deg", e.theta_b_deg},
+         {"measured", stats(e.measured)},
+         {"filled", stats(e.filled)}};
+  if (e.max_error_bound > 0) {
+    j["max_error_bound"] = e.max_error_bound;
+    j["max_error_met"] = e.max_error_met;
+  }
+  return j;
 }
 
 // An exported LUT or atlas (.ktx2, .dds) or the sidecar / manifest describing one. Value ranges

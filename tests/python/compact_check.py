@@ -329,7 +329,12 @@ def check_max_error(args):
                 fail(f"{name}: expected exactly one of {compact}, {ktx2}")
             chosen = compact if os.path.exists(compact) else ktx2
             with open(os.path.join(out, name + ".json")) as f:
-                fmt = json.load(f)["payload"].get("format", "rgb9e5")
+                side = json.load(f)
+            fmt = side["payload"].get("format", "rgb9e5")
+            comp = side["compression"]
+            if comp.get("max_error_bound") != bound or comp.get("max_error_met") is not True:
+                fail(f"{name}: sidecar records bound {comp.get('max_error_bound')}, met "
+                     f"{comp.get('max_error_met')}, for --max-error {bound}")
             word = {"compact_log_grid": "compact", "bc6h_ufloat": "BC6H", "rgb9e5": "RGB9E5"}[fmt]
             if name not in lines or f"{name}: {word} " not in lines[name]:
                 fail(f"{name}: stdout line {lines.get(name)!r} does not name {word}")

@@ -248,6 +248,10 @@ void PrintTextureText(const Json& j) {
     line("  filled       ", e["filled"]);
     std::printf("                 (measured: theta_out <= %s deg; filled: beyond it)\n",
                 Fixed(e["theta_b_deg"], "%g").c_str());
+    if (e.contains("max_error_bound"))
+      std::printf("  chosen by      --max-error %s: %s\n",
+                  Fixed(e["max_error_bound"], "%g").c_str(),
+                  e["max_error_met"].get<bool>() ? "met" : "NOT met (the most precise form)");
   }
   if (j.contains("extrapolation")) {
     if (j["extrapolation"].is_null())

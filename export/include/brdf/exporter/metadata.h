@@ -47,6 +47,10 @@ struct CertifiedError {
   ErrorStatistics measured, filled;
   std::uint64_t bytes = 0;         // the compressed payload
   std::uint64_t rgb9e5_bytes = 0;  // the same LUT as RGB9E5, for the ratio
+  // `--max-error E` that chose this representation (0: not chosen by a bound); written as
+  // "max_error_bound" with "max_error_met".
+  double max_error_bound = 0;
+  bool max_error_met = true;
 };
 
 struct TextureMetadata {
