@@ -11,15 +11,7 @@ work=$2
 rgl=${3:-/work/shared/brdf-data/rgl}
 brdf=$build/tools/brdf
 here=$(dirname "$0")
-mkdir -p "$work/noisy" "$work/noise-free" "$work/rgl"
-for m in $("$brdf" materials | awk 'NR > 1 { print $1 }'); do
-  "$brdf" capture --device sim --material "$m" --sample "$m" --out "$work/noisy/$m.bpc" --quiet --force
-  "$brdf" capture --device sim --material "$m" --sample "$m" --noise 0 \
-    --out "$work/noise-free/$m.bpc" --quiet --force
-done
-for f in "$rgl"/*.bsdf; do
-  "$brdf" import "$f" --out "$work/rgl/$(basename "$f" .bsdf).bpc" --force > /dev/null
-done
+"$(dirname "$0")/inputs.sh" "$brdf" "$work" "$rgl"
 for set in noisy noise-free rgl; do
   "$brdf" convert "$work/$set" --out "$work/out-$set" --compress bc6h --formats ktx2,exr,json \
     --exr-type float --jobs 2 --quiet --force
