@@ -6,8 +6,8 @@ and bash completions work from there, and lintian reports no error.
 
 Expected values come from outside the package: the GGX row of docs/design.md §9 evaluated in
 numpy on the packaged material file, the project version from CMake, the shared libraries the
-packaged ELF files need (readelf) and the Debian packages that hold them (dpkg -S), bash itself
-running the completion, man-db rendering the pages. A missing tool fails the test.
+packaged ELF files need (readelf) and the Debian packages that hold them (dpkg -S), apt's
+resolver (a simulated install), bash itself running the completion, man-db rendering the pages. A missing tool fails the test.
 
 Usage: debian_package_test.py BUILD_DIR VERSION
 """
@@ -42,7 +42,7 @@ def run(args, check=True, **kw):
     return p
 
 
-for tool in ("cpack", "dpkg-deb", "dpkg", "lintian", "man", "readelf", "bash", "ldconfig"):
+for tool in ("cpack", "dpkg-deb", "dpkg", "apt-get", "lintian", "man", "readelf", "bash", "ldconfig"):
     if shutil.which(tool) is None:
         sys.exit("FAIL: %s not found (tools/install-deps.sh installs it)" % tool)
 
@@ -144,6 +144,11 @@ try:
             fail("%s need %s, which no installed Debian package provides" % (users, so))
         elif not packages & dep_names:
             fail("%s need %s (package %s), not in Depends: %s" % (users, so, sorted(packages), depends))
+
+    # apt resolves Depends from Debian's packages (a simulation: nothing is installed).
+    p = run(["apt-get", "-s", "install", deb], check=False)
+    if p.returncode != 0 or not re.search(r"^Inst brdf-toolchain \(%s " % re.escape(VERSION), p.stdout, re.M):
+        fail("apt-get -s install %s: exit %d\n%s%s" % (deb, p.returncode, p.stdout[-2000:], p.stderr[-2000:]))
 
     # --- the unpacked tools ------------------------------------------------------------------
     env = {k: v for k, v in os.environ.items()
