@@ -164,14 +164,18 @@ TEST_P(UsbCapture, DevicesListsTheInstrumentAndCaptureOpensItByVidPidSerial) {
   std::filesystem::remove_all(tmpl);
 }
 
+// Root opens any node (CAP_DAC_OVERRIDE), so as root the tool runs with that capability
+// dropped (setpriv): the prefix RunTool puts before the tool.
+std::string AsUser() {
+  return ::geteuid() == 0 ? "setpriv --bounding-set -dac_override,-dac_read_search " : "";
+}
+
 TEST_P(UsbCapture, PermissionDeniedIsOneLineNamingTheNodeTheCauseAndTheUdevRule) {
-  // The emulated node with mode 000, as without the udev rule. Root opens any node
-  // (CAP_DAC_OVERRIDE), so as root the tool runs with that capability dropped (setpriv).
+  // The emulated node with mode 000, as without the udev rule.
   SimulatorConfig c = Config(LibraryMaterial("gold"), 1, 15, 15);
   EmulatedUsbInstrument emu(c, GetParam());
   emu.SetNodeMode(0);
-  const std::string as_user =
-      ::geteuid() == 0 ? "setpriv --bounding-set -dac_override,-dac_read_search " : "";
+  const std::string as_user = AsUser();
   const bool usb = GetParam() == UsbPersonality::kBulk;
   const std::string spec = std::string(usb ? "usb" : "hid") + ":1209:" + (usb ? "b7d1" : "b7d2");
   // The device (its IDs and node), the cause, and the remedy: the shipped rule, where it is
@@ -214,8 +218,6 @@ TEST_P(UsbCapture, PermissionDeniedNamesTheRuleOfTheInstalledTree) {
   SimulatorConfig c = Config(LibraryMaterial("gold"), 1, 15, 15);
   EmulatedUsbInstrument emu(c, GetParam());
   emu.SetNodeMode(0);
-  const std::string as_user =
-      ::geteuid() == 0 ? "setpriv --bounding-set -dac_override,-dac_read_search " : "";
   // <tree>/bin/brdf (a hard link: /proc/self/exe is then this path) and
   // <tree>/lib/udev/rules.d/70-brdf-scatterometer.rules, the layout `cmake --install` makes.
   std::string tmpl = std::string(BRDF_BINARY_DIR) + "/brdf_udev_tree_XXXXXX";
@@ -228,7 +230,7 @@ TEST_P(UsbCapture, PermissionDeniedNamesTheRuleOfTheInstalledTree) {
       std::string(BRDF_SOURCE_DIR) + "/device/udev/70-brdf-scatterometer.rules",
       tree / "lib/udev/rules.d/70-brdf-scatterometer.rules");
   int code = -1;
-  const std::string listed = RunTool("devices", &code, as_user, (tree / "bin/brdf").string());
+  const std::string listed = RunTool("devices", &code, AsUser(), (tree / "bin/brdf").string());
   EXPECT_EQ(code, 0) << listed;
   EXPECT_NE(listed.find("permission denied"), std::string::npos) << listed;
   EXPECT_NE(listed.find("(installed in " + (tree / "lib/udev/rules.d").string() + ","),

@@ -196,17 +196,21 @@ def shell_words(words):
     return " ".join(words)
 
 
-def option_cases(options, indent):
-    """case arms completing the values of options with a fixed set of choices."""
-    out = []
+def option_block(options, indent):
+    """Sets `opts` to the option names and completes the values of the option before the cursor:
+    a fixed set of choices, or file names (bash's default) for any other value."""
+    out = ['%sopts="%s"' % (indent, shell_words([n for names, _, _ in options for n in names]))]
+    cases = []
     for names, takes_value, choices in options:
         if takes_value and choices:
-            out.append('%s%s) COMPREPLY=($(compgen -W "%s" -- "$cur")); return ;;'
-                       % (indent, "|".join(names), shell_words(choices)))
+            cases.append('%s  %s) COMPREPLY=($(compgen -W "%s" -- "$cur")); return ;;'
+                         % (indent, "|".join(names), shell_words(choices)))
     valued = [n for names, takes_value, choices in options if takes_value and not choices
               for n in names]
-    if valued:  # a value of any other kind: file names (the default completion)
-        out.append("%s%s) return ;;" % (indent, "|".join(valued)))
+    if valued:
+        cases.append("%s  %s) return ;;" % (indent, "|".join(valued)))
+    if cases:
+        out += ["%scase $prev in" % indent] + cases + ["%sesac" % indent]
     return out
 
 
@@ -235,24 +239,13 @@ def completion(program, h, subcommand_helps):
         out.append("  local opts=''")
         out.append('  case $sub in')
         for sub, sh in subcommand_helps:
-            opts = sh.options()
             out.append("    %s)" % sub)
-            out.append("      opts=\"%s\"" % shell_words([n for names, _, _ in opts for n in names]))
-            cases = option_cases(opts, "        ")
-            if cases:
-                out.append('      case $prev in')
-                out.extend(cases)
-                out.append("      esac")
+            out.extend(option_block(sh.options(), "      "))
             out.append("      ;;")
         out.append("  esac")
     else:
-        opts = h.options()
-        out.append("  local opts=\"%s\"" % shell_words(top_options))
-        cases = option_cases(opts, "    ")
-        if cases:
-            out.append('  case $prev in')
-            out.extend(cases)
-            out.append("  esac")
+        out.append("  local opts")
+        out.extend(option_block(h.options(), "  "))
     out.append('  if [[ $cur == -* ]]; then')
     out.append('    COMPREPLY=($(compgen -W "$opts" -- "$cur"))')
     out.append("  fi")
