@@ -5,6 +5,9 @@
 # completions are generated from the built tools' --help texts (tools/packaging/cli_docs.py),
 # so they say what the programs say. Included from the top-level CMakeLists.txt after tools/.
 include(GNUInstallDirs)
+# Debian's Python runs the generator (also in a build without tests, where
+# cmake/Dependencies.cmake does not look for it).
+find_program(BRDF_PYTHON3 NAMES python3 PATHS /usr/bin NO_DEFAULT_PATH REQUIRED)
 
 set(BRDF_PACKAGING_SOURCE_DIR "${PROJECT_SOURCE_DIR}/tools/packaging")
 set(BRDF_PACKAGING_BINARY_DIR "${PROJECT_BINARY_DIR}/packaging")
@@ -57,6 +60,7 @@ if(BRDF_BUILD_PYTHON)
       "python3 (>= ${_major_minor}~), python3 (<< ${CMAKE_MATCH_1}.${_next_minor}), python3-numpy")
 endif()
 
+set(CPACK_GENERATOR "DEB")  # plain `cpack` makes the Debian package too
 set(CPACK_PACKAGE_NAME "brdf-toolchain")
 set(CPACK_PACKAGE_VERSION "${PROJECT_VERSION}")
 set(CPACK_PACKAGE_CONTACT "${BRDF_PACKAGE_MAINTAINER}")

@@ -276,10 +276,13 @@ try:
     viewhelp = help_entries(view.stdout)
 
     def render(page):
-        p = run(["man", "--warnings", "-E", "UTF-8", "-l", page], check=False,
-                env=dict(env, MANWIDTH="250", LC_ALL="C.UTF-8", MAN_KEEP_FORMATTING=""))
-        if p.returncode != 0 or p.stderr.strip():
-            fail("man -l %s: exit %d, %s" % (page, p.returncode, p.stderr.strip()))
+        """The page as man shows it: without a warning on an 80-column terminal; returned
+        250 columns wide (each entry on one line, for the searches below)."""
+        for width in ("80", "250"):
+            p = run(["man", "--warnings", "-E", "UTF-8", "-l", page], check=False,
+                    env=dict(env, MANWIDTH=width, LC_ALL="C.UTF-8", MAN_KEEP_FORMATTING=""))
+            if p.returncode != 0 or p.stderr.strip():
+                fail("man -l %s at %s columns: exit %d, %s" % (page, width, p.returncode, p.stderr.strip()))
         return re.sub(r".\x08", "", p.stdout)
 
     page = render(os.path.join(usr, "share/man/man1/brdf.1.gz"))

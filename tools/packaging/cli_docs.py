@@ -92,8 +92,14 @@ class Help:
 
 def roff(text):
     """Escapes plain text for roff: backslashes, hyphens (kept as ASCII minus signs, so options
-    can be copied), non-ASCII characters as groff's \\[uXXXX] glyphs."""
-    out = text.replace("\\", "\\e").replace("-", "\\-")
+    can be copied), non-ASCII characters as groff's \\[uXXXX] glyphs. Words too long for an
+    80-column terminal (a CSV header, a path) may break after a comma or slash (\\:)."""
+    words = []
+    for word in text.split(" "):
+        if len(word) > 30:
+            word = re.sub(r"([,/])(?=.)", "\\1\x00", word)
+        words.append(word)
+    out = " ".join(words).replace("\\", "\\e").replace("-", "\\-").replace("\x00", "\\:")
     out = "".join(c if ord(c) < 128 else "\\[u%04X]" % ord(c) for c in out)
     return out
 
@@ -152,6 +158,8 @@ ENVIRONMENT = [
 
 def man_page(name, version, date, h, subcommand_helps):
     out = ['.TH %s 1 "%s" "brdf-toolchain %s" "User Commands"' % (roff(name.upper()), date, version)]
+    # Left-aligned, no hyphenation: options and paths are shown whole, never stretched.
+    out += [".ad l", ".nh"]
     out.append(".SH NAME")
     summary = h.description.split(": ", 1)[-1] if h.description.startswith(name + ":") else h.description
     out.append("%s \\- %s" % (roff(name), roff(summary)))
