@@ -188,6 +188,8 @@ def man_page(name, version, date, h, subcommand_helps):
         out.append(paragraph(what))
     out.append(".SH FILES")
     for path, what in FILES:
+        if path.endswith(".rules") and name != "brdf":
+            continue  # only brdf talks to the instrument
         out.append(".TP")
         out.append("\\fI%s\\fR" % roff(path))
         out.append(paragraph(what))
