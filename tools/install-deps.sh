@@ -29,6 +29,9 @@ packages=(
 packages+=(fonts-dejavu-core)
 # The interactive brdf-view test presses keys and moves the mouse in an Xvfb window.
 packages+=(xdotool)
+# The Debian package (cpack -G DEB): dpkg-shlibdeps computes Depends; its test checks it with
+# lintian and renders the man pages with man-db.
+packages+=(dpkg-dev lintian man-db)
 
 # Debian's npm is a separate package; a Node.js that already ships npm (e.g. NodeSource's)
 # conflicts with it, so npm is only requested when no npm command exists.

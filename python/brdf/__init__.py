@@ -16,11 +16,15 @@ import numpy as _np
 
 from . import _paths
 
-# An installed package finds the material library relative to itself (the interpreter is not
-# installed beside it), through the variable the library reads; a value the user set wins.
-if _paths.MATERIALS_FROM_PACKAGE is not None and not _os.environ.get("BRDF_MATERIALS_DIR"):
-    _os.environ["BRDF_MATERIALS_DIR"] = _os.path.normpath(
-        _os.path.join(_os.path.dirname(_os.path.abspath(__file__)), _paths.MATERIALS_FROM_PACKAGE))
+# An installed package finds the material library and the modules (the image reader) relative
+# to itself (the interpreter is not installed beside it), through the variables the library
+# reads; a value the user set wins.
+for _variable, _relative in (("BRDF_MATERIALS_DIR", _paths.MATERIALS_FROM_PACKAGE),
+                             ("BRDF_MODULE_DIR", _paths.MODULES_FROM_PACKAGE)):
+    if _relative is not None and not _os.environ.get(_variable):
+        _os.environ[_variable] = _os.path.normpath(
+            _os.path.join(_os.path.dirname(_os.path.abspath(__file__)), _relative))
+del _variable, _relative
 
 from ._brdf import Error, FormatError, InvalidArgument, IoError
 from ._brdf import Source as _Source
