@@ -25,7 +25,8 @@ if _paths.MATERIALS_FROM_PACKAGE is not None and not _os.environ.get("BRDF_MATER
 from ._brdf import Error, FormatError, InvalidArgument, IoError
 from ._brdf import Source as _Source
 
-__all__ = ["open", "read_capture", "Source", "Error", "FormatError", "InvalidArgument", "IoError"]
+__all__ = ["open", "info", "read_capture", "Source", "Error", "FormatError", "InvalidArgument",
+           "IoError"]
 
 
 class Source:
@@ -59,6 +60,12 @@ class Source:
     def measured_theta_in_deg(self):
         """The measured light polar angles of a capture or LUT (empty for other sources)."""
         return list(self._source.measured_theta_in_deg)
+
+    def info(self):
+        """What the file holds: the document `brdf info --json` prints for it, as a dict
+        (brdf.info(path) describes a file without opening it for evaluation, damaged captures
+        included)."""
+        return info(self._source.path)
 
     def eval(self, wi, wo, jobs=0):
         """f_r (1/sr, RGB, not multiplied by cos) for N pairs of unit vectors.
@@ -103,6 +110,17 @@ def open(path_or_name):  # noqa: A001 (the module's entry point, like io.open)
     """Opens any file `brdf eval` evaluates (material .json, .bpc capture, .ktx2/.dds LUT or
     sidecar, RGL .bsdf, MERL .binary, tables) or a library material name ("gold")."""
     return Source(path_or_name)
+
+
+def info(path_or_name):
+    """The description `brdf info --json` prints for a file or library material, as a dict:
+    the same keys and values (statistics of every slice, metadata, header fields, "usable" and
+    "refusals" for captures and tables, warnings), non-finite statistics as None. Remedies in
+    the text ("advice", refusals) are phrased for Python (docs/python.md, "Errors"); files that
+    cannot be read at all raise as brdf.open does."""
+    import json
+    from ._brdf import describe
+    return json.loads(describe(str(path_or_name)))
 
 
 def read_capture(path):

@@ -11,7 +11,8 @@
 // Errors: brdf::IoError becomes brdf.IoError (an OSError), brdf::FormatError and
 // brdf::InvalidArgument brdf.FormatError / brdf.InvalidArgument (ValueErrors), any other
 // brdf::Error brdf.Error (a RuntimeError); the message is the library's one line, the text
-// after "brdf: error: " in what the CLI prints.
+// after "brdf: error: " in what the CLI prints, followed by "; " and the remedy in the module's
+// words when the error carries one (remedy.h).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -26,9 +27,11 @@
 #include "brdf/core/geometry.h"
 #include "brdf/core/parallel.h"
 #include "brdf/sources/capture.h"
+#include "brdf/sources/describe.h"
 #include "brdf/sources/detect.h"
 #include "brdf/sources/material_library.h"
 #include "brdf/sources/open.h"
+#include "remedy.h"
 
 namespace py = pybind11;
 
@@ -243,6 +246,13 @@ py::dict ReadCapture(const std::string& path_or_name) {
   return out;
 }
 
+// The JSON text of `brdf info --json` for the same file (sources::DescribeFile), remedies in the
+// module's words; brdf/__init__.py parses it.
+std::string Describe(const std::string& path_or_name) {
+  const std::string path = sources::ResolveSource(path_or_name);
+  return sources::DescribeFile(path, [](const Remedy& r) { return PythonRemedyText(r); });
+}
+
 }  // namespace
 
 }  // namespace brdf::python
@@ -250,13 +260,10 @@ py::dict ReadCapture(const std::string& path_or_name) {
 PYBIND11_MODULE(_brdf, m) {
   using brdf::python::Source;
   m.doc() = "Compiled core of the brdf module (use `import brdf`).";
-  // Later registrations are tried first: the subclasses before brdf::Error.
-  py::register_exception<brdf::Error>(m, "Error", PyExc_RuntimeError);
-  py::register_exception<brdf::FormatError>(m, "FormatError", PyExc_ValueError);
-  py::register_exception<brdf::InvalidArgument>(m, "InvalidArgument", PyExc_ValueError);
-  py::register_exception<brdf::IoError>(m, "IoError", PyExc_OSError);
+  brdf::python::RegisterExceptions(m);
 
   m.def("read_capture", &brdf::python::ReadCapture, py::arg("path"));
+  m.def("describe", &brdf::python::Describe, py::arg("path_or_name"));
 
   py::class_<Source>(m, "Source")
       .def(py::init<const std::string&>(), py::arg("path_or_name"))
