@@ -25,7 +25,7 @@ if _paths.MATERIALS_FROM_PACKAGE is not None and not _os.environ.get("BRDF_MATER
 from ._brdf import Error, FormatError, InvalidArgument, IoError
 from ._brdf import Source as _Source
 
-__all__ = ["open", "info", "read_capture", "Source", "Error", "FormatError", "InvalidArgument",
+__all__ = ["open", "info", "read_capture", "write_capture", "Source", "Error", "FormatError", "InvalidArgument",
            "IoError"]
 
 
@@ -136,3 +136,72 @@ def read_capture(path):
     """
     from ._brdf import read_capture as _read_capture
     return _read_capture(str(path))
+
+
+def _real_array(value, name, shape_text, ndim, n=None):
+    """`value` as a C-contiguous float32 array of `ndim` dimensions (N, or N×3), or
+    InvalidArgument in the style of the other shape messages."""
+    a = _np.asarray(value)
+    if a.dtype.kind not in "fiu":
+        raise InvalidArgument(f"{name}: expected {shape_text} of real numbers, got dtype {a.dtype}")
+    ok = a.ndim == ndim and (ndim == 1 or a.shape[1] == 3) and (n is None or a.shape[0] == n)
+    if not ok:
+        length = "" if n is None else f" (N = {n}, the length of theta_in)"
+        raise InvalidArgument(f"{name}: expected {shape_text}{length}, got shape {a.shape}")
+    return _np.ascontiguousarray(a, dtype=_np.float32)
+
+
+def write_capture(path, theta_in, phi_in, theta_out, phi_out, rgb, sigma=None, flags=None,
+                  metadata=None, overwrite=False):
+    """Writes samples measured elsewhere as a .bpc capture that every `brdf` command and
+    brdf.open read like one the instrument made.
+
+    theta_in, phi_in, theta_out, phi_out: N angles in degrees (light and view directions;
+    θin in [0, 90), θout in [0, 90], azimuths finite). rgb: N×3 f_r in 1/sr, linear RGB, not
+    multiplied by cos θ. sigma: N×3 one-sigma uncertainties, or None (none recorded). flags:
+    N integers, bits 0-3 (1 saturated, 2 below the noise floor, 4 interpolated, 8 invalid), or
+    None (all 0). Numbers are stored as float32, the format's precision (read_capture returns
+    float32, so its arrays round-trip bit for bit). Consecutive samples of one light direction
+    (θin, φin) form one slice, in the order given.
+    metadata: a dict with any of the keys read_capture returns ("sample_name",
+    "instrument_model", ..., "extra": a dict of text); software_version defaults to this
+    toolchain's.
+    The file is written as every brdf command writes a whole file: to a temporary sibling,
+    flushed to disk and renamed into place, so a crash leaves either no file or the complete
+    one; an existing file is replaced only with overwrite=True. Returns the number of slices.
+    Wrong shapes, dtypes or values raise brdf.InvalidArgument (a ValueError) naming the
+    argument and, for values, the index.
+    """
+    t_in = _real_array(theta_in, "theta_in", "a 1-D array (N)", 1)
+    n = t_in.shape[0]
+    if n == 0:
+        raise InvalidArgument("theta_in: expected at least one sample, got an empty array")
+    one_d = "a 1-D array (N)"
+    p_in = _real_array(phi_in, "phi_in", one_d, 1, n)
+    t_out = _real_array(theta_out, "theta_out", one_d, 1, n)
+    p_out = _real_array(phi_out, "phi_out", one_d, 1, n)
+    c = _real_array(rgb, "rgb", "an N×3 array", 2, n)
+    e = None if sigma is None else _real_array(sigma, "sigma", "an N×3 array", 2, n)
+    if flags is None:
+        f = _np.zeros(n, dtype=_np.uint8)
+    else:
+        f = _np.asarray(flags)
+        if f.dtype.kind not in "iu":
+            raise InvalidArgument(f"flags: expected a 1-D array (N) of integers, got dtype {f.dtype}")
+        if f.ndim != 1 or f.shape[0] != n:
+            raise InvalidArgument(
+                f"flags: expected a 1-D array (N) (N = {n}, the length of theta_in), got shape {f.shape}")
+        bad = _np.nonzero((f < 0) | (f > 15))[0]
+        if bad.size:
+            i = int(bad[0])
+            raise InvalidArgument(
+                f"flags[{i}]: expected bits 0-3 only (saturated 1, below noise floor 2, "
+                f"interpolated 4, invalid 8), got {int(f[i])}")
+        f = _np.ascontiguousarray(f, dtype=_np.uint8)
+    if metadata is None:
+        metadata = {}
+    if not isinstance(metadata, dict):
+        raise InvalidArgument(f"metadata: expected a dict, got {type(metadata).__name__}")
+    from ._brdf import write_capture as _write_capture
+    return _write_capture(_os.fspath(path), t_in, p_in, t_out, p_out, c, e, f, metadata,
+                          bool(overwrite))

@@ -17,13 +17,18 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstddef>
+#include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "brdf/core/bpc.h"
 #include "brdf/core/brdf_source.h"
 #include "brdf/core/error.h"
+#include "brdf/core/file_util.h"
 #include "brdf/core/geometry.h"
 #include "brdf/core/parallel.h"
 #include "brdf/sources/capture.h"
@@ -246,6 +251,134 @@ py::dict ReadCapture(const std::string& path_or_name) {
   return out;
 }
 
+// The metadata keys read_capture returns and write_capture takes ("extra" besides them).
+struct MetadataField {
+  const char* key;
+  std::string Metadata::*member;
+};
+constexpr MetadataField kMetadataFields[] = {
+    {"sample_name", &Metadata::sample_name},
+    {"instrument_model", &Metadata::instrument_model},
+    {"instrument_serial", &Metadata::instrument_serial},
+    {"firmware_version", &Metadata::firmware_version},
+    {"protocol_version", &Metadata::protocol_version},
+    {"calibration_reference", &Metadata::calibration_reference},
+    {"calibration_time", &Metadata::calibration_time},
+    {"capture_start", &Metadata::capture_start},
+    {"capture_end", &Metadata::capture_end},
+    {"operator_notes", &Metadata::operator_notes},
+    {"units", &Metadata::units},
+    {"software_version", &Metadata::software_version},
+};
+
+std::string MetadataKeyList() {
+  std::string out;
+  for (const MetadataField& f : kMetadataFields) out += std::string(f.key) + ", ";
+  return out + "extra";
+}
+
+// The metadata dict of write_capture (the keys read_capture returns; all optional).
+Metadata MetadataFromDict(const py::dict& d) {
+  Metadata m;
+  for (const auto& [key_handle, value] : d) {
+    if (!py::isinstance<py::str>(key_handle))
+      throw InvalidArgument("metadata: expected text keys, got " +
+                            std::string(py::str(py::repr(key_handle))));
+    const std::string key = key_handle.cast<std::string>();
+    if (key == "extra") {
+      if (!py::isinstance<py::dict>(value))
+        throw InvalidArgument("metadata['extra']: expected a dict of text values, got " +
+                              std::string(py::str(value.get_type().attr("__name__"))));
+      for (const auto& [k, v] : value.cast<py::dict>()) {
+        if (!py::isinstance<py::str>(k) || !py::isinstance<py::str>(v))
+          throw InvalidArgument("metadata['extra']: expected text keys and values, got " +
+                                std::string(py::str(py::repr(k))) + ": " +
+                                std::string(py::str(py::repr(v))));
+        m.extra[k.cast<std::string>()] = v.cast<std::string>();
+      }
+      continue;
+    }
+    const MetadataField* field = nullptr;
+    for (const MetadataField& f : kMetadataFields)
+      if (key == f.key) field = &f;
+    if (field == nullptr)
+      throw InvalidArgument("metadata: unknown key '" + key + "' (expected " + MetadataKeyList() +
+                            ")");
+    if (!py::isinstance<py::str>(value))
+      throw InvalidArgument("metadata['" + key + "']: expected text, got " +
+                            std::string(py::str(value.get_type().attr("__name__"))));
+    m.*(field->member) = value.cast<std::string>();
+  }
+  return m;
+}
+
+using FloatArray = py::array_t<float, py::array::c_style>;
+
+// A capture from arrays (brdf/__init__.py checked shapes and converted dtypes): consecutive
+// samples of one light direction (θin, φin) form one slice, in the order given. Written as
+// every whole-file writer writes (brdf::WriteBpc: a temporary sibling, fsync, rename), after
+// the overwrite rule of every writing command (CheckWritableOutput). Returns the slice count.
+std::size_t WriteCapture(const std::string& path, const FloatArray& ti, const FloatArray& pi,
+                         const FloatArray& to, const FloatArray& po, const FloatArray& rgb,
+                         const std::optional<FloatArray>& sigma,
+                         const py::array_t<std::uint8_t, py::array::c_style>& flags,
+                         const py::dict& metadata, bool overwrite) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext != ".bpc")
+    throw InvalidArgument(path + ": a capture is written as a .bpc file (the extension .bpc)");
+  Measurement m;
+  m.metadata = MetadataFromDict(metadata);
+  if (m.metadata.software_version.empty()) m.metadata.software_version = SoftwareVersion();
+  const auto n = static_cast<std::size_t>(ti.size());
+  const float *t_in = ti.data(), *p_in = pi.data(), *t_out = to.data(), *p_out = po.data();
+  const float* c = rgb.data();
+  const float* e = sigma ? sigma->data() : nullptr;
+  const std::uint8_t* fl = flags.data();
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto bad = [&](const char* name, const char* rule, float v) {
+      return InvalidArgument(std::string(name) + "[" + std::to_string(i) + "]: expected " + rule +
+                             ", got " + NumberText(v));
+    };
+    if (!(t_in[i] >= 0 && t_in[i] < 90))
+      throw bad("theta_in", "a light polar angle in [0, 90) degrees", t_in[i]);
+    if (!(t_out[i] >= 0 && t_out[i] <= 90))
+      throw bad("theta_out", "a polar angle in [0, 90] degrees", t_out[i]);
+    if (!std::isfinite(p_in[i])) throw bad("phi_in", "a finite azimuth in degrees", p_in[i]);
+    if (!std::isfinite(p_out[i])) throw bad("phi_out", "a finite azimuth in degrees", p_out[i]);
+    if ((fl[i] & ~kKnownSampleFlags) != 0)
+      throw InvalidArgument("flags[" + std::to_string(i) +
+                            "]: expected bits 0-3 only (saturated 1, below noise floor 2, "
+                            "interpolated 4, invalid 8), got " +
+                            std::to_string(fl[i]));
+    if (m.slices.empty() || m.slices.back().theta_in_deg != t_in[i] ||
+        m.slices.back().phi_in_deg != p_in[i]) {
+      Slice s;
+      s.theta_in_deg = t_in[i];
+      s.phi_in_deg = p_in[i];
+      s.has_sigma = e != nullptr;
+      m.slices.push_back(std::move(s));
+    }
+    Sample x;
+    x.theta_in_deg = t_in[i];
+    x.phi_in_deg = p_in[i];
+    x.theta_out_deg = t_out[i];
+    x.phi_out_deg = p_out[i];
+    for (int ch = 0; ch < 3; ++ch) {
+      x.rgb[ch] = c[3 * i + ch];
+      x.sigma[ch] = e ? e[3 * i + ch] : 0.0f;
+    }
+    x.flags = fl[i];
+    m.slices.back().samples.push_back(x);
+  }
+  CheckWritableOutput(path, overwrite);
+  {
+    const py::gil_scoped_release release;
+    WriteBpc(path, m);
+  }
+  return m.slices.size();
+}
+
 // The JSON text of `brdf info --json` for the same file (sources::DescribeFile), remedies in the
 // module's words; brdf/__init__.py parses it.
 std::string Describe(const std::string& path_or_name) {
@@ -264,6 +397,9 @@ PYBIND11_MODULE(_brdf, m) {
 
   m.def("read_capture", &brdf::python::ReadCapture, py::arg("path"));
   m.def("describe", &brdf::python::Describe, py::arg("path_or_name"));
+  m.def("write_capture", &brdf::python::WriteCapture, py::arg("path"), py::arg("theta_in"),
+        py::arg("phi_in"), py::arg("theta_out"), py::arg("phi_out"), py::arg("rgb"),
+        py::arg("sigma"), py::arg("flags"), py::arg("metadata"), py::arg("overwrite"));
 
   py::class_<Source>(m, "Source")
       .def(py::init<const std::string&>(), py::arg("path_or_name"))
