@@ -1,9 +1,10 @@
 // The compiled part of the Python module `brdf` (python/brdf/__init__.py wraps it): a file or a
 // library material opened by brdf::sources::OpenBrdf, evaluated for arrays of direction pairs.
 //
-// Bit-identical with `brdf eval --pairs`: eval_deg turns each angle pair into directions with
-// SphericalDirectionDeg and calls BrdfSource::Eval, exactly as tools/brdf/cmd_eval.cpp does, and
-// checks the polar angles by the same rule ([0, 90] degrees, finite azimuths).
+// Bit-identical with `brdf eval --pairs`: eval_deg calls brdf::EvalAnglePairsDeg
+// (brdf/core/eval_pairs.h: a LUT sampled in angle space, other sources at the directions of the
+// angles), as tools/brdf/cmd_eval.cpp does, and checks the polar angles by the same rule
+// ([0, 90] degrees, finite azimuths).
 //
 // Batches release the GIL and are shared out by brdf::ParallelChunks (brdf/core/parallel.h);
 // BrdfSource::Eval is const and used concurrently by the previewer the same way.
@@ -28,6 +29,7 @@
 #include "brdf/core/bpc.h"
 #include "brdf/core/brdf_source.h"
 #include "brdf/core/error.h"
+#include "brdf/core/eval_pairs.h"
 #include "brdf/core/file_util.h"
 #include "brdf/core/geometry.h"
 #include "brdf/core/parallel.h"
@@ -65,13 +67,18 @@ const char* EvaluationName(sources::Evaluation e) {
 // Runs f(i) for i in [0, n) without the GIL, on the library's threads for large batches:
 // `jobs` threads (0: one per core, brdf::ResolveJobs), one below kParallelThreshold pairs.
 template <class F>
-void ForEachPair(std::size_t n, int jobs_option, F f) {
+void ForEachRange(std::size_t n, int jobs_option, F f) {
   if (jobs_option < 0)
     throw InvalidArgument("jobs: expected 0 (one thread per core) or a positive count, got " +
                           std::to_string(jobs_option));
   const py::gil_scoped_release release;
   const int jobs = n >= kParallelThreshold ? ResolveJobs(jobs_option) : 1;
-  ParallelChunks(n, kChunk, jobs, nullptr, [&](std::size_t begin, std::size_t end) {
+  ParallelChunks(n, kChunk, jobs, nullptr, f);
+}
+
+template <class F>
+void ForEachPair(std::size_t n, int jobs_option, F f) {
+  ForEachRange(n, jobs_option, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) f(i);
   });
 }
@@ -159,12 +166,9 @@ class Source {
     py::array_t<double> out({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(3)});
     double* f = out.mutable_data();
     const BrdfSource& brdf = *opened_.brdf;
-    ForEachPair(n, jobs, [&](std::size_t i) {
-      const Rgb r = brdf.Eval(SphericalDirectionDeg(t_in[i], p_in[i]),
-                              SphericalDirectionDeg(t_out[i], p_out[i]));
-      f[3 * i] = r[0];
-      f[3 * i + 1] = r[1];
-      f[3 * i + 2] = r[2];
+    ForEachRange(n, jobs, [&](std::size_t begin, std::size_t end) {
+      EvalAnglePairsDeg(brdf, end - begin, t_in + begin, p_in + begin, t_out + begin, p_out + begin,
+                        f + 3 * begin);
     });
     return out;
   }
