@@ -4,6 +4,7 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <thread>
 #include <tuple>
 
@@ -571,6 +572,26 @@ void SimulatedFirmware::ProduceStreamFrame() {
     next_column_ = 0;
   }
   Send(MessageType::kRowData, EncodeRowData(data));
+}
+
+std::map<std::string, std::string> SimulatedCaptureSettings(const std::string& device,
+                                                            const std::string& material,
+                                                            const SimulatorConfig& config,
+                                                            const CaptureGeometry& geometry,
+                                                            const std::string& exposure) {
+  const auto g = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return std::string(buf);
+  };
+  return {{"device", device},
+          {"material", material},
+          {"noise_level", g(config.noise_level)},
+          {"seed", std::to_string(config.seed)},
+          {"theta_out_max_deg", g(geometry.theta_out_max_deg)},
+          {"theta_out_step_deg", g(geometry.theta_out_step_deg)},
+          {"phi_out_step_deg", g(geometry.phi_out_step_deg)},
+          {"exposure", exposure}};
 }
 
 }  // namespace brdf::device

@@ -25,7 +25,7 @@ if _paths.MATERIALS_FROM_PACKAGE is not None and not _os.environ.get("BRDF_MATER
 from ._brdf import Error, FormatError, InvalidArgument, IoError
 from ._brdf import Source as _Source
 
-__all__ = ["open", "info", "read_capture", "write_capture", "Source", "Error", "FormatError", "InvalidArgument",
+__all__ = ["open", "info", "read_capture", "write_capture", "fit", "convert", "preview", "capture", "Source", "Error", "FormatError", "InvalidArgument",
            "IoError"]
 
 
@@ -205,3 +205,203 @@ def write_capture(path, theta_in, phi_in, theta_out, phi_out, rgb, sigma=None, f
     from ._brdf import write_capture as _write_capture
     return _write_capture(_os.fspath(path), t_in, p_in, t_out, p_out, c, e, f, metadata,
                           bool(overwrite))
+
+
+def _tools():
+    """The compiled fit/convert/preview/capture part, loaded on first use (it links Ceres, the
+    previewer and the USB stack, which `import brdf` does not need)."""
+    from . import _brdf_tools
+    return _brdf_tools
+
+
+def _path_of(source_or_path):
+    return source_or_path.path if isinstance(source_or_path, Source) else _os.fspath(source_or_path)
+
+
+def _warn(lines):
+    import warnings
+    for line in lines:
+        warnings.warn(line, UserWarning, stacklevel=3)
+
+
+def _extrapolation_text(extrapolate):
+    if extrapolate is None:
+        return ""
+    if isinstance(extrapolate, str):
+        return extrapolate
+    try:
+        p, l = extrapolate
+    except (TypeError, ValueError):
+        raise InvalidArgument(
+            f"extrapolate: expected (p, l) or 'P,L', got {extrapolate!r}") from None
+    return f"{float(p)!r},{float(l)!r}"
+
+
+def fit(source_or_path, model="ggx", loss="ngan", robust=False, max_theta_out=None, starts=2,
+        jobs=0):
+    """Fits an analytic model, as `brdf fit INPUT --model MODEL --loss LOSS --out FILE.json`
+    does, and returns the material file that command writes, as a dict: the model's
+    parameters, "name", "model" and the report under "fit" (status, RMSE overall and per θin
+    slice, median relative error, warnings). The same input gives the same numbers as the CLI.
+
+    source_or_path: a brdf.Source, a file (capture, material, RGL, MERL, exported LUT, table)
+    or a library material name. model: a model name of `brdf fit --model` ("ggx", "lambert",
+    ...; one model per call). loss: "ngan", "log" or "cbrt". robust, max_theta_out (degrees),
+    starts: as `--robust`, `--max-theta-out`, `--starts`. jobs: Ceres' threads (0: one per
+    core); the result does not depend on it. Warnings opening the input are issued as Python
+    UserWarnings (the lines the CLI prints on stderr).
+    """
+    import json
+    text, warnings = _tools().fit(_path_of(source_or_path), str(model), str(loss), bool(robust),
+                                  0.0 if max_theta_out is None else float(max_theta_out),
+                                  int(starts), int(jobs))
+    _warn(warnings)
+    return json.loads(text)
+
+
+def convert(source_or_path, out_dir, formats="ktx2,dds,exr,png,json", extrapolate=None,
+            beyond=None, beyond_subdivide=None, exr_type="float", exr_compression="none",
+            overwrite=False, jobs=0):
+    """Writes the engine-ready LUT of a capture or material file, as
+    `brdf convert INPUT --out OUT_DIR` does for one input (same library call, same files, byte
+    for byte), and returns the paths written (order: ktx2, dds, exr, png, json).
+
+    formats: the comma-separated list of `--formats`. extrapolate: (p, l) or "P,L" for the
+    grazing-angle extrapolation (`--extrapolate P,L`; default: the input's own choice, else
+    1, 0.5). beyond, beyond_subdivide: the blind-spot fill of `--beyond` / `--beyond-subdivide`
+    (default: the command's). exr_type ("float", "half") and exr_compression ("none", "zip"):
+    `--exr-type`, `--exr-compression`. Existing outputs are replaced only with overwrite=True; every
+    file is written atomically and a failure leaves no partial set. Warnings (saturated
+    samples, ...) are issued as UserWarnings. Engine hand-offs and `--extrapolate auto` are
+    the CLI's (`brdf convert --engine ...`).
+    """
+    written, warnings = _tools().convert(
+        _path_of(source_or_path), _os.fspath(out_dir), str(formats),
+        _extrapolation_text(extrapolate), "" if beyond is None else str(beyond),
+        0 if beyond_subdivide is None else int(beyond_subdivide), str(exr_type),
+        str(exr_compression), bool(overwrite), int(jobs))
+    _warn(warnings)
+    return list(written)
+
+
+def _angle_pair(value, name):
+    if value is None:
+        return None
+    try:
+        a, b = value
+        return float(a), float(b)
+    except (TypeError, ValueError):
+        raise InvalidArgument(f"{name}: expected (theta, phi) in degrees, got {value!r}") from None
+
+
+def preview(source_or_path, size=512, env=None, env_rotation=0.0, mesh="sphere", light=None,
+            view=None, fov=0.0, estimator="auto", spp=None, rms=0.0, subdivisions=2, seed=1,
+            jobs=0, background=True, extrapolate=None):
+    """Renders a source under an environment map, as `brdf preview SOURCE --out IMAGE.exr`
+    does with the same options, and returns the image that command writes to the .exr: a
+    float32 array of shape (size, size, 3), linear radiance, row 0 at the top (no tone map;
+    for display, e.g. plt.imshow(np.clip(img, 0, 1) ** (1 / 2.2))).
+
+    env: "studio" (default), "sky", "furnace", "axes" or an .exr/.hdr file (`--env`);
+    env_rotation (degrees), mesh ("sphere", "plane" or a .ply/.obj file), view and light
+    ((theta, phi) in degrees; with a light and no env the light alone illuminates, as
+    `--light`), fov (degrees, > 0: perspective), estimator ("auto", "hierarchical", "mis",
+    "env", "brdf", "quadrature"), spp (passes; giving it selects Monte Carlo as `--spp`), rms
+    (target relative error), subdivisions, seed, jobs (0: one thread per core), background
+    (False: black where the object is not), extrapolate ((p, l) or "P,L" for captures).
+    """
+    import numpy as np  # noqa: F401 (the result is a numpy array)
+    a = _tools().PreviewArguments()
+    a.size = int(size)
+    a.env = "studio" if env is None else _os.fspath(env)
+    a.env_given = env is not None
+    a.env_rotation_deg = float(env_rotation)
+    a.mesh = _os.fspath(mesh)
+    a.light = _angle_pair(light, "light")
+    a.view = _angle_pair(view, "view")
+    a.fov_deg = float(fov)
+    a.estimator = str(estimator)
+    a.spp_given = spp is not None
+    a.spp = 64 if spp is None else int(spp)
+    a.rms = float(rms)
+    a.subdivisions = int(subdivisions)
+    a.seed = int(seed)
+    a.jobs = int(jobs)
+    a.background = bool(background)
+    a.extrapolate = _extrapolation_text(extrapolate)
+    image, warnings = _tools().preview(_path_of(source_or_path), a)
+    _warn(warnings)
+    return image
+
+
+def capture(material, out, sample=None, noise=1.0, seed=1, theta_in=(0, 20, 40, 60),
+            theta_out_max=75.0, theta_out_step=1.0, phi_out_step=1.0, exposure="auto",
+            operator_notes="", resume=False, overwrite=False, calibrate=False):
+    """Captures a virtual sample with the simulated instrument, as
+    `brdf capture --device sim --material MATERIAL --sample SAMPLE --out OUT` does with the same
+    options: the same session (the instrument's wire protocol, calibration, auto-ranged
+    exposure, noise from `seed`), the same crash-safe file (each slice flushed to disk as it
+    completes) and the same recorded settings, so either can resume the other's capture.
+
+    material: a library name or an evaluable file (the virtual sample). out: the .bpc to
+    write. sample: the sample name recorded (default: material). noise: 0 = ideal detector,
+    1 = the reference instrument. theta_in, theta_out_max, theta_out_step, phi_out_step:
+    the geometry in degrees (defaults: the reference instrument's). exposure: "auto" (per
+    θout row), "auto-slice" or milliseconds. resume: continue an interrupted capture in
+    `out`; overwrite: replace an existing file (with resume: accept a different instrument);
+    calibrate: with resume, measure new dark and white references.
+    Returns a dict: path, finished, resumed, slices_planned, slices_saved, new_samples,
+    saturated, below_noise_floor, message, warnings. Ctrl-C stops after the current slice
+    (KeyboardInterrupt; the file is a valid unfinished capture to resume).
+    """
+    t = _tools()
+    a = t.CaptureArguments()
+    a.material = _path_of(material)
+    a.out = _os.fspath(out)
+    a.sample = a.material if sample is None else str(sample)
+    a.operator_notes = str(operator_notes)
+    a.noise = _checked_number(noise, "noise", lambda v: v >= 0,
+                              "a level ≥ 0 (1 = reference instrument)")
+    a.seed = int(seed)
+    angles = [float(v) for v in _np.atleast_1d(_np.asarray(theta_in, dtype=float))]
+    if not angles:
+        raise InvalidArgument("theta_in: at least one angle is required")
+    for v in angles:
+        if not (0 <= v < 90):
+            raise InvalidArgument(f"theta_in: angles must be in [0, 90) degrees, got {v:g}")
+    a.theta_in_deg = angles
+    a.theta_out_max_deg = _checked_number(theta_out_max, "theta_out_max", lambda v: 0 <= v < 90,
+                                          "[0, 90) degrees")
+    a.theta_out_step_deg = _checked_number(theta_out_step, "theta_out_step",
+                                           lambda v: 0.01 <= v <= 90, "[0.01, 90] degrees")
+    a.phi_out_step_deg = _checked_number(phi_out_step, "phi_out_step",
+                                         lambda v: 0.01 <= v <= 360, "[0.01, 360] degrees")
+    text = str(exposure)
+    a.exposure = text
+    if text in ("auto", "auto-row"):
+        a.exposure_mode = 0
+    elif text == "auto-slice":
+        a.exposure_mode = 1
+    else:
+        try:
+            ms = float(text)
+        except ValueError:
+            ms = float("nan")
+        if not (ms > 0 and ms < float("inf")):
+            raise InvalidArgument(
+                f"exposure: expected auto, auto-slice or a time in ms, got {text!r}")
+        a.exposure_mode, a.exposure_ms = 2, ms
+    a.resume, a.overwrite, a.calibrate = bool(resume), bool(overwrite), bool(calibrate)
+    result = t.capture(a)
+    _warn(result["warnings"])
+    return result
+
+
+def _checked_number(value, name, rule, expected):
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise InvalidArgument(f"{name}: expected {expected}, got {value!r}") from None
+    if not (rule(v) and v == v):
+        raise InvalidArgument(f"{name}: expected {expected}, got {v:g}")
+    return v
