@@ -75,6 +75,15 @@ def main():
                   f"brdf eval --pairs {n_cli / t_cli / 1e6:.3f} M/s ({n_cli} pairs incl. "
                   f"start-up and text, median of 3); ratio {(n / t_py) / (n_cli / t_cli):.0f}x")
             if path.endswith(".ktx2"):
+                # The direction-vector path (LutBrdf::Eval per pair, what eval_deg called before
+                # brdf/core/eval_pairs.h), directions precomputed by numpy.
+                t, p = np.radians(args[0]), np.radians(args[1])
+                wi = np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], -1)
+                t, p = np.radians(args[2]), np.radians(args[3])
+                wo = np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], -1)
+                t_vec = median_seconds(lambda: s.eval(wi, wo), 5)
+                print(f"  eval(wi, wo), LutBrdf::Eval per pair: {n / t_vec / 1e6:.2f} M/s "
+                      f"(median of 5; eval_deg {t_vec / t_py:.2f}x faster)")
                 # The same texture looked up by numpy (bench/python/numpy_trilinear.py).
                 lut = NumpyLut.from_ktx2(path)
                 t_np = median_seconds(lambda: lut.eval_deg(*args), 3)

@@ -5,6 +5,9 @@
     f = gold.eval_deg(30, 0, np.linspace(0, 80, 81), 180)   # (81, 3) f_r in 1/sr, RGB
 
 Values are those `brdf eval` gives for the same file, bit for bit (the same library call).
+The other calls answer as the `brdf` commands of the same names do, through the same library
+entry points: info (`brdf info --json`), read_capture / write_capture (.bpc captures), fit,
+convert, preview and capture (the simulated instrument). docs/python.md has a worked example.
 Errors raise brdf.IoError (an OSError) for missing or unreadable files, brdf.FormatError or
 brdf.InvalidArgument (ValueErrors) for bad content, shapes and dtypes, with the one-line
 message the command-line tool prints after "brdf: error: ".
@@ -33,6 +36,7 @@ class Source:
     """One opened file or library material (brdf.open)."""
 
     def __init__(self, path_or_name):
+        """Opens the file or library material (brdf.open)."""
         self._source = _Source(str(path_or_name))
 
     @property
@@ -103,6 +107,7 @@ class Source:
         return self._source._eval_deg_flat(*flat, int(jobs)).reshape(shape + (3,))
 
     def __repr__(self):
+        """brdf.Source('path', evaluation='...')."""
         return f"brdf.Source({self.path!r}, evaluation={self.evaluation!r})"
 
 
@@ -215,16 +220,19 @@ def _tools():
 
 
 def _path_of(source_or_path):
+    """The path (or library name) a brdf.Source was opened with, or the argument as a path."""
     return source_or_path.path if isinstance(source_or_path, Source) else _os.fspath(source_or_path)
 
 
 def _warn(lines):
+    """Issues the CLI's stderr warning lines as Python UserWarnings."""
     import warnings
     for line in lines:
         warnings.warn(line, UserWarning, stacklevel=3)
 
 
 def _extrapolation_text(extrapolate):
+    """None, "P,L" or (p, l) as the text `--extrapolate` takes ("" for none)."""
     if extrapolate is None:
         return ""
     if isinstance(extrapolate, str):
@@ -285,6 +293,7 @@ def convert(source_or_path, out_dir, formats="ktx2,dds,exr,png,json", extrapolat
 
 
 def _angle_pair(value, name):
+    """None or (theta, phi) in degrees as two floats; InvalidArgument naming `name` otherwise."""
     if value is None:
         return None
     try:
@@ -398,6 +407,7 @@ def capture(material, out, sample=None, noise=1.0, seed=1, theta_in=(0, 20, 40, 
 
 
 def _checked_number(value, name, rule, expected):
+    """`value` as a float satisfying `rule`, else InvalidArgument "<name>: expected ..."."""
     try:
         v = float(value)
     except (TypeError, ValueError):

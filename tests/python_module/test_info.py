@@ -9,7 +9,7 @@ import json
 import pytest
 
 import brdf
-from conftest import run_cli
+from conftest import run_cli, sim_capture
 
 
 def cli_info(tool, path):
@@ -20,11 +20,7 @@ def cli_info(tool, path):
 
 
 def capture(tool, tmp_path, material="gold"):
-    out = tmp_path / f"{material}.bpc"
-    code, _, err = run_cli(tool, "capture", "--device", "sim", "--material", material, "--sample",
-                           material, "--phi-out-step", "10", "--out", out, "--quiet")
-    assert code == 0, err
-    return out
+    return sim_capture(tool, tmp_path, material, phi_out_step=10)
 
 
 def assert_same_document(tool, path):

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import brdf
-from conftest import run_cli
+from conftest import run_cli, sim_capture
 
 # What differs between two files of the same samples: their names and the header chunk's
 # metadata text (a capture's header records the metadata it started with, a whole-file write
@@ -24,21 +24,13 @@ def info(tool, path):
     return json.loads(out)
 
 
-def sim_capture(tool, tmp_path, material, *extra):
-    out = tmp_path / f"{material}.bpc"
-    code, _, err = run_cli(tool, "capture", "--device", "sim", "--material", material, "--sample",
-                           material, "--phi-out-step", "8", "--out", out, "--quiet", *extra)
-    assert code == 0, err
-    return out
-
-
 def arrays_of(d):
     return (d["theta_in_deg"], d["phi_in_deg"], d["theta_out_deg"], d["phi_out_deg"], d["rgb"])
 
 
 @pytest.mark.parametrize("material, extra", [("gold", ()), ("plastic_glossy_red", ("--noise", "0"))])
 def test_round_trip_gives_the_same_info(brdf_tool, tmp_path, material, extra):
-    original = sim_capture(brdf_tool, tmp_path, material, *extra)
+    original = sim_capture(brdf_tool, tmp_path, material, *extra, phi_out_step=8)
     d = brdf.read_capture(original)
     copy = tmp_path / "copy.bpc"
     slices = brdf.write_capture(copy, *arrays_of(d), sigma=d["sigma"], flags=d["flags"],
