@@ -360,8 +360,9 @@ def capture(material, out, sample=None, noise=1.0, seed=1, theta_in=(0, 20, 40, 
     `out`; overwrite: replace an existing file (with resume: accept a different instrument);
     calibrate: with resume, measure new dark and white references.
     Returns a dict: path, finished, resumed, slices_planned, slices_saved, new_samples,
-    saturated, below_noise_floor, message, warnings. Ctrl-C stops after the current slice
-    (KeyboardInterrupt; the file is a valid unfinished capture to resume).
+    saturated, below_noise_floor, message, warnings. Ctrl-C stops the capture
+    (KeyboardInterrupt): the completed slices are in the file, a valid unfinished capture that
+    resume=True (or `brdf capture --resume`) completes.
     """
     t = _tools()
     a = t.CaptureArguments()

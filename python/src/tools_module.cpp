@@ -15,7 +15,7 @@
 //  - capture: the simulated instrument behind the in-process loopback link and
 //    device::RunCaptureSession, the session `brdf capture --device sim` runs (crash-safe,
 //    resumable, the same recorded settings: device::SimulatedCaptureSettings). Ctrl-C stops it
-//    after the slice in progress, leaving a valid unfinished capture to resume.
+//    (KeyboardInterrupt), leaving a valid unfinished capture to resume.
 //
 // Long calls release the GIL.
 #include <pybind11/numpy.h>
@@ -24,12 +24,14 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <memory>
 #include <optional>
 #include <set>
 #include <string>
+#include <thread>
 #include <utility>
 #include <vector>
 
@@ -329,24 +331,36 @@ py::dict Capture(const CaptureArguments& a) {
   request.force = a.overwrite;
   request.calibrate = a.calibrate;
 
-  // Ctrl-C: Python's handler only sets a flag while the GIL is released; it is checked after
-  // every slice, and the session stops there (the file stays a valid unfinished capture).
-  std::atomic<bool> cancel{false};
+  // Ctrl-C: while the session runs (on a worker thread, without the GIL) this thread checks
+  // Python's signals every 20 ms; a KeyboardInterrupt sets `cancel`, the session stops after
+  // the slice in progress (the file stays a valid unfinished capture) and is re-raised here.
+  std::atomic<bool> cancel{false}, done{false};
   bool interrupted_by_user = false;
-  device::SessionEvents events;
-  events.on_slice = [&](const device::SliceProgress&) {
-    const py::gil_scoped_acquire gil;
-    if (PyErr_CheckSignals() != 0) {
-      interrupted_by_user = true;
-      cancel.store(true);
-    }
-  };
   device::CaptureSessionResult r;
+  std::exception_ptr error;
   {
     const py::gil_scoped_release release;
-    r = device::RunCaptureSession(request, link->transport(), events, &cancel);
+    std::thread session([&] {
+      try {
+        r = device::RunCaptureSession(request, link->transport(), {}, &cancel);
+      } catch (...) {
+        error = std::current_exception();
+      }
+      done.store(true);
+    });
+    while (!done.load()) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      if (interrupted_by_user) continue;
+      const py::gil_scoped_acquire gil;
+      if (PyErr_CheckSignals() != 0) {  // the exception stays set on this thread
+        interrupted_by_user = true;
+        cancel.store(true);
+      }
+    }
+    session.join();
   }
   if (interrupted_by_user) throw py::error_already_set();  // KeyboardInterrupt
+  if (error) std::rethrow_exception(error);
   using device::CaptureOutcome;
   if (r.outcome == CaptureOutcome::kRefused || r.outcome == CaptureOutcome::kFailed ||
       r.outcome == CaptureOutcome::kInterrupted) {

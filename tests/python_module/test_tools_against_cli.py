@@ -169,3 +169,36 @@ def test_capture_of_an_existing_file_needs_overwrite(tmp_path):
         brdf.capture("gold", path, phi_out_step=30, theta_out_step=15)
     assert brdf.capture("gold", path, phi_out_step=30, theta_out_step=15,
                         overwrite=True)["finished"]
+
+
+def test_ctrl_c_stops_a_capture_and_leaves_it_resumable(data_dir, tmp_path):
+    # In a child interpreter, so that a late signal cannot reach pytest: SIGINT as soon as the
+    # first slice is in the file, during a capture of an RGL sample at 0.5° steps (4 slices of
+    # about 55,000 samples).
+    import os
+    import subprocess
+    import sys
+    rgl = data_dir / "rgl" / "aurora_white_rgb.bsdf"
+    path = tmp_path / "big.bpc"
+    script = (
+        "import os, signal, threading, time, brdf\n"
+        f"path = {str(path)!r}\n"
+        "def interrupt():\n"
+        "    while not (os.path.exists(path) and os.path.getsize(path) > 100000):\n"
+        "        time.sleep(0.001)\n"
+        "    os.kill(os.getpid(), signal.SIGINT)\n"
+        "threading.Thread(target=interrupt, daemon=True).start()\n"
+        "try:\n"
+        f"    brdf.capture({str(rgl)!r}, path, phi_out_step=0.5)\n"
+        "except KeyboardInterrupt:\n"
+        "    print('interrupted')\n")
+    p = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True,
+                       timeout=300, env=os.environ)
+    assert p.returncode == 0 and p.stdout.strip() == "interrupted", p.stdout + p.stderr
+    about = brdf.info(path)
+    assert about["finished"] is False and about["missing_theta_in_deg"], about
+    r = brdf.capture(rgl, path, phi_out_step=0.5, resume=True)
+    assert r["resumed"] and r["finished"]
+    whole = tmp_path / "whole.bpc"
+    brdf.capture(rgl, whole, phi_out_step=0.5)
+    assert np.array_equal(brdf.read_capture(path)["rgb"], brdf.read_capture(whole)["rgb"])
