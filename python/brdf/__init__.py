@@ -278,8 +278,9 @@ def convert(source_or_path, out_dir, formats="ktx2,dds,exr,png,json", extrapolat
     grazing-angle extrapolation (`--extrapolate P,L`; default: the input's own choice, else
     1, 0.5). beyond, beyond_subdivide: the blind-spot fill of `--beyond` / `--beyond-subdivide`
     (default: the command's). exr_type ("float", "half") and exr_compression ("none", "zip"):
-    `--exr-type`, `--exr-compression`. Existing outputs are replaced only with overwrite=True; every
-    file is written atomically and a failure leaves no partial set. Warnings (saturated
+    `--exr-type`, `--exr-compression`. Existing outputs are replaced only with overwrite=True;
+    every file is written atomically, and a failure removes the outputs the call created (a
+    file it replaced keeps its new content). Warnings (saturated
     samples, ...) are issued as UserWarnings. Engine hand-offs and `--extrapolate auto` are
     the CLI's (`brdf convert --engine ...`).
     """

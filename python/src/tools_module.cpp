@@ -9,7 +9,7 @@
 //    input gives the same text). FitMaterial silences Ceres' glog once for the process.
 //  - convert: sources::LutFromInput then exporter::ExportLut, the files of `brdf convert` for
 //    one input (no engine hand-offs), each written atomically; a failure removes the outputs
-//    this call already renamed into place, as the command does.
+//    this call created (the command's OutputGuard, tools/, also removes replaced ones).
 //  - preview: sources::OpenBrdf then preview::RenderPreview, the linear image `brdf preview`
 //    writes to an .exr.
 //  - capture: the simulated instrument behind the in-process loopback link and
