@@ -4,11 +4,11 @@
 #include <bit>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <thread>
 #include <tuple>
 
 #include "brdf/core/error.h"
+#include "brdf/core/text_format.h"
 #include "brdf/core/virtual_capture.h"
 #include "brdf/device/white_reference.h"
 
@@ -579,18 +579,13 @@ std::map<std::string, std::string> SimulatedCaptureSettings(const std::string& d
                                                             const SimulatorConfig& config,
                                                             const CaptureGeometry& geometry,
                                                             const std::string& exposure) {
-  const auto g = [](double v) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%g", v);
-    return std::string(buf);
-  };
   return {{"device", device},
           {"material", material},
-          {"noise_level", g(config.noise_level)},
+          {"noise_level", ShortNumberText(config.noise_level)},
           {"seed", std::to_string(config.seed)},
-          {"theta_out_max_deg", g(geometry.theta_out_max_deg)},
-          {"theta_out_step_deg", g(geometry.theta_out_step_deg)},
-          {"phi_out_step_deg", g(geometry.phi_out_step_deg)},
+          {"theta_out_max_deg", ShortNumberText(geometry.theta_out_max_deg)},
+          {"theta_out_step_deg", ShortNumberText(geometry.theta_out_step_deg)},
+          {"phi_out_step_deg", ShortNumberText(geometry.phi_out_step_deg)},
           {"exposure", exposure}};
 }
 

@@ -1,8 +1,9 @@
 #include "remedy.h"
 
-#include <cstdio>
 #include <exception>
 #include <vector>
+
+#include "brdf/core/text_format.h"
 
 namespace py = pybind11;
 
@@ -10,13 +11,10 @@ namespace brdf::python {
 
 namespace {
 
+// "40, 60": the slices a remedy names, spelled as capture metadata spells angles.
 std::string DegList(const std::vector<double>& values) {
   std::string out;
-  for (double v : values) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%g", v);
-    out += (out.empty() ? "" : ", ") + std::string(buf);
-  }
+  for (double v : values) out += (out.empty() ? "" : ", ") + ShortNumberText(v);
   return out;
 }
 
