@@ -21,6 +21,7 @@ packages=(
   clang libclang-rt-14-dev
   python3 python3-numpy python3-scipy
   python3-dev pybind11-dev python3-pybind11 python3-pytest  # the Python module (python/), its tests
+  python3-matplotlib  # docs/python.md's worked example, run by tests/python_module (Agg backend)
   nodejs
   # Engine hand-off tests (tests/engines): real clients for the shipped files.
   chromium glslang-tools spirv-cross mono-mcs python3-openimageio
