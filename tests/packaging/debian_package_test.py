@@ -123,8 +123,9 @@ try:
             with open(path, "rb") as fh:
                 if fh.read(4) == b"\x7fELF":
                     elves.append(path)
-    if len(elves) != 4:
-        fail("expected 4 ELF files (brdf, brdf-view, the module, the Python extension), found %s" % elves)
+    if len(elves) != 5:
+        fail("expected 5 ELF files (brdf, brdf-view, the image-reader module, the Python "
+             "extension and its tools extension), found %s" % elves)
     needed = {}  # soname -> the packaged files that need it
     for elf in elves:
         for so in re.findall(r"\(NEEDED\)\s+Shared library: \[([^]]+)\]",
