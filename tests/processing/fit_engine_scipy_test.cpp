@@ -4,7 +4,7 @@
 // same model (bench/fit/scipy_baseline.py, transcribed from the engines' shader sources) to the
 // same samples with solid-angle weights the oracle computes from the grid itself
 // (tests/python/fit_weights.py), from the fitted parameters, from the middle of the range and
-// from two random points (tests/python/engine_fit_oracle.py). A fit that stops short of its
+// from a random point (tests/python/engine_fit_oracle.py). A fit that stops short of its
 // optimum, or settles in a worse local one, fails.
 #include <gtest/gtest.h>
 
@@ -24,7 +24,7 @@ namespace brdf::processing {
 namespace {
 
 // A red plastic and a gold-like metal (no diffuse, coloured f0), captured by the simulated
-// reference instrument at noise level 1 with θout every 1° and φout every 6° (18,240 samples):
+// reference instrument at noise level 1 with θout every 1° and φout every 8° (13,680 samples):
 // neither is exactly any engine model, so every fit has a residual to minimise.
 TEST(FitEngines, EngineFitsReachScipysOptimumOfTheSameModel) {
   const brdf::test::ScopedTempDir tmp("fit-engine-scipy");
@@ -38,7 +38,7 @@ TEST(FitEngines, EngineFitsReachScipysOptimumOfTheSameModel) {
   for (const Material* truth : {&plastic, &metal}) {
     const std::string label = truth == &metal ? "metal" : "plastic";
     SCOPED_TRACE(label);
-    device::SimulatedFirmware firmware(device::testing::Config(*truth, 1.0, 1, 6, 21));
+    device::SimulatedFirmware firmware(device::testing::Config(*truth, 1.0, 1, 8, 21));
     const Measurement meas = device::testing::CaptureMeasurement(firmware);
     FitOptions o;
     const std::filesystem::path dir = tmp / label;

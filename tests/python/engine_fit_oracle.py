@@ -8,8 +8,8 @@ solid-angle weights are computed here from the grid, fit_weights.py) and job.jso
 {"fits": [{"model", "fitted": material file}]}. The engine models and the ngan residuals
 √w·cosθin·(f − m) come from bench/fit/scipy_baseline.py (transcribed from the engines' shader
 sources, not from the C++). For every fit, scipy.optimize.least_squares (trf, bounds [0, 1])
-runs from the fitted parameters, from the middle of the range and from two seeded random
-points; the lowest final cost is SciPy's optimum. Prints one JSON object:
+runs from the fitted parameters, from the middle of the range and from a seeded random
+point; the lowest final cost is SciPy's optimum. Prints one JSON object:
   weight_difference   the largest relative difference of the fit's own √w and fit_weights.py's
   fits: [{"model", "cost_at_fitted" (½·Σ r² at the fitted parameters), "scipy_cost",
           "scipy_x", "fitted_x", "scipy_start" (which start reached it)}]
@@ -42,7 +42,7 @@ def main():
         residuals, x_fit, lo, hi = sb.problem(d, model, fitted, "ngan")
         r_fit = residuals(x_fit)
         starts = {"fitted": x_fit, "middle": 0.5 * (lo + hi)}
-        for k in range(2):
+        for k in range(1):
             starts["random%d" % k] = rng.uniform(lo, hi)
         best = None
         for name, x0 in starts.items():
