@@ -16,30 +16,14 @@
 #include "brdf/device/driver.h"
 #include "brdf/device/protocol.h"
 #include "brdf/device/transport.h"
+#include "replay_transport.h"  // fuzz/: the fuzz entry's hostile instrument
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size);
 
 namespace brdf::device {
 namespace {
 
-// An instrument that answers anything with the given bytes, in chunks of varying size.
-class ReplayTransport final : public Transport {
- public:
-  explicit ReplayTransport(std::span<const std::uint8_t> bytes) : bytes_(bytes) {}
-  void Write(std::span<const std::uint8_t>) override {}
-  std::size_t Read(std::span<std::uint8_t> buffer, int) override {
-    if (at_ >= bytes_.size()) return 0;
-    const std::size_t n = std::min({buffer.size(), 1 + at_ % 13, bytes_.size() - at_});
-    std::copy_n(bytes_.begin() + static_cast<std::ptrdiff_t>(at_), n, buffer.begin());
-    at_ += n;
-    return n;
-  }
-  std::string Description() const override { return "replay"; }
-
- private:
-  std::span<const std::uint8_t> bytes_;
-  std::size_t at_ = 0;
-};
+using fuzz::ReplayTransport;
 
 // The driver through one slice on `bytes`: the slice, or nothing after a brdf::Error (its
 // message in *error).
@@ -49,12 +33,7 @@ std::optional<Slice> DriveOneSlice(const std::vector<std::uint8_t>& bytes, std::
   options.timeout_ms = 1;
   Driver driver(link, options);
   try {
-    const InstrumentInfo& info = driver.Connect();
-    driver.SetExposure({});
-    driver.MeasureDark();
-    const double theta = info.geometry.theta_in_deg.empty() ? 0 : info.geometry.theta_in_deg[0];
-    driver.MeasureWhite(theta);
-    return driver.MeasureSlice(theta);
+    return fuzz::MeasureOneSlice(driver);
   } catch (const Error& e) {
     *error = e.what();
     return std::nullopt;

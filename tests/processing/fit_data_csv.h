@@ -8,10 +8,17 @@
 // of φout samples in each row, normalised to sum 1).
 #pragma once
 
+#include <gtest/gtest.h>
+
+#include <nlohmann/json.hpp>
+
 #include <filesystem>
 #include <fstream>
+#include <optional>
+#include <string>
 
 #include "fit_data.h"  // private to brdf_fit: the exact samples a fit uses
+#include "test_support.h"
 
 namespace brdf::processing::testing {
 
@@ -23,6 +30,27 @@ inline void WriteFitData(const std::filesystem::path& path, const FitData& data)
     out << s.g.n_dot_l << ',' << s.g.n_dot_v << ',' << s.g.n_dot_h << ',' << s.g.v_dot_h << ','
         << s.g.l_dot_v << ',' << s.g.v_dot_r << ',' << s.m[0] << ',' << s.m[1] << ',' << s.m[2]
         << ',' << s.cos_in << ',' << s.sqrt_w << ',' << s.slice << '\n';
+}
+
+// Runs tests/python/SCRIPT on `dir` with Debian's python3 (BRDF_PYTHON3) and returns the JSON it
+// printed; a failed run is a test failure (the oracle is required, never skipped) and nullopt.
+// Checks the one figure every fit oracle reports: the fit's own √weights are the cells' solid
+// angles the oracle computed from the grid.
+inline std::optional<nlohmann::json> RunFitOracle(const std::string& script,
+                                                  const std::filesystem::path& dir) {
+  const std::string cmd = std::string(BRDF_PYTHON3) + " " + BRDF_SOURCE_DIR + "/tests/python/" +
+                          script + " '" + dir.string() + "'";
+  const brdf::test::CommandOutput oracle = brdf::test::RunCommand(cmd);
+  if (oracle.status != 0) {
+    ADD_FAILURE() << cmd << " failed (needs /usr/bin/python3 with numpy and SciPy: "
+                  << "tools/install-deps.sh)\n"
+                  << oracle.out;
+    return std::nullopt;
+  }
+  nlohmann::json want = nlohmann::json::parse(oracle.out);
+  EXPECT_LT(want["weight_difference"].get<double>(), 1e-9)
+      << "the fit's sample weights are not the cells' solid angles";
+  return want;
 }
 
 }  // namespace brdf::processing::testing
