@@ -1082,6 +1082,16 @@ def main():
                     codes = " ".join(f"{c}={r[0]}" for c, r in results.items())
                     first = next((r[2].strip().split("\n")[0] for r in results.values() if r[2].strip()), "")
                     print(f"{v.seed.name} [{v.label}] {codes} | {first[:200]}")
+        # The value classes (tests/tools/hostile_values.py): one verdict per file across the
+        # commands for values no material has, under-determined fits and odd θin lists.
+        if re.search(args.only, "value class"):
+            import hostile_values
+            value_findings, value_runs, value_counts = hostile_values.run(
+                args.tool, os.path.join(work, "seeds"), work, args.table)
+            findings += value_findings
+            runs += value_runs
+            for command, n in value_counts.items():
+                counts["values " + command] = counts.get("values " + command, 0) + n
         for f in findings:
             print("FINDING:", f)
         print(f"hostile_inputs: {len(seeds)} seeds, {len(selected)} files, {runs} runs "

@@ -35,8 +35,14 @@ struct CleanSlice {
 CleanSlice CleanSliceSamples(const Slice& slice, std::size_t slice_index);
 
 // Why a sample not flagged invalid cannot be used ("θout outside [−90°, 90°]", "red value not a
-// finite number"), or nullptr. The one rule of CleanSliceSamples and FindLutInputProblems.
-const char* SampleDefect(const Sample& sample);
+// finite number", a value no surface has: docs/design.md §4), or nullptr. The one rule of
+// CleanSliceSamples and FindLutInputProblems. `negative_allowance` is the slice's
+// (NegativeAllowance); a sample's own 5σ widens it.
+const char* SampleDefect(const Sample& sample, double negative_allowance);
+
+// How far below zero a value of `slice` may lie and still be noise around zero (1/sr):
+// kNegativeFractionOfPeak of the slice's largest plausible value, at least kNegativeFloorPerSr.
+double NegativeAllowance(const Slice& slice);
 
 // Validates the slice's own θin (finite, [0°, 90°)). Throws InvalidArgument.
 void CheckSliceThetaIn(const Slice& slice, std::size_t slice_index);

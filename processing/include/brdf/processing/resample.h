@@ -99,6 +99,17 @@ struct ResampleReport {
   BeyondReport beyond;                      // what filled the blind spots
 };
 
+// Values no surface has (docs/design.md §4, "Values no surface has"): a sample not flagged
+// invalid is refused (kBadSamples, like a NaN) when a channel's f_r·max(cosθout, cos 89°) exceeds
+// kMaxFrCosPerSr, or when f_r is negative beyond noise around zero: below −max(allowance, 5σ),
+// the allowance being kNegativeFractionOfPeak of the slice's largest plausible value, at least
+// kNegativeFloorPerSr (σ the sample's own, when recorded).
+inline constexpr double kMaxFrCosPerSr = 1e5;
+inline constexpr double kMinBoundCos = 0.017452406437283512;  // cos 89°
+inline constexpr double kNegativeFloorPerSr = 1e-3;
+inline constexpr double kNegativeFractionOfPeak = 0.01;
+inline constexpr double kNegativeSigmas = 5.0;
+
 // One reason BuildLut refuses a measurement (or, for kDegenerateRange, would build a LUT with no
 // angular information).
 struct LutInputProblem {
@@ -132,8 +143,9 @@ std::vector<LutInputProblem> FindLutInputProblems(const Measurement& measurement
 // Requirements (InvalidArgument otherwise, naming the sample and what is wrong):
 //  - at least one slice; the θin values, in any order, are k·Δin for k = 0…K−1 (uniform,
 //    starting at 0°, no duplicates; within 1e-3°); LUT slice k is θin = k·Δin exactly;
-//  - every slice has at least one valid sample; valid samples have finite values, finite φout
-//    and θout ∈ [−90°, 90°]; some valid sample has θout > 0.
+//  - every slice has at least one valid sample; valid samples have finite values a surface can
+//    have (kMaxFrCosPerSr above), finite φout and θout ∈ [−90°, 90°]; some valid sample has
+//    θout > 0.
 // (FindLutInputProblems lists every violation; BuildLut throws InvalidArgument with the first.)
 // `report`, when not null, receives θb, the methods used and sample counts.
 Lut BuildLut(const Measurement& measurement, const ExtrapolationParams& params = {},
