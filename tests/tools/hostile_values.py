@@ -17,7 +17,7 @@ give it, written down here from the rule of docs/design.md §4 and §9 and docs/
   one-per-slice        one sample per slice                      nobody; a ggx fit warns, and
                                                                  --extrapolate auto keeps p 1, l 0.5
   csv-one-row          a CSV with one data row                   nobody; fit warns
-  theta-in-30          capture --theta-in 30                     convert only (θin ≠ k·Δin);
+  theta-in-30          capture --theta-in 30                     convert, atlas (θin ≠ k·Δin);
   theta-in-10-30-50    capture --theta-in 10,30,50               capture warns, info exits 1
   material-bad-extrapolate  gold.json, "extrapolate": p = −1     every reader
 
@@ -150,9 +150,12 @@ def keep_one_per_slice(_, records):
     return [next(r for r in records if abs(r[2] - 30) < 1e-3 and abs(r[3]) < 1e-3)]
 
 
-REFUSED_BY_ALL = {"info": 1, "eval": 1, "convert": 1, "preview": 1, "fit": 1, "export-csv": 0}
-ACCEPTED_BY_ALL = {"info": 0, "eval": 0, "convert": 0, "preview": 0, "fit": 0, "export-csv": 0}
-CONVERT_ONLY = {"info": 1, "eval": 0, "convert": 1, "preview": 0, "fit": 0, "export-csv": 0}
+REFUSED_BY_ALL = {"info": 1, "eval": 1, "convert": 1, "atlas": 1, "preview": 1, "fit": 1,
+                  "export-csv": 0}
+ACCEPTED_BY_ALL = {"info": 0, "eval": 0, "convert": 0, "atlas": 0, "preview": 0, "fit": 0,
+                   "export-csv": 0}
+CONVERT_ONLY = {"info": 1, "eval": 0, "convert": 1, "atlas": 1, "preview": 0, "fit": 0,
+                "export-csv": 0}
 
 
 class ValueClass:
@@ -208,7 +211,8 @@ def make_classes(tool, seeds_dir, work):
     path = os.path.join(vdir, "material-bad-extrapolate.json")
     json.dump(gold, open(path, "w"))
     classes.append(ValueClass("material-bad-extrapolate", path,
-                              {"info": 1, "eval": 1, "convert": 1, "preview": 1, "fit": 1}))
+                              {"info": 1, "eval": 1, "convert": 1, "atlas": 1, "preview": 1,
+                               "fit": 1}))
     return classes
 
 
@@ -222,6 +226,7 @@ def command_line(command, vc, out):
         "eval": ["eval", p, "--in", "30,0", "--out", "30,180"],
         "convert": ["convert", p, "--quiet", "--formats", "json,ktx2", "--out",
                     os.path.join(out, "conv")],
+        "atlas": ["atlas", p, "--quiet", "--jobs", "1", "--out", os.path.join(out, "atlas")],
         "convert-auto": ["convert", p, "--quiet", "--formats", "json", "--extrapolate", "auto",
                          "--out", os.path.join(out, "auto")],
         "preview": ["preview", p, "--size", "32", "--spp", "1", "--jobs", "1", "--quiet",
