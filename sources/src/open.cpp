@@ -166,6 +166,9 @@ PreparedMeasurement Prepare(const std::string& path, FileKind kind,
                             std::string(FileKindName(kind)));
   }
   out.extrapolation = ChooseExtrapolation(path, kind, command_line, &out.warnings);
+  out.measured = kind == FileKind::kCapture || kind == FileKind::kZemax ||
+                 kind == FileKind::kLightTools || kind == FileKind::kCsv ||
+                 kind == FileKind::kGonio;
   if (evaluable) *evaluable = std::move(source);
   return out;
 }
@@ -434,6 +437,7 @@ OpenedForView OpenForView(const std::string& path_or_name, const OpenOptions& op
   // Any distinct θin, as OpenBrdf evaluates them (processing::MeasurementAsBrdf).
   processing::ResampleOptions resample = options.resample;
   resample.require_uniform_theta_in = false;
+  resample.check_measured_values = p.measured;
   processing::ResampleReport report;
   out.lut = processing::BuildLut(p.measurement, p.extrapolation.params, resample, &report);
   out.theta_b_deg = report.theta_b_deg;
@@ -462,8 +466,10 @@ InputLut LutFromInput(const std::string& path, FileKind kind,
   PreparedMeasurement p = PrepareMeasurement(path, kind, command_line);
   out.warnings = std::move(p.warnings);
   out.saturated_samples = CountSaturated(p.measurement);
+  processing::ResampleOptions resample = resample_options;
+  resample.check_measured_values = p.measured;
   processing::ResampleReport report;
-  out.lut = processing::BuildLut(p.measurement, p.extrapolation.params, resample_options, &report);
+  out.lut = processing::BuildLut(p.measurement, p.extrapolation.params, resample, &report);
   if (report.beyond.used != processing::BeyondMethod::kClamp) out.beyond = report.beyond;
   if (auto note = ClipNote(path, out.lut)) out.warnings.push_back(std::move(*note));
   if (report.theta_b_deg < 90.0)

@@ -140,6 +140,15 @@ TEST_F(OneVerdict, ConvertWarnsWhenTheTexturesClip) {
   const ToolRun plain = Convert(Write("plain.bpc", Base()));
   EXPECT_EQ(plain.exit_code, 0) << plain.err;
   EXPECT_EQ(plain.err.find("clip"), std::string::npos) << plain.err;
+  // A material's lobe sharper than the 1° texels: its virtual capture holds the model's own
+  // values (GGX α = 0.001, f0 = 1: at a mirror direction D = 1/(π α²) ≈ 3.2e5 and
+  // f_r = F·G·D/(4 cosθi cosθo) ≳ D/4 ≈ 8e4 > 65408), converted with the warning rather than
+  // refused as a measurement would be.
+  const fs::path mirror = dir_ / "mirror.json";
+  WriteText(mirror, R"({"model": "ggx", "kd": 0, "f0": 1, "alpha": 0.001})");
+  const ToolRun sharp = Convert(mirror);
+  EXPECT_EQ(sharp.exit_code, 0) << sharp.err;
+  EXPECT_NE(sharp.err.find("above 65408"), std::string::npos) << sharp.err;
 }
 
 // docs/design.md §9: with fewer usable samples than twice the parameters one channel depends

@@ -138,7 +138,9 @@ std::vector<LutInputProblem> FindLutInputProblems(const Measurement& m,
     };
     std::vector<Defect> defects;
     std::size_t valid = 0, invalid = 0;
-    const double allowance = detail::NegativeAllowance(s);
+    const std::optional<double> allowance =
+        options.check_measured_values ? std::optional<double>(detail::NegativeAllowance(s))
+                                      : std::nullopt;
     for (std::size_t n = 0; n < s.samples.size(); ++n) {
       const Sample& x = s.samples[n];
       if (x.flags & kFlagInvalid) {

@@ -110,27 +110,30 @@ double NegativeAllowance(const Slice& slice) {
   return std::max(kNegativeFloorPerSr, kNegativeFractionOfPeak * peak);
 }
 
-const char* SampleDefect(const Sample& s, double negative_allowance) {
+const char* SampleDefect(const Sample& s, std::optional<double> negative_allowance) {
   if (s.flags & kFlagInvalid) return nullptr;
   const double theta = s.theta_out_deg;
   if (!(theta >= -90.0 && theta <= 90.0)) return "θout outside [−90°, 90°]";
   if (!std::isfinite(s.phi_out_deg)) return "φout not a finite number";
   for (int c = 0; c < 3; ++c)
     if (!std::isfinite(s.rgb[c])) return kNotFinite[c];
+  if (!negative_allowance) return nullptr;
   const double cos_out = BoundCos(s);
   for (int c = 0; c < 3; ++c) {
     const double v = s.rgb[c];
     // σ widens the allowance only when it is a finite, non-negative number.
     const double sigma = s.sigma[c] >= 0.0f && std::isfinite(s.sigma[c]) ? s.sigma[c] : 0.0;
-    if (v < -std::max(negative_allowance, kNegativeSigmas * sigma)) return kTooNegative[c];
+    if (v < -std::max(*negative_allowance, kNegativeSigmas * sigma)) return kTooNegative[c];
     if (v * cos_out > kMaxFrCosPerSr) return kTooLarge[c];
   }
   return nullptr;
 }
 
-CleanSlice CleanSliceSamples(const Slice& slice, std::size_t slice_index) {
+CleanSlice CleanSliceSamples(const Slice& slice, std::size_t slice_index,
+                             bool check_measured_values) {
   CleanSlice out;
-  const double allowance = NegativeAllowance(slice);
+  const std::optional<double> allowance =
+      check_measured_values ? std::optional<double>(NegativeAllowance(slice)) : std::nullopt;
   out.points.reserve(slice.samples.size());
   for (std::size_t n = 0; n < slice.samples.size(); ++n) {
     const Sample& s = slice.samples[n];
@@ -431,7 +434,7 @@ std::optional<RegularGrid> DetectRegularGrid(const std::vector<Point>& points,
 SliceInterpolator::SliceInterpolator(const Slice& slice, std::size_t slice_index,
                                      const ResampleOptions& options) {
   CheckSliceThetaIn(slice, slice_index);
-  CleanSlice clean = CleanSliceSamples(slice, slice_index);
+  CleanSlice clean = CleanSliceSamples(slice, slice_index, options.check_measured_values);
   report_.theta_in_deg = slice.theta_in_deg;
   report_.valid_samples = clean.points.size();
   report_.invalid_samples = clean.invalid;

@@ -73,6 +73,12 @@ struct ResampleOptions {
   // extra slices k·Δin up to beyond.max_theta_in_deg. kClamp builds the LUT as before (the
   // measured slices only, §6 band). Not applied to a θin list that is not k·Δin.
   BeyondOptions beyond;
+  // The rule of values no surface has (kMaxFrCosPerSr below, docs/design.md §4) is for
+  // measured values (captures, tables). false for a virtual capture of an evaluable file (a
+  // material, RGL or MERL file, an exported LUT): its values are the model's own, exactly, and a
+  // lobe sharper than the LUT's 1° texels may exceed the limit; the textures then clip it, with
+  // the warning of sources::ClipNote. Finite values and angles are required either way.
+  bool check_measured_values = true;
 
   // Throws InvalidArgument naming the bad option.
   void Validate() const;

@@ -78,6 +78,10 @@ struct PreparedMeasurement {
   Measurement measurement;
   ExtrapolationChoice extrapolation;
   std::vector<std::string> warnings;
+  // Measured values (a capture, a table), held to the rule of values no surface has
+  // (docs/design.md §4); false for a virtual capture of an evaluable file, whose values are the
+  // model's (ResampleOptions::check_measured_values).
+  bool measured = true;
 };
 // Captures follow the damaged-capture rule (capture.h); material files are captured noise-free
 // on the reference geometry (brdf/core/virtual_capture.h); third-party tables (Zemax,
