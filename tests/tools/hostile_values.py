@@ -24,8 +24,9 @@ give it, written down here from the rule of docs/design.md §4 and §9 and docs/
 `export-csv` copies every sample (a CSV can hold any finite number): it accepts the value classes
 and says, in a warning naming slice and sample, what the other commands refuse.
 
-Every run is also held to the pass's bounds: at most TIMEOUT_S of wall time and PEAK_RSS_BYTES of
-peak resident memory (ru_maxrss of that one child, from wait4). Bad map texels (NaN, ±Inf,
+Every run is also held to the pass's bounds: at most CPU_LIMIT_S (10 s) of CPU time, TIMEOUT_S of
+wall time, and PEAK_RSS_BYTES of peak resident memory (ru_maxrss and ru_utime + ru_stime of that
+one child, from wait4). Bad map texels (NaN, ±Inf,
 negative, an all-Inf map) are the environment-map reader's class and are checked with that
 fix (issue 20, finding 7), not here.
 """
@@ -37,7 +38,6 @@ import struct
 import subprocess
 import tempfile
 import threading
-import time
 
 import hostile_inputs as hi
 
@@ -46,19 +46,22 @@ import hostile_inputs as hi
 # leaves room for a slow machine's allocator and still catches memory that grows with a value
 # rather than with the file.
 PEAK_RSS_BYTES = 1 << 30
+# 10 s of CPU per run (the pass's CPU_LIMIT_S where it has one, enforced with RLIMIT_CPU), and its
+# wall-clock limit for a run that waits without computing.
+CPU_LIMIT_S = getattr(hi, "CPU_LIMIT_S", 10)
 
 
 def run_measured(tool, args, cwd):
-    """(exit code or "timeout", stdout, stderr, wall seconds, peak RSS bytes) of one run, under
-    the pass's address-space limit."""
+    """(exit code or "timeout", stdout, stderr, CPU seconds, peak RSS bytes) of one run, under
+    the pass's address-space, CPU and wall-clock limits."""
     with tempfile.TemporaryFile() as out_f, tempfile.TemporaryFile() as err_f:
         def limits():
             import resource
             resource.setrlimit(resource.RLIMIT_AS, (hi.ADDRESS_SPACE_BYTES, hi.ADDRESS_SPACE_BYTES))
             resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
+            resource.setrlimit(resource.RLIMIT_CPU, (CPU_LIMIT_S, CPU_LIMIT_S + 1))
             os.setsid()
 
-        start = time.monotonic()
         proc = subprocess.Popen([tool] + args, cwd=cwd, stdin=subprocess.DEVNULL, stdout=out_f,
                                 stderr=err_f, preexec_fn=limits)
         timed_out = []
@@ -75,12 +78,12 @@ def run_measured(tool, args, cwd):
         _, status, usage = os.wait4(proc.pid, 0)
         timer.cancel()
         proc.returncode = os.waitstatus_to_exitcode(status)  # reaped here, not by Popen
-        wall = time.monotonic() - start
+        cpu = usage.ru_utime + usage.ru_stime
         out_f.seek(0)
         err_f.seek(0)
         code = "timeout" if timed_out else proc.returncode
         return (code, out_f.read().decode("utf-8", "replace"),
-                err_f.read().decode("utf-8", "replace"), wall, usage.ru_maxrss * 1024)
+                err_f.read().decode("utf-8", "replace"), cpu, usage.ru_maxrss * 1024)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -244,13 +247,15 @@ def check_class(tool, vc, work, findings, counts):
     results = {}
     commands = list(vc.expected) + (["convert-auto"] if vc.auto_defaults else [])
     for command in commands:
-        code, stdout, stderr, wall, rss = run_measured(tool, command_line(command, vc, out), work)
-        results[command] = (code, stdout, stderr, wall, rss)
+        code, stdout, stderr, cpu, rss = run_measured(tool, command_line(command, vc, out), work)
+        results[command] = (code, stdout, stderr, cpu, rss)
         counts[command] = counts.get(command, 0) + 1
         where = f"value class {vc.name} {command}"
         if code == "timeout":
             findings.append(f"{where}: timed out after {hi.TIMEOUT_S} s")
             continue
+        if cpu > CPU_LIMIT_S:
+            findings.append(f"{where}: {cpu:.1f} s of CPU > {CPU_LIMIT_S} s")
         if rss > PEAK_RSS_BYTES:
             findings.append(f"{where}: peak RSS {rss / 2**20:.0f} MiB > "
                             f"{PEAK_RSS_BYTES / 2**20:.0f} MiB")
@@ -331,9 +336,9 @@ def run(tool, seeds_dir, work, table=False):
             codes = " ".join(f"{c}={r[0]}" for c, r in results.items())
             first = next((r[2].strip().split("\n")[0] for r in results.values() if r[2].strip()),
                          "")
-            wall = max(r[3] for r in results.values())
+            cpu = max(r[3] for r in results.values())
             rss = max(r[4] for r in results.values())
-            print(f"value class {vc.name} {codes} (slowest {wall:.2f} s, peak RSS "
+            print(f"value class {vc.name} {codes} (slowest {cpu:.2f} s CPU, peak RSS "
                   f"{rss / 2**20:.0f} MiB) | {first[:200]}")
     shutil.rmtree(os.path.join(work, "values-out"), ignore_errors=True)
     return findings, runs, counts
