@@ -983,7 +983,10 @@ def check_agreement(variant, results, work, index, findings):
         ocode, _, oerr = results[other]
         if not isinstance(code, int) or not isinstance(ocode, int):
             continue
-        if code != 0 and ocode == 0:
+        # A capture refused by the LUT exports alone (θin not k·Δin: "evaluable" true,
+        # "convertible" false) is evaluated by eval by design (docs/robustness.md).
+        export_only = doc.get("evaluable") is True and doc.get("convertible") is False
+        if code != 0 and ocode == 0 and not (other == "eval" and export_only):
             findings.append(f"{where}: info refuses (exit {code}: {err.strip()[:200]}) but "
                             f"{other} accepts it")
         if code == 0 and ocode != 0 and not warned:
