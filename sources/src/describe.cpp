@@ -112,19 +112,20 @@ void AddPointCloudJson(const Measurement& m, Json* j,
   (*j)["metadata"] = MetadataJson(m.metadata);
 }
 
-// The reasons a measurement cannot be resampled into a LUT (the library checks every reader
-// applies), one line each, plus the LUT's own requirement of θin = k·Δin.
-void AddRefusalsJson(const std::string& path, const std::vector<std::string>& refusals,
-                     const Measurement* m, Json* j) {
+// The verdict (one rule, brdf/sources/capture.h): "refusals" lists every reason a reading
+// command refuses the file, one line each; "usable" is true when none does; "evaluable" when
+// eval, preview, fit and brdf-view accept it (they do unless `refusals` is not empty). For
+// captures, "convertible": convert and atlas accept it too (`export_refusals` are theirs alone).
+void AddRefusalsJson(const std::vector<std::string>& refusals,
+                     const std::vector<std::string>* export_refusals, Json* j) {
   Json list = Json::array();
   for (const std::string& r : refusals) list.push_back(r);
-  if (m != nullptr && !m->slices.empty() && refusals.empty()) {
-    for (const processing::LutInputProblem& p : processing::FindLutInputProblems(*m))
-      if (p.kind == processing::LutInputProblem::Kind::kThetaInNotUniform)
-        list.push_back(path + ": a LUT cannot be built from it: " + p.message);
-  }
+  if (export_refusals)
+    for (const std::string& r : *export_refusals) list.push_back(r);
   (*j)["refusals"] = list;
-  (*j)["usable"] = refusals.empty();
+  (*j)["usable"] = list.empty();
+  (*j)["evaluable"] = refusals.empty();
+  if (export_refusals) (*j)["convertible"] = list.empty();
 }
 
 Json DescribeBpc(const std::string& path, const Phrasing& say) {
@@ -148,10 +149,12 @@ Json DescribeBpc(const std::string& path, const Phrasing& say) {
                              {"slice", p.slice_index},
                              {"message", p.message}});
   }
-  std::vector<std::string> refusals;
+  std::vector<std::string> refusals, export_refusals;
   for (const CaptureRefusal& refusal : a.refusals)
     refusals.push_back(say.Line(refusal.ToError(path)));
-  AddRefusalsJson(path, refusals, &m, &j);
+  for (const CaptureRefusal& refusal : a.export_refusals)
+    export_refusals.push_back(say.Line(refusal.ToError(path)));
+  AddRefusalsJson(refusals, &export_refusals, &j);
   j["planned_theta_in_deg"] = a.planned_theta_in_deg;
   j["plan_recorded"] = a.plan_recorded;
   j["missing_theta_in_deg"] = a.missing_theta_in_deg;
@@ -170,7 +173,7 @@ Json DescribeBpc(const std::string& path, const Phrasing& say) {
 }
 
 Json DescribeMaterial(const std::string& path) {
-  const Material material = LoadMaterialFile(path);
+  const Material material = LoadMaterialInput(path);
   Json j;
   j["file"] = path;
   j["format"] = "material";
@@ -331,7 +334,7 @@ Json DescribeImported(const std::string& path, ImportFormat format, const Phrasi
     for (const processing::LutInputProblem& p :
          processing::FindLutInputProblems(*table_m, any_theta_in))
       refusals.push_back(path + ": " + p.message);
-    AddRefusalsJson(path, refusals, nullptr, &j);
+    AddRefusalsJson(refusals, nullptr, &j);
   }
   return j;
 }

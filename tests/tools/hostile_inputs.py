@@ -1061,7 +1061,10 @@ def check_agreement(variant, results, work, index, findings):
         ocode, _, oerr = results[other]
         if not isinstance(code, int) or not isinstance(ocode, int):
             continue
-        if code != 0 and ocode == 0:
+        # A capture refused by the LUT exports alone (θin not k·Δin: "evaluable" true,
+        # "convertible" false) is evaluated by eval by design (docs/robustness.md).
+        export_only = doc.get("evaluable") is True and doc.get("convertible") is False
+        if code != 0 and ocode == 0 and not (other == "eval" and export_only):
             findings.append(f"{where}: info refuses (exit {code}: {err.strip()[:200]}) but "
                             f"{other} accepts it")
         if code == 0 and ocode != 0 and not warned:
@@ -1168,6 +1171,16 @@ def main():
         findings += [f"lie rule '{label}' matches nothing in its seed: it tests nothing"
                      for label in UNMATCHED_LIES]
         lie_files = sum(1 for _, v in selected if v.label != "valid" and not v.special)
+        # The value classes (tests/tools/hostile_values.py): one verdict per file across the
+        # commands for values no material has, under-determined fits and odd θin lists.
+        if re.search(args.only, "value class"):
+            import hostile_values
+            value_findings, value_runs, value_counts = hostile_values.run(
+                args.tool, os.path.join(work, "seeds"), work, args.table)
+            findings += value_findings
+            runs += value_runs
+            for command, n in value_counts.items():
+                counts["values " + command] = counts.get("values " + command, 0) + n
         for f in findings:
             print("FINDING:", f)
         print("hostile_inputs: lies per seed: " +

@@ -93,14 +93,17 @@ int RunAtlas(const AtlasOptions& options) {
       [&](std::size_t i, JobResult& result) {
         const BatchInput& in = found.inputs[i];
         std::optional<processing::ExtrapolationParams> chosen = extrapolate;
+        std::string auto_warning;
         if (auto_extrapolate)
           if (const auto automatic = AutoExtrapolationFor(in.path, in.kind)) {
             chosen = automatic->params;
             fitted[i].push_back(automatic->record_json);
+            auto_warning = automatic->warning;
           }
         sources::InputLut built = sources::LutFromInput(in.path, in.kind, chosen, resample);
         exporter::ValidateLutForExport(built.lut);
         result.warnings = std::move(built.warnings);
+        if (!auto_warning.empty()) result.warnings.push_back(auto_warning);
         if (auto note = sources::SaturationNote(in.path, built.saturated_samples))
           result.warnings.push_back(std::move(*note));
         saturated[i] = std::move(built.saturated_samples);

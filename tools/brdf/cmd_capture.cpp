@@ -306,6 +306,7 @@ int RunCapture(const CaptureOptions& o) {
                      "wrote %s: %zu slices, %s new samples, %s saturated, %s below noise floor\n",
                      o.out.c_str(), r.slices_saved, Thousands(r.new_samples).c_str(),
                      Thousands(r.saturated).c_str(), Thousands(r.below_noise_floor).c_str());
+      WarnAboutVerdict(o.out);
       return 0;
     case device::CaptureOutcome::kNothingToResume:
       if (!o.quiet) std::fprintf(stderr, "%s\n", r.message.c_str());

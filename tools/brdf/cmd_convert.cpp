@@ -157,6 +157,7 @@ int RunConvert(const ConvertOptions& options) {
         if (automatic) chosen = automatic->params;
         sources::InputLut built = sources::LutFromInput(in.path, in.kind, chosen, resample);
         result.warnings = std::move(built.warnings);
+        if (automatic && !automatic->warning.empty()) result.warnings.push_back(automatic->warning);
         if (auto note = sources::SaturationNote(in.path, built.saturated_samples))
           result.warnings.push_back(std::move(*note));
         exporter::TextureMetadata metadata;

@@ -33,24 +33,34 @@ std::string TripleText(const Json& v) {
   return Fixed(v[0]) + " " + Fixed(v[1]) + " " + Fixed(v[2]);
 }
 
-// Which commands the "usable" verdict speaks for: convert reads captures (and material files),
-// a third-party table is evaluated directly and converted only after 'brdf import'.
+// Which commands the verdict speaks for: convert reads captures (and material files), a
+// third-party table is evaluated directly and converted only after 'brdf import'; a capture
+// refused by the LUT exports alone (θin not k·Δin) is evaluated by every other command.
 const char* JudgingCommands(const Json& j) {
-  return IsImportedFormat(j) ? "'brdf eval'" : "'brdf convert' and 'brdf eval'";
+  if (IsImportedFormat(j)) return "'brdf eval'";
+  if (j.value("evaluable", true) && !j.value("convertible", true))
+    return "'brdf convert' and 'brdf atlas'";
+  return "'brdf convert' and 'brdf eval'";
 }
+
+// "s" when JudgingCommands names one command.
+const char* VerbS(const Json& j) { return IsImportedFormat(j) ? "s" : ""; }
 
 void PrintRefusalsText(const Json& j) {
   if (j.contains("warnings"))
     for (const auto& w : j["warnings"]) std::printf("%s\n", w.get<std::string>().c_str());
   if (!j.contains("refusals")) return;
-  const char* verb_s = IsImportedFormat(j) ? "s" : "";  // one command, or two
   if (j["refusals"].empty()) {
-    std::printf("usable: yes (%s accept%s it)\n", JudgingCommands(j), verb_s);
+    std::printf("usable: yes (%s accept%s it)\n", JudgingCommands(j), VerbS(j));
     return;
   }
-  std::printf("usable: no; %s refuse%s it: %zu reason%s\n", JudgingCommands(j), verb_s,
+  std::printf("usable: no; %s refuse%s it: %zu reason%s\n", JudgingCommands(j), VerbS(j),
               j["refusals"].size(), j["refusals"].size() == 1 ? "" : "s");
   for (const auto& r : j["refusals"]) std::printf("  %s\n", r.get<std::string>().c_str());
+  if (j.value("evaluable", false) && !j.value("convertible", true))
+    std::printf(
+        "evaluable: yes ('brdf eval', 'brdf preview', 'brdf fit' and brdf-view accept it; only "
+        "the LUT textures need θin = k·Δin)\n");
 }
 
 void PrintBpcText(const Json& j) {
@@ -89,7 +99,8 @@ void PrintBpcText(const Json& j) {
                 f["interpolated"].dump().c_str(), f["invalid"].dump().c_str());
   }
   if (j["problems"].empty()) {
-    std::printf("problems: none\n");
+    // "none" only when nothing else is wrong either: the refusals follow.
+    std::printf(j["refusals"].empty() ? "problems: none\n" : "damage: none (chunks intact)\n");
   } else {
     std::printf("problems: %zu\n", j["problems"].size());
     for (const Json& p : j["problems"])
@@ -308,7 +319,7 @@ int RunInfo(const InfoOptions& options) {
   if (j.contains("usable") && !j["usable"].get<bool>()) {
     const std::size_t n = j["refusals"].size();
     std::fprintf(stderr, "brdf: %s: %zu problem%s that %s refuse%s%s\n", file.c_str(), n,
-                 n == 1 ? "" : "s", JudgingCommands(j), IsImportedFormat(j) ? "s" : "",
+                 n == 1 ? "" : "s", JudgingCommands(j), VerbS(j),
                  options.json ? " (listed under \"refusals\")" : " (listed above)");
     return 1;
   }
