@@ -78,10 +78,13 @@ TEST_F(PreviewCli, IblEngineRendersTheSplitSumAndComparesItWithTheTruth) {
   const exporter::ExrFile exr = exporter::ReadExr((dir_ / "e.exr").string());
   EXPECT_EQ(exr.Attribute("brdf:estimator"), "engine-split-sum");
   EXPECT_EQ(exr.Attribute("brdf:ibl"), "engine");
-  for (int y = 6; y < 42; ++y)
-    for (int x = 6; x < 42; ++x)
-      if (std::hypot(x + 0.5 - 24.0, y + 0.5 - 24.0) < 0.45 * 48 - 1.5)
+  for (int y = 6; y < 42; ++y) {
+    for (int x = 6; x < 42; ++x) {
+      if (std::hypot(x + 0.5 - 24.0, y + 0.5 - 24.0) < 0.45 * 48 - 1.5) {
         for (int c = 0; c < 3; ++c) EXPECT_NEAR(exr.image.Pixel(x, y)[c], 1.0, 5e-3);
+      }
+    }
+  }
   const ToolRun gold =
       Run("preview " + Quote(kMaterials + "gold.json") + " --ibl engine" + " --compare " +
           Quote(kMaterials + "gold.json") + " --size 32 --quiet --out " + Quote(dir_ / "g.exr"));
