@@ -227,9 +227,16 @@ try {
       const [name, file] = item.split('=');
       const src = readFileSync(file, 'utf8').replace(/^#version.*\n/, '');
       const s3 = src.match(/uniform\s+(?:highp\s+)?sampler3D\s+(\w+);/);
-      const s2 = src.match(/uniform\s+(?:highp\s+)?sampler2D\s+(\w+);/);
+      // (the pairs: the one named so when there is one; the Godot shader declares its IBL pack's
+      // sampler2D before the harness's)
+      const s2 = src.match(/uniform\s+(?:highp\s+)?sampler2D\s+(\w*pairs\w*);/) ||
+                 src.match(/uniform\s+(?:highp\s+)?sampler2D\s+(\w+);/);
       if (!s3 || !s2) throw new Error(`${file}: no sampler3D/sampler2D uniforms:\n` + src);
-      return [name, src, s3[1], s2[1]];
+      // Other samplers (the Godot shader's IBL pack and radiance cube map) get a texture of
+      // their own type: two sampler types on one texture unit make WebGL refuse the draw.
+      const extra = [...src.matchAll(/uniform\s+(?:highp\s+)?(sampler2D|samplerCube)\s+(\w+);/g)]
+        .filter((m) => m[2] !== s2[1]).map((m) => [m[2], m[1]]);
+      return [name, src, s3[1], s2[1], extra];
     });
     const sidecar = args.sidecar ? JSON.parse(readFileSync(args.sidecar, 'utf8')).texel_convention.glsl : null;
     for (const [prefix, file] of pairSets) {
@@ -239,21 +246,25 @@ try {
       rows.forEach((r, i) => {
         for (let k = 0; k < 3; k++) data.set([r[3 * k], r[3 * k + 1], r[3 * k + 2], 0], (k * count + i) * 4);
       });
-      const runPairs = async (source, lutName, pairsName) => fromBase64(await page.eval(`(async () => {
+      const runPairs = async (source, lutName, pairsName, extra = []) => fromBase64(await page.eval(`(async () => {
           const M = window.measuredBrdf;
           const mod = await import('${base}/web/${manifest.engines.web.files.shader}');
           const source = ${JSON.stringify(source)}.replace('@MEASURED_BRDF_GLSL@', mod.MEASURED_BRDF_GLSL);
           const t = M.dataTexture(new Float32Array(${JSON.stringify(Array.from(data))}), ${count}, 3);
-          return M.toBase64(M.runFragment(source, { ${lutName}: { value: M.texture }, ${pairsName}: { value: t } }, ${count}, 1)); })()`));
+          const uniforms = { ${lutName}: { value: M.texture }, ${pairsName}: { value: t } };
+          for (const [name, type] of ${JSON.stringify(extra)})
+            uniforms[name] = { value: type === 'samplerCube' ? new M.THREE.WebGLCubeRenderTarget(4).texture
+                                                             : M.dataTexture(new Float32Array(4), 1, 1) };
+          return M.toBase64(M.runFragment(source, uniforms, ${count}, 1)); })()`));
       const format = (out) => Array.from({ length: count }, (_, i) =>
         `${out[i * 4]} ${out[i * 4 + 1]} ${out[i * 4 + 2]}`).join('\n') + '\n';
-      const write = async (lang, source, lutName, pairsName) =>
-        writeFileSync(join(outDir, `${prefix}_${lang}.txt`), format(await runPairs(source, lutName, pairsName)));
+      const write = async (lang, source, lutName, pairsName, extra) =>
+        writeFileSync(join(outDir, `${prefix}_${lang}.txt`), format(await runPairs(source, lutName, pairsName, extra)));
       await write('glsl', '@MEASURED_BRDF_GLSL@' + glslMain, 'lut', 'pairs');
       await write('tangent', '@MEASURED_BRDF_GLSL@' + tangentMain(prefix === 'exact'), 'lut', 'pairs');
       // The sidecar's snippet starts with its precision statements, as it ships.
       if (sidecar) await write('sidecar', sidecar + glslMain, 'lut', 'pairs');
-      for (const [name, src, s3, s2] of harnesses) await write(name, src, s3, s2);
+      for (const [name, src, s3, s2, extra] of harnesses) await write(name, src, s3, s2, extra);
     }
   }
 

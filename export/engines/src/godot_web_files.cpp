@@ -17,9 +17,22 @@ std::string GodotShader(const exporter::ShaderLutLayout& layout) {
 // because Godot multiplies DIFFUSE_LIGHT by it (the measured colour is in f_r itself).
 // LIGHT_COLOR is the light's colour x energy x PI in Godot 4 and Godot's own Lambert term adds
 // LIGHT_COLOR * ATTENUATION * NdotL / PI, so f_r = albedo / PI reproduces it exactly.
+// Image-based lighting (docs/engines.md, "ibl"): Godot's own ambient and reflection terms are
+// disabled (they would light a white Lambertian); instead fragment() adds the material's probe
+// term as EMISSION from the IBL pack (measured_brdf_ibl_pack: <name>_ibl.dds, or its row of an
+// atlas's pack with measured_brdf_ibl_row = (row + 0.5) / rows) and a GGX-prefiltered radiance
+// cube map in the layout of Godot's own radiance maps (mip level = perceptual roughness x
+// max level, e.g. a baked ReflectionProbe's or the sky's exported radiance; Godot 4 spatial
+// shaders cannot read the scene's radiance map themselves). measured_brdf_radiance_max_lod = 0
+// (the default) leaves the probe term out.
 shader_type spatial;
+render_mode ambient_light_disabled;
 
 uniform sampler3D measured_brdf_lut : filter_linear, repeat_disable, hint_default_black;
+uniform sampler2D measured_brdf_ibl_pack : filter_linear, repeat_disable, hint_default_black;
+uniform samplerCube measured_brdf_radiance : filter_linear_mipmap, hint_default_black;
+uniform float measured_brdf_ibl_row = 0.5;
+uniform float measured_brdf_radiance_max_lod = 0.0;
 
 )~~" + exporter::MeasuredBrdfShaderCode(exporter::ShaderLanguage::kGodot, layout) +
          R"~~(
@@ -28,6 +41,19 @@ void fragment() {
   METALLIC = 0.0;
   SPECULAR = 0.0;
   ROUGHNESS = 1.0;
+  if (measured_brdf_radiance_max_lod > 0.0) {
+    // World space, where the cube map is indexed; two probe fetches and the pack row.
+    vec3 n = normalize((INV_VIEW_MATRIX * vec4(NORMAL, 0.0)).xyz);
+    vec3 v = normalize((INV_VIEW_MATRIX * vec4(VIEW, 0.0)).xyz);
+    vec3 ibl_diffuse;
+    vec3 ibl_specular;
+    float alpha_eq = MeasuredBrdfIblPack(measured_brdf_ibl_row, max(dot(n, v), 0.0), ibl_diffuse,
+                                         ibl_specular);
+    vec3 irradiance = textureLod(measured_brdf_radiance, n, measured_brdf_radiance_max_lod).rgb;
+    vec3 prefiltered = textureLod(measured_brdf_radiance, MeasuredBrdfIblReflect(n, v),
+                                  sqrt(alpha_eq) * measured_brdf_radiance_max_lod).rgb;
+    EMISSION = MeasuredBrdfIblRadiance(ibl_diffuse, ibl_specular, irradiance, prefiltered);
+  }
 }
 
 // NORMAL, LIGHT and VIEW are view-space unit vectors pointing away from the surface.
@@ -122,10 +148,19 @@ void main() {{
 const FRAGMENT_SHADER = MEASURED_BRDF_GLSL + `
 uniform highp sampler3D measuredBrdfLut;
 uniform vec3 lightDirection;  // world space, towards the light
-uniform vec3 lightColor;      // irradiance at normal incidence, linear RGB
+uniform vec3 lightColor;      // irradiance at normal incidence, linear RGB (0: no light)
 uniform float exposure;
 uniform vec2 cellTexels;      // atlas: the material's cell origin (manifest "cells"); else 0, 0
 uniform bool encodeSrgb;      // false: linear radiance (float render targets)
+#ifdef MEASURED_BRDF_IBL
+// three.js's own PMREM (PMREMGenerator: a cube map whose mip levels hold the GGX-prefiltered
+// radiance, roughness 1 at ENVMAP_MAX_LOD) and its roughnessToMip (envmap_common_pars_fragment).
+#define USE_ENVMAP
+#define ENVMAP_TYPE_PMREM
+#include <envmap_common_pars_fragment>
+uniform highp sampler2D iblPack;  // NAME_ibl.dds (loadMeasuredBrdfIblPack)
+uniform float iblPackRow;         // (row + 0.5) / rows of the material's pack row
+#endif
 in vec3 v_normal_world;
 in vec3 v_position_world;
 layout(location = 0) out highp vec4 fragColor;
@@ -137,27 +172,92 @@ void main() {{
   vec3 n = normalize(v_normal_world);
   vec3 v = normalize(cameraPosition - v_position_world);
   vec3 l = normalize(lightDirection);
-  vec3 f = MeasuredBrdfCell(measuredBrdfLut, cellTexels, n, l, v);
-  vec3 radiance = f * lightColor * max(dot(n, l), 0.0) * exposure;
+  vec3 radiance = vec3(0.0);
+  if (lightColor != vec3(0.0)) {{
+    vec3 f = MeasuredBrdfCell(measuredBrdfLut, cellTexels, n, l, v);
+    radiance = f * lightColor * max(dot(n, l), 0.0);
+  }}
+#ifdef MEASURED_BRDF_IBL
+  // One pack row (two texels at mu) and two probe fetches: the PMREM's last level (GGX alpha 1
+  // = the cosine lobe: irradiance / pi) about n, and the level of alpha_eq about R.
+  vec3 ibl_diffuse, ibl_specular;
+  float alpha_eq = MeasuredBrdfIblPack(iblPack, iblPackRow, max(dot(n, v), 0.0), ibl_diffuse,
+                                       ibl_specular);
+  vec3 r = MeasuredBrdfIblReflect(n, v);
+  vec3 irradiance = textureLod(envMap, envMapRotation * n, ENVMAP_MAX_LOD).rgb;
+  vec3 prefiltered = textureLod(envMap, envMapRotation * r, roughnessToMip(sqrt(alpha_eq))).rgb;
+  radiance += MeasuredBrdfIblRadiance(ibl_diffuse, ibl_specular, irradiance, prefiltered) *
+              envMapIntensity;
+#endif
+  radiance *= exposure;
   fragColor = vec4(encodeSrgb ? SrgbFromLinear(radiance) : radiance, 1.0);
 }}
 `;
 
-// A ShaderMaterial lit by one directional light. Options: lightDirection (THREE.Vector3,
-// towards the light), lightColor (THREE.Color or Vector3, linear), exposure, encodeSrgb,
-// cell ([x0, y0]: an atlas material's cell origin in texels, from the manifest).
+// The IBL pack texture (NAME_ibl.dds, docs/engines.md): a DDS RGBA16F 2D texture, read here
+// (header checked: DX10, DXGI format 10, 2D) into a half-float DataTexture with linear
+// filtering and clamp-to-edge, row 0 at v = 0 as the file stores it.
+export async function loadMeasuredBrdfIblPack(url) {{
+  const response = await fetch(url);
+  if (!response.ok) throw new Error(`measured BRDF: ${{url}}: HTTP ${{response.status}}`);
+  const bytes = await response.arrayBuffer();
+  const view = new DataView(bytes);
+  const word = (at) => view.getUint32(at, true);
+  if (bytes.byteLength < 148 || word(0) !== 0x20534444 || word(84) !== 0x30315844)
+    throw new Error(`measured BRDF: ${{url}}: not a DX10 DDS file`);
+  if (word(128) !== 10 || word(132) !== 3)
+    throw new Error(`measured BRDF: ${{url}}: expected DXGI format 10 (RGBA16F) 2D, got format ${{word(128)}}, dimension ${{word(132)}}`);
+  const height = word(12), width = word(16);
+  if (bytes.byteLength < 148 + width * height * 8)
+    throw new Error(`measured BRDF: ${{url}}: ${{bytes.byteLength}} bytes, expected ${{148 + width * height * 8}}`);
+  const texture = new THREE.DataTexture(new Uint16Array(bytes, 148, width * height * 4), width,
+                                        height, THREE.RGBAFormat, THREE.HalfFloatType);
+  texture.minFilter = THREE.LinearFilter;
+  texture.magFilter = THREE.LinearFilter;
+  texture.wrapS = THREE.ClampToEdgeWrapping;
+  texture.wrapT = THREE.ClampToEdgeWrapping;
+  texture.generateMipmaps = false;
+  texture.flipY = false;
+  texture.colorSpace = THREE.NoColorSpace;
+  texture.needsUpdate = true;
+  return texture;
+}}
+
+// A ShaderMaterial lit by one directional light and, with options.environment, by the
+// environment's probes. Options: lightDirection (THREE.Vector3, towards the light), lightColor
+// (THREE.Color or Vector3, linear; zero vector: no light), exposure, encodeSrgb, cell ([x0, y0]:
+// an atlas material's cell origin in texels, from the manifest), environment (the texture of
+// PMREMGenerator.fromEquirectangular/fromScene: its GGX-prefiltered cube map), iblPack (the
+// texture of loadMeasuredBrdfIblPack), iblPackRow (the material's row, 0 for a single LUT; the
+// manifest's "ibl" "row"), environmentIntensity.
 export function createMeasuredBrdfMaterial(texture, options = {{}}) {{
   const color = options.lightColor ?? new THREE.Vector3(1, 1, 1);
+  const uniforms = {{
+    measuredBrdfLut: {{ value: texture }},
+    lightDirection: {{ value: (options.lightDirection ?? new THREE.Vector3(0, 0, 1)).clone() }},
+    lightColor: {{ value: new THREE.Vector3(color.x ?? color.r, color.y ?? color.g, color.z ?? color.b) }},
+    exposure: {{ value: options.exposure ?? 1.0 }},
+    cellTexels: {{ value: new THREE.Vector2(...(options.cell ?? [0, 0])) }},
+    encodeSrgb: {{ value: options.encodeSrgb ?? true }},
+  }};
+  const defines = {{}};
+  const environment = options.environment ?? null;
+  if (environment) {{
+    if (!environment.isPMREMTexture || !options.iblPack)
+      throw new Error('measured BRDF: options.environment must be a PMREMGenerator texture, with options.iblPack');
+    const rows = options.iblPack.image.height;
+    defines.MEASURED_BRDF_IBL = '';
+    defines.ENVMAP_MAX_LOD = `${{environment.mipmaps.length - 1}}.0`;
+    uniforms.envMap = {{ value: environment }};
+    uniforms.envMapIntensity = {{ value: options.environmentIntensity ?? 1.0 }};
+    uniforms.envMapRotation = {{ value: new THREE.Matrix3() }};  // a PMREM needs no flip
+    uniforms.iblPack = {{ value: options.iblPack }};
+    uniforms.iblPackRow = {{ value: ((options.iblPackRow ?? 0) + 0.5) / rows }};
+  }}
   return new THREE.ShaderMaterial({{
     glslVersion: THREE.GLSL3,
-    uniforms: {{
-      measuredBrdfLut: {{ value: texture }},
-      lightDirection: {{ value: (options.lightDirection ?? new THREE.Vector3(0, 0, 1)).clone() }},
-      lightColor: {{ value: new THREE.Vector3(color.x ?? color.r, color.y ?? color.g, color.z ?? color.b) }},
-      exposure: {{ value: options.exposure ?? 1.0 }},
-      cellTexels: {{ value: new THREE.Vector2(...(options.cell ?? [0, 0])) }},
-      encodeSrgb: {{ value: options.encodeSrgb ?? true }},
-    }},
+    defines,
+    uniforms,
     vertexShader: VERTEX_SHADER,
     fragmentShader: FRAGMENT_SHADER,
   }});
