@@ -170,7 +170,10 @@ vec3 SrgbFromLinear(vec3 c) {{
 }}
 void main() {{
   vec3 n = normalize(v_normal_world);
-  vec3 v = normalize(cameraPosition - v_position_world);
+  // Towards the camera; for an orthographic camera the same for every pixel (its +z axis in the
+  // world), as three's own materials take it (isOrthographic).
+  vec3 v = isOrthographic ? normalize(vec3(viewMatrix[0][2], viewMatrix[1][2], viewMatrix[2][2]))
+                          : normalize(cameraPosition - v_position_world);
   vec3 l = normalize(lightDirection);
   vec3 radiance = vec3(0.0);
   if (lightColor != vec3(0.0)) {{
