@@ -39,6 +39,9 @@ Asserted:
     divided by E = D + S), each rendered by the same page, must break the bound against the CPU
     split sum for gold (the test fails if they would pass; for rough and diffuse materials a
     10 % change of α_eq moves the image by less than the bound, which is printed).
+  - the shipped viewer (index.html?material=gold&env=furnace&ibl=1&lights=0&tonemap=linear
+    &background=0) in a 512 x 512 window: title "ready", canvas over the whole window, the
+    sphere centred and 0.9 of it across, centre pixel sRGB(E(1));
 Reported, not asserted: browser against the truth per material (the split sum's own error,
 largest at the rim of glossy materials), next to the CPU split sum against the truth.
 Usage: ibl_browser_test.py BRDF_TOOL SOURCE_DIR CHROMIUM DATA_DIR [--keep]  (Debian python3)
@@ -161,6 +164,33 @@ def furnace_error(image, manifest, mu_uncertainty=0.0):
     return float((excess / np.maximum(want, 1e-3)).max())
 
 
+def check_viewer(png, manifest):
+    """The shipped index.html in a 512 x 512 window (furnace, ibl=1, lights=0, tonemap=linear,
+    background=0): the canvas covers the window (no page-background #111 pixel), the sphere is
+    centred and 0.9 of the window across (its middle row and column), and its centre pixel is
+    sRGB(E(1)) of the manifest within 2/255."""
+    img = oiio.ImageBuf(png).get_pixels(oiio.UINT8)[..., :3].astype(int)
+    h, w = img.shape[:2]
+    expect((h, w) == (512, 512), f"viewer screenshot {w}x{h}")
+    lit = img.max(-1) > 0
+    page = (img == 17).all(-1)
+    expect(not page.any(), f"viewer: {int(page.sum())} pixels show the page, not the canvas")
+    row, col = lit[h // 2], lit[:, w // 2]
+    across = (np.flatnonzero(row)[[0, -1]] if row.any() else np.array([0, -1]))
+    down = (np.flatnonzero(col)[[0, -1]] if col.any() else np.array([0, -1]))
+    centre_x, centre_y = across.mean(), down.mean()
+    diameter = across[1] - across[0] + 1
+    expect(abs(centre_x - (w - 1) / 2) <= 1.5 and abs(centre_y - (h - 1) / 2) <= 1.5,
+           f"viewer: sphere centred at ({centre_x}, {centre_y})")
+    expect(abs(diameter - 0.9 * h) <= 4, f"viewer: sphere {diameter} px across, expected {0.9 * h:.0f}")
+    e = albedo_at(manifest, np.array(1.0))
+    srgb = np.where(e <= 0.0031308, 12.92 * e, 1.055 * np.power(np.clip(e, 0, 1), 1 / 2.4) - 0.055) * 255
+    got = img[h // 2 - 1:h // 2 + 1, w // 2 - 1:w // 2 + 1].reshape(-1, 3).mean(0)
+    expect(np.abs(got - srgb).max() <= 2.0, f"viewer: centre pixel {got} vs sRGB(E(1)) {srgb}")
+    print(f"viewer: title ready, canvas covers the 512x512 window, sphere {diameter} px across centred at "
+          f"({centre_x:.1f}, {centre_y:.1f}), centre {np.round(got, 1)} vs sRGB(E(1)) {np.round(srgb, 1)}")
+
+
 def main():
     tool, source, chromium, data_dir = sys.argv[1:5]
     keep = "--keep" in sys.argv
@@ -202,7 +232,7 @@ def main():
         ["node", os.path.join(source, "tests", "node", "render_ibl.mjs"), "--web",
          os.path.join(out, "web"), "--materials", ",".join(names), "--env", env, "--out", renders,
          "--size", str(SIZE), "--chromium", chromium,
-         "--standard", ",".join(f"{v:.9g}" for v in standard)],
+         "--standard", ",".join(f"{v:.9g}" for v in standard), "--viewer", GGX_REFERENCE],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     refs = os.path.join(work, "refs")
     os.makedirs(refs)
@@ -274,6 +304,8 @@ def main():
     cpu_furnace = furnace_error(read_exr(furnace_cpu), manifests[CAPTURE])
     print(f"{CAPTURE} ({slices} slices): --ibl engine under the white furnace: max relative error {cpu_furnace:.5f}")
     expect(cpu_furnace <= FURNACE_TOLERANCE, f"--ibl engine furnace: max relative error {cpu_furnace:.5f}")
+
+    check_viewer(os.path.join(renders, "viewer.png"), manifests[GGX_REFERENCE])
 
     for m, caught in mutation_caught.items():
         print(f"mutation {m}: fails the split-sum bound for {len(caught)} of {len(names)} materials: "

@@ -19,10 +19,13 @@
 //   NAME.furnace.f32   under a uniform radiance 1 (three's PMREM of a constant map)
 // and with --standard R,G,B,METALNESS,ROUGHNESS: standard.f32, three's MeshStandardMaterial
 // lit by the same PMREM (scene.environment), plus info.json (renderer, timings, PMREM size).
-// With --bench: bench.json, frame times of the measured material and MeshStandardMaterial
+// With --viewer NAME: viewer.png, a screenshot of the shipped index.html in a 512 x 512 window
+// (?material=NAME&env=furnace&ibl=1&lights=0&tonemap=linear&background=0) once its title is
+// "ready". With --bench: bench.json, frame times of the measured material and MeshStandardMaterial
 // under the same environment at --bench-size, alternating.
 // Usage: node render_ibl.mjs --web DIR --materials A,B,... --env FILE.exr --out DIR
-//        [--size N] [--standard r,g,b,m,ro] [--bench] [--bench-size N] [--chromium PATH]
+//        [--size N] [--standard r,g,b,m,ro] [--viewer NAME] [--bench] [--bench-size N]
+//        [--chromium PATH]
 import { createServer } from 'node:http';
 import { readFileSync, writeFileSync, existsSync, statSync } from 'node:fs';
 import { join, extname, resolve, dirname } from 'node:path';
@@ -230,7 +233,29 @@ try {
     })()`);
     writeFileSync(join(outDir, 'bench.json'), JSON.stringify(bench, null, 2));
   }
-  writeFileSync(join(outDir, 'info.json'), JSON.stringify({ ...setup, size, material_ms: timings }, null, 2));
+  // The shipped viewer as a person opens it, in a 512 x 512 window: furnace, probes only,
+  // linear tone map, no background; a screenshot once document.title says "ready".
+  let viewer = null;
+  if (args.viewer) {
+    const t = await send('Target.createTarget', { url: 'about:blank' });
+    const v = await send('Target.attachToTarget', { targetId: t.targetId, flatten: true });
+    await send('Emulation.setDeviceMetricsOverride', { width: 512, height: 512, deviceScaleFactor: 1, mobile: false }, v.sessionId);
+    await send('Runtime.enable', {}, v.sessionId);
+    const query = `material=${encodeURIComponent(args.viewer)}&env=furnace&ibl=1&lights=0&tonemap=linear&background=0&three=/three/`;
+    await send('Page.navigate', { url: `${base}/web/index.html?${query}` }, v.sessionId);
+    let title = '';
+    for (;;) {
+      if (Date.now() > deadline) fail(`viewer: document.title stayed "${title}"\n${consoleLines.join('\n')}`);
+      title = (await send('Runtime.evaluate', { expression: 'document.title', returnByValue: true }, v.sessionId)).result.value;
+      if (title === 'ready' || title === 'error') break;
+      await sleep(100);
+    }
+    if (title !== 'ready') fail(`viewer: document.title "${title}"\n${consoleLines.join('\n')}`);
+    const shot = await send('Page.captureScreenshot', { format: 'png' }, v.sessionId);
+    writeFileSync(join(outDir, 'viewer.png'), Buffer.from(shot.data, 'base64'));
+    viewer = { query, title };
+  }
+  writeFileSync(join(outDir, 'info.json'), JSON.stringify({ ...setup, size, material_ms: timings, viewer }, null, 2));
   console.log(JSON.stringify({ ok: true, ...setup, material_ms: timings }));
   cleanup();
 } catch (e) {

@@ -157,6 +157,7 @@ try {
     minFilter: window.measuredBrdf.texture.minFilter, linear: window.measuredBrdf.THREE.LinearFilter,
     size: [window.measuredBrdf.texture.image.width, window.measuredBrdf.texture.image.height, window.measuredBrdf.texture.image.depth],
     webgl2: window.measuredBrdf.renderer.capabilities.isWebGL2 !== false,
+    camera: window.measuredBrdf.camera.position.toArray(),
     renderer: (() => { const gl = window.measuredBrdf.renderer.getContext(); const e = gl.getExtension('WEBGL_debug_renderer_info'); return e ? gl.getParameter(e.UNMASKED_RENDERER_WEBGL) : gl.getParameter(gl.RENDERER); })() })`);
   const image = fromBase64(await page.eval(`window.measuredBrdf.renderSphere(${size}, ${JSON.stringify(light)})`));
   // Rows come bottom first from readPixels; store top first.
@@ -165,7 +166,7 @@ try {
   writeFileSync(join(outDir, 'image.f32'), Buffer.from(flipped.buffer));
   writeFileSync(join(outDir, 'image.json'), JSON.stringify({
     width: size, height: size, channels: 4, rows: 'top first', light_direction: light,
-    light_color: [1, 1, 1], exposure: 1, camera: { fov_y_deg: 30, position: [0, 0, 5], target: [0, 0, 0] },
+    light_color: [1, 1, 1], exposure: 1, camera: { fov_y_deg: 30, position: info.camera, target: [0, 0, 0] },
     sphere: { radius: 1, centre: [0, 0, 0] }, three_revision: info.revision, texture: info }, null, 2));
 
   // Probe texels: texelFetch and a filtered fetch at the texel centre.
