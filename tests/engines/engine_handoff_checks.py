@@ -29,22 +29,11 @@ import tempfile
 
 import numpy as np
 
+from check_support import FAILURES, expect, run
+
 MATERIAL = {"model": "ggx", "kd": [0.3, 0.2, 0.1], "f0": [0.9, 0.6, 0.3], "alpha": 0.2}
-FAILURES = []
 
 
-def expect(condition, message):
-    if not condition:
-        FAILURES.append(message)
-        print("FAIL " + message)
-
-
-def run(cmd, **kw):
-    r = subprocess.run(cmd, capture_output=True, text=True, **kw)
-    if r.returncode != 0:
-        print(f"FAILED ({r.returncode}): {' '.join(cmd)}\n{r.stdout}\n{r.stderr[-3000:]}")
-        sys.exit(1)
-    return r.stdout
 
 
 def decode_rgb9e5(words):

@@ -57,6 +57,8 @@ import time
 import numpy as np
 import OpenImageIO as oiio
 
+from check_support import FAILURES, expect, run
+
 SIZE = 128
 LIBRARY = ["gold", "plastic_glossy_red", "paper_white", "wood_walnut"]
 RGL = ["chm_mint_rgb", "vch_silk_blue_rgb"]
@@ -66,21 +68,8 @@ SPLIT_SUM_RMSE, SPLIT_SUM_P95 = 0.02, 0.06
 FURNACE_TOLERANCE = 0.005
 STANDARD_RATIO = 1.25
 TRUTH_MEDIAN_RMSE, TRUTH_P95 = 0.03, 0.10
-FAILURES = []
 
 
-def expect(condition, message):
-    if not condition:
-        FAILURES.append(message)
-        print("FAIL " + message)
-
-
-def run(cmd, **kw):
-    r = subprocess.run(cmd, capture_output=True, text=True, **kw)
-    if r.returncode != 0:
-        print(f"FAILED ({r.returncode}): {' '.join(cmd)}\n{r.stdout}\n{r.stderr[-4000:]}")
-        sys.exit(1)
-    return r.stdout
 
 
 def write_environment(path):

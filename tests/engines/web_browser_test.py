@@ -26,6 +26,8 @@ import subprocess
 import sys
 import tempfile
 
+from check_support import run
+
 MATERIAL = {"model": "ggx", "kd": [0.10, 0.20, 0.35], "f0": [0.04, 0.04, 0.04], "alpha": 0.35}
 
 # The HLSL harnesses: a function Evaluate(Lut, LutSampler, N, L, V) calling the shipped code as
@@ -106,13 +108,6 @@ void main() {
 }
 """
 
-
-def run(cmd, **kw):
-    r = subprocess.run(cmd, capture_output=True, text=True, **kw)
-    if r.returncode != 0:
-        print(f"FAILED ({r.returncode}): {' '.join(cmd)}\n{r.stdout}\n{r.stderr[-4000:]}")
-        sys.exit(1)
-    return r.stdout
 
 
 def es_harnesses(out, work):

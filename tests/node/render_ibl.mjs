@@ -26,11 +26,10 @@
 // Usage: node render_ibl.mjs --web DIR --materials A,B,... --env FILE.exr --out DIR
 //        [--size N] [--standard r,g,b,m,ro] [--viewer NAME] [--bench] [--bench-size N]
 //        [--chromium PATH]
-import { createServer } from 'node:http';
-import { readFileSync, writeFileSync, existsSync, statSync } from 'node:fs';
-import { join, extname, resolve, dirname } from 'node:path';
+import { writeFileSync, existsSync } from 'node:fs';
+import { join, resolve, dirname, basename } from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { startChromium } from './headless_chromium.mjs';
+import { serveFolders, startChromium } from './headless_chromium.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
 const args = {};
@@ -63,22 +62,8 @@ window.EXRLoader = EXRLoader;
 window.iblReady = true;
 </script></body></html>`;
 
-const types = { '.html': 'text/html', '.js': 'text/javascript', '.json': 'application/json' };
-const server = createServer((req, res) => {
-  const url = new URL(req.url, 'http://127.0.0.1');
-  if (url.pathname === '/ibl.html') { res.writeHead(200, { 'Content-Type': 'text/html' }); res.end(page); return; }
-  const route = url.pathname.startsWith('/web/') ? [webDir, url.pathname.slice(5)]
-              : url.pathname.startsWith('/three/') ? [threeDir, url.pathname.slice(7)]
-              : url.pathname === '/env.exr' ? [dirname(envFile), envFile.slice(dirname(envFile).length + 1)] : null;
-  const file = route && resolve(route[0], decodeURIComponent(route[1]));
-  if (!file || !file.startsWith(route[0]) || !existsSync(file) || !statSync(file).isFile()) {
-    res.writeHead(404); res.end('not found'); return;
-  }
-  res.writeHead(200, { 'Content-Type': types[extname(file)] || 'application/octet-stream' });
-  res.end(readFileSync(file));
-});
-await new Promise((ok) => server.listen(0, '127.0.0.1', ok));
-const base = `http://127.0.0.1:${server.address().port}`;
+const { server, base } = await serveFolders(
+  { '/web/': webDir, '/three/': threeDir, '/env/': dirname(envFile) }, { '/ibl.html': page });
 const { send, fail, cleanup, consoleLines } = await startChromium({ chromium: args.chromium || 'chromium', name: 'render_ibl', deadline, server });
 const sleep = (ms) => new Promise((ok) => setTimeout(ok, ms));
 
@@ -106,7 +91,7 @@ try {
     renderer.setPixelRatio(1);
     renderer.setSize(size, size);
     const t0 = performance.now();
-    const exr = await new window.EXRLoader().setDataType(THREE.FloatType).loadAsync('/env.exr');
+    const exr = await new window.EXRLoader().setDataType(THREE.FloatType).loadAsync('/env/${basename(envFile)}');
     exr.mapping = THREE.EquirectangularReflectionMapping;
     const pmrem = new THREE.PMREMGenerator(renderer);
     const env = pmrem.fromEquirectangular(exr).texture;

@@ -18,11 +18,10 @@
 // Usage: node render_web.mjs --web DIR --material NAME --out DIR [--size N] [--pairs FILE]
 //        [--exact FILE] [--sidecar FILE.json] [--es-harness NAME=FILE,...]
 //        [--cell NAME (an atlas material)] [--bench] [--chromium PATH]
-import { createServer } from 'node:http';
-import { readFileSync, writeFileSync, existsSync, statSync } from 'node:fs';
-import { join, extname, resolve, dirname } from 'node:path';
+import { readFileSync, writeFileSync, existsSync } from 'node:fs';
+import { join, resolve, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { startChromium } from './headless_chromium.mjs';
+import { serveFolders, startChromium } from './headless_chromium.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
 const args = {};
@@ -46,21 +45,7 @@ const chromium = args.chromium || 'chromium';
 const deadline = Date.now() + 240000;
 
 // A static server for /web/ (the exported folder) and /three/ (the npm package).
-const types = { '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/javascript',
-                '.json': 'application/json', '.ktx2': 'application/octet-stream' };
-const server = createServer((req, res) => {
-  const url = new URL(req.url, 'http://127.0.0.1');
-  const route = url.pathname.startsWith('/web/') ? [webDir, url.pathname.slice(5)]
-              : url.pathname.startsWith('/three/') ? [threeDir, url.pathname.slice(7)] : null;
-  const file = route && resolve(route[0], decodeURIComponent(route[1]));
-  if (!file || !file.startsWith(route[0]) || !existsSync(file) || !statSync(file).isFile()) {
-    res.writeHead(404); res.end('not found'); return;
-  }
-  res.writeHead(200, { 'Content-Type': types[extname(file)] || 'application/octet-stream' });
-  res.end(readFileSync(file));
-});
-await new Promise((ok) => server.listen(0, '127.0.0.1', ok));
-const base = `http://127.0.0.1:${server.address().port}`;
+const { server, base } = await serveFolders({ '/web/': webDir, '/three/': threeDir });
 
 const { send, fail, cleanup, consoleLines } = await startChromium({
   chromium, name: 'render_web', deadline, server, extraArgs: ['--window-size=1100,1100'] });
