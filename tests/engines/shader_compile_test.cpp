@@ -187,8 +187,8 @@ TEST_F(ShaderCompile, UnityIblFunctionsCompileForUrpAndHdrp) {
       if (e.path().extension() == ".hlsl") include = e.path().filename().string();
     ASSERT_FALSE(include.empty());
     for (const auto& [pipeline, stand_ins, function] :
-         {std::tuple{"urp", kUrpStandIns, "MeasuredBrdfIblUrp_float"},
-          std::tuple{"hdrp", kHdrpStandIns, "MeasuredBrdfIblHdrp_float"}}) {
+         {std::tuple{"urp", kUrpStandIns, "MeasuredBrdfIbl_float"},
+          std::tuple{"hdrp", kHdrpStandIns, "MeasuredBrdfIbl_float"}}) {
       const std::string harness = std::string(kUnityStandIns) + stand_ins + "#include \"" +
                                   include + "\"\n" + R"(
 Texture2D g_pack; SamplerState g_pack_sampler;

@@ -8,13 +8,27 @@
 //                                    `server`, removes the profile
 //   consoleLines                     the pages' console output and uncaught exceptions
 // Every step is bounded by `deadline` (a Date.now() value): past it the script fails.
-// serveFolders() is the static HTTP server the pages are loaded from.
+// serveFolders() is the static HTTP server the pages are loaded from; parseOptions() reads the
+// scripts' `--name value` and `--flag` arguments.
 import { spawn } from 'node:child_process';
 import { createServer } from 'node:http';
 import { mkdtempSync, readFileSync, existsSync, rmSync, statSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, extname, resolve } from 'node:path';
 import WebSocket from 'ws';
+
+// `--name value` pairs and bare `--flag`s (true) into an object; anything else throws.
+export function parseOptions(argv) {
+  const args = {};
+  for (let i = 0; i < argv.length; i++) {
+    const a = argv[i];
+    if (!a.startsWith('--')) throw new Error(`unexpected argument ${a}`);
+    const next = argv[i + 1];
+    if (next === undefined || next.startsWith('--')) args[a.slice(2)] = true;
+    else { args[a.slice(2)] = next; i++; }
+  }
+  return args;
+}
 
 const contentTypes = { '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/javascript',
                        '.json': 'application/json' };

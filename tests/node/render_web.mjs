@@ -21,17 +21,10 @@
 import { readFileSync, writeFileSync, existsSync } from 'node:fs';
 import { join, resolve, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { serveFolders, startChromium } from './headless_chromium.mjs';
+import { parseOptions, serveFolders, startChromium } from './headless_chromium.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
-const args = {};
-for (let i = 2; i < process.argv.length; i++) {
-  const a = process.argv[i];
-  if (!a.startsWith('--')) throw new Error(`unexpected argument ${a}`);
-  const next = process.argv[i + 1];
-  if (next === undefined || next.startsWith('--')) args[a.slice(2)] = true;
-  else { args[a.slice(2)] = next; i++; }
-}
+const args = parseOptions(process.argv.slice(2));
 for (const required of ['web', 'material', 'out'])
   if (!args[required]) { console.error(`render_web: --${required} is required`); process.exit(2); }
 const webDir = resolve(args.web), outDir = resolve(args.out);

@@ -157,44 +157,32 @@ void MeasuredBrdfRadiance_half(UnityTexture3D Lut, half3 N, half3 L, half3 V,
 
 // Image-based lighting with the pipeline's own probes (docs/engines.md, "ibl"): the probe
 // term of the measured material, added to MeasuredBrdfRadiance's direct lighting (Custom
-// Function Name MeasuredBrdfIblUrp or MeasuredBrdfIblHdrp; inputs IblPack (Texture 2D: the
-// <name>_ibl.dds pack, linear, clamp, no mips, sRGB off), IblRow (Float: (row + 0.5) / rows,
-// 0.5 for one LUT), N, V (world space); output Out = radiance). One pack row (two texels at
-// mu = N.V) and two probe fetches:
+// Function Name MeasuredBrdfIbl; inputs IblPack (Texture 2D: the <name>_ibl.dds pack, linear,
+// clamp, no mips, sRGB off), IblRow (Float: (row + 0.5) / rows, 0.5 for one LUT), N, V (world
+// space); output Out = radiance). One pack row (two texels at mu = N.V) and two probe fetches:
 //   URP (its Lighting.hlsl included, as in Lit and Unlit graphs): SampleSH(N) (irradiance / pi)
 //     and GlossyEnvironmentReflection(R, perceptual roughness sqrt(alpha_eq), 1) (the
 //     reflection probe, or the sky, at URP's mip for that roughness);
 //   HDRP (Core's AmbientProbe.hlsl included): EvaluateAmbientProbe(N) and the sky's
 //     GGX-prefiltered cube map SampleSkyTexture(R, PerceptualRoughnessToMipmapLevel(...), 0).
-void MeasuredBrdfIblTerm(Texture2D pack, SamplerState pack_sampler, float row, float3 n,
-                         float3 v, out float3 r, out float3 diffuse, out float3 specular,
-                         out float perceptual_roughness)
-{
-    float alpha_eq = MeasuredBrdfIblPack(pack, pack_sampler, row, saturate(dot(n, v)), diffuse,
-                                         specular);
-    r = MeasuredBrdfIblReflect(n, v);
-    perceptual_roughness = sqrt(alpha_eq);
-}
 #if defined(UNIVERSAL_LIGHTING_INCLUDED)
-void MeasuredBrdfIblUrp_float(UnityTexture2D IblPack, float IblRow, float3 N, float3 V,
-                              out float3 Out)
-{
-    float3 n = normalize(N), v = normalize(V), r, d, s;
-    float roughness;
-    MeasuredBrdfIblTerm(IblPack.tex, IblPack.samplerstate, IblRow, n, v, r, d, s, roughness);
-    Out = MeasuredBrdfIblRadiance(d, s, SampleSH(n),
-                                  GlossyEnvironmentReflection(r, roughness, 1.0));
-}
+#define MEASURED_BRDF_IRRADIANCE(n) SampleSH(n)
+#define MEASURED_BRDF_PREFILTERED(r, roughness) GlossyEnvironmentReflection(r, roughness, 1.0)
 #elif defined(__AMBIENTPROBE_HLSL__)
-void MeasuredBrdfIblHdrp_float(UnityTexture2D IblPack, float IblRow, float3 N, float3 V,
-                               out float3 Out)
+#define MEASURED_BRDF_IRRADIANCE(n) EvaluateAmbientProbe(n)
+#define MEASURED_BRDF_PREFILTERED(r, roughness) \
+    SampleSkyTexture(r, PerceptualRoughnessToMipmapLevel(roughness), 0).rgb
+#endif
+#ifdef MEASURED_BRDF_IRRADIANCE
+void MeasuredBrdfIbl_float(UnityTexture2D IblPack, float IblRow, float3 N, float3 V,
+                           out float3 Out)
 {
-    float3 n = normalize(N), v = normalize(V), r, d, s;
-    float roughness;
-    MeasuredBrdfIblTerm(IblPack.tex, IblPack.samplerstate, IblRow, n, v, r, d, s, roughness);
-    Out = MeasuredBrdfIblRadiance(d, s, EvaluateAmbientProbe(n),
-                                  SampleSkyTexture(r, PerceptualRoughnessToMipmapLevel(roughness),
-                                                   0).rgb);
+    float3 n = normalize(N), v = normalize(V), d, s;
+    float alpha_eq = MeasuredBrdfIblPack(IblPack.tex, IblPack.samplerstate, IblRow,
+                                         saturate(dot(n, v)), d, s);
+    float3 r = MeasuredBrdfIblReflect(n, v);
+    Out = MeasuredBrdfIblRadiance(d, s, MEASURED_BRDF_IRRADIANCE(n),
+                                  MEASURED_BRDF_PREFILTERED(r, sqrt(alpha_eq)));
 }
 #endif
 #ifdef MEASURED_BRDF_BUILTIN_LIGHTING
