@@ -39,6 +39,8 @@ Asserted:
     divided by E = D + S), each rendered by the same page, must break the bound against the CPU
     split sum for gold (the test fails if they would pass; for rough and diffuse materials a
     10 % change of α_eq moves the image by less than the bound, which is printed).
+  - an atlas (gold, paper_white) from `brdf atlas --engine web`: its paper cell, read at the
+    cell's origin and the pack's row 1, renders as the single paper LUT within 0.1 % RMSE;
   - the shipped viewer (index.html?material=gold&env=furnace&ibl=1&lights=0&tonemap=linear
     &background=0) in a 512 x 512 window: title "ready", canvas over the whole window, the
     sphere centred and 0.9 of it across, centre pixel sRGB(E(1));
@@ -64,6 +66,8 @@ LIBRARY = ["gold", "plastic_glossy_red", "paper_white", "wood_walnut"]
 RGL = ["chm_mint_rgb", "vch_silk_blue_rgb"]
 CAPTURE = "gold_capture"  # data-samples/captures/gold.bpc, --beyond auto
 GGX_REFERENCE = "gold"
+ATLAS_CELL = "paper_white"  # cell 1 of the atlas "pair" (gold, paper_white)
+ATLAS_RMSE = 0.001
 SPLIT_SUM_RMSE, SPLIT_SUM_P95 = 0.02, 0.06
 FURNACE_TOLERANCE = 0.005
 STANDARD_RATIO = 1.25
@@ -205,6 +209,9 @@ def main():
     shutil.copyfile(os.path.join(source, "data-samples", "captures", "gold.bpc"), capture)
     run([tool, "convert", capture, "--beyond", "auto", "--out", out, "--engine", "web", "--quiet",
          "--formats", "ktx2"])
+    # An atlas of two library materials: its second cell (paper) must render as paper does.
+    run([tool, "atlas", "gold", ATLAS_CELL, "--out", os.path.join(out, "pair"), "--engine", "web",
+         "--quiet"])
     names = LIBRARY + RGL + [CAPTURE]
     manifests = {n: json.load(open(os.path.join(out, "web", n + ".manifest.json"))) for n in names}
     slices = len(manifests[CAPTURE]["theta_in_deg"])
@@ -219,7 +226,7 @@ def main():
     t0 = time.time()
     node = subprocess.Popen(
         ["node", os.path.join(source, "tests", "node", "render_ibl.mjs"), "--web",
-         os.path.join(out, "web"), "--materials", ",".join(names), "--env", env, "--out", renders,
+         os.path.join(out, "web"), "--materials", ",".join(names + ["pair:" + ATLAS_CELL]), "--env", env, "--out", renders,
          "--size", str(SIZE), "--chromium", chromium,
          "--standard", ",".join(f"{v:.9g}" for v in standard), "--viewer", GGX_REFERENCE],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
@@ -295,6 +302,13 @@ def main():
     expect(cpu_furnace <= FURNACE_TOLERANCE, f"--ibl engine furnace: max relative error {cpu_furnace:.5f}")
 
     check_viewer(os.path.join(renders, "viewer.png"), manifests[GGX_REFERENCE])
+
+    single = read_browser(os.path.join(renders, ATLAS_CELL + ".ibl.f32"))
+    cell = read_browser(os.path.join(renders, f"pair.{ATLAS_CELL}.ibl.f32"))
+    atlas_err = metrics(cell, single)
+    print(f"atlas pair, cell {ATLAS_CELL} (pack row 1): relative RMSE {atlas_err[0]:.6f} against "
+          f"the single LUT's render (bound {ATLAS_RMSE})")
+    expect(atlas_err[0] <= ATLAS_RMSE, f"atlas cell {ATLAS_CELL}: relative RMSE {atlas_err[0]:.6f} against its own LUT")
 
     for m, caught in mutation_caught.items():
         print(f"mutation {m}: fails the split-sum bound for {len(caught)} of {len(names)} materials: "

@@ -12,7 +12,8 @@
 // module takes one view direction for all pixels of an orthographic camera), the unit sphere's
 // diameter covering 0.9 of the frame.
 //
-// Writes into --out, per material NAME (rows top first, RGBA float32, not mirrored back):
+// Writes into --out, per material NAME (or ATLAS:CELL, written ATLAS.CELL; rows top first,
+// RGBA float32, not mirrored back):
 //   NAME.ibl.f32       the probe term alone (no direct light)
 //   NAME.alpha110.f32  the same with every alpha_eq of the pack 10 % larger (mutation)
 //   NAME.noE.f32       the same with the weights divided by E = D + S (mutation: E dropped)
@@ -23,7 +24,7 @@
 // (?material=NAME&env=furnace&ibl=1&lights=0&tonemap=linear&background=0) once its title is
 // "ready". With --bench: bench.json, frame times of the measured material and MeshStandardMaterial
 // under the same environment at --bench-size, alternating.
-// Usage: node render_ibl.mjs --web DIR --materials A,B,... --env FILE.exr --out DIR
+// Usage: node render_ibl.mjs --web DIR --materials A,B,ATLAS:CELL,... --env FILE.exr --out DIR
 //        [--size N] [--standard r,g,b,m,ro] [--viewer NAME] [--bench] [--bench-size N]
 //        [--chromium PATH]
 import { writeFileSync, existsSync } from 'node:fs';
@@ -127,7 +128,9 @@ try {
              renderer: (() => { const gl = renderer.getContext(); const e = gl.getExtension('WEBGL_debug_renderer_info'); return e ? gl.getParameter(e.UNMASKED_RENDERER_WEBGL) : gl.getParameter(gl.RENDERER); })() };
   })()`);
   const timings = {};
-  for (const name of materials) {
+  for (const entry of materials) {
+    // NAME, or ATLAS:CELL (a material of an atlas: its cell origin and its row of the pack).
+    const [name, cellName] = entry.split(':');
     const t0 = Date.now();
     const renders = await evaluate(`(async () => {
       const { THREE, env, furnace, render } = window.ibl;
@@ -135,9 +138,16 @@ try {
       const mod = await import('/web/' + manifest.engines.web.files.shader);
       const lut = await mod.loadMeasuredBrdfTexture('/web/${name}.ktx2', window.ibl.renderer);
       const pack = await mod.loadMeasuredBrdfIblPack('/web/' + manifest.ibl.texture.file);
+      let cell = [0, 0], row = manifest.ibl.row;
+      if (manifest.atlas) {
+        const m = manifest.cells.findIndex((c) => c.material === ${JSON.stringify(cellName ?? '')});
+        if (m < 0) throw new Error('${entry}: no such cell');
+        cell = [manifest.cells[m].x0, manifest.cells[m].y0];
+        row = manifest.ibl.cells[m].row;
+      }
       const material = (environment, iblPack) => mod.createMeasuredBrdfMaterial(lut, {
           lightColor: new THREE.Vector3(0, 0, 0), encodeSrgb: false, environment, iblPack,
-          iblPackRow: manifest.ibl.row });
+          iblPackRow: row, cell });
       // A copy of the pack with its halves changed by f(texel, channel, value, row of halves).
       const mutated = (f) => {
         const w = pack.image.width, src = pack.image.data, data = new Uint16Array(src.length);
@@ -160,8 +170,9 @@ try {
       return { ibl: render(material(env, pack)), alpha110: render(material(env, alpha110)),
                noE: render(material(env, noE)), furnace: render(material(furnace, pack)) };
     })()`);
-    for (const [k, v] of Object.entries(renders)) writeFileSync(join(outDir, `${name}.${k}.f32`), Buffer.from(fromBase64(v).buffer));
-    timings[name] = Date.now() - t0;
+    const stem = entry.replace(':', '.');
+    for (const [k, v] of Object.entries(renders)) writeFileSync(join(outDir, `${stem}.${k}.f32`), Buffer.from(fromBase64(v).buffer));
+    timings[entry] = Date.now() - t0;
   }
   if (args.standard) {
     const [r, g, b, metalness, roughness] = args.standard.split(',').map(Number);
