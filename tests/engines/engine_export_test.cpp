@@ -236,7 +236,9 @@ TEST_F(EngineExport, WritesEveryEngineFolderWithTheContainersAsBytes) {
                         "web/MeasuredBrdf.es300.glsl",
                         "web/MeasuredBrdf.450.glsl"})
     EXPECT_TRUE(fs::is_regular_file(dir_ / f)) << f;
-  EXPECT_EQ(r.written.size(), 21u);
+  for (const char* e : {"unity", "unreal", "godot", "web"})
+    EXPECT_TRUE(fs::is_regular_file(dir_ / e / "felt_ibl.dds")) << e;
+  EXPECT_EQ(r.written.size(), 25u);
   const std::string ktx2 = Read(dir_ / "felt.ktx2");
   EXPECT_EQ(Read(dir_ / "unity/felt.brdf3d"), ktx2);
   EXPECT_EQ(Read(dir_ / "web/felt.ktx2"), ktx2);
@@ -245,7 +247,7 @@ TEST_F(EngineExport, WritesEveryEngineFolderWithTheContainersAsBytes) {
   EXPECT_EQ(Read(dir_ / "unreal/felt.dds"), engines::EncodeRgba16fDds(exporter::PackLut(lut)));
   // The paths a failed conversion must remove are the per-material ones.
   const auto paths = engines::EngineOutputPaths(dir_.string(), "felt", ParseEngines("all"));
-  EXPECT_EQ(paths.size(), 11u);
+  EXPECT_EQ(paths.size(), 15u);
   for (const std::string& p : paths) EXPECT_TRUE(fs::is_regular_file(p)) << p;
 }
 

@@ -26,6 +26,8 @@ import subprocess
 import sys
 import tempfile
 
+from check_support import run
+
 MATERIAL = {"model": "ggx", "kd": [0.10, 0.20, 0.35], "f0": [0.04, 0.04, 0.04], "alpha": 0.35}
 
 # The HLSL harnesses: a function Evaluate(Lut, LutSampler, N, L, V) calling the shipped code as
@@ -87,7 +89,7 @@ void main() {
 GODOT_BUILTINS = """precision highp float;
 vec3 ALBEDO; float METALLIC; float SPECULAR; float ROUGHNESS;
 vec3 NORMAL; vec3 LIGHT; vec3 VIEW; vec3 LIGHT_COLOR; float ATTENUATION;
-vec3 DIFFUSE_LIGHT; vec3 SPECULAR_LIGHT;
+vec3 DIFFUSE_LIGHT; vec3 SPECULAR_LIGHT; vec3 EMISSION; mat4 INV_VIEW_MATRIX;
 """
 GODOT_MAIN = """
 uniform highp sampler2D pairs;
@@ -106,13 +108,6 @@ void main() {
 }
 """
 
-
-def run(cmd, **kw):
-    r = subprocess.run(cmd, capture_output=True, text=True, **kw)
-    if r.returncode != 0:
-        print(f"FAILED ({r.returncode}): {' '.join(cmd)}\n{r.stdout}\n{r.stderr[-4000:]}")
-        sys.exit(1)
-    return r.stdout
 
 
 def es_harnesses(out, work):
@@ -164,13 +159,16 @@ def es_harnesses(out, work):
     godot = os.path.join(out, "godot")
     with open(os.path.join(godot, only(godot, ".gdshader"))) as f:
         src = f.read()
-    for pattern, repl in ((r"shader_type spatial;", ""),
-                          (r"uniform sampler3D (\w+) : [^;]+;", r"uniform highp sampler3D \1;"),
-                          (r"void fragment\(\)", "void godot_fragment()"),
-                          (r"void light\(\)", "void godot_light()")):
+    for pattern, repl, count in ((r"shader_type spatial;", "", 1),
+                                 (r"render_mode [^;]+;", "", 1),
+                                 (r"uniform (sampler3D|sampler2D|samplerCube) (\w+) : [^;]+;",
+                                  r"uniform highp \1 \2;", 3),
+                                 (r"uniform float (\w+) = [^;]+;", r"uniform float \1;", 2),
+                                 (r"void fragment\(\)", "void godot_fragment()", 1),
+                                 (r"void light\(\)", "void godot_light()", 1)):
         src, n = re.subn(pattern, repl, src)
-        if n != 1:
-            print(f"FAILED: the Godot shader has {n} matches of {pattern!r}, expected 1")
+        if n != count:
+            print(f"FAILED: the Godot shader has {n} matches of {pattern!r}, expected {count}")
             sys.exit(1)
     godot_path = os.path.join(work, "godot_es.glsl")
     with open(godot_path, "w") as f:

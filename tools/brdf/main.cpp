@@ -396,7 +396,8 @@ int main(int argc, char** argv) {
   convert_cmd->add_option(
       "--engine", convert.engines,
       "Also write engine hand-off folders DIR/<engine>/ (importer, shader code, manifest, "
-      "texture in the engine's format): unity, unreal, godot, web (comma separated) or all");
+      "texture in the engine's format, IBL pack NAME_ibl.dds): unity, unreal, godot, web "
+      "(comma separated) or all");
   convert_cmd->add_option("--engine-fits", convert.engine_fits,
                           "With --engine: folder of `brdf fit` results (NAME.MODEL.json); each "
                           "manifest carries NAME's fits, with their errors, as fallback material");
