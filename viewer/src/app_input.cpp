@@ -82,7 +82,7 @@ void App::UpdateText() {
       const bool filled = k < static_cast<int>(source->coverage.size()) &&
                           source->coverage[static_cast<std::size_t>(k)].filled;
       if (std::abs(lut.theta_in_deg[k] - theta_in_deg_) < 1e-6) {
-        info << (filled ? " (filled slice: not measured)" : " (measured slice)");
+        info << (filled ? " (filled slice, translucent)" : " (measured slice)");
       } else {
         info << " (between measured slices, interpolated as the LUT does)";
       }
@@ -91,7 +91,7 @@ void App::UpdateText() {
            << (all_slices_ ? ", all slices" : "");
       info << "\narrows: white normal, orange light, cyan mirror";
       info << "\ntranslucent: extrapolated beyond θb = " << Fixed(source->theta_b_deg, 0)
-           << "° and the filled slices;  magenta: not measured";
+           << "°;  magenta: not measured";
     } else if (mode_ == Mode::kSlices) {
       info << "\nslice heat maps in the specular frame (θd = 0: mirror direction)";
     } else if (mode_ == Mode::kPreview) {
