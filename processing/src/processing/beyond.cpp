@@ -136,20 +136,21 @@ std::array<double, 3> RatioOf(const std::array<double, 3>& a, const std::array<d
   return r;
 }
 
-// Every texel's view in the slice at one θin, and the model there (computed once per θin).
-struct SliceGrid {
-  std::vector<View> view;                // index j·361 + i
-  std::vector<std::array<double, 3>> m;  // empty for M ≡ 1
-};
-
 // Every texel's view and shading geometry in the slice at one θin: the same for every fill
 // model, so one ExtendBeyondMeasured call computes them once per θin for all its fills (the
 // validations and the final one); the trigonometry of these was most of the fill's time.
 struct SliceGeometry {
   std::vector<View> view;          // index j·361 + i
-  std::vector<ShadingGeometry> g;  // GeometryAt(θin, view)
+  std::vector<ShadingGeometry> g;  // GeometryAt(θin, view); computed when a model needs it
 };
 using GeometryCache = std::map<long, SliceGeometry>;
+
+// Every texel's view in the slice at one θin (the shared SliceGeometry's), and the model there
+// (computed once per θin and model).
+struct SliceGrid {
+  const std::vector<View>& view;         // index j·361 + i
+  std::vector<std::array<double, 3>> m;  // empty for M ≡ 1
+};
 
 // M(new)/M(old) at texels; kHold's model is null (M ≡ 1).
 struct Ratio {
@@ -159,11 +160,19 @@ struct Ratio {
   const SliceGrid& Prepare(double theta_in_deg) const {
     const long key = std::lround(theta_in_deg * 1e6);
     if (auto it = grids->find(key); it != grids->end()) return it->second;
-    const SliceGeometry& s = GeometryOf(theta_in_deg, key);
-    SliceGrid g;
-    g.view = s.view;
+    SliceGeometry& s = GeometryOf(theta_in_deg, key);
+    SliceGrid g{s.view, {}};
     if (model) {
-      g.m.resize(g.view.size());
+      if (s.g.empty()) {
+        s.g.resize(s.view.size());
+        ForRows([&](int j) {
+          for (int i = 0; i < Lut::kWidth; ++i) {
+            const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
+            s.g[n] = GeometryAt(theta_in_deg, s.view[n].theta_deg, s.view[n].phi_deg);
+          }
+        });
+      }
+      g.m.resize(s.view.size());
       ForRows([&](int j) {
         for (int i = 0; i < Lut::kWidth; ++i) {
           const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
@@ -176,17 +185,13 @@ struct Ratio {
     }
     return grids->emplace(key, std::move(g)).first->second;
   }
-  const SliceGeometry& GeometryOf(double theta_in_deg, long key) const {
+  SliceGeometry& GeometryOf(double theta_in_deg, long key) const {
     if (auto it = geometry->find(key); it != geometry->end()) return it->second;
     SliceGeometry s;
     s.view.resize(static_cast<std::size_t>(Lut::kHeight) * Lut::kWidth);
-    s.g.resize(s.view.size());
     ForRows([&](int j) {
-      for (int i = 0; i < Lut::kWidth; ++i) {
-        const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
-        s.view[n] = TexelView(theta_in_deg, j, i);
-        s.g[n] = GeometryAt(theta_in_deg, s.view[n].theta_deg, s.view[n].phi_deg);
-      }
+      for (int i = 0; i < Lut::kWidth; ++i)
+        s.view[static_cast<std::size_t>(j) * Lut::kWidth + i] = TexelView(theta_in_deg, j, i);
     });
     return geometry->emplace(key, std::move(s)).first->second;
   }
@@ -194,8 +199,9 @@ struct Ratio {
     if (model == nullptr) return {1.0, 1.0, 1.0};
     return RatioOf(now.m[n], old.m[n]);
   }
-  std::shared_ptr<std::map<long, SliceGrid>> grids = std::make_shared<std::map<long, SliceGrid>>();
+  // Declared first so that it outlives the grids, which refer to its views.
   std::shared_ptr<GeometryCache> geometry = std::make_shared<GeometryCache>();
+  std::shared_ptr<std::map<long, SliceGrid>> grids = std::make_shared<std::map<long, SliceGrid>>();
 };
 
 // Slices every `step` degrees from 0 to the last measured one (which are kept as they are).
