@@ -28,7 +28,9 @@
 #include "brdf/core/zemax.h"
 #include "brdf/exporter/packed_volume.h"
 #include "brdf/exporter/rgb9e5.h"
+#include "brdf/processing/beyond.h"
 #include "brdf/processing/resample.h"
+#include "brdf/processing/sanity.h"
 #include "brdf/sources/capture.h"
 #include "brdf/sources/detect.h"
 #include "brdf/sources/material_library.h"
@@ -128,6 +130,21 @@ void AddRefusalsJson(const std::vector<std::string>& refusals,
   if (export_refusals) (*j)["convertible"] = list.empty();
 }
 
+// A usable capture read as the commands read it (OpenForView: the LUT `brdf eval` samples,
+// the default blind-spot fill included): "blind_spot_fill", the fill's record with its
+// leave-last-slice-out error (processing::BeyondReportJson; null when nothing was filled), and
+// "physical_sanity" (processing::PhysicalSanity, brdf/processing/sanity.h).
+void AddFillAndSanityJson(const std::string& path, Json* j) {
+  const OpenedForView opened = OpenForView(path);
+  if (!opened.measurement || !opened.resample_report) return;
+  const processing::BeyondReport& beyond = opened.resample_report->beyond;
+  (*j)["blind_spot_fill"] = beyond.used == processing::BeyondMethod::kClamp
+                                ? Json(nullptr)
+                                : Json::parse(processing::BeyondReportJson(beyond));
+  (*j)["physical_sanity"] = Json::parse(processing::SanityReportJson(
+      processing::PhysicalSanity(opened.lut, *opened.measurement, opened.theta_b_deg)));
+}
+
 Json DescribeBpc(const std::string& path, const Phrasing& say) {
   const CaptureAssessment a = AssessCapture(path);
   const BpcReadResult& r = a.read;
@@ -169,6 +186,7 @@ Json DescribeBpc(const std::string& path, const Phrasing& say) {
           ": " + say(Remedy{RemedyKind::kResumeCapture, path, r.valid_bytes});
     }
   }
+  if (a.usable()) AddFillAndSanityJson(path, &j);
   return j;
 }
 
@@ -394,6 +412,7 @@ Json DescribeTexture(const std::string& path) {
     j["files"] = t.sidecar->files;
     if (t.sidecar->certified_error)
       j["certified_error"] = CertifiedErrorJson(*t.sidecar->certified_error);
+    if (!t.sidecar->beyond_json.empty()) j["blind_spot_fill"] = Json::parse(t.sidecar->beyond_json);
   }
   // Cells holding data: the whole texture for a LUT, the materials' cells for an atlas.
   std::vector<std::array<int, 2>> origins = {{0, 0}};

@@ -459,6 +459,7 @@ InputLut LutFromInput(const std::string& path, FileKind kind,
     if (t.sidecar) {
       out.extrapolation = t.sidecar->extrapolation;
       out.saturated_samples = t.sidecar->saturated_samples;
+      out.beyond_json = t.sidecar->beyond_json;
     }
     out.lut = std::move(t.texture.lut);
     return out;
@@ -470,7 +471,10 @@ InputLut LutFromInput(const std::string& path, FileKind kind,
   resample.check_measured_values = p.measured;
   processing::ResampleReport report;
   out.lut = processing::BuildLut(p.measurement, p.extrapolation.params, resample, &report);
-  if (report.beyond.used != processing::BeyondMethod::kClamp) out.beyond = report.beyond;
+  if (report.beyond.used != processing::BeyondMethod::kClamp) {
+    out.beyond = report.beyond;
+    out.beyond_json = processing::BeyondReportJson(report.beyond);
+  }
   if (auto note = ClipNote(path, out.lut)) out.warnings.push_back(std::move(*note));
   if (report.theta_b_deg < 90.0)
     out.extrapolation = exporter::ExtrapolationInfo{p.extrapolation.params.p,
@@ -519,6 +523,21 @@ std::optional<std::string> SaturationNote(
   if (total == 0) return std::nullopt;
   return path + ": " + std::to_string(total) + " saturated sample" + (total == 1 ? "" : "s") +
          " (" + per_slice + "); their values are clipped";
+}
+
+std::optional<std::string> LeaveLastSliceOutNote(const std::string& path,
+                                                 const std::optional<processing::BeyondReport>& b) {
+  if (!b || !b->validation) return std::nullopt;
+  const auto percent = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3g %%", 100.0 * v);
+    return std::string(buf);
+  };
+  std::string method(processing::BeyondMethodName(b->used));
+  if (b->model) method += " (" + std::string(ModelName(b->model->material.model)) + ")";
+  return path + ": blind-spot fill " + method + ": the θin " + Deg(b->validation->theta_in_deg) +
+         "° slice predicted from the others within " + percent(b->validation->median) +
+         " (median), " + percent(b->validation->p90) + " (p90)";
 }
 
 }  // namespace brdf::sources

@@ -235,7 +235,10 @@ def main():
     mat = os.path.join(work, "gold_like.json")
     json.dump(MATERIAL, open(mat, "w"))
     out = os.path.join(work, "out")
-    run([tool, "convert", mat, "--out", out, "--engine", "all", "--quiet", "--formats", "ktx2,json"])
+    # --beyond clamp: the reference layout (θin 0/20/40/60, 2 × 2 tiles) these checks spell out;
+    # the default fill's 9 slices go through the same writers (web_browser_test.py runs them).
+    run([tool, "convert", mat, "--out", out, "--engine", "all", "--quiet", "--formats", "ktx2,json",
+         "--beyond", "clamp"])
     # A misspelt engine: one line, exit 1, nothing written.
     bad = subprocess.run([tool, "convert", mat, "--out", os.path.join(work, "bad"), "--engine",
                           "unity,unrael"], capture_output=True, text=True)

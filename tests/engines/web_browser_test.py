@@ -7,7 +7,9 @@ KTX2 with three.js's KTX2Loader and renders a sphere with the shipped ShaderMate
 the code under test:
   - the float image with a numpy reference from the analytic material (RMS and max error),
   - the manifest's probe texels with the KTX2 file and with what the GPU fetched,
-  - every shipped shader with `brdf eval` of the LUT, for 300 random direction pairs and for
+  - every shipped shader with `brdf eval` of the LUT (the default blind-spot fill: θin 0–80°
+    every 10°), for 300 random direction pairs, 100 more in the filled region (light at θin
+    65–85°, view at θout 76–88°: neither measured by the instrument), and for
     the exact directions where angle math meets a pole or the horizon (views exactly along the
     normal, at the horizon, in the mirror direction; lights exactly along the normal): the
     three.js module's GLSL (MeasuredBrdfCell, MeasuredBrdfTangent), the sidecar's
@@ -194,6 +196,11 @@ def main():
          "--formats", "ktx2,json"])
     web = os.path.join(out, "web")
     ktx2 = os.path.join(out, "ggx_blue.ktx2")
+    with open(os.path.join(out, "ggx_blue.json")) as f:
+        beyond = json.load(f).get("beyond") or {}
+    if beyond.get("extrapolated_theta_in") != [70.0, 80.0]:
+        print(f"FAILED: the LUT carries no filled slices at θin 70 and 80° ({beyond})")
+        return 1
     angles, nlv = os.path.join(work, "angles.txt"), os.path.join(work, "nlv.txt")
     run([sys.executable, check, "gen-pairs", "300", "11", angles, nlv])
     exact_angles = os.path.join(work, "exact_angles.txt")

@@ -86,6 +86,7 @@ int RunAtlas(const AtlasOptions& options) {
   std::vector<std::optional<std::vector<exporter::SaturatedCount>>> saturated(found.inputs.size());
   std::vector<std::optional<exporter::ExtrapolationInfo>> extrapolation(found.inputs.size());
   std::vector<std::vector<std::string>> fitted(found.inputs.size());  // --extrapolate auto's record
+  std::vector<std::string> beyond(found.inputs.size());               // the blind-spot fill's
 
   Progress progress("atlas", found.inputs.size(), !options.quiet);
   const std::vector<JobResult> results = RunJobs(
@@ -108,6 +109,7 @@ int RunAtlas(const AtlasOptions& options) {
           result.warnings.push_back(std::move(*note));
         saturated[i] = std::move(built.saturated_samples);
         extrapolation[i] = built.extrapolation;
+        beyond[i] = std::move(built.beyond_json);
         luts[i] = std::move(built.lut);
       },
       [&](std::size_t i, const JobResult& result) {
@@ -134,7 +136,7 @@ int RunAtlas(const AtlasOptions& options) {
   for (std::size_t i = 0; i < luts.size(); ++i)
     materials.push_back({found.inputs[i].name, &luts[i],
                          sources::RecordedSourceName(found.inputs[i].path), saturated[i],
-                         extrapolation[i], fitted[i]});
+                         extrapolation[i], fitted[i], beyond[i]});
   CreateOutputFolder(fs::path(options.out).parent_path().string());
   const OutputGuard guard(outputs);
   std::vector<std::string> written;
