@@ -17,31 +17,14 @@
 #include "brdf/device/protocol.h"
 #include "brdf/device/simulator.h"
 #include "brdf/device/transport.h"
+#include "replay_transport.h"
 
 namespace {
 
 using namespace brdf;
 using namespace brdf::device;
 
-// An "instrument" that answers anything with the fuzz input, in chunks of varying size.
-class ReplayTransport final : public Transport {
- public:
-  explicit ReplayTransport(std::span<const std::uint8_t> bytes) : bytes_(bytes) {}
-  void Write(std::span<const std::uint8_t>) override {}
-  std::size_t Read(std::span<std::uint8_t> buffer, int) override {
-    if (at_ >= bytes_.size()) return 0;
-    const std::size_t chunk = 1 + (bytes_[at_] % 97);
-    const std::size_t n = std::min({buffer.size(), chunk, bytes_.size() - at_});
-    std::copy_n(bytes_.begin() + static_cast<std::ptrdiff_t>(at_), n, buffer.begin());
-    at_ += n;
-    return n;
-  }
-  std::string Description() const override { return "fuzz"; }
-
- private:
-  std::span<const std::uint8_t> bytes_;
-  std::size_t at_ = 0;
-};
+using fuzz::ReplayTransport;
 
 void DecodePayload(const Frame& f) {
   try {
@@ -101,12 +84,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     ReplayTransport link(bytes);
     Driver driver(link, DriverOptions{});
     try {
-      const InstrumentInfo& info = driver.Connect();
-      driver.SetExposure({});
-      driver.MeasureDark();
-      const double theta = info.geometry.theta_in_deg.empty() ? 0 : info.geometry.theta_in_deg[0];
-      driver.MeasureWhite(theta);
-      driver.MeasureSlice(theta);
+      fuzz::MeasureOneSlice(driver);
     } catch (const Error&) {
     }
   }

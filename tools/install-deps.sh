@@ -21,6 +21,7 @@ packages=(
   clang libclang-rt-14-dev
   python3 python3-numpy python3-scipy
   python3-dev pybind11-dev python3-pybind11 python3-pytest  # the Python module (python/), its tests
+  python3-matplotlib  # docs/python.md's worked example, run by tests/python_module (Agg backend)
   nodejs
   # Engine hand-off tests (tests/engines): real clients for the shipped files.
   chromium glslang-tools spirv-cross mono-mcs python3-openimageio
@@ -29,6 +30,9 @@ packages=(
 packages+=(fonts-dejavu-core)
 # The interactive brdf-view test presses keys and moves the mouse in an Xvfb window.
 packages+=(xdotool)
+# The Debian package (cpack -G DEB): dpkg-shlibdeps computes Depends; its test checks it with
+# lintian and renders the man pages with man-db.
+packages+=(dpkg-dev lintian man-db)
 
 # Debian's npm is a separate package; a Node.js that already ships npm (e.g. NodeSource's)
 # conflicts with it, so npm is only requested when no npm command exists.

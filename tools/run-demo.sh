@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The main job on the built-in defaults: installs the Debian packages, builds the toolchain,
 # captures every material of the virtual sample library with the simulated scatterometer and
-# converts the captures into engine-ready lookup textures.
+# converts the captures into engine-ready lookup textures and engine kits (luts/web/index.html:
+# the environment-lit viewer, served by any local static file server).
 # Usage: tools/run-demo.sh [OUT_DIR]   (default: out/demo)
 # The test suite runs this same script on a reduced job (tests/tools/CMakeLists.txt, run_demo):
 #   BRDF_DEMO_TOOLS=DIR        use the brdf and brdf-view already built in DIR (no install, no build)
@@ -36,8 +37,22 @@ for material in $materials; do
   "$brdf" capture --device sim --material "$material" --sample "$material" \
     --out "$out/captures/$material.bpc" --seed 1 --force "${capture_options[@]}"
 done
-echo "== converting captures to RGB9E5 lookup textures -> $out/luts"
-"$brdf" convert "$out/captures" --out "$out/luts" --force
+echo "== converting captures to RGB9E5 lookup textures and engine kits -> $out/luts"
+"$brdf" convert "$out/captures" --out "$out/luts" --force --engine all
+# The web kit's viewer loads three.js from ./node_modules/three/: the pinned copy the tests use
+# (tools/install-npm-deps.sh, from the local npm cache), so the page works from a local file
+# server with no network.
+if [ -z "${BRDF_DEMO_TOOLS:-}" ]; then "$root/tools/install-npm-deps.sh"; fi
+three="$root/tests/node/node_modules/three"
+if [ -f "$three/build/three.module.js" ]; then
+  mkdir -p "$out/luts/web/node_modules/three/examples"
+  cp -r "$three/build" "$three/package.json" "$out/luts/web/node_modules/three/"
+  cp -r "$three/examples/jsm" "$out/luts/web/node_modules/three/examples/"
+  echo "environment-lit viewer: python3 -m http.server -d $out/luts/web 8000, then open"
+  echo "  http://localhost:8000/index.html?material=gold&env=studio&ibl=1&lights=0&tonemap=linear"
+else
+  echo "environment-lit viewer: three.js not found ($three); run tools/install-npm-deps.sh, or npm install in $out/luts/web"
+fi
 echo "== packing the library into one atlas -> $out/atlas"
 mkdir -p "$out/atlas"
 "$brdf" atlas "$out/captures" --out "$out/atlas/library" --force

@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 """Timings of the Python module brdf: `import brdf` and eval_deg throughput, against
-`brdf eval --pairs` on the same source and pairs (docs/benchmarks/python.md).
+`brdf eval --pairs` on the same source and pairs and, for the exported LUT, against a pure-numpy
+trilinear lookup of the same texture (numpy_trilinear.py) (docs/benchmarks/python.md).
 
 Usage: PYTHONPATH=build/dev/python /usr/bin/python3 bench/python/bench_python.py build/dev/tools/brdf
 Medians of several runs, baselines measured in the same run (the machine is shared and noisy).
@@ -15,6 +16,9 @@ import time
 import numpy as np
 
 import brdf
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from numpy_trilinear import NumpyLut  # noqa: E402
 
 
 def median_seconds(f, runs):
@@ -70,6 +74,24 @@ def main():
                   f"jobs=1: {n / t_one / 1e6:.2f} M/s); "
                   f"brdf eval --pairs {n_cli / t_cli / 1e6:.3f} M/s ({n_cli} pairs incl. "
                   f"start-up and text, median of 3); ratio {(n / t_py) / (n_cli / t_cli):.0f}x")
+            if path.endswith(".ktx2"):
+                # The direction-vector path (LutBrdf::Eval per pair, what eval_deg called before
+                # brdf/core/eval_pairs.h), directions precomputed by numpy.
+                t, p = np.radians(args[0]), np.radians(args[1])
+                wi = np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], -1)
+                t, p = np.radians(args[2]), np.radians(args[3])
+                wo = np.stack([np.sin(t) * np.cos(p), np.sin(t) * np.sin(p), np.cos(t)], -1)
+                t_vec = median_seconds(lambda: s.eval(wi, wo), 5)
+                print(f"  eval(wi, wo), LutBrdf::Eval per pair: {n / t_vec / 1e6:.2f} M/s "
+                      f"(median of 5; eval_deg {t_vec / t_py:.2f}x faster)")
+                # The same texture looked up by numpy (bench/python/numpy_trilinear.py).
+                lut = NumpyLut.from_ktx2(path)
+                t_np = median_seconds(lambda: lut.eval_deg(*args), 3)
+                diff = np.max(np.abs(lut.eval_deg(*(a[:100000] for a in args)) -
+                                     s.eval_deg(*(a[:100000] for a in args))))
+                print(f"  numpy trilinear lookup of the same texture: {n / t_np / 1e6:.2f} M/s "
+                      f"(median of 3; eval_deg {t_np / t_py:.1f}x faster; largest difference "
+                      f"{diff:.2g} 1/sr on 100,000 pairs)")
 
 
 if __name__ == "__main__":

@@ -8,6 +8,7 @@
 #include <tuple>
 
 #include "brdf/core/error.h"
+#include "brdf/core/text_format.h"
 #include "brdf/core/virtual_capture.h"
 #include "brdf/device/white_reference.h"
 
@@ -571,6 +572,21 @@ void SimulatedFirmware::ProduceStreamFrame() {
     next_column_ = 0;
   }
   Send(MessageType::kRowData, EncodeRowData(data));
+}
+
+std::map<std::string, std::string> SimulatedCaptureSettings(const std::string& device,
+                                                            const std::string& material,
+                                                            const SimulatorConfig& config,
+                                                            const CaptureGeometry& geometry,
+                                                            const std::string& exposure) {
+  return {{"device", device},
+          {"material", material},
+          {"noise_level", ShortNumberText(config.noise_level)},
+          {"seed", std::to_string(config.seed)},
+          {"theta_out_max_deg", ShortNumberText(geometry.theta_out_max_deg)},
+          {"theta_out_step_deg", ShortNumberText(geometry.theta_out_step_deg)},
+          {"phi_out_step_deg", ShortNumberText(geometry.phi_out_step_deg)},
+          {"exposure", exposure}};
 }
 
 }  // namespace brdf::device

@@ -11,7 +11,9 @@
 #include <cstdio>
 #include <cstring>
 #include <cwchar>
+#include <filesystem>
 #include <mutex>
+#include <system_error>
 
 #include "brdf/core/error.h"
 #include "brdf/device/driver.h"
@@ -369,7 +371,18 @@ UsbModel ModelFor(std::uint16_t vid, std::uint16_t pid) {
 }  // namespace
 
 std::string UdevRemedy() {
-  return "copy the udev rule 70-brdf-scatterometer.rules (installed in " BRDF_UDEV_RULES_DIR
+  // The rule of this executable's installed tree (a package under /usr, a moved prefix), else
+  // where `cmake --install` puts it for the configured prefix.
+  std::string installed = BRDF_UDEV_RULES_DIR;
+  std::error_code ec;
+  const std::filesystem::path exe = std::filesystem::read_symlink("/proc/self/exe", ec);
+  if (!ec) {
+    const std::filesystem::path dir =
+        (exe.parent_path() / BRDF_UDEV_RULES_DIR_FROM_EXE).lexically_normal();
+    if (std::filesystem::is_regular_file(dir / "70-brdf-scatterometer.rules", ec))
+      installed = dir.string();
+  }
+  return "copy the udev rule 70-brdf-scatterometer.rules (installed in " + installed +
          ", in the sources device/udev/) to /etc/udev/rules.d/, run 'sudo udevadm control "
          "--reload && sudo udevadm trigger' and plug the instrument in again";
 }

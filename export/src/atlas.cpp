@@ -75,6 +75,7 @@ Atlas BuildAtlas(const std::vector<AtlasMaterial>& materials) {
     atlas.saturated_samples.push_back(materials[m].saturated_samples);
     atlas.extrapolation.push_back(materials[m].extrapolation);
     atlas.fitted_models_json.push_back(materials[m].fitted_models_json);
+    atlas.beyond_json.push_back(materials[m].beyond_json);
     const Lut& lut = *materials[m].lut;
     const int x0 = atlas.layout.cells.CellColumn(static_cast<int>(m)) * Lut::kWidth;
     const int y0 = atlas.layout.cells.CellRow(static_cast<int>(m)) * Lut::kHeight;
@@ -205,6 +206,9 @@ std::string AtlasManifestJson(const Atlas& atlas, const std::vector<std::string>
         fitted.push_back(detail::ParseEmbeddedJson(text, "fitted model"));
       materials.back()["fitted_models"] = std::move(fitted);
     }
+    if (i < atlas.beyond_json.size() && !atlas.beyond_json[i].empty())
+      materials.back()["beyond"] =
+          detail::ParseEmbeddedJson(atlas.beyond_json[i], "blind-spot fill record");
   }
   j["materials"] = std::move(materials);
   j["grid"] = {
@@ -326,6 +330,8 @@ AtlasManifest ParseAtlasManifest(std::string_view json_text, const std::string& 
     }
     if (list[i].contains("compression"))
       entry.certified_error = detail::ParseCertifiedError(e.Object("compression"), file);
+    if (list[i].contains("beyond") && list[i]["beyond"].is_object())
+      entry.beyond_json = list[i]["beyond"].dump();
     m.materials.push_back(std::move(entry));
   }
   detail::JsonFields p(f.Object("payload"), file, "payload.");

@@ -19,7 +19,7 @@ constexpr std::uint32_t kDdsdCaps = 0x1, kDdsdHeight = 0x2, kDdsdWidth = 0x4, kD
 constexpr std::uint32_t kDdpfFourCc = 0x4;
 constexpr std::uint32_t kDdsCapsTexture = 0x1000;
 constexpr std::uint32_t kDdsCaps2Volume = 0x200000;
-constexpr std::uint32_t kResourceDimensionTexture3d = 4;
+constexpr std::uint32_t kResourceDimensionTexture2d = 3, kResourceDimensionTexture3d = 4;
 
 std::string FourCcText(std::uint32_t v) {
   std::string s;
@@ -34,16 +34,18 @@ std::string FourCcText(std::uint32_t v) {
 
 namespace {
 
-// DDS_HEADER + DDS_HEADER_DXT10 of a single-mip volume; `size_flag` is DDSD_PITCH (the row
-// pitch of an uncompressed texture) or DDSD_LINEARSIZE (the bytes of one compressed slice).
+// DDS_HEADER + DDS_HEADER_DXT10 of a single-mip volume, or of a 2D texture for depth 0;
+// `size_flag` is DDSD_PITCH (the row pitch of an uncompressed texture) or DDSD_LINEARSIZE (the
+// bytes of one compressed slice).
 std::string VolumeHeader(int width, int height, int depth, std::uint32_t dxgi_format,
                          std::uint32_t size_flag, std::uint32_t pitch_or_linear_size) {
+  const bool volume = depth > 0;
   std::string out;
   out.reserve(kDdsDataOffset);
   out.append(kDdsMagic.begin(), kDdsMagic.end());
   AppendU32(out, 124);  // dwSize
   AppendU32(out, kDdsdCaps | kDdsdHeight | kDdsdWidth | size_flag | kDdsdPixelFormat |
-                     kDdsdMipMapCount | kDdsdDepth);
+                     kDdsdMipMapCount | (volume ? kDdsdDepth : 0u));
   AppendU32(out, static_cast<std::uint32_t>(height));
   AppendU32(out, static_cast<std::uint32_t>(width));
   AppendU32(out, pitch_or_linear_size);
@@ -55,14 +57,14 @@ std::string VolumeHeader(int width, int height, int depth, std::uint32_t dxgi_fo
   AppendU32(out, kFourCcDx10);
   for (int i = 0; i < 5; ++i) AppendU32(out, 0);  // bit count and masks unused with FOURCC
   AppendU32(out, kDdsCapsTexture);
-  AppendU32(out, kDdsCaps2Volume);
+  AppendU32(out, volume ? kDdsCaps2Volume : 0u);
   AppendU32(out, 0);  // dwCaps3
   AppendU32(out, 0);  // dwCaps4
   AppendU32(out, 0);  // dwReserved2
   AppendU32(out, dxgi_format);
-  AppendU32(out, kResourceDimensionTexture3d);
+  AppendU32(out, volume ? kResourceDimensionTexture3d : kResourceDimensionTexture2d);
   AppendU32(out, 0);  // miscFlag
-  AppendU32(out, 1);  // arraySize: 1 for a 3D texture
+  AppendU32(out, 1);  // arraySize: 1 (one 3D or 2D texture)
   AppendU32(out, 0);  // miscFlags2: DDS_ALPHA_MODE_UNKNOWN
   return out;
 }
@@ -73,6 +75,13 @@ std::string DdsVolumeHeader(int width, int height, int depth, std::uint32_t dxgi
                             int bytes_per_texel) {
   return VolumeHeader(
       width, height, depth, dxgi_format, kDdsdPitch,
+      static_cast<std::uint32_t>(width) * static_cast<std::uint32_t>(bytes_per_texel));
+}
+
+std::string DdsTexture2dHeader(int width, int height, std::uint32_t dxgi_format,
+                               int bytes_per_texel) {
+  return VolumeHeader(
+      width, height, 0, dxgi_format, kDdsdPitch,
       static_cast<std::uint32_t>(width) * static_cast<std::uint32_t>(bytes_per_texel));
 }
 

@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "brdf/core/error.h"
+#include "brdf/core/ibl_pack.h"
 
 namespace brdf::exporter {
 
@@ -136,6 +137,43 @@ FLOAT3 MeasuredBrdfCell(@LUT_PARAM@FLOAT2 cell_texels, FLOAT3 n, FLOAT3 l_in, FL
 FLOAT3 MeasuredBrdf(@LUT_PARAM@FLOAT3 n, FLOAT3 l, FLOAT3 v) {
   return MeasuredBrdfCell(@LUT_ARG@FLOAT2(0.0, 0.0), n, l, v);
 }
+
+// Image-based lighting (docs/engines.md, "ibl"): the split sum of the material's IBL pack,
+//   radiance = diffuse(mu) * irradiance(n)/pi + specular(mu) * prefiltered(alpha_eq(mu), R),
+// mu = dot(n, v), R = reflect(-v, n); irradiance/pi is the probe's cosine-convolved radiance
+// (1 under a uniform radiance 1) and prefiltered the GGX-prefiltered probe about R at
+// alpha_eq (GGX alpha = perceptual roughness squared). Under a white furnace the material
+// reflects exactly its directional albedo diffuse + specular.
+CONST MEASURED_BRDF_IBL_ROWS = @IBL_ROWS@;
+
+// The material's row of the RGBA16F pack texture (NAME_ibl.dds: 2 * ROWS texels wide, texel i
+// = (diffuse_rgb, alpha_eq) at mu_i = (i + 0.5)/ROWS, texel ROWS + i = (specular_rgb, fit
+// residual)) read at mu; pack_v = (row + 0.5)/rows (0.5 for a single LUT). Sampler: linear,
+// clamp-to-edge, no mipmaps, no sRGB decode. Returns alpha_eq; diffuse and specular are the
+// weights of the two probe values.
+float MeasuredBrdfIblPack(@PACK_PARAM@float pack_v, float mu, out FLOAT3 diffuse,
+                          out FLOAT3 specular) {
+  float tex_u = clamp(mu * MEASURED_BRDF_IBL_ROWS, 0.5, MEASURED_BRDF_IBL_ROWS - 0.5) /
+                (2.0 * MEASURED_BRDF_IBL_ROWS);
+  FLOAT2 uv_d = FLOAT2(tex_u, pack_v);
+  FLOAT2 uv_s = FLOAT2(tex_u + 0.5, pack_v);
+  FLOAT4 d = @PACK_FETCH_D@;
+  FLOAT4 s = @PACK_FETCH_S@;
+  diffuse = d.rgb;
+  specular = s.rgb;
+  return max(d.a, 0.0);
+}
+
+// The direction the specular probe is read in: R = reflect(-v, n) = 2 (n.v) n - v.
+FLOAT3 MeasuredBrdfIblReflect(FLOAT3 n, FLOAT3 v) {
+  return n * (2.0 * dot(n, v)) - v;
+}
+
+// The probe term from the pack's weights and the engine's two probe values.
+FLOAT3 MeasuredBrdfIblRadiance(FLOAT3 diffuse, FLOAT3 specular, FLOAT3 irradiance_over_pi,
+                               FLOAT3 prefiltered) {
+  return diffuse * irradiance_over_pi + specular * prefiltered;
+}
 )~~";
 
 // The compact decoder's fetch (compact_lut.h): the grid position from the LUT coordinates, two
@@ -229,21 +267,30 @@ std::string MeasuredBrdfShaderCode(ShaderLanguage language, const ShaderLutLayou
   ReplaceAll(code, "@SLICES@", ShaderFloat(layout.slices));
   ReplaceAll(code, "@TEXELS_U@", ShaderFloat(layout.texture_width));
   ReplaceAll(code, "@TEXELS_V@", ShaderFloat(layout.texture_height));
+  ReplaceAll(code, "@IBL_ROWS@", ShaderFloat(IblPack::kRows));
   switch (language) {
     case ShaderLanguage::kGlsl:
       code = "precision highp float;\nprecision highp sampler3D;\n" + code;
       ReplaceAll(code, "CONST ", "const float ");
+      ReplaceAll(code, "FLOAT4", "vec4");
       ReplaceAll(code, "FLOAT3", "vec3");
       ReplaceAll(code, "FLOAT2", "vec2");
       ReplaceAll(code, "ATAN2(", "atan(");
+      ReplaceAll(code, "@PACK_PARAM@", "highp sampler2D pack, ");
+      ReplaceAll(code, "@PACK_FETCH_D@", "textureLod(pack, uv_d, 0.0)");
+      ReplaceAll(code, "@PACK_FETCH_S@", "textureLod(pack, uv_s, 0.0)");
       ReplaceAll(code, "@LUT_PARAM@", "highp sampler3D lut, ");
       ReplaceAll(code, "@LUT_ARG@", "lut, ");
       ReplaceAll(code, "@FETCH@", "textureLod(lut, uvw, 0.0).rgb");
       break;
     case ShaderLanguage::kHlsl:
       ReplaceAll(code, "CONST ", "static const float ");
+      ReplaceAll(code, "FLOAT4", "float4");
       ReplaceAll(code, "FLOAT3", "float3");
       ReplaceAll(code, "FLOAT2", "float2");
+      ReplaceAll(code, "@PACK_PARAM@", "Texture2D pack, SamplerState pack_sampler, ");
+      ReplaceAll(code, "@PACK_FETCH_D@", "pack.SampleLevel(pack_sampler, uv_d, 0.0)");
+      ReplaceAll(code, "@PACK_FETCH_S@", "pack.SampleLevel(pack_sampler, uv_s, 0.0)");
       ReplaceAll(code, "ATAN2(", "atan2(");
       ReplaceAll(code, "@LUT_PARAM@", "Texture3D lut, SamplerState lut_sampler, ");
       ReplaceAll(code, "@LUT_ARG@", "lut, lut_sampler, ");
@@ -251,10 +298,14 @@ std::string MeasuredBrdfShaderCode(ShaderLanguage language, const ShaderLutLayou
       break;
     case ShaderLanguage::kGodot:
       ReplaceAll(code, "CONST ", "const float ");
+      ReplaceAll(code, "FLOAT4", "vec4");
       ReplaceAll(code, "FLOAT3", "vec3");
       ReplaceAll(code, "FLOAT2", "vec2");
       ReplaceAll(code, "ATAN2(", "atan(");
       ReplaceAll(code, "@LUT_PARAM@", "");
+      ReplaceAll(code, "@PACK_PARAM@", "");
+      ReplaceAll(code, "@PACK_FETCH_D@", "textureLod(measured_brdf_ibl_pack, uv_d, 0.0)");
+      ReplaceAll(code, "@PACK_FETCH_S@", "textureLod(measured_brdf_ibl_pack, uv_s, 0.0)");
       ReplaceAll(code, "@LUT_ARG@", "");
       ReplaceAll(code, "@FETCH@", "textureLod(measured_brdf_lut, uvw, 0.0).rgb");
       break;

@@ -125,6 +125,7 @@ SidecarInfo ParseSidecarJson(std::string_view json_text, const std::string& file
       throw FormatError(file, "member 'fitted_models'", "an array", j["fitted_models"].type_name());
     for (const auto& m : j["fitted_models"]) info.fitted_models_json.push_back(m.dump());
   }
+  if (j.contains("beyond") && j["beyond"].is_object()) info.beyond_json = j["beyond"].dump();
   detail::JsonFields t(f.Object("tool"), file, "tool.");
   info.tool_version = t.String("version");
   detail::JsonFields p(f.Object("payload"), file, "payload.");

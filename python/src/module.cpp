@@ -1,9 +1,10 @@
 // The compiled part of the Python module `brdf` (python/brdf/__init__.py wraps it): a file or a
 // library material opened by brdf::sources::OpenBrdf, evaluated for arrays of direction pairs.
 //
-// Bit-identical with `brdf eval --pairs`: eval_deg turns each angle pair into directions with
-// SphericalDirectionDeg and calls BrdfSource::Eval, exactly as tools/brdf/cmd_eval.cpp does, and
-// checks the polar angles by the same rule ([0, 90] degrees, finite azimuths).
+// Bit-identical with `brdf eval --pairs`: eval_deg calls brdf::EvalAnglePairsDeg
+// (brdf/core/eval_pairs.h: a LUT sampled in angle space, other sources at the directions of the
+// angles), as tools/brdf/cmd_eval.cpp does, and checks the polar angles by the same rule
+// ([0, 90] degrees, finite azimuths).
 //
 // Batches release the GIL and are shared out by brdf::ParallelChunks (brdf/core/parallel.h);
 // BrdfSource::Eval is const and used concurrently by the previewer the same way.
@@ -11,24 +12,33 @@
 // Errors: brdf::IoError becomes brdf.IoError (an OSError), brdf::FormatError and
 // brdf::InvalidArgument brdf.FormatError / brdf.InvalidArgument (ValueErrors), any other
 // brdf::Error brdf.Error (a RuntimeError); the message is the library's one line, the text
-// after "brdf: error: " in what the CLI prints.
+// after "brdf: error: " in what the CLI prints, followed by "; " and the remedy in the module's
+// words when the error carries one (remedy.h).
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <cctype>
 #include <cmath>
 #include <cstddef>
+#include <filesystem>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "brdf/core/bpc.h"
 #include "brdf/core/brdf_source.h"
 #include "brdf/core/error.h"
+#include "brdf/core/eval_pairs.h"
+#include "brdf/core/file_util.h"
 #include "brdf/core/geometry.h"
 #include "brdf/core/parallel.h"
 #include "brdf/sources/capture.h"
+#include "brdf/sources/describe.h"
 #include "brdf/sources/detect.h"
 #include "brdf/sources/material_library.h"
 #include "brdf/sources/open.h"
+#include "remedy.h"
 
 namespace py = pybind11;
 
@@ -57,13 +67,18 @@ const char* EvaluationName(sources::Evaluation e) {
 // Runs f(i) for i in [0, n) without the GIL, on the library's threads for large batches:
 // `jobs` threads (0: one per core, brdf::ResolveJobs), one below kParallelThreshold pairs.
 template <class F>
-void ForEachPair(std::size_t n, int jobs_option, F f) {
+void ForEachRange(std::size_t n, int jobs_option, F f) {
   if (jobs_option < 0)
     throw InvalidArgument("jobs: expected 0 (one thread per core) or a positive count, got " +
                           std::to_string(jobs_option));
   const py::gil_scoped_release release;
   const int jobs = n >= kParallelThreshold ? ResolveJobs(jobs_option) : 1;
-  ParallelChunks(n, kChunk, jobs, nullptr, [&](std::size_t begin, std::size_t end) {
+  ParallelChunks(n, kChunk, jobs, nullptr, f);
+}
+
+template <class F>
+void ForEachPair(std::size_t n, int jobs_option, F f) {
+  ForEachRange(n, jobs_option, [&](std::size_t begin, std::size_t end) {
     for (std::size_t i = begin; i < end; ++i) f(i);
   });
 }
@@ -151,12 +166,9 @@ class Source {
     py::array_t<double> out({static_cast<py::ssize_t>(n), static_cast<py::ssize_t>(3)});
     double* f = out.mutable_data();
     const BrdfSource& brdf = *opened_.brdf;
-    ForEachPair(n, jobs, [&](std::size_t i) {
-      const Rgb r = brdf.Eval(SphericalDirectionDeg(t_in[i], p_in[i]),
-                              SphericalDirectionDeg(t_out[i], p_out[i]));
-      f[3 * i] = r[0];
-      f[3 * i + 1] = r[1];
-      f[3 * i + 2] = r[2];
+    ForEachRange(n, jobs, [&](std::size_t begin, std::size_t end) {
+      EvalAnglePairsDeg(brdf, end - begin, t_in + begin, p_in + begin, t_out + begin, p_out + begin,
+                        f + 3 * begin);
     });
     return out;
   }
@@ -243,6 +255,141 @@ py::dict ReadCapture(const std::string& path_or_name) {
   return out;
 }
 
+// The metadata keys read_capture returns and write_capture takes ("extra" besides them).
+struct MetadataField {
+  const char* key;
+  std::string Metadata::*member;
+};
+constexpr MetadataField kMetadataFields[] = {
+    {"sample_name", &Metadata::sample_name},
+    {"instrument_model", &Metadata::instrument_model},
+    {"instrument_serial", &Metadata::instrument_serial},
+    {"firmware_version", &Metadata::firmware_version},
+    {"protocol_version", &Metadata::protocol_version},
+    {"calibration_reference", &Metadata::calibration_reference},
+    {"calibration_time", &Metadata::calibration_time},
+    {"capture_start", &Metadata::capture_start},
+    {"capture_end", &Metadata::capture_end},
+    {"operator_notes", &Metadata::operator_notes},
+    {"units", &Metadata::units},
+    {"software_version", &Metadata::software_version},
+};
+
+std::string MetadataKeyList() {
+  std::string out;
+  for (const MetadataField& f : kMetadataFields) out += std::string(f.key) + ", ";
+  return out + "extra";
+}
+
+// The metadata dict of write_capture (the keys read_capture returns; all optional).
+Metadata MetadataFromDict(const py::dict& d) {
+  Metadata m;
+  for (const auto& [key_handle, value] : d) {
+    if (!py::isinstance<py::str>(key_handle))
+      throw InvalidArgument("metadata: expected text keys, got " +
+                            std::string(py::str(py::repr(key_handle))));
+    const std::string key = key_handle.cast<std::string>();
+    if (key == "extra") {
+      if (!py::isinstance<py::dict>(value))
+        throw InvalidArgument("metadata['extra']: expected a dict of text values, got " +
+                              std::string(py::str(value.get_type().attr("__name__"))));
+      for (const auto& [k, v] : value.cast<py::dict>()) {
+        if (!py::isinstance<py::str>(k) || !py::isinstance<py::str>(v))
+          throw InvalidArgument("metadata['extra']: expected text keys and values, got " +
+                                std::string(py::str(py::repr(k))) + ": " +
+                                std::string(py::str(py::repr(v))));
+        m.extra[k.cast<std::string>()] = v.cast<std::string>();
+      }
+      continue;
+    }
+    const MetadataField* field = nullptr;
+    for (const MetadataField& f : kMetadataFields)
+      if (key == f.key) field = &f;
+    if (field == nullptr)
+      throw InvalidArgument("metadata: unknown key '" + key + "' (expected " + MetadataKeyList() +
+                            ")");
+    if (!py::isinstance<py::str>(value))
+      throw InvalidArgument("metadata['" + key + "']: expected text, got " +
+                            std::string(py::str(value.get_type().attr("__name__"))));
+    m.*(field->member) = value.cast<std::string>();
+  }
+  return m;
+}
+
+using FloatArray = py::array_t<float, py::array::c_style>;
+
+// A capture from arrays (brdf/__init__.py checked shapes and converted dtypes): consecutive
+// samples of one light direction (θin, φin) form one slice, in the order given. Written as
+// every whole-file writer writes (brdf::WriteBpc: a temporary sibling, fsync, rename), after
+// the overwrite rule of every writing command (CheckWritableOutput). Returns the slice count.
+std::size_t WriteCapture(const std::string& path, const FloatArray& ti, const FloatArray& pi,
+                         const FloatArray& to, const FloatArray& po, const FloatArray& rgb,
+                         const std::optional<FloatArray>& sigma,
+                         const py::array_t<std::uint8_t, py::array::c_style>& flags,
+                         const py::dict& metadata, bool overwrite) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (ext != ".bpc")
+    throw InvalidArgument(path + ": a capture is written as a .bpc file (the extension .bpc)");
+  Measurement m;
+  m.metadata = MetadataFromDict(metadata);
+  if (m.metadata.software_version.empty()) m.metadata.software_version = SoftwareVersion();
+  const auto n = static_cast<std::size_t>(ti.size());
+  const float *t_in = ti.data(), *p_in = pi.data(), *t_out = to.data(), *p_out = po.data();
+  const float* c = rgb.data();
+  const float* e = sigma ? sigma->data() : nullptr;
+  const std::uint8_t* fl = flags.data();
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto bad = [&](const char* name, const char* rule, float v) {
+      return InvalidArgument(std::string(name) + "[" + std::to_string(i) + "]: expected " + rule +
+                             ", got " + NumberText(v));
+    };
+    if (!(t_in[i] >= 0 && t_in[i] < 90))
+      throw bad("theta_in", "a light polar angle in [0, 90) degrees", t_in[i]);
+    if (!(t_out[i] >= 0 && t_out[i] <= 90))
+      throw bad("theta_out", "a polar angle in [0, 90] degrees", t_out[i]);
+    if (!std::isfinite(p_in[i])) throw bad("phi_in", "a finite azimuth in degrees", p_in[i]);
+    if (!std::isfinite(p_out[i])) throw bad("phi_out", "a finite azimuth in degrees", p_out[i]);
+    if ((fl[i] & ~kKnownSampleFlags) != 0)
+      throw InvalidArgument("flags[" + std::to_string(i) +
+                            "]: expected bits 0-3 only (saturated 1, below noise floor 2, "
+                            "interpolated 4, invalid 8), got " +
+                            std::to_string(fl[i]));
+    if (m.slices.empty() || m.slices.back().theta_in_deg != t_in[i] ||
+        m.slices.back().phi_in_deg != p_in[i]) {
+      Slice s;
+      s.theta_in_deg = t_in[i];
+      s.phi_in_deg = p_in[i];
+      s.has_sigma = e != nullptr;
+      m.slices.push_back(std::move(s));
+    }
+    Sample x;
+    x.theta_in_deg = t_in[i];
+    x.phi_in_deg = p_in[i];
+    x.theta_out_deg = t_out[i];
+    x.phi_out_deg = p_out[i];
+    for (int ch = 0; ch < 3; ++ch) {
+      x.rgb[ch] = c[3 * i + ch];
+      x.sigma[ch] = e ? e[3 * i + ch] : 0.0f;
+    }
+    x.flags = fl[i];
+    m.slices.back().samples.push_back(x);
+  }
+  CheckWritableOutput(path, overwrite);
+  {
+    const py::gil_scoped_release release;
+    WriteBpc(path, m);
+  }
+  return m.slices.size();
+}
+
+// The JSON text of `brdf info --json` for the same file (sources::DescribeFile), remedies in the
+// module's words; brdf/__init__.py parses it.
+std::string Describe(const std::string& path_or_name) {
+  const std::string path = sources::ResolveSource(path_or_name);
+  return sources::DescribeFile(path, [](const Remedy& r) { return PythonRemedyText(r); });
+}
+
 }  // namespace
 
 }  // namespace brdf::python
@@ -250,13 +397,13 @@ py::dict ReadCapture(const std::string& path_or_name) {
 PYBIND11_MODULE(_brdf, m) {
   using brdf::python::Source;
   m.doc() = "Compiled core of the brdf module (use `import brdf`).";
-  // Later registrations are tried first: the subclasses before brdf::Error.
-  py::register_exception<brdf::Error>(m, "Error", PyExc_RuntimeError);
-  py::register_exception<brdf::FormatError>(m, "FormatError", PyExc_ValueError);
-  py::register_exception<brdf::InvalidArgument>(m, "InvalidArgument", PyExc_ValueError);
-  py::register_exception<brdf::IoError>(m, "IoError", PyExc_OSError);
+  brdf::python::RegisterExceptions(m);
 
   m.def("read_capture", &brdf::python::ReadCapture, py::arg("path"));
+  m.def("describe", &brdf::python::Describe, py::arg("path_or_name"));
+  m.def("write_capture", &brdf::python::WriteCapture, py::arg("path"), py::arg("theta_in"),
+        py::arg("phi_in"), py::arg("theta_out"), py::arg("phi_out"), py::arg("rgb"),
+        py::arg("sigma"), py::arg("flags"), py::arg("metadata"), py::arg("overwrite"));
 
   py::class_<Source>(m, "Source")
       .def(py::init<const std::string&>(), py::arg("path_or_name"))

@@ -209,6 +209,19 @@ CaptureAssessment AssessCapture(const std::string& path, BpcReadResult read) {
     }
   }
   if (!a.refusals.empty()) a.refusal = a.refusals.front();
+  if (a.refusals.empty()) {
+    // The exported slices' own requirement, by the rule BuildLut applies for them.
+    for (const processing::LutInputProblem& p : processing::FindLutInputProblems(r.measurement))
+      if (p.kind == processing::LutInputProblem::Kind::kThetaInNotUniform)
+        a.export_refusals.push_back(
+            {"slices (θin " + DegList(a.present_theta_in_deg) + "°)",
+             "θin = k·Δin from 0° for the LUT textures (docs/design.md §5)",
+             p.message.find("got ") != std::string::npos
+                 ? p.message.substr(p.message.find("got ") + 4)
+                 : p.message,
+             "evaluating it needs no such steps; only the exported slices do",
+             Remedy{RemedyKind::kRecapture, path}, CaptureRefusal::Cause::kValues});
+  }
   for (const BpcProblem& p : r.problems)
     if (p.kind == BpcProblemKind::kTrailingData)
       a.warnings.push_back(path + ": warning: " + std::to_string(p.size) +
@@ -234,6 +247,20 @@ Measurement LoadCaptureForCopy(const std::string& path, std::vector<std::string>
       throw refusal.ToError(path);  // nothing to copy from an unfinished capture: resume it
   if (warnings) {
     warnings->insert(warnings->end(), a.warnings.begin(), a.warnings.end());
+    // What the copy keeps that every reading command refuses (an incomplete slice, values no
+    // LUT is built from): said, so that a CSV read back does not silently pass for a capture
+    // the others accept.
+    for (const CaptureRefusal& refusal : a.refusals) {
+      if (refusal.cause != CaptureRefusal::Cause::kIncompleteSlice &&
+          refusal.cause != CaptureRefusal::Cause::kValues)
+        continue;
+      std::string why = refusal.ToError(path).what();
+      if (why.compare(0, path.size() + 2, path + ": ") == 0) why.erase(0, path.size() + 2);
+      warnings->push_back(path +
+                          ": warning: copied as it is, though the capture is refused "
+                          "by every command that reads it: " +
+                          why);
+    }
     if (!a.read.finished && !a.missing_theta_in_deg.empty())
       warnings->push_back(path + ": warning: an unfinished capture: planned θin " +
                           DegList(a.missing_theta_in_deg) +

@@ -30,7 +30,9 @@
 #include "brdf/exporter/packed_volume.h"
 #include "brdf/exporter/rgb9e5.h"
 #include "brdf/exporter/sidecar.h"
+#include "brdf/processing/beyond.h"
 #include "brdf/processing/resample.h"
+#include "brdf/processing/sanity.h"
 #include "brdf/sources/capture.h"
 #include "brdf/sources/detect.h"
 #include "brdf/sources/material_library.h"
@@ -114,19 +116,35 @@ void AddPointCloudJson(const Measurement& m, Json* j,
   (*j)["metadata"] = MetadataJson(m.metadata);
 }
 
-// The reasons a measurement cannot be resampled into a LUT (the library checks every reader
-// applies), one line each, plus the LUT's own requirement of θin = k·Δin.
-void AddRefusalsJson(const std::string& path, const std::vector<std::string>& refusals,
-                     const Measurement* m, Json* j) {
+// The verdict (one rule, brdf/sources/capture.h): "refusals" lists every reason a reading
+// command refuses the file, one line each; "usable" is true when none does; "evaluable" when
+// eval, preview, fit and brdf-view accept it (they do unless `refusals` is not empty). For
+// captures, "convertible": convert and atlas accept it too (`export_refusals` are theirs alone).
+void AddRefusalsJson(const std::vector<std::string>& refusals,
+                     const std::vector<std::string>* export_refusals, Json* j) {
   Json list = Json::array();
   for (const std::string& r : refusals) list.push_back(r);
-  if (m != nullptr && !m->slices.empty() && refusals.empty()) {
-    for (const processing::LutInputProblem& p : processing::FindLutInputProblems(*m))
-      if (p.kind == processing::LutInputProblem::Kind::kThetaInNotUniform)
-        list.push_back(path + ": a LUT cannot be built from it: " + p.message);
-  }
+  if (export_refusals)
+    for (const std::string& r : *export_refusals) list.push_back(r);
   (*j)["refusals"] = list;
-  (*j)["usable"] = refusals.empty();
+  (*j)["usable"] = list.empty();
+  (*j)["evaluable"] = refusals.empty();
+  if (export_refusals) (*j)["convertible"] = list.empty();
+}
+
+// A usable capture read as the commands read it (OpenForView: the LUT `brdf eval` samples,
+// the default blind-spot fill included): "blind_spot_fill", the fill's record with its
+// leave-last-slice-out error (processing::BeyondReportJson; null when nothing was filled), and
+// "physical_sanity" (processing::PhysicalSanity, brdf/processing/sanity.h).
+void AddFillAndSanityJson(const std::string& path, Json* j) {
+  const OpenedForView opened = OpenForView(path);
+  if (!opened.measurement || !opened.resample_report) return;
+  const processing::BeyondReport& beyond = opened.resample_report->beyond;
+  (*j)["blind_spot_fill"] = beyond.used == processing::BeyondMethod::kClamp
+                                ? Json(nullptr)
+                                : Json::parse(processing::BeyondReportJson(beyond));
+  (*j)["physical_sanity"] = Json::parse(processing::SanityReportJson(
+      processing::PhysicalSanity(opened.lut, *opened.measurement, opened.theta_b_deg)));
 }
 
 Json DescribeBpc(const std::string& path, const Phrasing& say) {
@@ -150,10 +168,12 @@ Json DescribeBpc(const std::string& path, const Phrasing& say) {
                              {"slice", p.slice_index},
                              {"message", p.message}});
   }
-  std::vector<std::string> refusals;
+  std::vector<std::string> refusals, export_refusals;
   for (const CaptureRefusal& refusal : a.refusals)
     refusals.push_back(say.Line(refusal.ToError(path)));
-  AddRefusalsJson(path, refusals, &m, &j);
+  for (const CaptureRefusal& refusal : a.export_refusals)
+    export_refusals.push_back(say.Line(refusal.ToError(path)));
+  AddRefusalsJson(refusals, &export_refusals, &j);
   j["planned_theta_in_deg"] = a.planned_theta_in_deg;
   j["plan_recorded"] = a.plan_recorded;
   j["missing_theta_in_deg"] = a.missing_theta_in_deg;
@@ -168,11 +188,12 @@ Json DescribeBpc(const std::string& path, const Phrasing& say) {
           ": " + say(Remedy{RemedyKind::kResumeCapture, path, r.valid_bytes});
     }
   }
+  if (a.usable()) AddFillAndSanityJson(path, &j);
   return j;
 }
 
 Json DescribeMaterial(const std::string& path) {
-  const Material material = LoadMaterialFile(path);
+  const Material material = LoadMaterialInput(path);
   Json j;
   j["file"] = path;
   j["format"] = "material";
@@ -333,7 +354,7 @@ Json DescribeImported(const std::string& path, ImportFormat format, const Phrasi
     for (const processing::LutInputProblem& p :
          processing::FindLutInputProblems(*table_m, any_theta_in))
       refusals.push_back(path + ": " + p.message);
-    AddRefusalsJson(path, refusals, nullptr, &j);
+    AddRefusalsJson(refusals, nullptr, &j);
   }
   return j;
 }
@@ -398,6 +419,7 @@ Json DescribeTexture(const std::string& path) {
     j["files"] = t.sidecar->files;
     if (t.sidecar->certified_error)
       j["certified_error"] = CertifiedErrorJson(*t.sidecar->certified_error);
+    if (!t.sidecar->beyond_json.empty()) j["blind_spot_fill"] = Json::parse(t.sidecar->beyond_json);
   }
   // Cells holding data: the whole texture for a LUT, the materials' cells for an atlas.
   std::vector<std::array<int, 2>> origins = {{0, 0}};

@@ -13,6 +13,7 @@
 #include "brdf/core/virtual_capture.h"
 #include "brdf/exporter/compact_lut.h"
 #include "brdf/exporter/packed_volume.h"
+#include "brdf/exporter/rgb9e5.h"
 #include "brdf/processing/measurement_brdf.h"
 #include "brdf/sources/capture.h"
 #include "text.h"
@@ -66,6 +67,12 @@ OpenedTexture OpenSingleLut(const std::string& path, std::vector<std::string>* w
 
 }  // namespace
 
+Material LoadMaterialInput(const std::string& path) {
+  Material material = LoadMaterialFile(path);
+  processing::ExtrapolationFromJson(ReadFileText(path, kMaxJsonBytes), path);
+  return material;
+}
+
 ExtrapolationChoice ChooseExtrapolation(
     const std::string& input_path, FileKind kind,
     const std::optional<processing::ExtrapolationParams>& command_line,
@@ -109,7 +116,7 @@ PreparedMeasurement Prepare(const std::string& path, FileKind kind,
       out.measurement = LoadCaptureForLut(path, &out.warnings);
       break;
     case FileKind::kMaterial: {
-      auto material = std::make_shared<AnalyticBrdf>(LoadMaterialFile(path));
+      auto material = std::make_shared<AnalyticBrdf>(LoadMaterialInput(path));
       out.measurement = CaptureFile(*material, path, kind);
       out.measurement.metadata.extra["model"] = std::string(ModelName(material->material().model));
       source = std::move(material);
@@ -139,6 +146,13 @@ PreparedMeasurement Prepare(const std::string& path, FileKind kind,
       ImportOptions import_options;
       import_options.allow_btdf = allow_btdf;
       out.measurement = ImportFile(path, *ImportFormatOf(kind), import_options);
+      // The values, by the rule every evaluation of a table applies (BuildLut with any θin):
+      // a fit or a virtual capture refuses what `eval` refuses.
+      processing::ResampleOptions any_theta_in;
+      any_theta_in.require_uniform_theta_in = false;
+      if (const auto problems = processing::FindLutInputProblems(out.measurement, any_theta_in);
+          !problems.empty())
+        throw InvalidArgument(path + ": " + problems.front().message);
       const auto it = out.measurement.metadata.extra.find("scatter_type");
       if (it != out.measurement.metadata.extra.end() && it->second.rfind("BTDF", 0) == 0)
         out.warnings.push_back(path +
@@ -153,6 +167,9 @@ PreparedMeasurement Prepare(const std::string& path, FileKind kind,
                             std::string(FileKindName(kind)));
   }
   out.extrapolation = ChooseExtrapolation(path, kind, command_line, &out.warnings);
+  out.measured = kind == FileKind::kCapture || kind == FileKind::kZemax ||
+                 kind == FileKind::kLightTools || kind == FileKind::kCsv ||
+                 kind == FileKind::kGonio;
   if (evaluable) *evaluable = std::move(source);
   return out;
 }
@@ -338,7 +355,7 @@ OpenedSource OpenBrdf(const std::string& path_or_name, const OpenOptions& option
   out.kind = DetectFileKind(path);
   switch (out.kind) {
     case FileKind::kMaterial:
-      out.brdf = std::make_unique<AnalyticBrdf>(LoadMaterialFile(path));
+      out.brdf = std::make_unique<AnalyticBrdf>(LoadMaterialInput(path));
       out.evaluation = Evaluation::kAnalytic;
       return out;
     case FileKind::kRgl:
@@ -429,6 +446,7 @@ OpenedForView OpenForView(const std::string& path_or_name, const OpenOptions& op
   // Any distinct θin, as OpenBrdf evaluates them (processing::MeasurementAsBrdf).
   processing::ResampleOptions resample = options.resample;
   resample.require_uniform_theta_in = false;
+  resample.check_measured_values = p.measured;
   processing::ResampleReport report;
   out.lut = processing::BuildLut(p.measurement, p.extrapolation.params, resample, &report);
   out.theta_b_deg = report.theta_b_deg;
@@ -450,6 +468,7 @@ InputLut LutFromInput(const std::string& path, FileKind kind,
     if (t.sidecar) {
       out.extrapolation = t.sidecar->extrapolation;
       out.saturated_samples = t.sidecar->saturated_samples;
+      out.beyond_json = t.sidecar->beyond_json;
     }
     out.lut = std::move(t.texture.lut);
     return out;
@@ -457,13 +476,37 @@ InputLut LutFromInput(const std::string& path, FileKind kind,
   PreparedMeasurement p = PrepareMeasurement(path, kind, command_line);
   out.warnings = std::move(p.warnings);
   out.saturated_samples = CountSaturated(p.measurement);
+  processing::ResampleOptions resample = resample_options;
+  resample.check_measured_values = p.measured;
   processing::ResampleReport report;
-  out.lut = processing::BuildLut(p.measurement, p.extrapolation.params, resample_options, &report);
-  if (report.beyond.used != processing::BeyondMethod::kClamp) out.beyond = report.beyond;
+  out.lut = processing::BuildLut(p.measurement, p.extrapolation.params, resample, &report);
+  if (report.beyond.used != processing::BeyondMethod::kClamp) {
+    out.beyond = report.beyond;
+    out.beyond_json = processing::BeyondReportJson(report.beyond);
+  }
+  if (auto note = ClipNote(path, out.lut)) out.warnings.push_back(std::move(*note));
   if (report.theta_b_deg < 90.0)
     out.extrapolation = exporter::ExtrapolationInfo{p.extrapolation.params.p,
                                                     p.extrapolation.params.l, report.theta_b_deg};
   return out;
+}
+
+std::optional<std::string> ClipNote(const std::string& path, const Lut& lut) {
+  std::size_t negative = 0, above = 0;
+  for (float v : lut.texels) {
+    negative += v < 0.0f;
+    above += v > exporter::kRgb9e5MaxValue;
+  }
+  if (negative == 0 && above == 0) return std::nullopt;
+  std::string what;
+  if (negative > 0) what = std::to_string(negative) + " negative (written as 0)";
+  if (above > 0)
+    what += (what.empty() ? "" : ", ") + std::to_string(above) + " above " +
+            NumberText(exporter::kRgb9e5MaxValue) + " (written as " +
+            NumberText(exporter::kRgb9e5MaxValue) + ")";
+  return path + ": warning: the RGB9E5 textures clip " + what + " of the LUT's " +
+         std::to_string(lut.texels.size()) + " texel values (RGB9E5 holds [0, " +
+         NumberText(exporter::kRgb9e5MaxValue) + "] 1/sr)";
 }
 
 std::vector<exporter::SaturatedCount> CountSaturated(const Measurement& m) {
@@ -489,6 +532,21 @@ std::optional<std::string> SaturationNote(
   if (total == 0) return std::nullopt;
   return path + ": " + std::to_string(total) + " saturated sample" + (total == 1 ? "" : "s") +
          " (" + per_slice + "); their values are clipped";
+}
+
+std::optional<std::string> LeaveLastSliceOutNote(const std::string& path,
+                                                 const std::optional<processing::BeyondReport>& b) {
+  if (!b || !b->validation) return std::nullopt;
+  const auto percent = [](double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%.3g %%", 100.0 * v);
+    return std::string(buf);
+  };
+  std::string method(processing::BeyondMethodName(b->used));
+  if (b->model) method += " (" + std::string(ModelName(b->model->material.model)) + ")";
+  return path + ": blind-spot fill " + method + ": the θin " + Deg(b->validation->theta_in_deg) +
+         "° slice predicted from the others within " + percent(b->validation->median) +
+         " (median), " + percent(b->validation->p90) + " (p90)";
 }
 
 }  // namespace brdf::sources

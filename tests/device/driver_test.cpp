@@ -515,6 +515,71 @@ TEST(Capture, CorruptFrameIsRetriedAndTheCaptureEqualsAnUndisturbedOne) {
   }
 }
 
+// DriverOptions::retries bounds the attempts of one step: a step damaged `retries` times in a row
+// is still measured (after exactly that many retries), one damaged once more stops the capture
+// with the damage. The frame of each attempt is found from the firmware's own frame count: an
+// attempt that fails at frame F costs D frames more than the undisturbed capture, so the same
+// frame of the next attempt is F + D.
+TEST(Capture, AStepIsRetriedExactlyUpToTheRetryLimit) {
+  const std::uint64_t first = kSetupFrames + kSliceFrames + 4;  // a ROW_DATA of slice 2
+  auto run = [&](const std::vector<std::uint64_t>& corrupt, int retries_allowed,
+                 std::vector<int>* attempts, std::uint64_t* frames) {
+    SimulatorConfig c = Config(LibraryMaterial("gold"), 0, 5, 5);
+    for (std::uint64_t f : corrupt) c.faults.faults.push_back({FaultType::kCorrupt, f});
+    SimulatedFirmware fw(c);
+    LoopbackTransport link(fw);
+    DriverOptions options;
+    options.retries = retries_allowed;
+    Driver driver(link, options);
+    CapturePlan plan;
+    plan.theta_in_deg = {0, 20, 40, 60};
+    CaptureCallbacks callbacks;
+    std::size_t slices = 0;
+    callbacks.on_retry = [&](const DriverFault&, int attempt) { attempts->push_back(attempt); };
+    callbacks.on_slice = [&](const Slice&, const SliceReport&) { ++slices; };
+    try {
+      Capture(driver, plan, callbacks);
+    } catch (...) {
+      *frames = fw.frames_sent();
+      throw;
+    }
+    *frames = fw.frames_sent();
+    return slices;
+  };
+  std::vector<int> attempts;
+  std::uint64_t clean_frames = 0, one_retry_frames = 0;
+  ASSERT_EQ(run({}, 2, &attempts, &clean_frames), 4u);
+  ASSERT_EQ(run({first}, 2, &attempts, &one_retry_frames), 4u);
+  ASSERT_EQ(attempts, std::vector<int>{1});
+  const std::uint64_t d = one_retry_frames - clean_frames;
+  ASSERT_GT(d, 4u);
+  for (int limit : {0, 1, 2, 4}) {
+    SCOPED_TRACE("retries " + std::to_string(limit));
+    std::vector<std::uint64_t> faults;
+    for (int k = 0; k < limit; ++k) faults.push_back(first + static_cast<std::uint64_t>(k) * d);
+    // `limit` damaged attempts in a row: measured, after exactly `limit` retries.
+    attempts.clear();
+    std::uint64_t frames = 0;
+    EXPECT_EQ(run(faults, limit, &attempts, &frames), 4u);
+    std::vector<int> want;
+    for (int k = 1; k <= limit; ++k) want.push_back(k);
+    EXPECT_EQ(attempts, want);
+    EXPECT_EQ(frames, clean_frames + static_cast<std::uint64_t>(limit) * d);
+    // One more: the capture stops with the damage, having tried limit + 1 times.
+    faults.push_back(first + static_cast<std::uint64_t>(limit) * d);
+    attempts.clear();
+    try {
+      run(faults, limit, &attempts, &frames);
+      ADD_FAILURE() << limit + 1 << " damaged attempts in a row did not stop the capture";
+    } catch (const DriverFault& e) {
+      // The damaged frame is named (the driver may report it as the frame the sequence lost).
+      EXPECT_TRUE(e.retryable()) << e.what();
+      EXPECT_NE(std::string(e.what()).find("CRC-32"), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(attempts, want);
+  }
+}
+
 TEST(Capture, InstrumentThatStopsAnsweringStopsTheCapture) {
   SimulatorConfig c = Config(LibraryMaterial("gold"), 1, 5, 5);
   c.faults.faults.push_back({FaultType::kStall, (kSetupFrames + kSliceFrames + 1) + 1});

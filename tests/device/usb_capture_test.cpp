@@ -90,9 +90,10 @@ INSTANTIATE_TEST_SUITE_P(Transports, UsbCapture,
 // environment (preload library and testbed), so it finds the device on "its" USB bus.
 
 // `prefix` goes before the tool (e.g. a command that drops privileges).
-std::string RunTool(const std::string& args, int* exit_code, const std::string& prefix = "") {
+std::string RunTool(const std::string& args, int* exit_code, const std::string& prefix = "",
+                    const std::string& tool = BRDF_TOOL) {
   std::string out;
-  std::FILE* pipe = ::popen((prefix + std::string(BRDF_TOOL) + " " + args + " 2>&1").c_str(), "r");
+  std::FILE* pipe = ::popen((prefix + tool + " " + args + " 2>&1").c_str(), "r");
   if (pipe == nullptr) return out;
   char buf[4096];
   for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, pipe)) > 0;) out.append(buf, n);
@@ -163,14 +164,18 @@ TEST_P(UsbCapture, DevicesListsTheInstrumentAndCaptureOpensItByVidPidSerial) {
   std::filesystem::remove_all(tmpl);
 }
 
+// Root opens any node (CAP_DAC_OVERRIDE), so as root the tool runs with that capability
+// dropped (setpriv): the prefix RunTool puts before the tool.
+std::string AsUser() {
+  return ::geteuid() == 0 ? "setpriv --bounding-set -dac_override,-dac_read_search " : "";
+}
+
 TEST_P(UsbCapture, PermissionDeniedIsOneLineNamingTheNodeTheCauseAndTheUdevRule) {
-  // The emulated node with mode 000, as without the udev rule. Root opens any node
-  // (CAP_DAC_OVERRIDE), so as root the tool runs with that capability dropped (setpriv).
+  // The emulated node with mode 000, as without the udev rule.
   SimulatorConfig c = Config(LibraryMaterial("gold"), 1, 15, 15);
   EmulatedUsbInstrument emu(c, GetParam());
   emu.SetNodeMode(0);
-  const std::string as_user =
-      ::geteuid() == 0 ? "setpriv --bounding-set -dac_override,-dac_read_search " : "";
+  const std::string as_user = AsUser();
   const bool usb = GetParam() == UsbPersonality::kBulk;
   const std::string spec = std::string(usb ? "usb" : "hid") + ":1209:" + (usb ? "b7d1" : "b7d2");
   // The device (its IDs and node), the cause, and the remedy: the shipped rule, where it is
@@ -205,6 +210,33 @@ TEST_P(UsbCapture, PermissionDeniedIsOneLineNamingTheNodeTheCauseAndTheUdevRule)
     EXPECT_NE(refused.find(w), std::string::npos) << "'" << w << "' in: " << refused;
   EXPECT_FALSE(std::filesystem::exists(out));
   std::filesystem::remove_all(tmpl);
+}
+
+// An installed tree (the Debian package under /usr, a moved prefix) names its own copy of the
+// rule in the remedy, found from the executable's folder, not the configured prefix's.
+TEST_P(UsbCapture, PermissionDeniedNamesTheRuleOfTheInstalledTree) {
+  SimulatorConfig c = Config(LibraryMaterial("gold"), 1, 15, 15);
+  EmulatedUsbInstrument emu(c, GetParam());
+  emu.SetNodeMode(0);
+  // <tree>/bin/brdf (a hard link: /proc/self/exe is then this path) and
+  // <tree>/lib/udev/rules.d/70-brdf-scatterometer.rules, the layout `cmake --install` makes.
+  std::string tmpl = std::string(BRDF_BINARY_DIR) + "/brdf_udev_tree_XXXXXX";
+  ASSERT_NE(::mkdtemp(tmpl.data()), nullptr);
+  const std::filesystem::path tree = tmpl;
+  std::filesystem::create_directories(tree / "bin");
+  std::filesystem::create_directories(tree / "lib/udev/rules.d");
+  std::filesystem::create_hard_link(BRDF_TOOL, tree / "bin/brdf");
+  std::filesystem::copy_file(
+      std::string(BRDF_SOURCE_DIR) + "/device/udev/70-brdf-scatterometer.rules",
+      tree / "lib/udev/rules.d/70-brdf-scatterometer.rules");
+  int code = -1;
+  const std::string listed = RunTool("devices", &code, AsUser(), (tree / "bin/brdf").string());
+  EXPECT_EQ(code, 0) << listed;
+  EXPECT_NE(listed.find("permission denied"), std::string::npos) << listed;
+  EXPECT_NE(listed.find("(installed in " + (tree / "lib/udev/rules.d").string() + ","),
+            std::string::npos)
+      << listed;
+  std::filesystem::remove_all(tree);
 }
 
 // ---- Faults over every transport ---------------------------------------------------------

@@ -237,7 +237,9 @@ TEST_F(EngineExport, WritesEveryEngineFolderWithTheContainersAsBytes) {
                         "web/MeasuredBrdf.450.glsl",
                         "web/MeasuredBrdf.compact.es300.glsl"})
     EXPECT_TRUE(fs::is_regular_file(dir_ / f)) << f;
-  EXPECT_EQ(r.written.size(), 22u);
+  for (const char* e : {"unity", "unreal", "godot", "web"})
+    EXPECT_TRUE(fs::is_regular_file(dir_ / e / "felt_ibl.dds")) << e;
+  EXPECT_EQ(r.written.size(), 26u);
   const std::string ktx2 = Read(dir_ / "felt.ktx2");
   EXPECT_EQ(Read(dir_ / "unity/felt.brdf3d"), ktx2);
   EXPECT_EQ(Read(dir_ / "web/felt.ktx2"), ktx2);
@@ -246,7 +248,7 @@ TEST_F(EngineExport, WritesEveryEngineFolderWithTheContainersAsBytes) {
   EXPECT_EQ(Read(dir_ / "unreal/felt.dds"), engines::EncodeRgba16fDds(exporter::PackLut(lut)));
   // The paths a failed conversion must remove are the per-material ones.
   const auto paths = engines::EngineOutputPaths(dir_.string(), "felt", ParseEngines("all"));
-  EXPECT_EQ(paths.size(), 11u);
+  EXPECT_EQ(paths.size(), 15u);
   for (const std::string& p : paths) EXPECT_TRUE(fs::is_regular_file(p)) << p;
 }
 
@@ -272,7 +274,13 @@ TEST_F(EngineExport, ManifestProbesAreTheTexturesOwnTexels) {
       const auto expect =
           Decode(U32(ktx2, level + 4 * ((static_cast<std::size_t>(z) * 181 + y) * 361 + x)));
       for (int c = 0; c < 3; ++c) EXPECT_EQ(p["rgb"][c].get<double>(), expect[c]) << p.dump();
+      // docs/design.md §5: u = (φd/1° + 0.5)/361, v = (θd/1° + 0.5)/181, w = (θin/Δin + 0.5)/K,
+      // texel (i, j) at (φd, θd) = (i°, j°) (one material: the cell starts at texel 0).
       EXPECT_DOUBLE_EQ(p["uvw"][0].get<double>(), (x + 0.5) / 361);
+      EXPECT_DOUBLE_EQ(p["uvw"][1].get<double>(), (y + 0.5) / 181);
+      EXPECT_DOUBLE_EQ(p["uvw"][2].get<double>(), (z + 0.5) / 4);
+      EXPECT_EQ(p["phi_d_deg"].get<int>(), x);
+      EXPECT_EQ(p["theta_d_deg"].get<int>(), y);
       EXPECT_DOUBLE_EQ(p["theta_in_deg"].get<double>(), 20.0 * z);
     }
     // Each slice's probes include its peak: the texel of largest Rec.709 luminance.

@@ -10,6 +10,10 @@
   - The Unreal editor script byte-compiled (py_compile) and run against a stub `unreal`
     module: both import routes ask for sRGB off, TC_HDR, no mips, clamp, tiles 361 × 181.
   - The Godot .import file: importer 3d_texture, 2 × 2 slices, no mipmaps.
+  - The IBL pack texture NAME_ibl.dds (of a LUT and of a two-material atlas): DXGI 10, 2D, one
+    mip, 128 × cells; every half is numpy's float16 of the manifest's "ibl" numbers (texel i:
+    diffuse_rgb, alpha_eq at mu_i; texel 64 + i: specular_rgb, fit_residual), identical in
+    every engine folder.
   - `brdf fit` output passed with --engine-fits is the manifest's fallback material, as written.
 Usage: engine_handoff_checks.py BRDF_TOOL SOURCE_DIR MCS MONO   (Debian /usr/bin/python3)
 """
@@ -25,22 +29,11 @@ import tempfile
 
 import numpy as np
 
+from check_support import FAILURES, expect, run
+
 MATERIAL = {"model": "ggx", "kd": [0.3, 0.2, 0.1], "f0": [0.9, 0.6, 0.3], "alpha": 0.2}
-FAILURES = []
 
 
-def expect(condition, message):
-    if not condition:
-        FAILURES.append(message)
-        print("FAIL " + message)
-
-
-def run(cmd, **kw):
-    r = subprocess.run(cmd, capture_output=True, text=True, **kw)
-    if r.returncode != 0:
-        print(f"FAILED ({r.returncode}): {' '.join(cmd)}\n{r.stdout}\n{r.stderr[-3000:]}")
-        sys.exit(1)
-    return r.stdout
 
 
 def decode_rgb9e5(words):
@@ -92,6 +85,39 @@ def check_dds(out, name):
            "godot DDS is not the RGB9E5 volume with the KTX2's payload")
     print("godot DDS: DXGI 67 volume, 1 mip, payload identical to the KTX2 level 0 image")
     return words, want
+
+
+def check_ibl_pack(folder, name, engines):
+    d = parse_dds(os.path.join(folder, engines[0], name + "_ibl.dds"))
+    manifest = json.load(open(os.path.join(folder, engines[0], name + ".manifest.json")))
+    ibl = manifest["ibl"]
+    cells = ibl["cells"] if manifest["atlas"] else [ibl]
+    expect(d["size"] == 124 and d["fourcc"] == b"DX10" and d["dxgi"] == 10 and d["mips"] == 1,
+           f"{name}_ibl.dds header {d['fourcc']} dxgi {d['dxgi']} mips {d['mips']}")
+    expect(d["dimension"] == 3 and not (d["caps2"] & 0x200000) and not (d["flags"] & 0x800000),
+           f"{name}_ibl.dds is not a 2D texture (dimension {d['dimension']})")
+    expect((d["width"], d["height"], d["pitch"]) == (128, len(cells), 128 * 8),
+           f"{name}_ibl.dds size {d['width']}x{d['height']} pitch {d['pitch']}")
+    texels = np.frombuffer(d["data"], dtype="<f2").reshape(len(cells), 128, 4)
+    for m, c in enumerate(cells):
+        expect(c.get("row", m) == m, f"{name}: cell {m} row {c.get('row')}")
+        want = np.zeros((128, 4))
+        want[:64, :3] = c["diffuse_rgb"]
+        want[:64, 3] = c["alpha_eq"]
+        want[64:, :3] = c["specular_rgb"]
+        want[64:, 3] = c["fit_residual"]
+        got = texels[m]
+        same = np.array_equal(got, want.astype(np.float16))
+        expect(same, f"{name}_ibl.dds row {m} differs from float16 of the manifest by "
+                     f"{np.abs(got.astype(float) - want).max()}")
+        albedo = np.asarray(c["albedo_rgb"])
+        split = np.abs(np.asarray(c["diffuse_rgb"]) + np.asarray(c["specular_rgb"]) - albedo)
+        expect(split.max() <= 1e-6 * max(1.0, albedo.max()), f"{name}: D + S differs from E by {split.max()}")
+    data = open(os.path.join(folder, engines[0], name + "_ibl.dds"), "rb").read()
+    for e in engines[1:]:
+        expect(open(os.path.join(folder, e, name + "_ibl.dds"), "rb").read() == data,
+               f"{e}/{name}_ibl.dds differs from {engines[0]}'s")
+    print(f"{name}_ibl.dds: DXGI 10 2D 128x{len(cells)}, 1 mip; every half is float16 of the manifest's pack")
 
 
 def check_unity(out, name, mcs, mono, work, words, want):
@@ -209,7 +235,10 @@ def main():
     mat = os.path.join(work, "gold_like.json")
     json.dump(MATERIAL, open(mat, "w"))
     out = os.path.join(work, "out")
-    run([tool, "convert", mat, "--out", out, "--engine", "all", "--quiet", "--formats", "ktx2,json"])
+    # --beyond clamp: the reference layout (θin 0/20/40/60, 2 × 2 tiles) these checks spell out;
+    # the default fill's 9 slices go through the same writers (web_browser_test.py runs them).
+    run([tool, "convert", mat, "--out", out, "--engine", "all", "--quiet", "--formats", "ktx2,json",
+         "--beyond", "clamp"])
     # A misspelt engine: one line, exit 1, nothing written.
     bad = subprocess.run([tool, "convert", mat, "--out", os.path.join(work, "bad"), "--engine",
                           "unity,unrael"], capture_output=True, text=True)
@@ -222,6 +251,16 @@ def main():
     check_unity(out, "gold_like", mcs, mono, work, words, want)
     check_unreal(out, work)
     check_godot(out, "gold_like")
+    check_ibl_pack(out, "gold_like", ["unity", "unreal", "godot", "web"])
+    # An atlas of two materials: one pack row per cell, in cell order.
+    lamb = os.path.join(work, "grey.json")
+    json.dump({"model": "lambert", "rho": [0.5, 0.4, 0.3]}, open(lamb, "w"))
+    run([tool, "atlas", mat, lamb, "--out", os.path.join(work, "atlas", "pair"), "--engine", "web,godot", "--quiet"])
+    check_ibl_pack(os.path.join(work, "atlas"), "pair", ["web", "godot"])
+    lambert_row = json.load(open(os.path.join(work, "atlas", "web", "pair.manifest.json")))["ibl"]["cells"][1]
+    e = np.asarray(lambert_row["albedo_rgb"])
+    expect(lambert_row["material"] == "grey" and np.abs(e[8:] - [0.5, 0.4, 0.3]).max() < 0.005,
+           f"atlas cell 1 is not the Lambertian: {lambert_row['material']}, E {e[32]}")
     if FAILURES:
         print(f"{len(FAILURES)} check(s) failed; kept {work}")
         return 1

@@ -14,6 +14,7 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <tuple>
 
 #include <nlohmann/json.hpp>
 
@@ -158,6 +159,55 @@ UnityGI UnityGlobalIllumination(UnityGIInput data, half occlusion, half3 normal)
 }
 )";
 
+// Stand-ins for the probe functions URP (Lighting.hlsl) and HDRP (Core's AmbientProbe.hlsl,
+// ShaderVariablesFunctions.hlsl) give the image-based-lighting functions, with their signatures.
+constexpr const char* kUrpStandIns = R"(
+#define UNIVERSAL_LIGHTING_INCLUDED
+struct UnityTexture2D { Texture2D tex; SamplerState samplerstate; };
+half3 SampleSH(half3 normalWS) { return normalWS * 0.5 + 0.5; }
+half3 GlossyEnvironmentReflection(half3 reflectVector, half perceptualRoughness, half occlusion) {
+  return reflectVector * perceptualRoughness * occlusion;
+}
+)";
+constexpr const char* kHdrpStandIns = R"(
+#define __AMBIENTPROBE_HLSL__
+struct UnityTexture2D { Texture2D tex; SamplerState samplerstate; };
+float3 EvaluateAmbientProbe(float3 normalWS) { return normalWS * 0.5 + 0.5; }
+float PerceptualRoughnessToMipmapLevel(float perceptualRoughness) { return perceptualRoughness * 6.0; }
+TextureCube _SkyTexture; SamplerState s_trilinear_clamp_sampler;
+float4 SampleSkyTexture(float3 texCoord, float lod, int sliceIndex) {
+  return _SkyTexture.SampleLevel(s_trilinear_clamp_sampler, texCoord, lod + sliceIndex);
+}
+)";
+
+TEST_F(ShaderCompile, UnityIblFunctionsCompileForUrpAndHdrp) {
+  for (const std::vector<double>& thetas :
+       {std::vector<double>{0, 20, 40, 60}, {0, 10, 20, 30, 40, 50, 60, 70, 80}}) {
+    const fs::path out = ExportAll(thetas);
+    std::string include;
+    for (const auto& e : fs::directory_iterator(out / "unity"))
+      if (e.path().extension() == ".hlsl") include = e.path().filename().string();
+    ASSERT_FALSE(include.empty());
+    for (const auto& [pipeline, stand_ins, function] :
+         {std::tuple{"urp", kUrpStandIns, "MeasuredBrdfIbl_float"},
+          std::tuple{"hdrp", kHdrpStandIns, "MeasuredBrdfIbl_float"}}) {
+      const std::string harness = std::string(kUnityStandIns) + stand_ins + "#include \"" +
+                                  include + "\"\n" + R"(
+Texture2D g_pack; SamplerState g_pack_sampler;
+float4 main(float3 n : TEXCOORD0, float3 v : TEXCOORD1) : SV_Target {
+  UnityTexture2D t; t.tex = g_pack; t.samplerstate = g_pack_sampler;
+  float3 o; )" + function + R"((t, 0.5, n, v, o);
+  return float4(o, 1.0);
+}
+)";
+      const std::string file = (out / "unity" / (std::string(pipeline) + ".hlsl")).string();
+      std::ofstream(file) << harness;
+      ExpectCompiles("-D -V -e main -S frag -o " + (dir_ / "ibl.spv").string() + " " + file,
+                     std::string("Unity ") + pipeline + " IBL in " + include);
+    }
+  }
+}
+
 TEST_F(ShaderCompile, UnityIncludeCompilesForShaderGraphAndBuiltInPipeline) {
   for (const std::vector<double>& thetas : {std::vector<double>{0, 20, 40, 60}, {10, 25, 40}}) {
     const fs::path out = ExportAll(thetas);
@@ -214,6 +264,46 @@ float4 main(float3 n : TEXCOORD0, float3 l : TEXCOORD1, float3 v : TEXCOORD2) : 
                  "Unreal Custom node");
 }
 
+TEST_F(ShaderCompile, UnrealIblCustomNodeCompilesAsTheCommentSays) {
+  const fs::path out = ExportAll({0, 10, 20, 30, 40, 50, 60, 70, 80});
+  std::string ush;
+  for (const auto& e : fs::directory_iterator(out / "unreal"))
+    if (e.path().extension() == ".ush") ush = e.path().filename().string();
+  ASSERT_FALSE(ush.empty());
+  const std::string text = Read(out / "unreal" / ush);
+  std::smatch m;
+  ASSERT_TRUE(
+      std::regex_search(text, m, std::regex(R"(// Code:\s+(return MeasuredBrdfIblUnreal[^\n]+;))")))
+      << text;
+  // Stand-ins for what Unreal's base pass gives a material (ReflectionEnvironmentShared.ush,
+  // the View uniform buffer), and the Custom node's Additional Define.
+  const std::string harness =
+      std::string(R"(
+struct FViewStandIn { float4 SkyLightColor; };
+static const FViewStandIn View = { float4(1, 1, 1, 1) };
+TextureCube SkyCube; SamplerState SkyCubeSampler;
+float3 GetSkySHDiffuse(float3 Normal) { return Normal * 0.5 + 0.5; }
+float3 GetSkyLightReflection(float3 ReflectionVector, float Roughness, out float OutSkyAverageBrightness) {
+  OutSkyAverageBrightness = 1.0;
+  return SkyCube.SampleLevel(SkyCubeSampler, ReflectionVector, Roughness * 6.0).rgb;
+}
+#define MEASURED_BRDF_UNREAL_SKY 1
+#include ")") +
+      ush + "\"\n" +
+      "float3 CustomExpression1(Texture2D IblPack, SamplerState IblPackSampler, float IblRow, "
+      "float3 N, float3 V) {\n  " +
+      m[1].str() + "\n}\n" + R"(
+Texture2D Material_Texture2D_0; SamplerState Material_Texture2D_0Sampler;
+float4 main(float3 n : TEXCOORD0, float3 v : TEXCOORD1) : SV_Target {
+  return float4(CustomExpression1(Material_Texture2D_0, Material_Texture2D_0Sampler, 0.5, n, v), 1.0);
+}
+)";
+  const std::string file = (out / "unreal" / "ibl_harness.hlsl").string();
+  std::ofstream(file) << harness;
+  ExpectCompiles("-D -V -e main -S frag -o " + (dir_ / "ue_ibl.spv").string() + " " + file,
+                 "Unreal IBL Custom node");
+}
+
 // Godot's shading language is GLSL ES 3.0 plus a header, uniform hints and built-ins; strip
 // exactly those and the rest must be valid GLSL ES 3.00.
 TEST_F(ShaderCompile, GodotShaderIsValidOnceGodotsAdditionsAreReplaced) {
@@ -222,18 +312,23 @@ TEST_F(ShaderCompile, GodotShaderIsValidOnceGodotsAdditionsAreReplaced) {
   ASSERT_NE(src.find("shader_type spatial;"), std::string::npos);
   ASSERT_NE(src.find("void light()"), std::string::npos);
   src = std::regex_replace(src, std::regex(R"(shader_type spatial;)"), "");
-  src = std::regex_replace(src, std::regex(R"(uniform sampler3D (\w+) : [^;]+;)"),
-                           "uniform highp sampler3D $1;");
+  src = std::regex_replace(src, std::regex(R"(render_mode [^;]+;)"), "");
+  src = std::regex_replace(
+      src, std::regex(R"(uniform (sampler3D|sampler2D|samplerCube) (\w+) : [^;]+;)"),
+      "uniform highp $1 $2;");
+  // GLSL ES has no uniform initialisers; Godot's are defaults the material starts from.
+  src = std::regex_replace(src, std::regex(R"(uniform float (\w+) = [^;]+;)"), "uniform float $1;");
   src = std::regex_replace(src, std::regex(R"(void fragment\(\))"), "void godot_fragment()");
   src = std::regex_replace(src, std::regex(R"(void light\(\))"), "void godot_light()");
   const std::string builtins =
       "#version 300 es\nprecision highp float;\n"
       "vec3 ALBEDO; float METALLIC; float SPECULAR; float ROUGHNESS;\n"
       "vec3 NORMAL; vec3 LIGHT; vec3 VIEW; vec3 LIGHT_COLOR; float ATTENUATION;\n"
-      "vec3 DIFFUSE_LIGHT; vec3 SPECULAR_LIGHT;\n";
+      "vec3 DIFFUSE_LIGHT; vec3 SPECULAR_LIGHT; vec3 EMISSION; mat4 INV_VIEW_MATRIX;\n";
   const std::string tail =
-      "out vec4 color;\nvoid main() { godot_fragment(); godot_light(); color = vec4(DIFFUSE_LIGHT, "
-      "1.0); }\n";
+      "out vec4 color;\nvoid main() { godot_fragment(); godot_light(); color = vec4(DIFFUSE_LIGHT "
+      "+ "
+      "EMISSION, 1.0); }\n";
   ExpectCompiles("-S frag " + Write("godot.frag", builtins + src + tail),
                  "Godot shader as GLSL ES");
 }

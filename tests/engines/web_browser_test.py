@@ -7,7 +7,9 @@ KTX2 with three.js's KTX2Loader and renders a sphere with the shipped ShaderMate
 the code under test:
   - the float image with a numpy reference from the analytic material (RMS and max error),
   - the manifest's probe texels with the KTX2 file and with what the GPU fetched,
-  - every shipped shader with `brdf eval` of the LUT, for 300 random direction pairs and for
+  - every shipped shader with `brdf eval` of the LUT (the default blind-spot fill: θin 0–80°
+    every 10°), for 300 random direction pairs, 100 more in the filled region (light at θin
+    65–85°, view at θout 76–88°: neither measured by the instrument), and for
     the exact directions where angle math meets a pole or the horizon (views exactly along the
     normal, at the horizon, in the mirror direction; lights exactly along the normal): the
     three.js module's GLSL (MeasuredBrdfCell, MeasuredBrdfTangent), the sidecar's
@@ -25,6 +27,8 @@ import shutil
 import subprocess
 import sys
 import tempfile
+
+from check_support import run
 
 MATERIAL = {"model": "ggx", "kd": [0.10, 0.20, 0.35], "f0": [0.04, 0.04, 0.04], "alpha": 0.35}
 
@@ -87,7 +91,7 @@ void main() {
 GODOT_BUILTINS = """precision highp float;
 vec3 ALBEDO; float METALLIC; float SPECULAR; float ROUGHNESS;
 vec3 NORMAL; vec3 LIGHT; vec3 VIEW; vec3 LIGHT_COLOR; float ATTENUATION;
-vec3 DIFFUSE_LIGHT; vec3 SPECULAR_LIGHT;
+vec3 DIFFUSE_LIGHT; vec3 SPECULAR_LIGHT; vec3 EMISSION; mat4 INV_VIEW_MATRIX;
 """
 GODOT_MAIN = """
 uniform highp sampler2D pairs;
@@ -106,13 +110,6 @@ void main() {
 }
 """
 
-
-def run(cmd, **kw):
-    r = subprocess.run(cmd, capture_output=True, text=True, **kw)
-    if r.returncode != 0:
-        print(f"FAILED ({r.returncode}): {' '.join(cmd)}\n{r.stdout}\n{r.stderr[-4000:]}")
-        sys.exit(1)
-    return r.stdout
 
 
 def es_harnesses(out, work):
@@ -164,13 +161,16 @@ def es_harnesses(out, work):
     godot = os.path.join(out, "godot")
     with open(os.path.join(godot, only(godot, ".gdshader"))) as f:
         src = f.read()
-    for pattern, repl in ((r"shader_type spatial;", ""),
-                          (r"uniform sampler3D (\w+) : [^;]+;", r"uniform highp sampler3D \1;"),
-                          (r"void fragment\(\)", "void godot_fragment()"),
-                          (r"void light\(\)", "void godot_light()")):
+    for pattern, repl, count in ((r"shader_type spatial;", "", 1),
+                                 (r"render_mode [^;]+;", "", 1),
+                                 (r"uniform (sampler3D|sampler2D|samplerCube) (\w+) : [^;]+;",
+                                  r"uniform highp \1 \2;", 3),
+                                 (r"uniform float (\w+) = [^;]+;", r"uniform float \1;", 2),
+                                 (r"void fragment\(\)", "void godot_fragment()", 1),
+                                 (r"void light\(\)", "void godot_light()", 1)):
         src, n = re.subn(pattern, repl, src)
-        if n != 1:
-            print(f"FAILED: the Godot shader has {n} matches of {pattern!r}, expected 1")
+        if n != count:
+            print(f"FAILED: the Godot shader has {n} matches of {pattern!r}, expected {count}")
             sys.exit(1)
     godot_path = os.path.join(work, "godot_es.glsl")
     with open(godot_path, "w") as f:
@@ -196,6 +196,11 @@ def main():
          "--formats", "ktx2,json"])
     web = os.path.join(out, "web")
     ktx2 = os.path.join(out, "ggx_blue.ktx2")
+    with open(os.path.join(out, "ggx_blue.json")) as f:
+        beyond = json.load(f).get("beyond") or {}
+    if beyond.get("extrapolated_theta_in") != [70.0, 80.0]:
+        print(f"FAILED: the LUT carries no filled slices at θin 70 and 80° ({beyond})")
+        return 1
     angles, nlv = os.path.join(work, "angles.txt"), os.path.join(work, "nlv.txt")
     run([sys.executable, check, "gen-pairs", "300", "11", angles, nlv])
     exact_angles = os.path.join(work, "exact_angles.txt")

@@ -8,11 +8,53 @@
 //                                    `server`, removes the profile
 //   consoleLines                     the pages' console output and uncaught exceptions
 // Every step is bounded by `deadline` (a Date.now() value): past it the script fails.
+// serveFolders() is the static HTTP server the pages are loaded from; parseOptions() reads the
+// scripts' `--name value` and `--flag` arguments.
 import { spawn } from 'node:child_process';
-import { mkdtempSync, readFileSync, existsSync, rmSync } from 'node:fs';
+import { createServer } from 'node:http';
+import { mkdtempSync, readFileSync, existsSync, rmSync, statSync } from 'node:fs';
 import { tmpdir } from 'node:os';
-import { join } from 'node:path';
+import { join, extname, resolve } from 'node:path';
 import WebSocket from 'ws';
+
+// `--name value` pairs and bare `--flag`s (true) into an object; anything else throws.
+export function parseOptions(argv) {
+  const args = {};
+  for (let i = 0; i < argv.length; i++) {
+    const a = argv[i];
+    if (!a.startsWith('--')) throw new Error(`unexpected argument ${a}`);
+    const next = argv[i + 1];
+    if (next === undefined || next.startsWith('--')) args[a.slice(2)] = true;
+    else { args[a.slice(2)] = next; i++; }
+  }
+  return args;
+}
+
+const contentTypes = { '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/javascript',
+                       '.json': 'application/json' };
+
+// Serves `routes` (URL prefix such as '/web/' -> folder; nothing outside a folder) and `pages`
+// (exact path -> HTML text) on 127.0.0.1; resolves to { server, base } (base: 'http://...').
+export async function serveFolders(routes, pages = {}) {
+  const server = createServer((req, res) => {
+    const path = new URL(req.url, 'http://127.0.0.1').pathname;
+    if (pages[path] !== undefined) {
+      res.writeHead(200, { 'Content-Type': 'text/html' });
+      res.end(pages[path]);
+      return;
+    }
+    const prefix = Object.keys(routes).find((p) => path.startsWith(p));
+    const root = prefix && resolve(routes[prefix]);
+    const file = root && resolve(root, decodeURIComponent(path.slice(prefix.length)));
+    if (!file || !file.startsWith(root) || !existsSync(file) || !statSync(file).isFile()) {
+      res.writeHead(404); res.end('not found'); return;
+    }
+    res.writeHead(200, { 'Content-Type': contentTypes[extname(file)] || 'application/octet-stream' });
+    res.end(readFileSync(file));
+  });
+  await new Promise((ok) => server.listen(0, '127.0.0.1', ok));
+  return { server, base: `http://127.0.0.1:${server.address().port}` };
+}
 
 export async function startChromium({ chromium, name, deadline, server, extraArgs = [] }) {
   const profile = mkdtempSync(join(tmpdir(), `brdf-${name}-`));

@@ -18,21 +18,13 @@
 // Usage: node render_web.mjs --web DIR --material NAME --out DIR [--size N] [--pairs FILE]
 //        [--exact FILE] [--sidecar FILE.json] [--es-harness NAME=FILE,...]
 //        [--cell NAME (an atlas material)] [--bench] [--chromium PATH]
-import { createServer } from 'node:http';
-import { readFileSync, writeFileSync, existsSync, statSync } from 'node:fs';
-import { join, extname, resolve, dirname } from 'node:path';
+import { readFileSync, writeFileSync, existsSync } from 'node:fs';
+import { join, resolve, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
-import { startChromium } from './headless_chromium.mjs';
+import { parseOptions, serveFolders, startChromium } from './headless_chromium.mjs';
 
 const here = dirname(fileURLToPath(import.meta.url));
-const args = {};
-for (let i = 2; i < process.argv.length; i++) {
-  const a = process.argv[i];
-  if (!a.startsWith('--')) throw new Error(`unexpected argument ${a}`);
-  const next = process.argv[i + 1];
-  if (next === undefined || next.startsWith('--')) args[a.slice(2)] = true;
-  else { args[a.slice(2)] = next; i++; }
-}
+const args = parseOptions(process.argv.slice(2));
 for (const required of ['web', 'material', 'out'])
   if (!args[required]) { console.error(`render_web: --${required} is required`); process.exit(2); }
 const webDir = resolve(args.web), outDir = resolve(args.out);
@@ -46,21 +38,7 @@ const chromium = args.chromium || 'chromium';
 const deadline = Date.now() + 240000;
 
 // A static server for /web/ (the exported folder) and /three/ (the npm package).
-const types = { '.html': 'text/html', '.js': 'text/javascript', '.mjs': 'text/javascript',
-                '.json': 'application/json', '.ktx2': 'application/octet-stream' };
-const server = createServer((req, res) => {
-  const url = new URL(req.url, 'http://127.0.0.1');
-  const route = url.pathname.startsWith('/web/') ? [webDir, url.pathname.slice(5)]
-              : url.pathname.startsWith('/three/') ? [threeDir, url.pathname.slice(7)] : null;
-  const file = route && resolve(route[0], decodeURIComponent(route[1]));
-  if (!file || !file.startsWith(route[0]) || !existsSync(file) || !statSync(file).isFile()) {
-    res.writeHead(404); res.end('not found'); return;
-  }
-  res.writeHead(200, { 'Content-Type': types[extname(file)] || 'application/octet-stream' });
-  res.end(readFileSync(file));
-});
-await new Promise((ok) => server.listen(0, '127.0.0.1', ok));
-const base = `http://127.0.0.1:${server.address().port}`;
+const { server, base } = await serveFolders({ '/web/': webDir, '/three/': threeDir });
 
 const { send, fail, cleanup, consoleLines } = await startChromium({
   chromium, name: 'render_web', deadline, server, extraArgs: ['--window-size=1100,1100'] });
@@ -157,6 +135,7 @@ try {
     minFilter: window.measuredBrdf.texture.minFilter, linear: window.measuredBrdf.THREE.LinearFilter,
     size: [window.measuredBrdf.texture.image.width, window.measuredBrdf.texture.image.height, window.measuredBrdf.texture.image.depth],
     webgl2: window.measuredBrdf.renderer.capabilities.isWebGL2 !== false,
+    camera: window.measuredBrdf.camera.position.toArray(),
     renderer: (() => { const gl = window.measuredBrdf.renderer.getContext(); const e = gl.getExtension('WEBGL_debug_renderer_info'); return e ? gl.getParameter(e.UNMASKED_RENDERER_WEBGL) : gl.getParameter(gl.RENDERER); })() })`);
   const image = fromBase64(await page.eval(`window.measuredBrdf.renderSphere(${size}, ${JSON.stringify(light)})`));
   // Rows come bottom first from readPixels; store top first.
@@ -165,7 +144,7 @@ try {
   writeFileSync(join(outDir, 'image.f32'), Buffer.from(flipped.buffer));
   writeFileSync(join(outDir, 'image.json'), JSON.stringify({
     width: size, height: size, channels: 4, rows: 'top first', light_direction: light,
-    light_color: [1, 1, 1], exposure: 1, camera: { fov_y_deg: 30, position: [0, 0, 5], target: [0, 0, 0] },
+    light_color: [1, 1, 1], exposure: 1, camera: { fov_y_deg: 30, position: info.camera, target: [0, 0, 0] },
     sphere: { radius: 1, centre: [0, 0, 0] }, three_revision: info.revision, texture: info }, null, 2));
 
   // Probe texels: texelFetch and a filtered fetch at the texel centre.
@@ -227,9 +206,16 @@ try {
       const [name, file] = item.split('=');
       const src = readFileSync(file, 'utf8').replace(/^#version.*\n/, '');
       const s3 = src.match(/uniform\s+(?:highp\s+)?sampler3D\s+(\w+);/);
-      const s2 = src.match(/uniform\s+(?:highp\s+)?sampler2D\s+(\w+);/);
+      // (the pairs: the one named so when there is one; the Godot shader declares its IBL pack's
+      // sampler2D before the harness's)
+      const s2 = src.match(/uniform\s+(?:highp\s+)?sampler2D\s+(\w*pairs\w*);/) ||
+                 src.match(/uniform\s+(?:highp\s+)?sampler2D\s+(\w+);/);
       if (!s3 || !s2) throw new Error(`${file}: no sampler3D/sampler2D uniforms:\n` + src);
-      return [name, src, s3[1], s2[1]];
+      // Other samplers (the Godot shader's IBL pack and radiance cube map) get a texture of
+      // their own type: two sampler types on one texture unit make WebGL refuse the draw.
+      const extra = [...src.matchAll(/uniform\s+(?:highp\s+)?(sampler2D|samplerCube)\s+(\w+);/g)]
+        .filter((m) => m[2] !== s2[1]).map((m) => [m[2], m[1]]);
+      return [name, src, s3[1], s2[1], extra];
     });
     const sidecar = args.sidecar ? JSON.parse(readFileSync(args.sidecar, 'utf8')).texel_convention.glsl : null;
     for (const [prefix, file] of pairSets) {
@@ -239,21 +225,25 @@ try {
       rows.forEach((r, i) => {
         for (let k = 0; k < 3; k++) data.set([r[3 * k], r[3 * k + 1], r[3 * k + 2], 0], (k * count + i) * 4);
       });
-      const runPairs = async (source, lutName, pairsName) => fromBase64(await page.eval(`(async () => {
+      const runPairs = async (source, lutName, pairsName, extra = []) => fromBase64(await page.eval(`(async () => {
           const M = window.measuredBrdf;
           const mod = await import('${base}/web/${manifest.engines.web.files.shader}');
           const source = ${JSON.stringify(source)}.replace('@MEASURED_BRDF_GLSL@', mod.MEASURED_BRDF_GLSL);
           const t = M.dataTexture(new Float32Array(${JSON.stringify(Array.from(data))}), ${count}, 3);
-          return M.toBase64(M.runFragment(source, { ${lutName}: { value: M.texture }, ${pairsName}: { value: t } }, ${count}, 1)); })()`));
+          const uniforms = { ${lutName}: { value: M.texture }, ${pairsName}: { value: t } };
+          for (const [name, type] of ${JSON.stringify(extra)})
+            uniforms[name] = { value: type === 'samplerCube' ? new M.THREE.WebGLCubeRenderTarget(4).texture
+                                                             : M.dataTexture(new Float32Array(4), 1, 1) };
+          return M.toBase64(M.runFragment(source, uniforms, ${count}, 1)); })()`));
       const format = (out) => Array.from({ length: count }, (_, i) =>
         `${out[i * 4]} ${out[i * 4 + 1]} ${out[i * 4 + 2]}`).join('\n') + '\n';
-      const write = async (lang, source, lutName, pairsName) =>
-        writeFileSync(join(outDir, `${prefix}_${lang}.txt`), format(await runPairs(source, lutName, pairsName)));
+      const write = async (lang, source, lutName, pairsName, extra) =>
+        writeFileSync(join(outDir, `${prefix}_${lang}.txt`), format(await runPairs(source, lutName, pairsName, extra)));
       await write('glsl', '@MEASURED_BRDF_GLSL@' + glslMain, 'lut', 'pairs');
       await write('tangent', '@MEASURED_BRDF_GLSL@' + tangentMain(prefix === 'exact'), 'lut', 'pairs');
       // The sidecar's snippet starts with its precision statements, as it ships.
       if (sidecar) await write('sidecar', sidecar + glslMain, 'lut', 'pairs');
-      for (const [name, src, s3, s2] of harnesses) await write(name, src, s3, s2);
+      for (const [name, src, s3, s2, extra] of harnesses) await write(name, src, s3, s2, extra);
     }
   }
 

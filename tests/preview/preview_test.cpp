@@ -265,6 +265,45 @@ TEST(PreviewEstimators, EnvironmentBrdfAndMisAgreeWithinErrorBars) {
   ExpectEstimatorsAgree(AnalyticBrdf(test::LafortuneN20()), studio, 64);
 }
 
+// The renderer's error bars against the scatter they describe: two renders that differ only in
+// the seed (each pixel's random shift of its Kronecker sequence) are independent estimates, so
+// √(mean over the object of (L₁ − L₂)² / 2) / mean L is the relative RMS error the images
+// actually have. The renderer's own estimate (PreviewImage::relative_rms_estimate) is the
+// spread of its passes as if they were independent; successive points of a Kronecker sequence
+// are not (they stratify), so the estimate is conservative: 1.4–1.7 × the scatter here. It
+// must never understate the error (≥ 0.9 × the scatter, which ~800 pixels know to about 5 %)
+// and stay an error bar of the right size (≤ 2.5 ×).
+TEST(PreviewEstimators, ErrorBarsMatchTheScatterOfTwoSeeds) {
+  const EnvironmentMap studio = EnvironmentMap::Studio(128, 64);
+  const AnalyticBrdf ggx(
+      MakeMaterial(Model::kGgx, {0.2, 0.1, 0.05}, {0.8, 0.8, 0.8}, {0.25, 0.25, 0.25}));
+  for (Estimator e : {Estimator::kMis, Estimator::kBrdf}) {
+    SCOPED_TRACE(static_cast<int>(e));
+    PreviewOptions o = SmallOptions(32, e, 32);
+    o.seed = 1;
+    const PreviewImage a = RenderPreview(ggx, studio, o);
+    o.seed = 2;
+    const PreviewImage b = RenderPreview(ggx, studio, o);
+    double squares = 0, sum = 0;
+    std::size_t n = 0;
+    for (std::size_t p = 0; p < a.object.size(); ++p)
+      if (a.object[p] && b.object[p]) {
+        const double la = Lum(&a.rgb[3 * p]), lb = Lum(&b.rgb[3 * p]);
+        squares += (la - lb) * (la - lb);
+        sum += 0.5 * (la + lb);
+        ++n;
+      }
+    ASSERT_GT(n, 500u);
+    const double scatter = std::sqrt(squares / (2.0 * n)) / (sum / n);
+    const double estimate = 0.5 * (a.relative_rms_estimate + b.relative_rms_estimate);
+    ASSERT_GT(scatter, 0);
+    EXPECT_GT(estimate / scatter, 0.9) << "estimate " << estimate << ", scatter " << scatter;
+    EXPECT_LT(estimate / scatter, 2.5) << "estimate " << estimate << ", scatter " << scatter;
+    RecordProperty("estimate_over_scatter_" + std::to_string(static_cast<int>(e)),
+                   std::to_string(estimate / scatter));
+  }
+}
+
 TEST(PreviewEstimators, RglFileAgreesWithItsOwnDirectQuadrature) {
   const std::string path = DataDir() + "/rgl/cc_ibiza_sunset_rgb.bsdf";
   ASSERT_TRUE(fs::exists(path)) << "set BRDF_DATA_DIR to the shared brdf-data folder (" << path
@@ -315,11 +354,13 @@ TEST(PreviewHighlight, SharpGgxHighlightSitsWhereMirrorReflectionPredicts) {
 
 // A white Lambertian under the axis-coded map: each normal's colour against NumPy's integral of
 // the continuous map, and the background straight behind the sphere is −x (cyan).
-TEST(PreviewOrientation, AxisCodedMapAppearsWhereTheDocumentedFrameSaysItIs) {
+// `spp` MIS passes, each probe within `tolerance` (relative) + 0.003 of the oracle.
+void ExpectAxisCodedOrientation(const EnvironmentMap& axes, int spp = 1024,
+                                double tolerance = 0.02) {
+  SCOPED_TRACE(axes.name());
   const AnalyticBrdf white(MakeMaterial(Model::kLambert, {1, 1, 1}, {}, {}));
-  const EnvironmentMap axes = EnvironmentMap::AxisCoded(512, 256);
   const int size = 61;
-  PreviewOptions o = SmallOptions(size, Estimator::kMis, 1024);
+  PreviewOptions o = SmallOptions(size, Estimator::kMis, spp);
   o.camera.fill = 0.5;
   const PreviewImage image = RenderPreview(white, axes, o);
   struct Probe {
@@ -336,7 +377,7 @@ TEST(PreviewOrientation, AxisCodedMapAppearsWhereTheDocumentedFrameSaysItIs) {
                                                 std::to_string(n.y) + " " + std::to_string(n.z));
     ASSERT_EQ(expected.size(), 3u);
     for (int ch = 0; ch < 3; ++ch)
-      EXPECT_NEAR(image.Pixel(p.x, p.y)[ch], expected[ch], 0.02 * expected[ch] + 0.003)
+      EXPECT_NEAR(image.Pixel(p.x, p.y)[ch], expected[ch], tolerance * expected[ch] + 0.003)
           << p.what << " channel " << ch << " got " << image.Pixel(p.x, p.y)[ch] << " want "
           << expected[ch];
   }
@@ -346,6 +387,47 @@ TEST(PreviewOrientation, AxisCodedMapAppearsWhereTheDocumentedFrameSaysItIs) {
   EXPECT_LT(behind[0], 0.1);
   EXPECT_GT(behind[1], 0.4);
   EXPECT_GT(behind[2], 0.4);
+}
+
+TEST(PreviewOrientation, AxisCodedMapAppearsWhereTheDocumentedFrameSaysItIs) {
+  ExpectAxisCodedOrientation(EnvironmentMap::AxisCoded(512, 256));
+}
+
+// Maps read from files keep the documented orientation: the axis-coded map written by NumPy as
+// an OpenEXR file (OpenImageIO) and as a run-length encoded Radiance .hdr (bytes written by the
+// oracle), read by EnvironmentMap::Load. Every pixel centre's direction reads the colour the
+// formula gives there (the .hdr's 8-bit mantissas: within 1/128 of the largest channel), and
+// the sphere under the EXR shows the axes where the in-memory map does. A map mirrored in
+// either direction swaps +y/−y or +z/−z: green for magenta, blue for yellow.
+TEST(PreviewOrientation, MapsReadFromExrAndHdrFilesKeepTheDocumentedOrientation) {
+  const brdf::test::ScopedTempDir tmp("preview-axes");
+  const int w = 256, h = 128;
+  const std::string cmd = std::string(BRDF_PYTHON3) +
+                          " " BRDF_SOURCE_DIR "/tests/python/preview_oracle.py write-axes '" +
+                          tmp.path().string() + "' " + std::to_string(w) + " " + std::to_string(h);
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  for (const char* name : {"axes.exr", "axes.hdr"}) {
+    SCOPED_TRACE(name);
+    const EnvironmentMap map = EnvironmentMap::Load((tmp / name).string());
+    ASSERT_EQ(map.width(), w);
+    ASSERT_EQ(map.height(), h);
+    for (int j = 0; j < h; j += 3)
+      for (int i = 0; i < w; i += 5) {
+        const double theta = (j + 0.5) / h * kPi, phi = (i + 0.5) / w * 2 * kPi;
+        const Vec3 d{std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi),
+                     std::cos(theta)};
+        const double px = std::max(0.0, d.x), py = std::max(0.0, d.y), pz = std::max(0.0, d.z);
+        const double nx = std::max(0.0, -d.x), ny = std::max(0.0, -d.y), nz = std::max(0.0, -d.z);
+        const double want[3] = {px + 0.5 * (ny + nz), py + 0.5 * (nx + nz), pz + 0.5 * (nx + ny)};
+        const double top = std::max({want[0], want[1], want[2]});
+        const Rgb got = map.Radiance(d);
+        for (int c = 0; c < 3; ++c)
+          ASSERT_NEAR(got[c], want[c], top / 128 + 1e-6)
+              << "pixel (" << i << ", " << j << ") channel " << c;
+      }
+    // A quarter of the in-memory test's passes: a mirror moves a probe's colour by far more.
+    if (std::string(name) == "axes.exr") ExpectAxisCodedOrientation(map, 256, 0.05);
+  }
 }
 
 // ---- χ² tests of every sampler's pdf against its sampling routine.

@@ -6,8 +6,10 @@
 //   large outliers (dust, a glint, a hot pixel: the value times 3–10 plus 0.2–1 1/sr). The robust
 //   fit must come back to the true parameters, the plain one is pulled away;
 // - SciPy: scipy.optimize.least_squares(loss="cauchy", f_scale=b) fitting the same model
-//   (bench/fit/scipy_baseline.py's transcription of the published formulas), samples and weights
-//   from the same start (tests/python/robust_fit_oracle.py) reaches the same cost and
+//   (bench/fit/scipy_baseline.py's transcription of the published formulas) on the same samples,
+//   with solid-angle weights the oracle computes from the grid itself
+//   (tests/python/fit_weights.py), from the same start (tests/python/robust_fit_oracle.py)
+//   reaches the same cost and
 //   parameters, numpy's Cauchy cost at the reported parameters is the reported cost (and its
 //   ½·Σ r² at the plain fit the plain fit's), and numpy's 1.4826 × median |r| at the start is
 //   the reported scale.
@@ -23,7 +25,7 @@
 
 #include "../device/device_test_support.h"
 #include "brdf/fit/fit.h"
-#include "fit_data.h"  // private to brdf_fit: the exact samples and weights a fit uses
+#include "fit_data_csv.h"
 #include "synthetic_capture.h"
 #include "test_support.h"
 
@@ -117,16 +119,6 @@ TEST(FitRobust, OutliersPullThePlainFitAwayButNotTheRobustOne) {
   }
 }
 
-void WriteFitData(const std::filesystem::path& path, const FitData& data) {
-  std::ofstream out(path);
-  out.precision(17);
-  out << "n_dot_l,n_dot_v,n_dot_h,v_dot_h,l_dot_v,v_dot_r,m_r,m_g,m_b,cos_in,sqrt_w\n";
-  for (const FitSample& s : data.samples)
-    out << s.g.n_dot_l << ',' << s.g.n_dot_v << ',' << s.g.n_dot_h << ',' << s.g.v_dot_h << ','
-        << s.g.l_dot_v << ',' << s.g.v_dot_r << ',' << s.m[0] << ',' << s.m[1] << ',' << s.m[2]
-        << ',' << s.cos_in << ',' << s.sqrt_w << '\n';
-}
-
 // From the plain fit as start (one refinement, the scale chosen there), under the ngan and the
 // log loss. Both optimisers minimise the same ½·Σ b²·ln(1 + r²/b²); the tolerances are those of
 // two converged optimisers of one smooth function: costs within 1e-6 relative (Ceres stops at
@@ -156,7 +148,7 @@ TEST(FitRobust, CostScaleAndOptimumAgreeWithScipyCauchy) {
       const std::filesystem::path dir =
           tmp / (std::string(c.label) + "-" + std::string(FitLossName(loss)));
       std::filesystem::create_directories(dir);
-      WriteFitData(dir / "fit_data.csv", PrepareFitData(meas, o));
+      testing::WriteFitData(dir / "fit_data.csv", PrepareFitData(meas, o));
       std::ofstream(dir / "start.json") << MaterialToJson(start);
       std::ofstream(dir / "fitted.json") << MaterialToJson(r.material);
       {
@@ -166,13 +158,10 @@ TEST(FitRobust, CostScaleAndOptimumAgreeWithScipyCauchy) {
         job["scale"] = r.report.robust_scale;
         std::ofstream(dir / "job.json") << job.dump();
       }
-      const std::string cmd = std::string(BRDF_PYTHON3) + " " + BRDF_SOURCE_DIR +
-                              "/tests/python/robust_fit_oracle.py '" + dir.string() + "'";
-      const brdf::test::CommandOutput oracle = brdf::test::RunCommand(cmd);
-      ASSERT_EQ(oracle.status, 0) << cmd << " failed (needs /usr/bin/python3 with numpy and "
-                                  << "SciPy: tools/install-deps.sh)\n"
-                                  << oracle.out;
-      const nlohmann::json want = nlohmann::json::parse(oracle.out);
+      const std::optional<nlohmann::json> oracle =
+          testing::RunFitOracle("robust_fit_oracle.py", dir);
+      ASSERT_TRUE(oracle.has_value());
+      const nlohmann::json& want = *oracle;
 
       // The plain fit's reported cost is numpy's ½·Σ r² at its parameters.
       const double plain_cost = want["plain_cost_at_start"].get<double>();

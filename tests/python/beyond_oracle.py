@@ -18,12 +18,20 @@ against values written here from the formulas of docs/design.md §9:
   5. measured texels unchanged bit for bit: the KTX2 of `convert --beyond clamp` and of the
      default, RGB9E5 words of every texel with θout ≤ θb of every measured slice;
   6. the leave-last-slice-out figure the sidecar records, recomputed from `brdf eval` of a
-     3-slice capture (θin 0/20/40) and of the 4-slice one at the 60° slice's texel directions.
+     3-slice capture (θin 0/20/40) and of the 4-slice one at the 60° slice's texel directions,
+     and the same figure in `brdf info --json` of the capture and in `brdf convert`'s line;
+  7. `brdf info --json`'s physical sanity report of a noisy capture (the simulator's default
+     detector noise) against NumPy: per LUT slice the directional albedo, measured part
+     (θout ≤ θb) and filled part, by a 0.75° × 1.5° midpoint quadrature of `brdf eval`; the
+     reciprocity residual over the pairs measured both ways, f(a → b, Δφ) against
+     f(b → a, Δφ); the saturated and below-noise counts from the file itself
+     (tests/python/bpc_reader.py, written from docs/formats/bpc.md).
 Exit status 1 with the failing checks listed.
 """
 import json
 import math
 import os
+import re
 import struct
 import subprocess
 import sys
@@ -240,6 +248,88 @@ def main(argv):
                   "%s: leave-last-slice-out (%s) from brdf eval: median %.4f p90 %.4f; sidecar "
                   "%.4f %.4f" % (n, method, med, p90, r["median_relative_error"],
                                  r["p90_relative_error"]))
+            info = json.loads(tool.run("info", "--json", paths[n]))["blind_spot_fill"]
+            i = info["leave_last_slice_out"]
+            check(info["method"] == method and close(med, i["median_relative_error"])
+                  and close(p90, i["p90_relative_error"]),
+                  "%s: brdf info --json reports the same leave-last-slice-out figure (%s %.4f "
+                  "%.4f)" % (n, info["method"], i["median_relative_error"],
+                             i["p90_relative_error"]))
+            conv = subprocess.run([exe, "convert", paths[n], "--out", out, "--formats", "json",
+                                   "--force"], capture_output=True, text=True)
+            line = [x for x in conv.stderr.splitlines() if "predicted from the others" in x]
+            nums = re.findall(r"within ([0-9.e+-]+) % \(median\), ([0-9.e+-]+) % \(p90\)",
+                              line[0] if line else "")
+            check(len(line) == 1 and "θin 60°" in line[0] and len(nums) == 1 and
+                  close(med, float(nums[0][0]) / 100) and close(p90, float(nums[0][1]) / 100),
+                  "%s: brdf convert prints one leave-last-slice-out line (%s; NumPy: median "
+                  "%.4f %%, p90 %.4f %%)" % (n, line, 100 * med, 100 * p90))
+
+        # 7. The physical sanity report of a noisy capture.
+        sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+        import bpc_reader  # noqa: E402
+        noisy = os.path.join(tmp, "gold_noisy.bpc")
+        tool.run("capture", "--device", "sim", "--material", os.path.join(tmp, "gold.json"),
+                 "--sample", "gold noisy", "--seed", "5", "--out", noisy, "--quiet", "--force")
+        rep = json.loads(tool.run("info", "--json", noisy))["physical_sanity"]
+        theta_b = rep["theta_b_deg"]
+        measured = [0.0, 20.0, 40.0, 60.0]
+        nt, nphi = 120, 240
+        tt = (np.arange(nt) + 0.5) * 90.0 / nt
+        pp = (np.arange(nphi) + 0.5) * 360.0 / nphi
+        T, P = np.meshgrid(tt, pp, indexing="ij")
+        w = np.cos(T * DEG) * np.sin(T * DEG) * (90.0 / nt * DEG) * (360.0 / nphi * DEG)
+        cap = bpc_reader.read_bpc(noisy)
+        flags = {round(s["theta_in_deg"], 6): s["records"]["flags"] for s in cap["slices"]}
+        check([s["theta_in"] for s in rep["slices"]] == [10.0 * k for k in range(9)],
+              "gold (noisy): the report covers the LUT's slices θin 0, 10, …, 80°")
+        for s in rep["slices"]:
+            ti = s["theta_in"]
+            pairs = np.stack([np.full(T.size, ti), np.zeros(T.size), T.ravel(), P.ravel()], 1)
+            f = tool.eval(noisy, pairs).reshape(nt, nphi, 3)
+            is_measured = ti in measured
+            inside = (T <= theta_b) if is_measured else np.zeros_like(T, bool)
+            a_meas = (f * (w * inside)[..., None]).sum((0, 1))
+            a_fill = (f * (w * ~inside)[..., None]).sum((0, 1))
+            got_m, got_f = np.array(s["albedo_measured"]), np.array(s["albedo_filled"])
+            ok = (np.abs(got_m - a_meas) <= 0.01 * a_meas + 1e-4).all() and \
+                (np.abs(got_f - a_fill) <= 0.01 * a_fill + 1e-4).all()
+            check(ok and s["measured"] == is_measured,
+                  "gold (noisy) θin %g°: albedo measured part %s + filled part %s; NumPy %s + %s"
+                  % (ti, np.round(got_m, 4).tolist(), np.round(got_f, 4).tolist(),
+                     np.round(a_meas, 4).tolist(), np.round(a_fill, 4).tolist()))
+            if not is_measured:
+                check(s["reciprocity"] is None, "gold (noisy) θin %g°: no reciprocity pairs in a "
+                      "filled slice" % ti)
+                continue
+            phi = np.arange(0.0, 360.0, 5.0)
+            res = []
+            for b in measured:
+                if b == ti or b > theta_b:
+                    continue
+                k = phi.size
+                f1 = tool.eval(noisy, np.stack([np.full(k, ti), np.zeros(k), np.full(k, b), phi],
+                                               1)).sum(1)
+                f2 = tool.eval(noisy, np.stack([np.full(k, b), np.zeros(k), np.full(k, ti), phi],
+                                               1)).sum(1)
+                res.extend((np.abs(f1 - f2) / (0.5 * (f1 + f2))).tolist())
+            res = np.sort(np.array(res))
+            r = s["reciprocity"]
+            check(r["pairs"] == res.size and abs(r["median_relative"] - res[res.size // 2]) <=
+                  1e-4 + 1e-3 * res[res.size // 2] and abs(r["max_relative"] - res[-1]) <=
+                  1e-4 + 1e-3 * res[-1] and res[-1] > 0,
+                  "gold (noisy) θin %g°: reciprocity residual median %.4f max %.4f over %d pairs;"
+                  " NumPy %.4f %.4f over %d" % (ti, r["median_relative"], r["max_relative"],
+                                                r["pairs"], res[res.size // 2], res[-1], res.size))
+            fl = flags[round(ti, 6)]
+            sat, low = int(((fl & 1) != 0).sum()), int(((fl & 2) != 0).sum())
+            check(s["saturated"] == sat and s["below_noise_floor"] == low,
+                  "gold (noisy) θin %g°: saturated %d, below noise %d; the file: %d, %d" % (
+                      ti, s["saturated"], s["below_noise_floor"], sat, low))
+            total = a_meas + a_fill  # NumPy's
+            check(s["energy_flag"] == bool((total > 1 + s["energy_margin"]).any()),
+                  "gold (noisy) θin %g°: energy flag %s for albedo %s" % (
+                      ti, s["energy_flag"], np.round(total, 4).tolist()))
     if FAILURES:
         print("%d check(s) failed" % len(FAILURES))
         return 1

@@ -40,8 +40,11 @@ def read(path):
 
 
 def convert(brdf, material, out_dir, *options):
+    # --beyond clamp: the measured 4 slices, the 2 × 2 composite checked below (the default
+    # blind-spot fill makes 9, a 3 × 3 composite of the same writer).
     run = subprocess.run([brdf, "convert", material, "--out", out_dir, "--formats",
-                          "exr,png,json", *options], capture_output=True, text=True, timeout=300)
+                          "exr,png,json", "--beyond", "clamp", *options], capture_output=True,
+                         text=True, timeout=300)
     if run.returncode != 0:
         sys.exit(f"FAIL: brdf convert {' '.join(options)}: {run.stderr.strip()}")
 

@@ -150,15 +150,27 @@ def ktx2_words(path):
     return words.reshape(depth, height, width)
 
 
+FILLED_PAIRS = 100
+
+
+def in_filled_region(theta_in, theta_out):
+    return theta_in >= 65.0 and theta_out >= 76.0
+
+
 def gen_pairs(count, seed, angles_out, nlv_out):
     rng = np.random.default_rng(seed)
     # θin over the measured slices and beyond the last (exchanged with the view by reciprocity
     # when the view is nearer the measured range, else clamped to the last slice), θout into
     # the extrapolated band; random azimuths and a random rotation of the whole frame.
-    theta_in = rng.uniform(0.0, 85.0, count)
-    theta_out = rng.uniform(0.0, 85.0, count)
-    phi_in = rng.uniform(0.0, 360.0, count)
-    phi_out = rng.uniform(0.0, 360.0, count)
+    # Then FILLED_PAIRS more in the region the blind-spot fill builds (docs/design.md §5, "Beyond
+    # the measured slices"): light at θin 65–85° and view at θout 76–88°, both past what the
+    # instrument measures (θin ≤ 60°, θout ≤ 75°).
+    theta_in = np.concatenate([rng.uniform(0.0, 85.0, count),
+                               rng.uniform(65.0, 85.0, FILLED_PAIRS)])
+    theta_out = np.concatenate([rng.uniform(0.0, 85.0, count),
+                                rng.uniform(76.0, 88.0, FILLED_PAIRS)])
+    phi_in = rng.uniform(0.0, 360.0, count + FILLED_PAIRS)
+    phi_out = rng.uniform(0.0, 360.0, count + FILLED_PAIRS)
     with open(angles_out, "w") as a, open(nlv_out, "w") as b:
         for t_i, p_i, t_o, p_o in zip(theta_in, phi_in, theta_out, phi_out):
             q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
@@ -243,6 +255,14 @@ def compare_pairs(name, cpu, gpu, angles, by_category):
             sel = np.array([x == c for x in cats])
             parts.append(f"{c} {worst_per_pair[sel].max():.3g}")
         line += " (max by case: " + ", ".join(parts) + ")"
+    else:
+        filled = np.array([in_filled_region(a[0], a[2]) for a in angles])
+        if filled.sum() < FILLED_PAIRS // 2:
+            print(f"FAIL {name}: only {filled.sum()} pairs in the filled region (θin ≥ 65°, "
+                  f"θout ≥ 76°)")
+            return False
+        line += (f"; filled region (θin 65–85°, θout 76–88°): {filled.sum()} pairs, max rel "
+                 f"diff {worst_per_pair[filled].max():.3g}")
     print(line)
     # Same texels, same coordinates: only float32 angle math and the GPU's filter weights differ
     # from the double-precision CPU lookup (measured: up to 4.6e-6, the HLSL paths).

@@ -50,3 +50,14 @@ def run_cli(tool, *args):
     """Runs `brdf ARGS`; returns (exit code, stdout, stderr)."""
     p = subprocess.run([tool, *map(str, args)], capture_output=True, text=True, timeout=600)
     return p.returncode, p.stdout, p.stderr
+
+
+def sim_capture(tool, folder, material, *extra, phi_out_step=6):
+    """`brdf capture --device sim` of a library material into folder/MATERIAL.bpc (sample name
+    = material); returns the path. `extra`: further options (--noise 0, --seed N, ...)."""
+    out = folder / f"{material}.bpc"
+    code, _, err = run_cli(tool, "capture", "--device", "sim", "--material", material, "--sample",
+                           material, "--phi-out-step", str(phi_out_step), "--out", out, "--quiet",
+                           *extra)
+    assert code == 0, err
+    return out

@@ -93,3 +93,15 @@ def test_interpreter_survives_errors(tmp_path):
         with pytest.raises((OSError, ValueError)):
             bad()
     assert brdf.open("gold").eval_deg(0, 0, 0, 0).shape == (3,)
+
+
+def test_value_no_surface_has_raises_as_eval_refuses_it(brdf_tool, tmp_path):
+    # docs/design.md §4: f_r = −1e30 is refused by every reader, naming slice and sample.
+    table = tmp_path / "negative.csv"
+    table.write_text("theta_in,phi_in,theta_out,phi_out,r,g,b\n"
+                     "0,0,10,0,0.1,0.1,0.1\n0,0,20,0,-1e30,0.1,0.1\n0,0,30,90,0.1,0.1,0.1\n")
+    with pytest.raises(ValueError) as e:
+        brdf.open(table)
+    assert "slice 0" in str(e.value) and "sample 1" in str(e.value), str(e.value)
+    assert_cli_message(cli_error_line(brdf_tool, "eval", table, "--in", "0,0", "--out", "10,0"),
+                       str(e.value))

@@ -33,11 +33,15 @@ def test_installed_package_uses_installed_materials(tmp_path):
         "try:\n"
         "    brdf.open('no_such_material_anywhere')\n"
         "except OSError as e:\n"
-        "    print(e)\n")
+        "    print(e)\n"
+        # The second compiled part (fit, convert, preview, capture) is installed beside it and
+        # finds the installed library too.
+        "print(brdf.preview('gold', size=8, estimator='quadrature').shape)\n")
     p = subprocess.run([python, "-c", script], capture_output=True, text=True, cwd=tmp_path,
                        env=env, timeout=120)
     assert p.returncode == 0, p.stderr
-    file_line, values_line, error_line = p.stdout.splitlines()
+    file_line, values_line, error_line, preview_line = p.stdout.splitlines()
+    assert preview_line == "(8, 8, 3)"
     assert pathlib.Path(file_line).resolve().is_relative_to(package.resolve())
     assert f"(library {materials.resolve()}: " in error_line, error_line
     # The installed module answers as the build tree's does.

@@ -9,18 +9,14 @@ import numpy as np
 import pytest
 
 import brdf
-from conftest import run_cli
+from conftest import run_cli, sim_capture
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "python"))
 import bpc_reader  # noqa: E402
 
 
 def capture(tool, tmp_path, name, *extra):
-    out = tmp_path / f"{name}.bpc"
-    code, _, err = run_cli(tool, "capture", "--device", "sim", "--material", name, "--sample",
-                           name, "--phi-out-step", "6", "--out", out, "--quiet", *extra)
-    assert code == 0, err
-    return out
+    return sim_capture(tool, tmp_path, name, *extra)
 
 
 @pytest.mark.parametrize("material, extra", [("gold", ()), ("paper_white", ("--noise", "0"))])

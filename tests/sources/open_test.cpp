@@ -117,11 +117,13 @@ TEST_F(Open, ForTheViewerACaptureIsReadAndResampledOnceForBothTheLutAndTheBrdf) 
     ASSERT_EQ(view.measurement->slices[k].samples.size(), written.slices[k].samples.size());
     EXPECT_EQ(view.measurement->slices[k].samples[7].rgb, written.slices[k].samples[7].rgb);
   }
-  // θb is the file's largest θout; the report describes the LUT's slices.
+  // θb is the file's largest θout; the report describes the measured slices. The LUT is the
+  // one the commands build, default blind-spot fill included: Δin/2 = 10° up to 80°
+  // (docs/design.md §5, "Beyond the measured slices").
   EXPECT_DOUBLE_EQ(view.theta_b_deg, 70.0);
   ASSERT_TRUE(view.resample_report.has_value());
   EXPECT_EQ(view.resample_report->slices.size(), 3u);
-  EXPECT_EQ(view.lut.theta_in_deg, (std::vector<double>{0, 20, 40}));
+  EXPECT_EQ(view.lut.theta_in_deg, (std::vector<double>{0, 10, 20, 30, 40, 50, 60, 70, 80}));
   // The BRDF samples that very LUT (one resampling, not two): same texels, same values.
   const auto* lut_brdf = dynamic_cast<const LutBrdf*>(view.brdf.get());
   ASSERT_NE(lut_brdf, nullptr);
@@ -140,7 +142,8 @@ TEST_F(Open, ForTheViewerAMaterialKeepsItsFormulaAndShowsItsReferenceCapture) {
   ASSERT_TRUE(view.measurement.has_value());
   ASSERT_EQ(view.measurement->slices.size(), 4u);
   for (const Slice& s : view.measurement->slices) EXPECT_EQ(s.samples.size(), 76u * 360u);
-  EXPECT_EQ(view.lut.theta_in_deg, (std::vector<double>{0, 20, 40, 60}));
+  // Its LUT, as `brdf convert` makes it with the default fill: 0–80° every 10°.
+  EXPECT_EQ(view.lut.theta_in_deg, (std::vector<double>{0, 10, 20, 30, 40, 50, 60, 70, 80}));
   EXPECT_DOUBLE_EQ(view.theta_b_deg, 75.0);
   // A sample of the capture is the formula at its own direction.
   const Sample& x = view.measurement->slices[2].samples[30 * 360 + 180];

@@ -32,13 +32,14 @@ TEST_F(AtlasCommand, EachCellEqualsThatMaterialsOwnLut) {
     EXPECT_TRUE(fs::is_regular_file(dir_ / "out" / (std::string("atlas") + ext))) << ext;
   EXPECT_TRUE(FilesStartingWith(dir_ / "out", ".").empty()) << "temporary files left behind";
 
-  // M = 3: Cm = ceil(√3) = 2 columns, Rm = ceil(3/2) = 2 rows of 361 × 181 cells.
+  // M = 3: Cm = ceil(√3) = 2 columns, Rm = ceil(3/2) = 2 rows of 361 × 181 cells. Both
+  // commands fill the blind spots by default: θin 0, 10, …, 80°, K = 9 (docs/design.md §5).
   const Texture3d atlas = ReadKtx2Layout(dir_ / "out" / "atlas.ktx2");
   EXPECT_EQ(atlas.format, 123u);
   ASSERT_EQ(atlas.width, 2u * 361u);
   ASSERT_EQ(atlas.height, 2u * 181u);
-  ASSERT_EQ(atlas.depth, 4u);
-  EXPECT_EQ(atlas.payload.size(), 722u * 362u * 4u * 4u);
+  ASSERT_EQ(atlas.depth, 9u);
+  EXPECT_EQ(atlas.payload.size(), 722u * 362u * 9u * 4u);
   EXPECT_TRUE(ReadDdsLayout(dir_ / "out" / "atlas.dds").payload == atlas.payload);
 
   const Json manifest = Json::parse(ReadAll(dir_ / "out" / "atlas.json"));
@@ -46,12 +47,24 @@ TEST_F(AtlasCommand, EachCellEqualsThatMaterialsOwnLut) {
   for (std::size_t m = 0; m < mats.size(); ++m) {
     SCOPED_TRACE(mats[m].first);
     EXPECT_EQ(manifest["materials"][m]["name"], mats[m].first);
+    // The manifest records the fill as a sidecar does: the measured slices of the virtual
+    // capture (docs/design.md §1), the ones past 60° that were filled, the method chosen.
+    const Json& beyond = manifest["materials"][m]["beyond"];
+    ASSERT_TRUE(beyond.is_object()) << manifest["materials"][m].dump();
+    EXPECT_EQ(beyond["measured_theta_in"].get<std::vector<double>>(),
+              (std::vector<double>{0, 20, 40, 60}));
+    EXPECT_EQ(beyond["extrapolated_theta_in"].get<std::vector<double>>(),
+              (std::vector<double>{70, 80}));
+    EXPECT_EQ(beyond["inserted_theta_in"].get<std::vector<double>>(),
+              (std::vector<double>{10, 30, 50}));
+    EXPECT_TRUE(beyond["method"] == "model" || beyond["method"] == "hold") << beyond["method"];
+    EXPECT_TRUE(beyond["leave_last_slice_out"].is_object());
     const Texture3d own = ReadKtx2Layout(dir_ / "own" / (mats[m].first + ".ktx2"));
-    // One material's payload: 361 · 181 · 4 texels · 4 bytes = 1,045,456 (docs/design.md §5).
-    EXPECT_EQ(own.payload.size(), 1045456u);
+    // One material's payload: 361 · 181 · 9 texels · 4 bytes = 2,352,276 (docs/design.md §5).
+    EXPECT_EQ(own.payload.size(), 2352276u);
     const std::size_t x0 = (m % 2) * 361, y0 = (m / 2) * 181;
     std::size_t differing = 0;
-    for (std::size_t k = 0; k < 4; ++k)
+    for (std::size_t k = 0; k < 9; ++k)
       for (std::size_t j = 0; j < 181; ++j)
         for (std::size_t i = 0; i < 361; ++i)
           differing += atlas.Word(x0 + i, y0 + j, k) != own.Word(i, j, k);
@@ -67,7 +80,7 @@ TEST_F(AtlasCommand, EachCellEqualsThatMaterialsOwnLut) {
 
   // The fourth cell (column 1, row 1) is unused and zero.
   std::size_t non_zero = 0;
-  for (std::size_t k = 0; k < 4; ++k)
+  for (std::size_t k = 0; k < 9; ++k)
     for (std::size_t j = 181; j < 362; ++j)
       for (std::size_t i = 361; i < 722; ++i) non_zero += atlas.Word(i, j, k) != 0;
   EXPECT_EQ(non_zero, 0u);

@@ -48,7 +48,10 @@ TEST_F(CaptureInputs, EvalOfCaptureMatchesAnalytic) {
             "30 0 30 180\n"
             "20 0 85 10\n"
             "20 90 30 270\n");
-  const ToolRun r = RunTool("eval " + Quote(bpc) + " --pairs " + Quote(dir_ / "pairs.txt"), dir_);
+  // --beyond clamp: the measured slices, the θin interpolation between them and the §6 band
+  // (the default fill inserts a 30° slice and replaces the band; tests/python/beyond_oracle.py).
+  const ToolRun r =
+      RunTool("eval " + Quote(bpc) + " --beyond clamp --pairs " + Quote(dir_ / "pairs.txt"), dir_);
   ASSERT_EQ(r.exit_code, 0) << r.err;
   std::istringstream lines(r.out);
   std::string line;
@@ -79,8 +82,8 @@ TEST_F(CaptureInputs, EvalOfCaptureMatchesAnalytic) {
   near(got[7], got[0]);  // isotropic: only φout − φin matters
 
   // With --extrapolate 0.2,0.3: f(75°)·((1 − α) + α·0.2), α = b((85 − 75)/15, 0.3).
-  const ToolRun x =
-      RunTool("eval " + Quote(bpc) + " --in 20,0 --out 85,10 --extrapolate 0.2,0.3", dir_);
+  const ToolRun x = RunTool(
+      "eval " + Quote(bpc) + " --in 20,0 --out 85,10 --extrapolate 0.2,0.3 --beyond clamp", dir_);
   ASSERT_EQ(x.exit_code, 0) << x.err;
   const double alpha = BezierByBisection(10.0 / 15.0, 0.3);
   const auto f75 = m.FAngles(20, 75, 10);
@@ -150,7 +153,8 @@ TEST_F(CaptureInputs, UnfinishedCaptureWithEverySliceIsConvertedWithAWarning) {
   EXPECT_NE(r.out.find("converted 2 of 2"), std::string::npos) << r.out;
   EXPECT_NE(r.err.find("no_end.bpc: warning: no intact end chunk"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("cut_end.bpc: warning: no intact end chunk"), std::string::npos) << r.err;
-  EXPECT_EQ(ReadKtx2Layout(dir_ / "out" / "no_end.ktx2").depth, 4u);
+  // The default fill: θin 0, 10, …, 80° (Δin/2 up to 80°, docs/design.md §5), 9 slices.
+  EXPECT_EQ(ReadKtx2Layout(dir_ / "out" / "no_end.ktx2").depth, 9u);
 }
 
 TEST_F(CaptureInputs, UnfinishedCaptureMissingSlicesIsRefused) {
@@ -169,15 +173,24 @@ TEST_F(CaptureInputs, UnfinishedCaptureMissingSlicesIsRefused) {
 }
 
 TEST_F(CaptureInputs, CaptureWithOtherThetaInStepsConverts) {
-  // θin 0/30/60 on a 5° lattice: K = 3, Δin = 30° recorded in the sidecar.
+  // θin 0/30/60 on a 5° lattice: K = 3, Δin = 30°. The default fill halves the step and
+  // extrapolates up to 80° (docs/design.md §5): θin 0, 15, …, 75°, 6 slices; --beyond clamp
+  // keeps the 3 measured ones.
   const fs::path p = dir_ / "tilted.bpc";
   WriteBpc(p.string(), CaptureOf(Lafortune20(), {0, 30, 60}, 75, 5, 5));
   const ToolRun r = RunTool(
       "convert " + Quote(p) + " --out " + Quote(dir_ / "out") + " --formats ktx2 --quiet", dir_);
   ASSERT_EQ(r.exit_code, 0) << r.out << r.err;
   const Texture3d t = ReadKtx2Layout(dir_ / "out" / "tilted.ktx2");
-  EXPECT_EQ(t.depth, 3u);
-  EXPECT_EQ(t.payload.size(), 361u * 181u * 3u * 4u);
+  EXPECT_EQ(t.depth, 6u);
+  EXPECT_EQ(t.payload.size(), 361u * 181u * 6u * 4u);
+  const ToolRun c = RunTool("convert " + Quote(p) + " --out " + Quote(dir_ / "clamped") +
+                                " --formats ktx2 --quiet --beyond clamp",
+                            dir_);
+  ASSERT_EQ(c.exit_code, 0) << c.out << c.err;
+  const Texture3d u = ReadKtx2Layout(dir_ / "clamped" / "tilted.ktx2");
+  EXPECT_EQ(u.depth, 3u);
+  EXPECT_EQ(u.payload.size(), 361u * 181u * 3u * 4u);
 }
 
 }  // namespace

@@ -26,8 +26,9 @@ class SourcesCli : public ToolTest {
     return p;
   }
   std::array<double, 3> Eval(const fs::path& file, const std::string& in, const std::string& out,
-                             std::string* err = nullptr) {
-    const ToolRun r = RunTool("eval " + Quote(file) + " --in " + in + " --out " + out, dir_);
+                             std::string* err = nullptr, const std::string& options = {}) {
+    const ToolRun r =
+        RunTool("eval " + Quote(file) + " --in " + in + " --out " + out + options, dir_);
     EXPECT_EQ(r.exit_code, 0) << r.err;
     if (err) *err = r.err;
     return ParseTriple(r.out);
@@ -52,11 +53,12 @@ void FixChunkCrcs(std::string& b, std::size_t at) {
 // LUT. Between measured θin both now interpolate linearly at the same specular-frame
 // coordinates: in the mirror direction θd = 0 in both neighbouring slices, so the value is the
 // mean of the two slices' mirror values, f(20°→20°) and f(40°→40°), exactly (texel centres on
-// capture nodes; 1e-6 covers the float32 storage).
+// capture nodes; 1e-6 covers the float32 storage). --beyond clamp: the measured slices alone
+// (the default fill inserts a 30° slice; the capture-against-texture half below uses it).
 TEST_F(SourcesCli, CaptureBetweenSlicesInterpolatesInTheSpecularFrameLikeTheLut) {
   const Analytic m = Ggx03();
   const fs::path bpc = WriteCapture("ggx", CaptureOf(m, {0, 20, 40, 60}));
-  const auto got = Eval(bpc, "30,0", "30,180");
+  const auto got = Eval(bpc, "30,0", "30,180", nullptr, " --beyond clamp");
   const auto f20 = m.FAngles(20, 20, 180), f40 = m.FAngles(40, 40, 180);
   for (int c = 0; c < 3; ++c) {
     const double mid = 0.5 * (f20[c] + f40[c]);
@@ -118,13 +120,16 @@ TEST_F(SourcesCli, EveryCommandThatReadsASourceAcceptsALibraryName) {
 }
 
 // The library form of the same guarantee: OpenBrdf of a capture and the float LUT that
-// BuildLut makes of it (what `brdf convert` encodes) agree to the last bit.
+// BuildLut makes of it with the commands' options (what `brdf convert` encodes, the default
+// blind-spot fill included: 9 slices 0–80°) agree to the last bit, filled region included.
 TEST_F(SourcesCli, OpenBrdfOfACaptureIsTheFloatLutSampledAsAGpuDoes) {
   const fs::path bpc = WriteCapture("laf", CaptureOf(Lafortune20(), {0, 20, 40, 60}, 75, 5, 5));
   const sources::OpenedSource s = sources::OpenBrdf(bpc.string());
   EXPECT_EQ(s.evaluation, sources::Evaluation::kResampledLut);
-  const Lut lut = processing::BuildLut(LoadBpc(bpc.string()));
-  for (double ti : {0.0, 13.0, 20.0, 31.5, 59.0})
+  const Lut lut =
+      processing::BuildLut(LoadBpc(bpc.string()), {}, sources::DefaultResampleOptions());
+  EXPECT_EQ(lut.slices(), 9);
+  for (double ti : {0.0, 13.0, 20.0, 31.5, 59.0, 67.0, 80.0})
     for (double to : {0.0, 17.0, 44.0, 74.0, 88.0})
       for (double po : {0.0, 91.0, 180.0, 333.0}) {
         const Rgb f = s.brdf->Eval(SphericalDirectionDeg(ti, 0), SphericalDirectionDeg(to, po));
@@ -136,17 +141,18 @@ TEST_F(SourcesCli, OpenBrdfOfACaptureIsTheFloatLutSampledAsAGpuDoes) {
 
 // One rule beyond the last slice for captures and LUTs: the nearest slice's value at the same
 // specular-frame angles (the GPU's clamp-to-edge along w), with a warning. In the mirror
-// direction of θin = 70° that is the 60° slice's mirror value f(60°→60°).
+// direction of θin = 70° that is the 60° slice's mirror value f(60°→60°). (--beyond clamp:
+// the rule for the LUT's last slice; the default fill moves that slice to 80°.)
 TEST_F(SourcesCli, BeyondTheLastSliceClampsWithAWarning) {
   const Analytic m = Ggx03();
   const fs::path bpc = WriteCapture("ggx", CaptureOf(m, {0, 20, 40, 60}));
   std::string err;
-  const auto got = Eval(bpc, "70,0", "70,180", &err);
+  const auto got = Eval(bpc, "70,0", "70,180", &err, " --beyond clamp");
   const auto f60 = m.FAngles(60, 60, 180);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(got[c], f60[c], 1e-6 * f60[c]) << c;
   EXPECT_NE(err.find("θin 70° is outside the measured range 0°–60°"), std::string::npos) << err;
   ASSERT_EQ(RunTool("convert " + Quote(bpc) + " --out " + Quote(dir_ / "luts") +
-                        " --formats ktx2,json --quiet",
+                        " --formats ktx2,json --quiet --beyond clamp",
                     dir_)
                 .exit_code,
             0);
@@ -154,7 +160,7 @@ TEST_F(SourcesCli, BeyondTheLastSliceClampsWithAWarning) {
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(lut[c], f60[c], Rgb9e5Step(2 * f60[0])) << c;
   EXPECT_NE(err.find("outside the measured range"), std::string::npos) << err;
   // Inside the range: no warning.
-  Eval(bpc, "60,0", "10,10", &err);
+  Eval(bpc, "60,0", "10,10", &err, " --beyond clamp");
   EXPECT_EQ(err.find("outside"), std::string::npos) << err;
 }
 
@@ -162,20 +168,23 @@ TEST_F(SourcesCli, BeyondTheLastSliceClampsWithAWarning) {
 // answers from measured slices, the same for the capture and its exported texture, without a
 // warning. The expected value is the material's own for the pair, which the capture holds in
 // its 40° slice at θout = 70° (measured, θout ≤ 75°), within the resampling error.
+// (--beyond clamp: the exchange rule at the LUT's last slice; the default fill builds its
+// slices past 60° by the same reciprocity, tests/python/beyond_oracle.py.)
 TEST_F(SourcesCli, BeyondTheLastSliceWithTheViewInsideUsesReciprocity) {
   const Analytic m = Ggx03();
   const fs::path bpc = WriteCapture("ggx", CaptureOf(m, {0, 20, 40, 60}));
   std::string err;
-  const auto got = Eval(bpc, "70,0", "40,180", &err);
+  const std::string clamp = " --beyond clamp";
+  const auto got = Eval(bpc, "70,0", "40,180", &err, clamp);
   EXPECT_EQ(err.find("outside"), std::string::npos) << err;
-  const auto exchanged = Eval(bpc, "40,180", "70,0", &err);
+  const auto exchanged = Eval(bpc, "40,180", "70,0", &err, clamp);
   const auto truth = m.FAngles(70, 40, 180);
   for (int c = 0; c < 3; ++c) {
     EXPECT_NEAR(got[c], exchanged[c], 1e-7 * exchanged[c]) << c;
     EXPECT_NEAR(got[c], truth[c], 0.02 * truth[c]) << c;
   }
   ASSERT_EQ(RunTool("convert " + Quote(bpc) + " --out " + Quote(dir_ / "luts") +
-                        " --formats ktx2,json --quiet",
+                        " --formats ktx2,json --quiet --beyond clamp",
                     dir_)
                 .exit_code,
             0);

@@ -11,6 +11,11 @@ control: a program that reads an image through brdf::image_io must show OpenImag
 Peak RSS (GNU time's %M, the child's ru_maxrss) of each non-image command must stay
 under 30 MiB (the start-up target is "under 50 ms and 30 MB"; time is measured by bench/startup.sh, since a
 timing assertion on a shared machine would fail for reasons that are not the program's).
+`info` of a capture is not a start-up-only command: it builds the capture's LUT with the
+default blind-spot fill for its leave-last-slice-out figure and physical sanity report
+(docs/design.md §5), which holds about 100 MB of slices, views and model values; it keeps
+the library check and a working-memory budget of 160 MiB, and the start-up budget is checked
+on `info` of a material file.
 
 usage: startup_libraries.py BRDF IMAGE_PROBE SAMPLES_DIR
 """
@@ -23,6 +28,7 @@ import tempfile
 
 FORBIDDEN = re.compile(r"lib(OpenImageIO|vtk|openvdb|gdal)[^/\s]*\.so")
 MAX_RSS_KIB = 30 * 1024
+MAX_FILL_RSS_KIB = 160 * 1024  # `info` of a capture: the blind-spot fill and sanity report
 
 
 def loaded_libraries(argv, workdir, tag):
@@ -74,7 +80,8 @@ def main():
         non_image = {
             "version": [brdf, "--version"],
             "materials": [brdf, "materials"],
-            "info": [brdf, "info", gold],
+            "info": [brdf, "info", material],
+            "info_capture": [brdf, "info", gold],
             "eval": [brdf, "eval", material, "--in", "40,0", "--out", "40,180"],
             # A small geometry: the point is what the process maps, not the capture's length.
             "capture": [brdf, "capture", "--device", "sim", "--material", "gold", "--sample",
@@ -94,9 +101,10 @@ def main():
         for tag, argv in non_image.items():
             rss = peak_rss_kib(argv, workdir)
             print(f"{tag}: peak RSS {rss} KiB")
-            if rss >= MAX_RSS_KIB:
+            budget = MAX_FILL_RSS_KIB if tag == "info_capture" else MAX_RSS_KIB
+            if rss >= budget:
                 failures.append(f"'brdf {' '.join(argv[1:])}' peaks at {rss} KiB, "
-                                f"budget {MAX_RSS_KIB} KiB")
+                                f"budget {budget} KiB")
         # The executable itself must not even list them (ldd resolves DT_NEEDED recursively).
         ldd = subprocess.run(["ldd", brdf], capture_output=True, text=True, check=True).stdout
         listed = sorted({m.group(0) for m in FORBIDDEN.finditer(ldd)})

@@ -134,25 +134,102 @@ def case_lobe_lambert(brdf_view, source_dir, tmp):
     print(f"lobe: {covered:.4f} of the predicted region covered, {stray} stray pixels")
 
 
+def ggx_mirror_luminance(material, theta_in_deg):
+    """Rec.709 luminance of a docs/design.md §9 ggx material's f_r in the mirror direction of a
+    light at theta_in (h = n: D = 1/(pi a^2), Smith G1 per direction, Schlick F at v.h = cos)."""
+    m = json.load(open(material))
+    kd, f0, a = (np.asarray(m[k], float) * np.ones(3) for k in ("kd", "f0", "alpha"))
+    c = np.cos(np.radians(theta_in_deg))
+    tan2 = (1 - c * c) / (c * c)
+    g1 = 2 / (1 + np.sqrt(1 + a * a * tan2))
+    f = kd / np.pi + (f0 + (1 - f0) * (1 - c) ** 5) * g1 * g1 / (np.pi * a * a) / (4 * c * c)
+    return float(f @ np.array([0.2126, 0.7152, 0.0722]))
+
+
+def lobe_coloured(img, p, radius=2):
+    """Whether any pixel within `radius` of image point p differs from the background."""
+    x, y = int(round(p[0])), int(round(p[1]))
+    h, w = img.shape[:2]
+    if not (radius <= x < w - radius and radius <= y < h - radius):
+        fail(f"point {p} projects outside the picture")
+    return bool(non_background(img[y - radius:y + radius + 1, x - radius:x + radius + 1]).any())
+
+
+def wireframe(img, p, radius=3):
+    """Whether the pixels around p hold the comparison lobe's wireframe (near-white lines: the
+    viewer's default for the second source)."""
+    x, y = int(round(p[0])), int(round(p[1]))
+    patch = img[y - radius:y + radius + 1, x - radius:x + radius + 1].reshape(-1, 3)
+    return bool(((patch.min(axis=1) > 150) & (np.ptp(patch, axis=1) < 40)).any())
+
+
+def beside(points, axis_from, axis_to, offset):
+    """`points` (image coordinates) moved `offset` pixels perpendicular to the image-space axis
+    from axis_from to axis_to: off the mirror arrow the viewer draws along that axis."""
+    d = np.asarray(axis_to, float) - np.asarray(axis_from, float)
+    n = np.array([-d[1], d[0]]) / np.linalg.norm(d)
+    return [np.asarray(q) + offset * n for q in points]
+
+
 def case_lobe_glossy(brdf_view, source_dir, tmp):
+    """Gold alone, then gold compared with silver, light at theta_in = 40 deg (a measured slice
+    of the reference geometry, so the lobe's mirror vertex is the LUT texel at theta_d = 0 and
+    holds the material's own value). The lobe's radius in a direction is f_r's luminance there,
+    so each lobe's mirror peak is at r_peak (ggx_mirror_luminance) along the mirror direction
+    (theta_in, 180 deg). Projected through the recorded camera (and a few pixels beside the
+    mirror arrow drawn along that axis), the gold lobe covers 85 % of its peak and not 115 %.
+    Silver (alpha 0.1 against gold's 0.15) peaks more than twice as far: with --compare, the
+    mirror direction at 1.3 and 1.5 x gold's peak shows the comparison lobe's wireframe, where the
+    gold-only picture is background."""
     width, height = 800, 600
-    shot = os.path.join(tmp, "gold.png")
-    gold = os.path.join(source_dir, "data-samples", "materials", "gold.json")
-    run_view(brdf_view, [gold, "--compare", gold, "--theta-in", "50", "--size",
-                         f"{width}x{height}", "--screenshot", shot], tmp)
-    img = read_png(shot, width, height)
-    check_not_blank(img, 0.01)
-    meta = json.load(open(shot + ".json"))
-    # The mirror direction (theta_in = 50 deg, phi = 180 deg) must project onto the half of the
-    # image left of the normal (the light is at +x, the camera looks from -y: +x is right).
-    cam = meta["camera"]
-    mirror = np.array([[-np.sin(np.radians(50)), 0, np.cos(np.radians(50))]]) * 0.01
-    origin = np.zeros((1, 3))
-    p_mirror = project_perspective(mirror, cam, width, height)[0]
-    p_origin = project_perspective(origin, cam, width, height)[0]
+    materials = os.path.join(source_dir, "data-samples", "materials")
+    gold, silver = os.path.join(materials, "gold.json"), os.path.join(materials, "silver.json")
+    theta = 40.0
+    mirror = np.array([-np.sin(np.radians(theta)), 0, np.cos(np.radians(theta))])
+    r_gold, r_silver = ggx_mirror_luminance(gold, theta), ggx_mirror_luminance(silver, theta)
+    if not r_silver > 1.8 * r_gold:
+        fail(f"silver's peak {r_silver:.3f} is not well beyond gold's {r_gold:.3f}")
+    shots = {}
+    for label, args in (("alone", [gold]), ("compare", [gold, "--compare", silver])):
+        shot = os.path.join(tmp, f"gold-{label}.png")
+        run_view(brdf_view, args + ["--theta-in", str(theta), "--size", f"{width}x{height}",
+                                    "--screenshot", shot], tmp)
+        img = read_png(shot, width, height)
+        check_not_blank(img, 0.01)
+        shots[label] = (img, json.load(open(shot + ".json"))["camera"])
+    img, cam = shots["alone"]
+    p_origin, p_mirror = project_perspective(np.array([[0, 0, 0], 0.01 * mirror]), cam, width,
+                                             height)
+    # The light is at +x and the camera looks from -y: the mirror side is left of the normal.
     if not p_mirror[0] < p_origin[0]:
         fail("camera: the mirror direction does not project left of the origin")
-    print("glossy lobe with --compare rendered")
+    inside, beyond = project_perspective(np.array([0.85 * r_gold * mirror, 1.15 * r_gold * mirror]),
+                                         cam, width, height)
+    for side in (-5, 5):
+        q = beside([inside], p_origin, p_mirror, side)[0]
+        if not lobe_coloured(img, q, 1):
+            fail(f"gold alone: nothing drawn at 0.85 x its mirror peak ({r_gold:.3f} 1/sr), "
+                 f"pixel {q}")
+    for side in (-8, 8):
+        q = beside([beyond], p_origin, p_mirror, side)[0]
+        if lobe_coloured(img, q, 1):
+            fail(f"gold alone: the lobe reaches beyond 1.15 x its mirror peak ({r_gold:.3f} 1/sr), "
+                 f"pixel {q}")
+    along = [f * r_gold * mirror for f in (1.3, 1.5)]
+    for label, (img, cam) in shots.items():
+        o, m = project_perspective(np.array([[0, 0, 0], 0.01 * mirror]), cam, width, height)
+        points = project_perspective(np.array(along), cam, width, height)
+        for q, p in zip(along, points):
+            for pb in beside([p], o, m, 6) + beside([p], o, m, -6):
+                shown = wireframe(img, pb)
+                if label == "compare" and not shown:
+                    fail(f"--compare: the comparison lobe (silver, peak {r_silver:.3f} 1/sr) is not "
+                         f"drawn at {np.linalg.norm(q):.3f} 1/sr along the mirror direction, pixel "
+                         f"{pb}: RGB {img[int(pb[1]), int(pb[0])]}")
+                if label == "alone" and (shown or lobe_coloured(img, pb, 1)):
+                    fail(f"gold alone shows a lobe at {np.linalg.norm(q):.3f} 1/sr, pixel {pb}")
+    print(f"glossy lobe: gold's peak {r_gold:.3f} 1/sr where projected, silver's comparison lobe "
+          f"(peak {r_silver:.3f} 1/sr) drawn at 1.3 and 1.5 x gold's")
 
 
 def case_slices(brdf_view, source_dir, tmp):

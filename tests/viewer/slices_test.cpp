@@ -80,12 +80,15 @@ TEST(SliceProbe, MapsTexelsBackToTheOutgoingDirectionTheyHold) {
     EXPECT_EQ(p.j, 13);
     EXPECT_EQ(p.value, source.lut.Texel(k, 13, 41)[1]);
   }
-  EXPECT_THROW(ProbeSlice(source, 4, Channel::kRed, 0, 0), InvalidArgument);
+  // One past the last slice (9 with the default blind-spot fill: 0–80° every 10°).
+  ASSERT_EQ(source.lut.slices(), 9);
+  EXPECT_THROW(ProbeSlice(source, 9, Channel::kRed, 0, 0), InvalidArgument);
 }
 
 TEST(SliceImage, HoldsTheChannelOfEveryTexelTopRowFirst) {
   const ViewSource source = ViewSourceFromMeasurement(CaptureWithBlindSpot(), {}, "blind");
-  const SliceImage img = BuildSliceImage(source, 2, Channel::kLuminance);
+  // Slice 4 of the filled LUT (θin 0, 10, …, 80°, docs/design.md §5) is the measured 40° one.
+  const SliceImage img = BuildSliceImage(source, 4, Channel::kLuminance);
   ASSERT_EQ(img.width, 361);
   ASSERT_EQ(img.height, 181);
   EXPECT_EQ(img.theta_in_deg, 40.0);
@@ -112,12 +115,18 @@ TEST(Coverage, BlindSpotIsUnmeasuredOnlyWhereSamplesWereInvalid) {
                 t > 75 ? Coverage::kExtrapolated : Coverage::kMeasured);
     }
   }
-  // Between 20° and 40° the LUT blends both slices at the same (θd, φd): the blind direction
-  // of the 20° slice, moved into the 30° specular frame, is unmeasured there too.
+  // Between 20° and the next LUT slice (30°, inserted by the default blind-spot fill) the LUT
+  // blends both slices at the same (θd, φd): the blind direction of the 20° slice, moved into
+  // the 25° specular frame, is unmeasured there too; the 30° slice itself is filled, shown as
+  // the extrapolated band is.
   const Vec3 w_d = SpecularFrame::FromThetaInDeg(20).ToSpecular(SphericalDirectionDeg(32, 105));
-  const Vec3 w30 = SpecularFrame::FromThetaInDeg(30).FromSpecular(w_d);
-  EXPECT_EQ(source.CoverageAt(30.0, RadToDeg(ThetaOf(w30)), RadToDeg(PhiOf(w30))),
+  const Vec3 w25 = SpecularFrame::FromThetaInDeg(25).FromSpecular(w_d);
+  EXPECT_EQ(source.CoverageAt(25.0, RadToDeg(ThetaOf(w25)), RadToDeg(PhiOf(w25))),
             Coverage::kUnmeasured);
+  ASSERT_EQ(source.lut.theta_in_deg, (std::vector<double>{0, 10, 20, 30, 40, 50, 60, 70, 80}));
+  ASSERT_TRUE(source.coverage[3].filled);
+  EXPECT_EQ(source.CoverageAt(30.0, 10.0, 0.0), Coverage::kExtrapolated);
+  EXPECT_EQ(source.CoverageAt(20.0, 10.0, 0.0), Coverage::kMeasured);
   // And the lobe marks those vertices.
   LobeOptions options;
   options.theta_in_deg = 20;

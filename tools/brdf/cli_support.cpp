@@ -7,6 +7,7 @@
 
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
+#include "brdf/sources/capture.h"
 
 namespace brdf::cli {
 
@@ -122,6 +123,18 @@ std::string JoinArguments(const std::vector<std::string>& arguments) {
   std::string joined;
   for (const std::string& a : arguments) joined += (joined.empty() ? "" : ", ") + a;
   return joined;
+}
+
+void WarnAboutVerdict(const std::string& out) {
+  const sources::CaptureAssessment a = sources::AssessCapture(out);
+  for (const sources::CaptureRefusal& refusal : a.refusals)
+    std::fprintf(stderr, "brdf: warning: %s (every command that reads the capture refuses it)\n",
+                 refusal.ToError(out).what());
+  for (const sources::CaptureRefusal& refusal : a.export_refusals)
+    std::fprintf(stderr,
+                 "brdf: warning: %s; 'brdf convert' and 'brdf atlas' will refuse the capture "
+                 "('brdf eval', 'brdf preview', 'brdf fit' and brdf-view accept it)\n",
+                 refusal.ToError(out).what());
 }
 
 }  // namespace brdf::cli

@@ -42,6 +42,12 @@ void CreateOutputFolder(const std::string& folder);
 
 // Prints one note on stderr naming the temporary files of killed runs that
 // brdf::CheckWritableOutputs removed (nothing when there were none).
+// After `capture` or `import` wrote the capture `out`: a warning on stderr for each reason the
+// verdict of brdf/sources/capture.h gives another command to refuse it (every reader, or the LUT
+// exports alone for a θin list that is not k·Δin), so the user hears it now, not at the first
+// convert.
+void WarnAboutVerdict(const std::string& out);
+
 void ReportRemovedTemporaries(const std::vector<std::string>& removed);
 
 }  // namespace brdf::cli

@@ -86,6 +86,7 @@ int RunAtlas(const AtlasOptions& options) {
   std::vector<std::optional<std::vector<exporter::SaturatedCount>>> saturated(found.inputs.size());
   std::vector<std::optional<exporter::ExtrapolationInfo>> extrapolation(found.inputs.size());
   std::vector<std::vector<std::string>> fitted(found.inputs.size());  // --extrapolate auto's record
+  std::vector<std::string> beyond(found.inputs.size());               // the blind-spot fill's
 
   Progress progress("atlas", found.inputs.size(), !options.quiet);
   const std::vector<JobResult> results = RunJobs(
@@ -93,18 +94,22 @@ int RunAtlas(const AtlasOptions& options) {
       [&](std::size_t i, JobResult& result) {
         const BatchInput& in = found.inputs[i];
         std::optional<processing::ExtrapolationParams> chosen = extrapolate;
+        std::string auto_warning;
         if (auto_extrapolate)
           if (const auto automatic = AutoExtrapolationFor(in.path, in.kind)) {
             chosen = automatic->params;
             fitted[i].push_back(automatic->record_json);
+            auto_warning = automatic->warning;
           }
         sources::InputLut built = sources::LutFromInput(in.path, in.kind, chosen, resample);
         exporter::ValidateLutForExport(built.lut);
         result.warnings = std::move(built.warnings);
+        if (!auto_warning.empty()) result.warnings.push_back(auto_warning);
         if (auto note = sources::SaturationNote(in.path, built.saturated_samples))
           result.warnings.push_back(std::move(*note));
         saturated[i] = std::move(built.saturated_samples);
         extrapolation[i] = built.extrapolation;
+        beyond[i] = std::move(built.beyond_json);
         luts[i] = std::move(built.lut);
       },
       [&](std::size_t i, const JobResult& result) {
@@ -131,7 +136,7 @@ int RunAtlas(const AtlasOptions& options) {
   for (std::size_t i = 0; i < luts.size(); ++i)
     materials.push_back({found.inputs[i].name, &luts[i],
                          sources::RecordedSourceName(found.inputs[i].path), saturated[i],
-                         extrapolation[i], fitted[i]});
+                         extrapolation[i], fitted[i], beyond[i]});
   CreateOutputFolder(fs::path(options.out).parent_path().string());
   const OutputGuard guard(outputs);
   std::vector<std::string> written;

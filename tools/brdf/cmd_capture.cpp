@@ -7,7 +7,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -105,20 +104,6 @@ void Validate(const CaptureOptions& o) {
 // Settings of the simulated instrument that must agree between an interrupted capture and its
 // resumption, as recorded in the metadata `extra` map. The planned θin list is the session's
 // (CaptureRequest::theta_in_deg, recorded as "theta_in_deg").
-std::map<std::string, std::string> SettingsOf(const CaptureOptions& o,
-                                              const std::string& material) {
-  char seed[32];
-  std::snprintf(seed, sizeof seed, "%llu", static_cast<unsigned long long>(o.seed));
-  return {{"device", o.device},
-          {"material", material},
-          {"noise_level", Deg(o.noise)},
-          {"seed", seed},
-          {"theta_out_max_deg", Deg(o.geometry.theta_out_max_deg)},
-          {"theta_out_step_deg", Deg(o.geometry.theta_out_step_deg)},
-          {"phi_out_step_deg", Deg(o.geometry.phi_out_step_deg)},
-          {"exposure", o.exposure}};
-}
-
 std::string Eta(double seconds) {
   char buf[32];
   if (seconds < 60)
@@ -262,7 +247,8 @@ int RunCapture(const CaptureOptions& o) {
   request.sample_name = o.sample;
   request.operator_notes = o.operator_notes;
   if (sim) {
-    request.settings = SettingsOf(o, source->Name());
+    request.settings =
+        device::SimulatedCaptureSettings(o.device, source->Name(), config, o.geometry, o.exposure);
     request.notes["material_file"] = sources::RecordedSourceName(material_path);
   } else {
     request.settings["device"] = o.device;
@@ -320,6 +306,7 @@ int RunCapture(const CaptureOptions& o) {
                      "wrote %s: %zu slices, %s new samples, %s saturated, %s below noise floor\n",
                      o.out.c_str(), r.slices_saved, Thousands(r.new_samples).c_str(),
                      Thousands(r.saturated).c_str(), Thousands(r.below_noise_floor).c_str());
+      WarnAboutVerdict(o.out);
       return 0;
     case device::CaptureOutcome::kNothingToResume:
       if (!o.quiet) std::fprintf(stderr, "%s\n", r.message.c_str());

@@ -180,15 +180,19 @@ int RunConvert(const ConvertOptions& options) {
         if (automatic) chosen = automatic->params;
         sources::InputLut built = sources::LutFromInput(in.path, in.kind, chosen, resample);
         result.warnings = std::move(built.warnings);
+        if (automatic && !automatic->warning.empty()) result.warnings.push_back(automatic->warning);
         if (auto note = sources::SaturationNote(in.path, built.saturated_samples))
           result.warnings.push_back(std::move(*note));
+        if (!options.quiet)
+          if (auto note = sources::LeaveLastSliceOutNote(in.path, built.beyond))
+            result.warnings.push_back(std::move(*note));
         exporter::TextureMetadata metadata;
         if (automatic) metadata.fitted_models_json.push_back(automatic->record_json);
         metadata.name = in.name;
         metadata.source = sources::RecordedSourceName(in.path);
         metadata.extrapolation = built.extrapolation;
         metadata.saturated_samples = built.saturated_samples;
-        if (built.beyond) metadata.beyond_json = processing::BeyondReportJson(*built.beyond);
+        metadata.beyond_json = built.beyond_json;
         std::vector<std::string> outputs =
             exporter::LutExportPaths(out_dir.string(), in.name, export_options);
         for (std::string& p : engines::EngineOutputPaths(out_dir.string(), in.name, engine_set))

@@ -15,8 +15,8 @@
 
 #include "brdf/core/brdf_source.h"
 #include "brdf/core/error.h"
+#include "brdf/core/eval_pairs.h"
 #include "brdf/core/file_util.h"
-#include "brdf/core/geometry.h"
 #include "brdf/sources/open.h"
 #include "cli_support.h"
 #include "commands.h"
@@ -92,14 +92,21 @@ int RunEval(const EvalOptions& options) {
   const sources::OpenedSource source = sources::OpenBrdf(options.file, open_options);
   for (const std::string& w : source.warnings) std::fprintf(stderr, "%s\n", w.c_str());
   std::set<double> warned_theta_in;  // one warning per θin beyond the measured range
-  for (const Pair& p : pairs) {
+  for (const Pair& p : pairs)
     if (const auto w = source.BeyondMeasuredWarning(p.theta_in_deg, p.theta_out_deg, options.file))
       if (warned_theta_in.insert(p.theta_in_deg).second) std::fprintf(stderr, "%s\n", w->c_str());
-    const Vec3 wi = SphericalDirectionDeg(p.theta_in_deg, p.phi_in_deg);
-    const Vec3 wo = SphericalDirectionDeg(p.theta_out_deg, p.phi_out_deg);
-    const Rgb f = source.brdf->Eval(wi, wo);
-    std::printf("%.9g %.9g %.9g\n", f[0], f[1], f[2]);
+  // The evaluation path of the Python module's eval_deg too (brdf/core/eval_pairs.h).
+  std::vector<double> angles[4], rgb(3 * pairs.size());
+  for (const Pair& p : pairs) {
+    angles[0].push_back(p.theta_in_deg);
+    angles[1].push_back(p.phi_in_deg);
+    angles[2].push_back(p.theta_out_deg);
+    angles[3].push_back(p.phi_out_deg);
   }
+  EvalAnglePairsDeg(*source.brdf, pairs.size(), angles[0].data(), angles[1].data(),
+                    angles[2].data(), angles[3].data(), rgb.data());
+  for (std::size_t i = 0; i < pairs.size(); ++i)
+    std::printf("%.9g %.9g %.9g\n", rgb[3 * i], rgb[3 * i + 1], rgb[3 * i + 2]);
   return 0;
 }
 

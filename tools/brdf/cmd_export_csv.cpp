@@ -42,6 +42,28 @@ void CheckFinite(const Measurement& m, const std::string& file) {
   }
 }
 
+// The capture's "slice i, sample j" written on `position` ("line N") of `text` (FormatCsv: a
+// header, then one line per sample in slice order); `position` itself when it is not a data line.
+std::string SampleOfCsvLine(const Measurement& m, const std::string& text,
+                            const std::string& position) {
+  unsigned long long line = 0;
+  if (std::sscanf(position.c_str(), "line %llu", &line) != 1) return "the CSV's " + position;
+  std::uint64_t header_lines = 0, n = 0;
+  for (std::size_t pos = 0; pos < text.size(); pos = text.find('\n', pos) + 1) {
+    ++n;
+    if (text.compare(pos, 8, "theta_in") == 0) header_lines = n;
+    if (header_lines != 0 || text.find('\n', pos) == std::string::npos) break;
+  }
+  if (header_lines == 0 || line <= header_lines) return "the CSV's " + position;
+  std::uint64_t index = static_cast<std::uint64_t>(line) - header_lines - 1;
+  for (std::size_t i = 0; i < m.slices.size(); ++i) {
+    if (index < m.slices[i].samples.size())
+      return "slice " + std::to_string(i) + ", sample " + std::to_string(index);
+    index -= m.slices[i].samples.size();
+  }
+  return "the CSV's " + position;
+}
+
 }  // namespace
 
 int RunExportCsv(const ExportCsvOptions& options) {
@@ -66,7 +88,9 @@ int RunExportCsv(const ExportCsvOptions& options) {
   try {
     ParseCsv(text, options.out);
   } catch (const FormatError& e) {
-    throw InvalidArgument(file + " cannot be written as a CSV point cloud: " + e.what());
+    // The CSV was never written: the refusal names the capture's slice and sample.
+    throw FormatError(file, SampleOfCsvLine(m, text, e.position()), e.expected(), e.got(),
+                      "the .bpc itself is intact; a CSV point cloud cannot hold this value");
   }
   WriteFileAtomically(options.out, text);
   // Warnings after the work: a refusal stays the one line on stderr.

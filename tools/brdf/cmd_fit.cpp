@@ -68,7 +68,10 @@ bool IsDirectInput(const std::string& path) {
 
 Measurement OpenForFit(const std::string& path, std::vector<std::string>* warnings) {
   const sources::FileKind kind = sources::DetectFileKind(path);
-  sources::PreparedMeasurement p = sources::PrepareMeasurement(path, kind, std::nullopt);
+  // Transmission (BTDF) tables are read mirrored into the reflection hemisphere, with a
+  // warning, as info, eval, preview and brdf-view read them (docs/robustness.md, "One verdict").
+  sources::PreparedMeasurement p =
+      sources::PrepareMeasurement(path, kind, std::nullopt, /*allow_btdf=*/true);
   for (std::string& w : p.warnings) warnings->push_back(std::move(w));
   return std::move(p.measurement);
 }
@@ -108,7 +111,9 @@ std::optional<AutoExtrapolationChoice> AutoExtrapolationFor(const std::string& p
   if (p.extrapolation.origin != sources::ExtrapolationChoice::Origin::kDefaults)
     return std::nullopt;
   const processing::AutoExtrapolationResult r = processing::ChooseExtrapolationAuto(p.measurement);
-  return AutoExtrapolationChoice{r.params, processing::AutoExtrapolationJson(r)};
+  return AutoExtrapolationChoice{
+      r.params, processing::AutoExtrapolationJson(r),
+      r.not_used.empty() ? std::string() : path + ": warning: --extrapolate auto: " + r.not_used};
 }
 
 int RunFit(const FitCommandOptions& options) {

@@ -84,6 +84,7 @@ int RunImport(const ImportOptions& options) {
               thetas.c_str(), m.SampleCount());
   if (invalid > 0) std::printf(", %zu flagged invalid", invalid);
   std::printf("\n");
+  WarnAboutVerdict(options.out);
   return 0;
 }
 

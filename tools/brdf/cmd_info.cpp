@@ -33,24 +33,100 @@ std::string TripleText(const Json& v) {
   return Fixed(v[0]) + " " + Fixed(v[1]) + " " + Fixed(v[2]);
 }
 
-// Which commands the "usable" verdict speaks for: convert reads captures (and material files),
-// a third-party table is evaluated directly and converted only after 'brdf import'.
+// Which commands the verdict speaks for: convert reads captures (and material files), a
+// third-party table is evaluated directly and converted only after 'brdf import'; a capture
+// refused by the LUT exports alone (θin not k·Δin) is evaluated by every other command.
 const char* JudgingCommands(const Json& j) {
-  return IsImportedFormat(j) ? "'brdf eval'" : "'brdf convert' and 'brdf eval'";
+  if (IsImportedFormat(j)) return "'brdf eval'";
+  if (j.value("evaluable", true) && !j.value("convertible", true))
+    return "'brdf convert' and 'brdf atlas'";
+  return "'brdf convert' and 'brdf eval'";
 }
+
+// "s" when JudgingCommands names one command.
+const char* VerbS(const Json& j) { return IsImportedFormat(j) ? "s" : ""; }
 
 void PrintRefusalsText(const Json& j) {
   if (j.contains("warnings"))
     for (const auto& w : j["warnings"]) std::printf("%s\n", w.get<std::string>().c_str());
   if (!j.contains("refusals")) return;
-  const char* verb_s = IsImportedFormat(j) ? "s" : "";  // one command, or two
   if (j["refusals"].empty()) {
-    std::printf("usable: yes (%s accept%s it)\n", JudgingCommands(j), verb_s);
+    std::printf("usable: yes (%s accept%s it)\n", JudgingCommands(j), VerbS(j));
     return;
   }
-  std::printf("usable: no; %s refuse%s it: %zu reason%s\n", JudgingCommands(j), verb_s,
+  std::printf("usable: no; %s refuse%s it: %zu reason%s\n", JudgingCommands(j), VerbS(j),
               j["refusals"].size(), j["refusals"].size() == 1 ? "" : "s");
   for (const auto& r : j["refusals"]) std::printf("  %s\n", r.get<std::string>().c_str());
+  if (j.value("evaluable", false) && !j.value("convertible", true))
+    std::printf(
+        "evaluable: yes ('brdf eval', 'brdf preview', 'brdf fit' and brdf-view accept it; only "
+        "the LUT textures need θin = k·Δin)\n");
+}
+
+std::string Percent(const Json& v) {
+  return v.is_null() ? "-" : Fixed(Json(100.0 * v.get<double>()), "%.3g") + " %";
+}
+
+std::string DegreeList(const Json& v) {
+  std::string out;
+  for (const auto& t : v) out += (out.empty() ? "" : ", ") + Fixed(t, "%g");
+  return out.empty() ? "none" : out;
+}
+
+// The blind-spot fill's record (a capture's, or a sidecar's): method, slices, validation.
+void PrintFillText(const Json& j, const char* indent) {
+  if (!j.contains("blind_spot_fill")) return;
+  const Json& b = j["blind_spot_fill"];
+  if (b.is_null()) {
+    std::printf("%sblind-spot fill: none (clamp: the last slice is read beyond it)\n", indent);
+    return;
+  }
+  std::string method = b["method"].get<std::string>();
+  if (b["model"].is_object() && b["model"].contains("model"))
+    method += " (" + b["model"]["model"].get<std::string>() + ")";
+  std::printf("%sblind-spot fill: %s; theta_in measured %s deg, inserted %s, extrapolated %s\n",
+              indent, method.c_str(), DegreeList(b["measured_theta_in"]).c_str(),
+              DegreeList(b["inserted_theta_in"]).c_str(),
+              DegreeList(b["extrapolated_theta_in"]).c_str());
+  const Json& v = b["leave_last_slice_out"];
+  if (v.is_object())
+    std::printf(
+        "%s  leave-last-slice-out: theta_in %s deg predicted from the others, relative error "
+        "median %s, p90 %s over %s texels\n",
+        indent, Fixed(v["theta_in"], "%g").c_str(), Percent(v["median_relative_error"]).c_str(),
+        Percent(v["p90_relative_error"]).c_str(), v["texels"].dump().c_str());
+  else
+    std::printf("%s  leave-last-slice-out: not validated (fewer than 3 measured slices)\n", indent);
+}
+
+// The physical sanity report (brdf/processing/sanity.h), one line per LUT slice.
+void PrintSanityText(const Json& j) {
+  if (!j.contains("physical_sanity")) return;
+  const Json& p = j["physical_sanity"];
+  std::printf(
+      "physical sanity (light at theta_in, phi_in 0; albedo r g b = measured part, theta_out "
+      "<= %s deg, + filled part):\n",
+      Fixed(p["theta_b_deg"], "%g").c_str());
+  std::size_t flagged = 0;
+  for (const Json& s : p["slices"]) {
+    std::string recip = "no pair measured both ways";
+    if (s["reciprocity"].is_object())
+      recip = "reciprocity residual median " + Percent(s["reciprocity"]["median_relative"]) +
+              ", max " + Percent(s["reciprocity"]["max_relative"]) + " over " +
+              s["reciprocity"]["pairs"].dump() + " pairs";
+    std::printf("  theta_in %s deg (%s): albedo %s + %s; %s", Fixed(s["theta_in"], "%g").c_str(),
+                s["measured"].get<bool>() ? "measured" : "filled",
+                TripleText(s["albedo_measured"]).c_str(), TripleText(s["albedo_filled"]).c_str(),
+                recip.c_str());
+    if (s["measured"].get<bool>())
+      std::printf("; saturated %s, below noise %s", s["saturated"].dump().c_str(),
+                  s["below_noise_floor"].dump().c_str());
+    std::printf("%s\n", s["energy_flag"].get<bool>() ? "; ENERGY: albedo above 1" : "");
+    flagged += s["energy_flag"].get<bool>();
+  }
+  std::printf("  energy: %s\n", flagged
+                                    ? "albedo above 1 beyond the noise in the slices marked ENERGY"
+                                    : "albedo within 1 + noise in every slice");
 }
 
 void PrintBpcText(const Json& j) {
@@ -89,13 +165,16 @@ void PrintBpcText(const Json& j) {
                 f["interpolated"].dump().c_str(), f["invalid"].dump().c_str());
   }
   if (j["problems"].empty()) {
-    std::printf("problems: none\n");
+    // "none" only when nothing else is wrong either: the refusals follow.
+    std::printf(j["refusals"].empty() ? "problems: none\n" : "damage: none (chunks intact)\n");
   } else {
     std::printf("problems: %zu\n", j["problems"].size());
     for (const Json& p : j["problems"])
       std::printf("  %s\n", p["message"].get<std::string>().c_str());
   }
   PrintRefusalsText(j);
+  PrintFillText(j, "");
+  PrintSanityText(j);
   if (j.contains("advice")) std::printf("note: %s\n", j["advice"].get<std::string>().c_str());
 }
 
@@ -262,6 +341,7 @@ void PrintTextureText(const Json& j) {
                   Fixed(j["extrapolation"]["l"], "%g").c_str(),
                   Fixed(j["extrapolation"]["theta_b_deg"], "%g").c_str());
   }
+  PrintFillText(j, "  ");
   if (j.contains("tool_version"))
     std::printf("  written by     brdf-toolchain %s\n",
                 j["tool_version"].get<std::string>().c_str());
@@ -312,7 +392,7 @@ int RunInfo(const InfoOptions& options) {
   if (j.contains("usable") && !j["usable"].get<bool>()) {
     const std::size_t n = j["refusals"].size();
     std::fprintf(stderr, "brdf: %s: %zu problem%s that %s refuse%s%s\n", file.c_str(), n,
-                 n == 1 ? "" : "s", JudgingCommands(j), IsImportedFormat(j) ? "s" : "",
+                 n == 1 ? "" : "s", JudgingCommands(j), VerbS(j),
                  options.json ? " (listed under \"refusals\")" : " (listed above)");
     return 1;
   }

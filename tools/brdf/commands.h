@@ -24,7 +24,7 @@ struct EvalOptions {
   double theta_out_deg = 0, phi_out_deg = 0;
   std::string extrapolate;  // "P,L" for captures; empty: per-material JSON, else 1,0.5
   // Captures: blind-spot fill, as `brdf convert --beyond` (processing::kDefaultBeyondMethod).
-  std::string beyond = "clamp";
+  std::string beyond = "auto";
   int beyond_subdivide = 2;  // captures: as `brdf convert --beyond-subdivide`
   // Many directions at once instead of --in/--out: a file ("-" = stdin) of lines
   // "THETA_IN PHI_IN THETA_OUT PHI_OUT" (degrees, blanks or commas between); one output line
@@ -45,7 +45,7 @@ struct ConvertOptions {
   std::string extrapolate;          // "P,L"; empty: per-material JSON, else 1,0.5
   // Blind-spot fill (brdf/processing/beyond.h): "clamp", "hold", "model" or "auto"; the default
   // is processing::kDefaultBeyondMethod.
-  std::string beyond = "clamp";
+  std::string beyond = "auto";
   int beyond_subdivide = 2;  // the filled LUT's θin step is the measured one divided by this
   std::string formats = kAllLutFormats;
   std::string exr_type = "float";  // EXR pixel type: "float" or "half"

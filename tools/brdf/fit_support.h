@@ -13,6 +13,9 @@ namespace brdf::cli {
 struct AutoExtrapolationChoice {
   processing::ExtrapolationParams params;
   std::string record_json;  // for the sidecar's "fitted_models": p, l, band errors, the GGX fit
+  // Why the fit was not used (processing::AutoExtrapolationResult::not_used), a full sentence
+  // starting with the path; empty when it was.
+  std::string warning;
 };
 
 // For a capture or material file: opens it as `brdf convert` does, fits GGX and chooses p, l.

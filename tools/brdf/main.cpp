@@ -320,7 +320,9 @@ int main(int argc, char** argv) {
       "checksum, "
       "extrapolation, value ranges), or a third-party measurement (Zemax or LightTools .bsdf "
       "with the integrated TIS per incidence, CSV point cloud, goniometer table, RGL .bsdf, "
-      "MERL .binary)");
+      "MERL .binary). Exit code 1 when a command that reads the file refuses it (\"usable\": "
+      "false, reasons under \"refusals\"; a θin list that is not k·Δin is refused by convert "
+      "and atlas alone)");
   info_cmd
       ->add_option("file", info.file,
                    "File to describe (.bpc, .json, .ktx2, .dds, .brdfc, .bsdf, .csv, .binary) or a "
@@ -405,7 +407,8 @@ int main(int argc, char** argv) {
   convert_cmd->add_option(
       "--engine", convert.engines,
       "Also write engine hand-off folders DIR/<engine>/ (importer, shader code, manifest, "
-      "texture in the engine's format): unity, unreal, godot, web (comma separated) or all");
+      "texture in the engine's format, IBL pack NAME_ibl.dds): unity, unreal, godot, web "
+      "(comma separated) or all");
   convert_cmd->add_option("--engine-fits", convert.engine_fits,
                           "With --engine: folder of `brdf fit` results (NAME.MODEL.json); each "
                           "manifest carries NAME's fits, with their errors, as fallback material");
@@ -512,7 +515,8 @@ int main(int argc, char** argv) {
       "export-csv",
       "Write a .bpc capture as a CSV point cloud "
       "(theta_in,phi_in,theta_out,phi_out,r,g,b[,sigma_r,sigma_g,sigma_b],flags; degrees, "
-      "f_r in 1/sr); values round-trip bit-exactly through 'brdf import'");
+      "f_r in 1/sr); values round-trip bit-exactly through 'brdf import'. Samples the other "
+      "commands refuse (an incomplete slice, values no surface has) are copied with a warning");
   export_csv_cmd->add_option("file", export_csv.file, "Capture to export (.bpc)")->required();
   export_csv_cmd->add_option("--out", export_csv.out, "Output .csv file (written atomically)")
       ->required();
@@ -541,7 +545,9 @@ int main(int argc, char** argv) {
       "Fit analytic BRDF models (lafortune, ggx, blinn-phong, ward, lambert) and the engines' "
       "shading models (unreal-defaultlit, unity-hdrp-lit[-specular], unity-urp-lit[-specular]) "
       "to captures, material files or measured BRDFs; writes material files with the fit "
-      "report under \"fit\"");
+      "report under \"fit\" (\"representable\": false, with a warning, for a fit with fewer "
+      "usable samples than twice the parameters per colour channel); transmission (BTDF) "
+      "tables are read mirrored into the reflection hemisphere, as eval reads them");
   fit_cmd
       ->add_option("inputs", fit.inputs,
                    "Captures (.bpc), material files (.json), RGL .bsdf or MERL .binary files, "

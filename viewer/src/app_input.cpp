@@ -79,8 +79,10 @@ void App::UpdateText() {
       const Lut& lut = source->lut;
       info << "\nθin = " << Fixed(theta_in_deg_, 1) << "°";
       const int k = NearestSlice();
+      const bool filled = k < static_cast<int>(source->coverage.size()) &&
+                          source->coverage[static_cast<std::size_t>(k)].filled;
       if (std::abs(lut.theta_in_deg[k] - theta_in_deg_) < 1e-6) {
-        info << " (measured slice)";
+        info << (filled ? " (filled slice, translucent)" : " (measured slice)");
       } else {
         info << " (between measured slices, interpolated as the LUT does)";
       }

@@ -121,7 +121,7 @@ Coverage ViewSource::CoverageAt(double theta_in_deg, double theta_out_deg,
     const Vec3 w_k = SpecularFrame::FromThetaInDeg(lut.theta_in_deg[k]).FromSpecular(w_d);
     const double theta_k = RadToDeg(ThetaOf(w_k));
     Coverage c = Coverage::kMeasured;
-    if (theta_k > theta_b_deg + 1e-9) {
+    if (coverage[k].filled || theta_k > theta_b_deg + 1e-9) {
       c = Coverage::kExtrapolated;
     } else if (!coverage[k].MeasuredAt(theta_k, RadToDeg(PhiOf(w_k)))) {
       c = Coverage::kUnmeasured;
@@ -155,6 +155,15 @@ ViewSource ViewSourceFromResampled(const Measurement& measurement, Lut lut,
                                   [&](const processing::SliceResampleReport& r) {
                                     return std::abs(r.theta_in_deg - theta_in) < 1e-3;
                                   });
+    if (slice == measurement.slices.end() && rep == report.slices.end()) {
+      CoverageMap filled;  // a slice of the blind-spot fill: nothing measured
+      filled.theta_in_deg = theta_in;
+      filled.measured.assign(
+          static_cast<std::size_t>(CoverageMap::kThetaCells) * CoverageMap::kPhiCells, 0);
+      filled.filled = true;
+      out.coverage.push_back(std::move(filled));
+      continue;
+    }
     if (slice == measurement.slices.end() || rep == report.slices.end()) {
       throw InvalidArgument("the measurement has no slice at θin = " + std::to_string(theta_in) +
                             "° although its LUT does");
@@ -167,8 +176,11 @@ ViewSource ViewSourceFromResampled(const Measurement& measurement, Lut lut,
 ViewSource ViewSourceFromMeasurement(const Measurement& measurement,
                                      const processing::ExtrapolationParams& params,
                                      std::string name) {
+  processing::ResampleOptions options;
+  options.beyond.method = processing::kDefaultBeyondMethod;
+  options.beyond.subdivisions = processing::kDefaultBeyondSubdivisions;
   processing::ResampleReport report;
-  Lut lut = processing::BuildLut(measurement, params, {}, &report);
+  Lut lut = processing::BuildLut(measurement, params, options, &report);
   return ViewSourceFromResampled(measurement, std::move(lut), report, std::move(name));
 }
 

@@ -76,12 +76,13 @@ std::string NumberTag(double v) {
 
 // The per-material file names of one engine folder (shared files excluded).
 struct MaterialFiles {
-  std::string texture, manifest, tiles, tiles_import;
+  std::string texture, manifest, tiles, tiles_import, ibl;
 };
 
 MaterialFiles FilesOf(Engine e, const std::string& name) {
   MaterialFiles f;
   f.manifest = name + ".manifest.json";
+  f.ibl = name + "_ibl.dds";
   switch (e) {
     case Engine::kUnity:
       f.texture = name + ".brdf3d";
@@ -288,6 +289,39 @@ ordered_json EngineSectionJson(Engine e, const Handoff& h) {
                       {"import", import}};
 }
 
+// The manifest's "ibl": for a LUT its pack (IblPackJson) with "texture"; for an atlas "texture"
+// and "cells", one pack per cell with its material and row.
+ordered_json IblJson(const Handoff& h) {
+  constexpr int kRows = IblPack::kRows;
+  ordered_json texture = {
+      {"file", h.name + "_ibl.dds"},
+      {"format", "DDS DXGI_FORMAT_R16G16B16A16_FLOAT (10), 2D, one mip; halves of the values here"},
+      {"width", 2 * kRows},
+      {"height", h.ibl.size()},
+      {"row_of_material", "row m = cell m (0 for a single LUT), row 0 first in the file, at v = 0"},
+      {"texels",
+       fmt::format("texel i < {0}: (diffuse_rgb, alpha_eq) at mu_i; texel {0} + i: (specular_rgb, "
+                   "fit_residual) at mu_i",
+                   kRows)},
+      {"sampling",
+       fmt::format("linear, clamp-to-edge, no mipmaps, no sRGB decode; u = clamp(mu * {0}, 0.5, "
+                   "{1}) / {2} (+ 0.5 for the specular half), v = (row + 0.5) / height",
+                   kRows, kRows - 0.5, 2 * kRows)}};
+  if (!h.atlas) {
+    ordered_json j = ordered_json::parse(IblPackJson(h.ibl.at(0)));
+    j["texture"] = texture;
+    j["row"] = 0;
+    return j;
+  }
+  ordered_json cells = ordered_json::array();
+  for (std::size_t m = 0; m < h.ibl.size(); ++m) {
+    ordered_json c = {{"material", h.cells[m].name}, {"row", m}};
+    c.update(ordered_json::parse(IblPackJson(h.ibl[m])));
+    cells.push_back(std::move(c));
+  }
+  return ordered_json{{"texture", texture}, {"cells", cells}};
+}
+
 // One manifest per material for every engine folder of the conversion (the same text in each,
 // hard-linked): the common description, then "engines" with one member per selected engine.
 std::string ManifestJson(const Handoff& h, const std::vector<Engine>& engines) {
@@ -328,7 +362,7 @@ std::string ManifestJson(const Handoff& h, const std::vector<Engine>& engines) {
       {"cells", cells},
       {"probe_texels", ProbeJson(h)},
       {"fallback_material", FallbackMaterialJson(h.fitted_models_json, h.fits)},
-      {"ibl", h.ibl_json.empty() ? ordered_json(nullptr) : ordered_json::parse(h.ibl_json)},
+      {"ibl", IblJson(h)},
       {"engines", sections},
       {"tool", {{"name", "brdf-toolchain"}, {"version", exporter::BrdfToolVersion()}}}};
   return j.dump(2) + "\n";
@@ -384,8 +418,8 @@ class SharedFiles {
 // returns the shared files it had to write.
 std::vector<std::string> StageEngineFolder(Engine e, const fs::path& dir, const Handoff& h,
                                            const Sources& src, StagedFiles& staged,
-                                           std::string& manifest_temp,
-                                           const std::string& manifest) {
+                                           std::string& manifest_temp, const std::string& manifest,
+                                           const std::string& ibl_dds) {
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (!fs::is_directory(dir))
@@ -457,6 +491,7 @@ std::vector<std::string> StageEngineFolder(Engine e, const fs::path& dir, const 
                [&] { return exporter::CompactBrdfGlslFile(h.layout); });
       break;
   }
+  staged.Write(path_of(f.ibl), ibl_dds);
   // The manifest: written into the first folder, hard-linked (from its temporary name) into
   // the others.
   const std::string manifest_path = path_of(f.manifest);
@@ -471,12 +506,15 @@ std::vector<std::string> WriteHandoff(const fs::path& base, const Handoff& h, co
                                       const EngineSet& engines) {
   const std::vector<Engine> selected = Selected(engines);
   const std::string manifest = ManifestJson(h, selected);
+  std::vector<const IblPack*> packs;
+  for (const IblPack& p : h.ibl) packs.push_back(&p);
+  const std::string ibl_dds = EncodeIblPackDds(packs);
   StagedFiles staged;
   std::string manifest_temp;
   std::vector<std::string> shared;
   for (Engine e : selected) {
     const auto w =
-        StageEngineFolder(e, base / FolderOf(e), h, src, staged, manifest_temp, manifest);
+        StageEngineFolder(e, base / FolderOf(e), h, src, staged, manifest_temp, manifest, ibl_dds);
     shared.insert(shared.end(), w.begin(), w.end());
   }
   staged.Commit();
@@ -539,7 +577,7 @@ std::vector<std::string> EngineOutputPaths(const std::string& out_dir, const std
   const fs::path base(out_dir);
   for (Engine e : Selected(engines)) {
     const MaterialFiles f = FilesOf(e, name);
-    for (const std::string* file : {&f.texture, &f.tiles, &f.tiles_import, &f.manifest})
+    for (const std::string* file : {&f.texture, &f.tiles, &f.tiles_import, &f.ibl, &f.manifest})
       if (!file->empty()) paths.push_back((base / FolderOf(e) / *file).string());
   }
   return paths;
@@ -634,7 +672,7 @@ EngineExportResult ExportLutWithEngines(const std::string& out_dir, const Lut& l
   h.fitted_models_json = metadata.fitted_models_json;
   h.fits = fits;
   // Image-based lighting: the pack of this LUT evaluated by its own rule (brdf/core/ibl_pack.h).
-  h.ibl_json = IblPackJson(ComputeIblPack(LutBrdf(lut, metadata.name)));
+  h.ibl = {ComputeIblPack(LutBrdf(lut, metadata.name))};
   const fs::path dir(out_dir);
   const auto main_file = [&](bool written, const char* ext) {
     return written ? (dir / (metadata.name + ext)).string() : std::string();
@@ -675,6 +713,9 @@ std::vector<std::string> WriteAtlasWithEngines(
                        atlas.layout.cells.CellRow(m) * Lut::kHeight});
     h.source += (m ? ", " : "") + atlas.sources[m];
   }
+  // One IBL pack per cell, from the material's own LUT (the atlas holds the same texels).
+  for (const exporter::AtlasMaterial& m : materials)
+    h.ibl.push_back(ComputeIblPack(LutBrdf(*m.lut, m.name)));
   const fs::path base = prefix_path.has_parent_path() ? prefix_path.parent_path() : fs::path(".");
   Sources src;  // WriteAtlas wrote all three
   src.ktx2_path = prefix + ".ktx2";

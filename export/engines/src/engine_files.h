@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "brdf/core/fitted_material.h"
+#include "brdf/core/ibl_pack.h"
 #include "brdf/exporter/exr.h"
 #include "brdf/exporter/packed_volume.h"
 #include "brdf/exporter/shader_code.h"
@@ -30,9 +31,9 @@ struct Handoff {
   exporter::GridLayout composite;  // slice grid of the flat EXR image (C × R)
   std::vector<std::string> fitted_models_json;
   std::vector<FittedMaterial> fits;  // `brdf fit` results, after fitted_models_json
-  // The material's IBL pack (brdf::IblPackJson of the LUT), the manifest's "ibl"; empty: null
-  // (atlases for now).
-  std::string ibl_json;
+  // The IBL pack of each cell's LUT (brdf/core/ibl_pack.h), in cell order: the manifest's "ibl"
+  // and the rows of NAME_ibl.dds.
+  std::vector<IblPack> ibl;
 };
 
 // "MeasuredBrdf" for the reference layout (θin 0, 20, 40, 60, a single 361 × 181 LUT), else

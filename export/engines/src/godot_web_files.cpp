@@ -17,9 +17,22 @@ std::string GodotShader(const exporter::ShaderLutLayout& layout) {
 // because Godot multiplies DIFFUSE_LIGHT by it (the measured colour is in f_r itself).
 // LIGHT_COLOR is the light's colour x energy x PI in Godot 4 and Godot's own Lambert term adds
 // LIGHT_COLOR * ATTENUATION * NdotL / PI, so f_r = albedo / PI reproduces it exactly.
+// Image-based lighting (docs/engines.md, "ibl"): Godot's own ambient and reflection terms are
+// disabled (they would light a white Lambertian); instead fragment() adds the material's probe
+// term as EMISSION from the IBL pack (measured_brdf_ibl_pack: <name>_ibl.dds, or its row of an
+// atlas's pack with measured_brdf_ibl_row = (row + 0.5) / rows) and a GGX-prefiltered radiance
+// cube map in the layout of Godot's own radiance maps (mip level = perceptual roughness x
+// max level, e.g. a baked ReflectionProbe's or the sky's exported radiance; Godot 4 spatial
+// shaders cannot read the scene's radiance map themselves). measured_brdf_radiance_max_lod = 0
+// (the default) leaves the probe term out.
 shader_type spatial;
+render_mode ambient_light_disabled;
 
 uniform sampler3D measured_brdf_lut : filter_linear, repeat_disable, hint_default_black;
+uniform sampler2D measured_brdf_ibl_pack : filter_linear, repeat_disable, hint_default_black;
+uniform samplerCube measured_brdf_radiance : filter_linear_mipmap, hint_default_black;
+uniform float measured_brdf_ibl_row = 0.5;
+uniform float measured_brdf_radiance_max_lod = 0.0;
 
 )~~" + exporter::MeasuredBrdfShaderCode(exporter::ShaderLanguage::kGodot, layout) +
          R"~~(
@@ -28,6 +41,19 @@ void fragment() {
   METALLIC = 0.0;
   SPECULAR = 0.0;
   ROUGHNESS = 1.0;
+  if (measured_brdf_radiance_max_lod > 0.0) {
+    // World space, where the cube map is indexed; two probe fetches and the pack row.
+    vec3 n = normalize((INV_VIEW_MATRIX * vec4(NORMAL, 0.0)).xyz);
+    vec3 v = normalize((INV_VIEW_MATRIX * vec4(VIEW, 0.0)).xyz);
+    vec3 ibl_diffuse;
+    vec3 ibl_specular;
+    float alpha_eq = MeasuredBrdfIblPack(measured_brdf_ibl_row, max(dot(n, v), 0.0), ibl_diffuse,
+                                         ibl_specular);
+    vec3 irradiance = textureLod(measured_brdf_radiance, n, measured_brdf_radiance_max_lod).rgb;
+    vec3 prefiltered = textureLod(measured_brdf_radiance, MeasuredBrdfIblReflect(n, v),
+                                  sqrt(alpha_eq) * measured_brdf_radiance_max_lod).rgb;
+    EMISSION = MeasuredBrdfIblRadiance(ibl_diffuse, ibl_specular, irradiance, prefiltered);
+  }
 }
 
 // NORMAL, LIGHT and VIEW are view-space unit vectors pointing away from the surface.
@@ -122,10 +148,20 @@ void main() {{
 const FRAGMENT_SHADER = MEASURED_BRDF_GLSL + `
 uniform highp sampler3D measuredBrdfLut;
 uniform vec3 lightDirection;  // world space, towards the light
-uniform vec3 lightColor;      // irradiance at normal incidence, linear RGB
+uniform vec3 lightColor;      // irradiance at normal incidence, linear RGB (0: no light)
 uniform float exposure;
 uniform vec2 cellTexels;      // atlas: the material's cell origin (manifest "cells"); else 0, 0
 uniform bool encodeSrgb;      // false: linear radiance (float render targets)
+uniform bool toneMapReinhard; // with encodeSrgb: x / (1 + x) per channel before the encoding
+#ifdef MEASURED_BRDF_IBL
+// three.js's own PMREM (PMREMGenerator: a cube map whose mip levels hold the GGX-prefiltered
+// radiance, roughness 1 at ENVMAP_MAX_LOD) and its roughnessToMip (envmap_common_pars_fragment).
+#define USE_ENVMAP
+#define ENVMAP_TYPE_PMREM
+#include <envmap_common_pars_fragment>
+uniform highp sampler2D iblPack;  // NAME_ibl.dds (loadMeasuredBrdfIblPack)
+uniform float iblPackRow;         // (row + 0.5) / rows of the material's pack row
+#endif
 in vec3 v_normal_world;
 in vec3 v_position_world;
 layout(location = 0) out highp vec4 fragColor;
@@ -135,29 +171,100 @@ vec3 SrgbFromLinear(vec3 c) {{
 }}
 void main() {{
   vec3 n = normalize(v_normal_world);
-  vec3 v = normalize(cameraPosition - v_position_world);
+  // Towards the camera; for an orthographic camera the same for every pixel (its +z axis in the
+  // world), as three's own materials take it (isOrthographic).
+  vec3 v = isOrthographic ? normalize(vec3(viewMatrix[0][2], viewMatrix[1][2], viewMatrix[2][2]))
+                          : normalize(cameraPosition - v_position_world);
   vec3 l = normalize(lightDirection);
-  vec3 f = MeasuredBrdfCell(measuredBrdfLut, cellTexels, n, l, v);
-  vec3 radiance = f * lightColor * max(dot(n, l), 0.0) * exposure;
+  vec3 radiance = vec3(0.0);
+  if (lightColor != vec3(0.0)) {{
+    vec3 f = MeasuredBrdfCell(measuredBrdfLut, cellTexels, n, l, v);
+    radiance = f * lightColor * max(dot(n, l), 0.0);
+  }}
+#ifdef MEASURED_BRDF_IBL
+  // One pack row (two texels at mu) and two probe fetches: the PMREM's last level (GGX alpha 1
+  // = the cosine lobe: irradiance / pi) about n, and the level of alpha_eq about R.
+  vec3 ibl_diffuse, ibl_specular;
+  float alpha_eq = MeasuredBrdfIblPack(iblPack, iblPackRow, max(dot(n, v), 0.0), ibl_diffuse,
+                                       ibl_specular);
+  vec3 r = MeasuredBrdfIblReflect(n, v);
+  vec3 irradiance = textureLod(envMap, envMapRotation * n, ENVMAP_MAX_LOD).rgb;
+  vec3 prefiltered = textureLod(envMap, envMapRotation * r, roughnessToMip(sqrt(alpha_eq))).rgb;
+  radiance += MeasuredBrdfIblRadiance(ibl_diffuse, ibl_specular, irradiance, prefiltered) *
+              envMapIntensity;
+#endif
+  radiance *= exposure;
+  if (encodeSrgb && toneMapReinhard) radiance = radiance / (1.0 + radiance);
   fragColor = vec4(encodeSrgb ? SrgbFromLinear(radiance) : radiance, 1.0);
 }}
 `;
 
-// A ShaderMaterial lit by one directional light. Options: lightDirection (THREE.Vector3,
-// towards the light), lightColor (THREE.Color or Vector3, linear), exposure, encodeSrgb,
-// cell ([x0, y0]: an atlas material's cell origin in texels, from the manifest).
+// The IBL pack texture (NAME_ibl.dds, docs/engines.md): a DDS RGBA16F 2D texture, read here
+// (header checked: DX10, DXGI format 10, 2D) into a half-float DataTexture with linear
+// filtering and clamp-to-edge, row 0 at v = 0 as the file stores it.
+export async function loadMeasuredBrdfIblPack(url) {{
+  const response = await fetch(url);
+  if (!response.ok) throw new Error(`measured BRDF: ${{url}}: HTTP ${{response.status}}`);
+  const bytes = await response.arrayBuffer();
+  const view = new DataView(bytes);
+  const word = (at) => view.getUint32(at, true);
+  if (bytes.byteLength < 148 || word(0) !== 0x20534444 || word(84) !== 0x30315844)
+    throw new Error(`measured BRDF: ${{url}}: not a DX10 DDS file`);
+  if (word(128) !== 10 || word(132) !== 3)
+    throw new Error(`measured BRDF: ${{url}}: expected DXGI format 10 (RGBA16F) 2D, got format ${{word(128)}}, dimension ${{word(132)}}`);
+  const height = word(12), width = word(16);
+  if (bytes.byteLength < 148 + width * height * 8)
+    throw new Error(`measured BRDF: ${{url}}: ${{bytes.byteLength}} bytes, expected ${{148 + width * height * 8}}`);
+  const texture = new THREE.DataTexture(new Uint16Array(bytes, 148, width * height * 4), width,
+                                        height, THREE.RGBAFormat, THREE.HalfFloatType);
+  texture.minFilter = THREE.LinearFilter;
+  texture.magFilter = THREE.LinearFilter;
+  texture.wrapS = THREE.ClampToEdgeWrapping;
+  texture.wrapT = THREE.ClampToEdgeWrapping;
+  texture.generateMipmaps = false;
+  texture.flipY = false;
+  texture.colorSpace = THREE.NoColorSpace;
+  texture.needsUpdate = true;
+  return texture;
+}}
+
+// A ShaderMaterial lit by one directional light and, with options.environment, by the
+// environment's probes. Options: lightDirection (THREE.Vector3, towards the light), lightColor
+// (THREE.Color or Vector3, linear; zero vector: no light), exposure, encodeSrgb (else linear
+// radiance out), toneMap ('linear': clamp, the default; 'reinhard'), cell ([x0, y0]:
+// an atlas material's cell origin in texels, from the manifest), environment (the texture of
+// PMREMGenerator.fromEquirectangular/fromScene: its GGX-prefiltered cube map), iblPack (the
+// texture of loadMeasuredBrdfIblPack), iblPackRow (the material's row, 0 for a single LUT; the
+// manifest's "ibl" "row"), environmentIntensity.
 export function createMeasuredBrdfMaterial(texture, options = {{}}) {{
   const color = options.lightColor ?? new THREE.Vector3(1, 1, 1);
+  const uniforms = {{
+    measuredBrdfLut: {{ value: texture }},
+    lightDirection: {{ value: (options.lightDirection ?? new THREE.Vector3(0, 0, 1)).clone() }},
+    lightColor: {{ value: new THREE.Vector3(color.x ?? color.r, color.y ?? color.g, color.z ?? color.b) }},
+    exposure: {{ value: options.exposure ?? 1.0 }},
+    cellTexels: {{ value: new THREE.Vector2(...(options.cell ?? [0, 0])) }},
+    encodeSrgb: {{ value: options.encodeSrgb ?? true }},
+    toneMapReinhard: {{ value: options.toneMap === 'reinhard' }},
+  }};
+  const defines = {{}};
+  const environment = options.environment ?? null;
+  if (environment) {{
+    if (!environment.isPMREMTexture || !options.iblPack)
+      throw new Error('measured BRDF: options.environment must be a PMREMGenerator texture, with options.iblPack');
+    const rows = options.iblPack.image.height;
+    defines.MEASURED_BRDF_IBL = '';
+    defines.ENVMAP_MAX_LOD = `${{environment.mipmaps.length - 1}}.0`;
+    uniforms.envMap = {{ value: environment }};
+    uniforms.envMapIntensity = {{ value: options.environmentIntensity ?? 1.0 }};
+    uniforms.envMapRotation = {{ value: new THREE.Matrix3() }};  // a PMREM needs no flip
+    uniforms.iblPack = {{ value: options.iblPack }};
+    uniforms.iblPackRow = {{ value: ((options.iblPackRow ?? 0) + 0.5) / rows }};
+  }}
   return new THREE.ShaderMaterial({{
     glslVersion: THREE.GLSL3,
-    uniforms: {{
-      measuredBrdfLut: {{ value: texture }},
-      lightDirection: {{ value: (options.lightDirection ?? new THREE.Vector3(0, 0, 1)).clone() }},
-      lightColor: {{ value: new THREE.Vector3(color.x ?? color.r, color.y ?? color.g, color.z ?? color.b) }},
-      exposure: {{ value: options.exposure ?? 1.0 }},
-      cellTexels: {{ value: new THREE.Vector2(...(options.cell ?? [0, 0])) }},
-      encodeSrgb: {{ value: options.encodeSrgb ?? true }},
-    }},
+    defines,
+    uniforms,
     vertexShader: VERTEX_SHADER,
     fragmentShader: FRAGMENT_SHADER,
   }});
@@ -171,19 +278,29 @@ std::string WebViewerHtml() {
   return fmt::format(
       R"~~(<!DOCTYPE html>
 <!-- Measured BRDF viewer, generated by {writer}. Serve this folder over HTTP (any static
-     server, e.g. `python3 -m http.server`) and open it; ?material=NAME picks NAME.ktx2 (an
-     atlas: ?material=PREFIX&cell=NAME).
+     server, e.g. `python3 -m http.server`) and open it:
+       index.html?material=NAME                     NAME.ktx2 lit by one light (drag to move it)
+       &env=studio|sky|furnace|URL.hdr|URL.exr      an environment (equirectangular; the
+                                                    built-in maps are those of brdf preview)
+       &ibl=1                                       light with it through three.js's PMREM and
+                                                    the material's IBL pack (default 1 with env)
+       &lights=0                                    no directional light
+       &tonemap=linear|reinhard                     linear: radiance clamped to 1, sRGB encoded
+       &exposure=STOPS  &cell=NAME (an atlas material)  &background=0 (no map behind)
+     The canvas fills the window and follows its size; the sphere fills most of it, the camera
+     looks along the normal at the window's centre (the preview's default view: the map is
+     turned as `brdf preview` shows it). document.title becomes "ready" when the first frame is
+     drawn (for headless screenshots).
      three.js r{min}+ is loaded from ./node_modules/three/ (run `npm install` here: package.json
-     names it) or from the folder given as ?three=URL/ (ending in /).
-     Drag to move the light; the sphere is shaded by the measured f_r alone. -->
+     names it) or from the folder given as ?three=URL/ (ending in /). -->
 <html lang="en">
 <head>
 <meta charset="utf-8">
 <title>Measured BRDF</title>
 <style>
-  html, body {{ margin: 0; height: 100%; background: #111; color: #ccc; font: 13px sans-serif; }}
-  canvas {{ display: block; }}
-  #status {{ position: absolute; left: 8px; top: 6px; }}
+  html, body {{ margin: 0; width: 100%; height: 100%; overflow: hidden; background: #111; color: #ccc; font: 13px sans-serif; }}
+  canvas {{ display: block; position: absolute; left: 0; top: 0; }}
+  #status {{ position: absolute; left: 8px; top: 6px; z-index: 1; }}
 </style>
 <script>
   // The import map must exist before the first module script; it is written from ?three=.
@@ -205,57 +322,198 @@ import * as THREE from 'three';
 const params = new URLSearchParams(location.search);
 const material = params.get('material') || '';
 const size = parseInt(params.get('size') || '0', 10);
+const envName = params.get('env') || '';
+const useIbl = envName !== '' && params.get('ibl') !== '0';
+const useLight = params.get('lights') !== '0';
+const toneMap = params.get('tonemap') === 'reinhard' ? 'reinhard' : 'linear';
 const status = document.getElementById('status');
 const renderer = new THREE.WebGLRenderer({{ antialias: false, preserveDrawingBuffer: true }});
 renderer.setPixelRatio(1);
-const width = size || window.innerWidth, height = size || window.innerHeight;
-renderer.setSize(width, height);
 document.body.appendChild(renderer.domElement);
 const scene = new THREE.Scene();
-const camera = new THREE.PerspectiveCamera(30, width / height, 0.1, 100);
-camera.position.set(0, 0, 5);
-camera.lookAt(0, 0, 0);
+const camera = new THREE.PerspectiveCamera(30, 1, 0.1, 100);
 const light = new THREE.Vector3(0.5, 0.6, 1.0).normalize();
+let width = 0, height = 0;
+// The camera on +z looks at the sphere's centre; its distance keeps the sphere's diameter at
+// 0.9 of the window's smaller side, as `brdf preview --fov 30` frames it.
+const fit = () => {{
+  width = size || window.innerWidth;
+  height = size || window.innerHeight;
+  renderer.setSize(width, height);
+  camera.aspect = width / height;
+  const tanHalf = 0.9 * Math.tan(THREE.MathUtils.degToRad(15)) * Math.min(1, camera.aspect);
+  camera.position.set(0, 0, 1 / Math.sin(Math.atan(tanHalf)));
+  camera.lookAt(0, 0, 0);
+  camera.updateProjectionMatrix();
+}};
+fit();
 window.measuredBrdf = {{ renderer, scene, camera, light, THREE, ready: null }};
+
+// brdf preview's frame (docs/preview.md: z up, default camera on +x, +y to its right) turned
+// into three's (camera on +z, y up, x to the right): (x, y, z)_preview = (z, x, y)_three, a
+// rotation. three's equirectangular lookup then reads preview azimuth phi at u = 0.75 - phi/2pi,
+// so a map in the preview's layout (row 0 = zenith, column 0 = azimuth 0, growing to the right)
+// is uploaded with column i taken from preview column (0.75 W - 1 - i) mod W, rows bottom first.
+function equirectTexture(w, h, previewRgb) {{
+  const data = new Float32Array(w * h * 4);
+  for (let j = 0; j < h; j++)
+    for (let i = 0; i < w; i++) {{
+      const ip = ((Math.round(0.75 * w) - 1 - i) % w + w) % w;
+      const src = (j * w + ip) * 3, dst = ((h - 1 - j) * w + i) * 4;
+      data[dst] = previewRgb[src]; data[dst + 1] = previewRgb[src + 1]; data[dst + 2] = previewRgb[src + 2]; data[dst + 3] = 1;
+    }}
+  const t = new THREE.DataTexture(data, w, h, THREE.RGBAFormat, THREE.FloatType);
+  t.mapping = THREE.EquirectangularReflectionMapping;
+  t.colorSpace = THREE.LinearSRGBColorSpace;
+  t.minFilter = THREE.LinearFilter; t.magFilter = THREE.LinearFilter;
+  t.needsUpdate = true;
+  return t;
+}}
+// The preview's built-in maps (preview/src/environment_map.cpp), evaluated at pixel centres.
+function builtinMap(name, w, h) {{
+  const rgb = new Float32Array(w * h * 3);
+  const dir = (i, j) => {{
+    const th = (j + 0.5) / h * Math.PI, ph = (i + 0.5) / w * 2 * Math.PI;
+    return [Math.sin(th) * Math.cos(ph), Math.sin(th) * Math.sin(ph), Math.cos(th)];
+  }};
+  const sph = (t, p) => {{ t *= Math.PI / 180; p *= Math.PI / 180; return [Math.sin(t) * Math.cos(p), Math.sin(t) * Math.sin(p), Math.cos(t)]; }};
+  const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+  const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+  const norm = (a) => {{ const l = Math.hypot(a[0], a[1], a[2]); return [a[0] / l, a[1] / l, a[2] / l]; }};
+  const smooth = (e0, e1, x) => {{ const t = Math.min(Math.max((x - e0) / (e1 - e0), 0), 1); return t * t * (3 - 2 * t); }};
+  if (name === 'furnace') {{ rgb.fill(1); return rgb; }}
+  if (name === 'studio') {{
+    // A gradient (0.05 at and below the horizon, 0.25 at the zenith) and three soft boxes.
+    const boxes = [[40, 35, 22, 16, 4, [4.0, 3.9, 3.7]], [70, 295, 14, 20, 5, [0.9, 0.95, 1.05]],
+                   [55, 165, 9, 28, 3, [3.0, 3.0, 3.0]]].map(([t, p, hw, hh, soft, c]) => {{
+      const centre = sph(t, p), right = norm(cross(centre, [0, 0, 1])), up = cross(right, centre);
+      return {{ centre, right, up, hw, hh, soft, c }};
+    }});
+    const edge = (half, soft, tan) => 1 - smooth(half - soft, half, Math.abs(Math.atan(tan)) * 180 / Math.PI);
+    for (let j = 0; j < h; j++)
+      for (let i = 0; i < w; i++) {{
+        const d = dir(i, j), g = 0.05 + 0.2 * Math.max(0, d[2]);
+        let c = [g, g, g * 1.05];
+        for (const b of boxes) {{
+          const ca = dot(d, b.centre);
+          if (ca <= 0) continue;
+          const k = edge(b.hw, b.soft, dot(d, b.right) / ca) * edge(b.hh, b.soft, dot(d, b.up) / ca);
+          c = c.map((x, ch) => x * (1 - k) + b.c[ch] * k);
+        }}
+        rgb.set(c, (j * w + i) * 3);
+      }}
+    return rgb;
+  }}
+  // 'sky': CIE standard clear sky (ISO 15469 type 12) relative to the zenith, tinted blue, the
+  // sun (irradiance 8 on a surface facing it) at theta 40, phi 30 over a disc of at least one
+  // pixel, a ground of albedo 0.2 lit by both.
+  const sun = sph(40, 30), sunTheta = 40 * Math.PI / 180;
+  const grad = (c) => 1 - Math.exp(-0.32 / c);
+  const ind = (g) => 1 + 10 * (Math.exp(-3 * g) - Math.exp(-1.5 * Math.PI)) + 0.45 * Math.cos(g) ** 2;
+  const zen = ind(sunTheta) * grad(1), tint = [0.55, 0.72, 1.0], sunTint = [1.0, 0.95, 0.85];
+  const radius = Math.max(0.265 * Math.PI / 180, 0.75 * Math.max(2 * Math.PI / w, Math.PI / h));
+  const omega = (j) => (Math.cos(j * Math.PI / h) - Math.cos((j + 1) * Math.PI / h)) * 2 * Math.PI / w;
+  const disc = []; let discOmega = 0;
+  for (let j = 0; j < h; j++)
+    for (let i = 0; i < w; i++) {{
+      const d = dir(i, j);
+      if (d[2] > 0) {{
+        const l = ind(Math.acos(Math.min(1, Math.max(-1, dot(d, sun))))) * grad(Math.max(d[2], 0.02)) / zen;
+        rgb.set(tint.map((t) => l * t), (j * w + i) * 3);
+      }}
+      const cs = dot(d, sun);
+      if (cs >= Math.cos(radius)) {{ disc.push(j * w + i); discOmega += omega(j) * cs; }}
+    }}
+  for (const p of disc) for (let c = 0; c < 3; c++) rgb[p * 3 + c] += 8 * sunTint[c] / discOmega;
+  const e = [0, 0, 0];
+  for (let j = 0; j < h; j++) {{
+    const ct = Math.cos((j + 0.5) * Math.PI / h);
+    if (ct <= 0) continue;
+    for (let i = 0; i < w; i++) for (let c = 0; c < 3; c++) e[c] += rgb[(j * w + i) * 3 + c] * ct * omega(j);
+  }}
+  for (let j = 0; j < h; j++) {{
+    if (Math.cos((j + 0.5) * Math.PI / h) > 0) continue;
+    for (let i = 0; i < w; i++) rgb.set(e.map((x) => 0.2 * x / Math.PI), (j * w + i) * 3);
+  }}
+  return rgb;
+}}
+async function loadEnvironment(name) {{
+  if (['studio', 'sky', 'furnace'].includes(name)) {{
+    const w = name === 'furnace' ? 64 : 1024, h = w / 2;
+    return equirectTexture(w, h, builtinMap(name, w, h));
+  }}
+  // A file: read as float RGB(A), rows top first (the loaders' data, before their flipY).
+  const exr = /\.exr($|\?)/i.test(name);
+  const {{ [exr ? 'EXRLoader' : 'HDRLoader']: Loader }} =
+      await import(exr ? 'three/addons/loaders/EXRLoader.js' : 'three/addons/loaders/HDRLoader.js');
+  const t = await new Loader().setDataType(THREE.FloatType).loadAsync(name);
+  const {{ width: w, height: h, data }} = t.image;
+  const channels = data.length / (w * h);
+  const rgb = new Float32Array(w * h * 3);
+  for (let j = 0; j < h; j++) {{
+    const row = t.flipY ? j : h - 1 - j;  // EXRLoader stores rows bottom first, HDRLoader top first
+    for (let i = 0; i < w; i++)
+      for (let c = 0; c < 3; c++) rgb[(j * w + i) * 3 + c] = data[(row * w + i) * channels + c];
+  }}
+  t.dispose();
+  return equirectTexture(w, h, rgb);
+}}
 
 window.measuredBrdf.ready = (async () => {{
   if (!material) throw new Error('add ?material=NAME to the address (NAME.ktx2 in this folder)');
   // The manifest names the module of the material's layout (one index.html for every layout).
   const manifest = await fetch(`./${{material}}.manifest.json`).then((r) => (r.ok ? r.json() : null));
   if (!manifest) throw new Error(`${{material}}.manifest.json: not found in this folder`);
-  const {{ loadMeasuredBrdfTexture, createMeasuredBrdfMaterial }} =
-      await import(`./${{manifest.engines.web.files.shader}}`);
-  const texture = await loadMeasuredBrdfTexture(`./${{material}}.ktx2`, renderer);
+  const module = await import(`./${{manifest.engines.web.files.shader}}`);
+  const texture = await module.loadMeasuredBrdfTexture(`./${{material}}.ktx2`, renderer);
   // An atlas: ?cell=NAME picks a material's cell from the manifest (default: the first).
-  let cell = [0, 0];
+  let cell = [0, 0], cellIndex = 0;
   if (manifest.atlas) {{
     const wanted = params.get('cell');
-    const c = manifest.cells.find((x) => x.material === wanted) || manifest.cells[0];
-    cell = [c.x0, c.y0];
+    cellIndex = Math.max(0, manifest.cells.findIndex((x) => x.material === wanted));
+    cell = [manifest.cells[cellIndex].x0, manifest.cells[cellIndex].y0];
   }}
-  const shader = createMeasuredBrdfMaterial(texture, {{ lightDirection: light, cell, exposure: parseFloat(params.get('exposure') || '1') }});
+  const options = {{ lightDirection: light, cell, exposure: Math.pow(2, parseFloat(params.get('exposure') || '0')), toneMap }};
+  if (!useLight) options.lightColor = new THREE.Vector3(0, 0, 0);
+  if (envName) {{
+    const map = await loadEnvironment(envName);
+    if (params.get('background') !== '0') scene.background = map;
+    if (useIbl) {{
+      const pmrem = new THREE.PMREMGenerator(renderer);
+      options.environment = pmrem.fromEquirectangular(map).texture;
+      pmrem.dispose();
+      const ibl = manifest.ibl;
+      options.iblPack = await module.loadMeasuredBrdfIblPack(`./${{ibl.texture.file}}`);
+      options.iblPackRow = manifest.atlas ? ibl.cells[cellIndex].row : ibl.row;
+    }}
+  }}
+  const shader = module.createMeasuredBrdfMaterial(texture, options);
   const sphere = new THREE.Mesh(new THREE.SphereGeometry(1, 128, 64), shader);
   scene.add(sphere);
-  Object.assign(window.measuredBrdf, {{ texture, shader, sphere }});
+  Object.assign(window.measuredBrdf, {{ texture, shader, sphere, environment: options.environment ?? null }});
   const draw = () => {{
     shader.uniforms.lightDirection.value.copy(light);
     renderer.render(scene, camera);
   }};
   window.measuredBrdf.draw = draw;
+  window.addEventListener('resize', () => {{ if (!size) {{ fit(); draw(); }} }});
   let dragging = false;
   renderer.domElement.addEventListener('pointerdown', () => {{ dragging = true; }});
   window.addEventListener('pointerup', () => {{ dragging = false; }});
   renderer.domElement.addEventListener('pointermove', (e) => {{
-    if (!dragging) return;
+    if (!dragging || !useLight) return;
     const x = (e.offsetX / width) * 2 - 1, y = 1 - (e.offsetY / height) * 2;
     const r2 = x * x + y * y;
     light.set(x, y, r2 < 1 ? Math.sqrt(1 - r2) : 0).normalize();
     draw();
   }});
   draw();
-  status.textContent = `${{material}} (drag to move the light)`;
+  renderer.getContext().finish();
+  // Nothing over the picture once it is drawn (headless screenshots); the title says so.
+  status.style.display = 'none';
+  document.title = 'ready';
   return true;
-}})().catch((e) => {{ status.textContent = String(e); throw e; }});
+}})().catch((e) => {{ status.textContent = String(e); document.title = 'error'; throw e; }});
 </script>
 </body>
 </html>

@@ -155,6 +155,36 @@ void MeasuredBrdfRadiance_half(UnityTexture3D Lut, half3 N, half3 L, half3 V,
     Out = (half3)f;
 }
 
+// Image-based lighting with the pipeline's own probes (docs/engines.md, "ibl"): the probe
+// term of the measured material, added to MeasuredBrdfRadiance's direct lighting (Custom
+// Function Name MeasuredBrdfIbl; inputs IblPack (Texture 2D: the <name>_ibl.dds pack, linear,
+// clamp, no mips, sRGB off), IblRow (Float: (row + 0.5) / rows, 0.5 for one LUT), N, V (world
+// space); output Out = radiance). One pack row (two texels at mu = N.V) and two probe fetches:
+//   URP (its Lighting.hlsl included, as in Lit and Unlit graphs): SampleSH(N) (irradiance / pi)
+//     and GlossyEnvironmentReflection(R, perceptual roughness sqrt(alpha_eq), 1) (the
+//     reflection probe, or the sky, at URP's mip for that roughness);
+//   HDRP (Core's AmbientProbe.hlsl included): EvaluateAmbientProbe(N) and the sky's
+//     GGX-prefiltered cube map SampleSkyTexture(R, PerceptualRoughnessToMipmapLevel(...), 0).
+#if defined(UNIVERSAL_LIGHTING_INCLUDED)
+#define MEASURED_BRDF_IRRADIANCE(n) SampleSH(n)
+#define MEASURED_BRDF_PREFILTERED(r, roughness) GlossyEnvironmentReflection(r, roughness, 1.0)
+#elif defined(__AMBIENTPROBE_HLSL__)
+#define MEASURED_BRDF_IRRADIANCE(n) EvaluateAmbientProbe(n)
+#define MEASURED_BRDF_PREFILTERED(r, roughness) \
+    SampleSkyTexture(r, PerceptualRoughnessToMipmapLevel(roughness), 0).rgb
+#endif
+#ifdef MEASURED_BRDF_IRRADIANCE
+void MeasuredBrdfIbl_float(UnityTexture2D IblPack, float IblRow, float3 N, float3 V,
+                           out float3 Out)
+{
+    float3 n = normalize(N), v = normalize(V), d, s;
+    float alpha_eq = MeasuredBrdfIblPack(IblPack.tex, IblPack.samplerstate, IblRow,
+                                         saturate(dot(n, v)), d, s);
+    float3 r = MeasuredBrdfIblReflect(n, v);
+    Out = MeasuredBrdfIblRadiance(d, s, MEASURED_BRDF_IRRADIANCE(n),
+                                  MEASURED_BRDF_PREFILTERED(r, sqrt(alpha_eq)));
+}
+#endif
 #ifdef MEASURED_BRDF_BUILTIN_LIGHTING
 UNITY_DECLARE_TEX3D(_MeasuredBrdfLut);
 
@@ -197,9 +227,35 @@ std::string UnrealUsh(const exporter::ShaderLutLayout& layout) {
 // N, L, V (float3: world-space normal, direction to the light, direction to the camera),
 // Code:   return MeasuredBrdf(Lut, LutSampler, normalize(N), normalize(L), normalize(V));
 // The result is f_r in 1/sr; multiply by the light colour and saturate(dot(N, L)) for radiance.
+//
+// Image-based lighting (docs/engines.md, "ibl"): a second Custom node, same include, Additional
+// Defines MEASURED_BRDF_UNREAL_SKY = 1, inputs IblPack (TextureObject of <name>_ibl.dds: sRGB
+// off, TC_HDR, no mips, clamp; Unreal passes IblPack and IblPackSampler), IblRow ((row + 0.5) /
+// rows, 0.5 for one LUT), N, V, Output Type CMOT Float 3, added to the direct term (Emissive
+// of an Unlit material, or the lit sum):
+// Code:   return MeasuredBrdfIblUnreal(IblPack, IblPackSampler, IblRow, normalize(N), normalize(V));
+// It reads the Sky Light, Unreal's own probe: GetSkySHDiffuse (irradiance / pi) and
+// GetSkyLightReflection at roughness sqrt(alpha_eq) (the captured sky cube map at Unreal's mip
+// for that roughness), each times the light's colour; one pack row, two probe fetches.
 #pragma once
 
-)~~" + exporter::MeasuredBrdfShaderCode(exporter::ShaderLanguage::kHlsl, layout);
+)~~" + exporter::MeasuredBrdfShaderCode(exporter::ShaderLanguage::kHlsl, layout) +
+         R"~~(
+#if MEASURED_BRDF_UNREAL_SKY
+float3 MeasuredBrdfIblUnreal(Texture2D IblPack, SamplerState IblPackSampler, float IblRow,
+                             float3 N, float3 V)
+{
+    float3 diffuse, specular;
+    float alpha_eq = MeasuredBrdfIblPack(IblPack, IblPackSampler, IblRow, saturate(dot(N, V)),
+                                         diffuse, specular);
+    float sky_brightness;
+    float3 prefiltered = GetSkyLightReflection(MeasuredBrdfIblReflect(N, V), sqrt(alpha_eq),
+                                               sky_brightness);
+    return MeasuredBrdfIblRadiance(diffuse, specular, GetSkySHDiffuse(N) * View.SkyLightColor.rgb,
+                                   prefiltered);
+}
+#endif
+)~~";
 }
 
 std::string UnrealImportPython() {

@@ -188,9 +188,12 @@ void ConcentratedNodes(double lo, double hi, double c, double sigma, double peak
 IblPack ComputeIblPack(const BrdfSource& source) {
   constexpr int kRows = IblPack::kRows;
   constexpr int kTheta = IblPack::kThetaSteps, kPhi = IblPack::kPhiSteps;
-  // Histogram of the lobe over γ, the angle between l and R, in [0, π], for the moments about
-  // R (linear splatting: exact for constant and linear functions of γ, second order otherwise).
+  // Histogram of the lobe over t = √(1 − cosγ) = √2·sin(γ/2) ∈ [0, √2], γ the angle between l
+  // and R, for the moments about R (linear splatting: exact for constant and linear functions of
+  // t, second order otherwise). t is nearly proportional to γ where lobes are narrow (γ ≪ 1) and
+  // takes a square root per sample instead of an arc cosine.
   constexpr int kBins = 1024;
+  constexpr double kMaxT = 1.4142135623730951;
   IblPack pack;
   pack.mu.resize(kRows);
   pack.albedo.resize(kRows);
@@ -200,7 +203,10 @@ IblPack ComputeIblPack(const BrdfSource& source) {
   pack.residual.resize(kRows);
 
   std::vector<Bands> p_bins(kBins);
-  for (int b = 0; b < kBins; ++b) Legendre(std::cos(kPi * b / (kBins - 1)), &p_bins[b]);
+  for (int b = 0; b < kBins; ++b) {
+    const double t = kMaxT * b / (kBins - 1);
+    Legendre(1.0 - t * t, &p_bins[b]);
+  }
   std::vector<Rgb> hist(kBins);
   Bands p{};
   const KappaTable& table = Kappa();
@@ -250,7 +256,7 @@ IblPack ComputeIblPack(const BrdfSource& source) {
         }
         const double w = row_weight * phi_w[k];
         const double cos_gamma = std::clamp(Dot(l, r), -1.0, 1.0);
-        const double x = std::acos(cos_gamma) * (1.0 / kPi) * (kBins - 1);
+        const double x = std::sqrt(1.0 - cos_gamma) * ((kBins - 1) / kMaxT);
         const int b = std::min(kBins - 2, static_cast<int>(x));
         const double frac = x - b;
         for (int c = 0; c < 3; ++c) {
@@ -266,10 +272,17 @@ IblPack ComputeIblPack(const BrdfSource& source) {
         for (int l = 0; l < kBands; ++l) m[c].at_n[l] += ring[c] * p[l];
       }
     }
-    for (int b = 0; b < kBins; ++b)
-      for (int c = 0; c < 3; ++c)
-        if (hist[b][c] != 0.0)
-          for (int l = 0; l < kBands; ++l) m[c].at_r[l] += hist[b][c] * p_bins[b][l];
+    // Bins the lobe never reached are skipped; the three channels share each bin's P_ℓ.
+    for (int b = 0; b < kBins; ++b) {
+      const Rgb& h = hist[b];
+      if (h[0] == 0.0 && h[1] == 0.0 && h[2] == 0.0) continue;
+      const Bands& pb = p_bins[b];
+      for (int l = 0; l < kBands; ++l) {
+        m[0].at_r[l] += h[0] * pb[l];
+        m[1].at_r[l] += h[1] * pb[l];
+        m[2].at_r[l] += h[2] * pb[l];
+      }
+    }
     for (int c = 0; c < 3; ++c) m[c].e = e[c];
     Moments luma;
     luma.e = Luma(e);

@@ -107,6 +107,13 @@ AutoExtrapolationResult ChooseExtrapolationAuto(const Measurement& measurement, 
   options.threads = threads;
   FitResult fit = FitMaterial(measurement, options);
   AutoExtrapolationResult out = FitExtrapolationToModel(measurement, fit.material);
+  if (Underdetermined(fit.report.samples_used, options.model)) {
+    // A fit the data does not determine says nothing about the fall-off beyond θb.
+    out.not_used = UnderdeterminedWarning(fit.report.samples_used, options.model) +
+                   "; the default extrapolation p = 1, l = 0.5 is used instead";
+    out.params = ExtrapolationParams{};
+    out.band_rmse = out.band_rmse_clamp;
+  }
   out.fit = std::move(fit);
   return out;
 }
@@ -122,6 +129,7 @@ std::string AutoExtrapolationJson(const AutoExtrapolationResult& result) {
       "theta_b and 90 deg";
   j["band_rmse"] = result.band_rmse;
   j["band_rmse_clamp"] = result.band_rmse_clamp;
+  if (!result.not_used.empty()) j["fit_not_used"] = result.not_used;
   if (result.fit) j["ggx_fit"] = nlohmann::ordered_json::parse(FittedMaterialToJson(*result.fit));
   return j.dump();
 }

@@ -162,6 +162,32 @@ FitData PrepareFitData(const Measurement& measurement, const FitOptions& options
   return data;
 }
 
+int ParametersPerChannel(Model model) {
+  return static_cast<int>(DescribeModel(model).parameters.size());
+}
+
+int ParameterCount(Model model) {
+  int n = 0;
+  for (const ParameterInfo& p : DescribeModel(model).parameters) n += p.rgb ? 3 : 1;
+  return n;
+}
+
+bool Underdetermined(std::size_t samples_used, Model model) {
+  return samples_used < static_cast<std::size_t>(kSamplesPerParameter) *
+                            static_cast<std::size_t>(ParametersPerChannel(model));
+}
+
+std::string UnderdeterminedWarning(std::size_t samples_used, Model model) {
+  if (!Underdetermined(samples_used, model)) return {};
+  const int per_channel = ParametersPerChannel(model);
+  return std::to_string(samples_used) + " usable sample" + (samples_used == 1 ? "" : "s") +
+         " for " + std::to_string(ParameterCount(model)) + " parameters (" +
+         std::to_string(per_channel) + " per colour channel): the data does not determine the " +
+         std::string(ModelName(model)) + " fit (at least " +
+         std::to_string(kSamplesPerParameter * per_channel) +
+         " usable samples needed); not representable";
+}
+
 void FillErrors(const FitData& data, const Material& material, FitReport* report) {
   report->samples_used = data.samples.size();
   report->excluded_invalid = data.excluded_invalid;
@@ -284,6 +310,11 @@ void FillErrors(const FitData& data, const Material& material, FitReport* report
   report->hue_spread = spread;
   report->colour_shift = spread > 0.02;
   report->representable = !report->colour_shift && worst <= 0.05;
+  if (const std::string w = UnderdeterminedWarning(data.samples.size(), material.model);
+      !w.empty()) {
+    report->representable = false;
+    report->warnings.push_back(w);
+  }
   if (report->colour_shift) {
     report->warnings.push_back(ColourShiftWarning(spread, material.model));
   } else if (worst > 0.05) {

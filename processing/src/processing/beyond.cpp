@@ -136,9 +136,19 @@ std::array<double, 3> RatioOf(const std::array<double, 3>& a, const std::array<d
   return r;
 }
 
-// Every texel's view in the slice at one θin, and the model there (computed once per θin).
+// Every texel's view and shading geometry in the slice at one θin: the same for every fill
+// model, so one ExtendBeyondMeasured call computes them once per θin for all its fills (the
+// validations and the final one); the trigonometry of these was most of the fill's time.
+struct SliceGeometry {
+  std::vector<View> view;          // index j·361 + i
+  std::vector<ShadingGeometry> g;  // GeometryAt(θin, view); computed when a model needs it
+};
+using GeometryCache = std::map<long, SliceGeometry>;
+
+// Every texel's view in the slice at one θin (the shared SliceGeometry's), and the model there
+// (computed once per θin and model).
 struct SliceGrid {
-  std::vector<View> view;                // index j·361 + i
+  const std::vector<View>& view;         // index j·361 + i
   std::vector<std::array<double, 3>> m;  // empty for M ≡ 1
 };
 
@@ -150,22 +160,47 @@ struct Ratio {
   const SliceGrid& Prepare(double theta_in_deg) const {
     const long key = std::lround(theta_in_deg * 1e6);
     if (auto it = grids->find(key); it != grids->end()) return it->second;
-    SliceGrid g;
-    g.view.resize(static_cast<std::size_t>(Lut::kHeight) * Lut::kWidth);
-    if (model) g.m.resize(g.view.size());
-    ForRows([&](int j) {
-      for (int i = 0; i < Lut::kWidth; ++i) {
-        const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
-        g.view[n] = TexelView(theta_in_deg, j, i);
-        if (model) g.m[n] = model->Eval(theta_in_deg, g.view[n].theta_deg, g.view[n].phi_deg);
+    SliceGeometry& s = GeometryOf(theta_in_deg, key);
+    SliceGrid g{s.view, {}};
+    if (model) {
+      if (s.g.empty()) {
+        s.g.resize(s.view.size());
+        ForRows([&](int j) {
+          for (int i = 0; i < Lut::kWidth; ++i) {
+            const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
+            s.g[n] = GeometryAt(theta_in_deg, s.view[n].theta_deg, s.view[n].phi_deg);
+          }
+        });
       }
-    });
+      g.m.resize(s.view.size());
+      ForRows([&](int j) {
+        for (int i = 0; i < Lut::kWidth; ++i) {
+          const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
+          // FillModel::Eval at the cached geometry (the same numbers).
+          const Rgb f =
+              models::EvaluateRgb(model->material.model, s.g[n], model->material.values.data());
+          g.m[n] = {f[0], f[1], f[2]};
+        }
+      });
+    }
     return grids->emplace(key, std::move(g)).first->second;
+  }
+  SliceGeometry& GeometryOf(double theta_in_deg, long key) const {
+    if (auto it = geometry->find(key); it != geometry->end()) return it->second;
+    SliceGeometry s;
+    s.view.resize(static_cast<std::size_t>(Lut::kHeight) * Lut::kWidth);
+    ForRows([&](int j) {
+      for (int i = 0; i < Lut::kWidth; ++i)
+        s.view[static_cast<std::size_t>(j) * Lut::kWidth + i] = TexelView(theta_in_deg, j, i);
+    });
+    return geometry->emplace(key, std::move(s)).first->second;
   }
   std::array<double, 3> Between(const SliceGrid& now, const SliceGrid& old, std::size_t n) const {
     if (model == nullptr) return {1.0, 1.0, 1.0};
     return RatioOf(now.m[n], old.m[n]);
   }
+  // Declared first so that it outlives the grids, which refer to its views.
+  std::shared_ptr<GeometryCache> geometry = std::make_shared<GeometryCache>();
   std::shared_ptr<std::map<long, SliceGrid>> grids = std::make_shared<std::map<long, SliceGrid>>();
 };
 
@@ -550,6 +585,14 @@ Lut ExtendBeyondMeasured(const Lut& measured, double theta_b, const BeyondOption
         measured.texels.begin() +
             static_cast<std::ptrdiff_t>(head.theta_in_deg.size() * Lut::kHeight * Lut::kWidth * 3));
   }
+  // One geometry cache for every fill below (the ratios differ only in their model).
+  const auto geometry = std::make_shared<GeometryCache>();
+  const auto ratio_of = [&](const FillModel* model) {
+    Ratio ratio;
+    ratio.model = model;
+    ratio.geometry = geometry;
+    return ratio;
+  };
   const auto validate_with = [&](const Ratio& ratio) {
     BeyondReport scratch;
     const Lut f = Fill(head, theta_b, last, fill_step, ratio, &scratch);
@@ -557,13 +600,13 @@ Lut ExtendBeyondMeasured(const Lut& measured, double theta_b, const BeyondOption
   };
   BeyondMethod use = options.method;
   if (validate && (use == BeyondMethod::kHold || use == BeyondMethod::kAuto))
-    r.validation_hold = validate_with(Ratio{});
+    r.validation_hold = validate_with(ratio_of(nullptr));
   // kModel: the family whose fill predicts the left-out slice best (GGX without validation).
   Model family = Model::kGgx;
   if (validate && (use == BeyondMethod::kModel || use == BeyondMethod::kAuto)) {
     for (Model m : {Model::kGgx, Model::kWard, Model::kLafortune}) {
       const FillModel head_model = Widened(FitFillModel(head, theta_b, m));
-      const LeaveLastSliceOut v = validate_with(Ratio{&head_model});
+      const LeaveLastSliceOut v = validate_with(ratio_of(&head_model));
       if (!r.validation_model || Key(v) < Key(*r.validation_model)) {
         r.validation_model = v;
         family = m;
@@ -581,9 +624,9 @@ Lut ExtendBeyondMeasured(const Lut& measured, double theta_b, const BeyondOption
   if (use == BeyondMethod::kModel) {
     r.model = FitFillModel(measured, theta_b, family);
     const FillModel ratio_model = Widened(*r.model);
-    return Fill(measured, theta_b, options.max_theta_in_deg, fill_step, Ratio{&ratio_model}, &r);
+    return Fill(measured, theta_b, options.max_theta_in_deg, fill_step, ratio_of(&ratio_model), &r);
   }
-  return Fill(measured, theta_b, options.max_theta_in_deg, fill_step, Ratio{}, &r);
+  return Fill(measured, theta_b, options.max_theta_in_deg, fill_step, ratio_of(nullptr), &r);
 }
 
 }  // namespace brdf::processing

@@ -138,13 +138,16 @@ std::vector<LutInputProblem> FindLutInputProblems(const Measurement& m,
     };
     std::vector<Defect> defects;
     std::size_t valid = 0, invalid = 0;
+    const std::optional<double> allowance =
+        options.check_measured_values ? std::optional<double>(detail::NegativeAllowance(s))
+                                      : std::nullopt;
     for (std::size_t n = 0; n < s.samples.size(); ++n) {
       const Sample& x = s.samples[n];
       if (x.flags & kFlagInvalid) {
         ++invalid;
         continue;
       }
-      if (const char* d = detail::SampleDefect(x)) {
+      if (const char* d = detail::SampleDefect(x, allowance)) {
         auto it = std::find_if(defects.begin(), defects.end(),
                                [&](const Defect& e) { return e.what == d; });
         if (it == defects.end())

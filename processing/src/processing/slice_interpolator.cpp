@@ -74,19 +74,66 @@ void CheckSliceThetaIn(const Slice& slice, std::size_t slice_index) {
     throw InvalidArgument(SliceName(slice, slice_index) + ": φin is not a finite number");
 }
 
-const char* SampleDefect(const Sample& s) {
+namespace {
+
+// The per-channel defect names of SampleDefect (static strings: messages quote them).
+constexpr const char* kNotFinite[3] = {"red value not a finite number",
+                                       "green value not a finite number",
+                                       "blue value not a finite number"};
+constexpr const char* kTooNegative[3] = {
+    "red f_r negative beyond noise (below the slice's noise allowance)",
+    "green f_r negative beyond noise (below the slice's noise allowance)",
+    "blue f_r negative beyond noise (below the slice's noise allowance)"};
+constexpr const char* kTooLarge[3] = {
+    "red f_r·cosθout above 1e5 1/sr (more than a perfect mirror reflects)",
+    "green f_r·cosθout above 1e5 1/sr (more than a perfect mirror reflects)",
+    "blue f_r·cosθout above 1e5 1/sr (more than a perfect mirror reflects)"};
+
+// cosθout of a sample as the upper bound uses it (docs/design.md §4): at least cos 89°, so a
+// sample on the horizon is bounded too.
+double BoundCos(const Sample& s) {
+  return std::max(std::cos(DegToRad(std::fabs(static_cast<double>(s.theta_out_deg)))),
+                  kMinBoundCos);
+}
+
+}  // namespace
+
+double NegativeAllowance(const Slice& slice) {
+  double peak = 0;
+  for (const Sample& s : slice.samples) {
+    if (s.flags & kFlagInvalid) continue;
+    const double c = BoundCos(s);
+    for (float v : s.rgb)
+      if (std::isfinite(v) && v * c <= kMaxFrCosPerSr)
+        peak = std::max(peak, static_cast<double>(v));
+  }
+  return std::max(kNegativeFloorPerSr, kNegativeFractionOfPeak * peak);
+}
+
+const char* SampleDefect(const Sample& s, std::optional<double> negative_allowance) {
   if (s.flags & kFlagInvalid) return nullptr;
   const double theta = s.theta_out_deg;
   if (!(theta >= -90.0 && theta <= 90.0)) return "θout outside [−90°, 90°]";
   if (!std::isfinite(s.phi_out_deg)) return "φout not a finite number";
-  if (!std::isfinite(s.rgb[0])) return "red value not a finite number";
-  if (!std::isfinite(s.rgb[1])) return "green value not a finite number";
-  if (!std::isfinite(s.rgb[2])) return "blue value not a finite number";
+  for (int c = 0; c < 3; ++c)
+    if (!std::isfinite(s.rgb[c])) return kNotFinite[c];
+  if (!negative_allowance) return nullptr;
+  const double cos_out = BoundCos(s);
+  for (int c = 0; c < 3; ++c) {
+    const double v = s.rgb[c];
+    // σ widens the allowance only when it is a finite, non-negative number.
+    const double sigma = s.sigma[c] >= 0.0f && std::isfinite(s.sigma[c]) ? s.sigma[c] : 0.0;
+    if (v < -std::max(*negative_allowance, kNegativeSigmas * sigma)) return kTooNegative[c];
+    if (v * cos_out > kMaxFrCosPerSr) return kTooLarge[c];
+  }
   return nullptr;
 }
 
-CleanSlice CleanSliceSamples(const Slice& slice, std::size_t slice_index) {
+CleanSlice CleanSliceSamples(const Slice& slice, std::size_t slice_index,
+                             bool check_measured_values) {
   CleanSlice out;
+  const std::optional<double> allowance =
+      check_measured_values ? std::optional<double>(NegativeAllowance(slice)) : std::nullopt;
   out.points.reserve(slice.samples.size());
   for (std::size_t n = 0; n < slice.samples.size(); ++n) {
     const Sample& s = slice.samples[n];
@@ -99,7 +146,7 @@ CleanSlice CleanSliceSamples(const Slice& slice, std::size_t slice_index) {
     };
     double theta = s.theta_out_deg;
     double phi = s.phi_out_deg;
-    if (const char* defect = SampleDefect(s))
+    if (const char* defect = SampleDefect(s, allowance))
       throw InvalidArgument(where() + ": " + defect +
                             " (a sample without a usable value must be flagged invalid)");
     if (theta < 0) {  // in-plane goniometer convention: −θ is the opposite azimuth
@@ -387,7 +434,7 @@ std::optional<RegularGrid> DetectRegularGrid(const std::vector<Point>& points,
 SliceInterpolator::SliceInterpolator(const Slice& slice, std::size_t slice_index,
                                      const ResampleOptions& options) {
   CheckSliceThetaIn(slice, slice_index);
-  CleanSlice clean = CleanSliceSamples(slice, slice_index);
+  CleanSlice clean = CleanSliceSamples(slice, slice_index, options.check_measured_values);
   report_.theta_in_deg = slice.theta_in_deg;
   report_.valid_samples = clean.points.size();
   report_.invalid_samples = clean.invalid;

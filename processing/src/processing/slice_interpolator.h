@@ -32,11 +32,19 @@ struct CleanSlice {
 
 // Drops kFlagInvalid samples, normalises angles and validates the rest. `slice_index` only
 // names the slice in messages. Throws InvalidArgument.
-CleanSlice CleanSliceSamples(const Slice& slice, std::size_t slice_index);
+CleanSlice CleanSliceSamples(const Slice& slice, std::size_t slice_index,
+                             bool check_measured_values = true);
 
 // Why a sample not flagged invalid cannot be used ("θout outside [−90°, 90°]", "red value not a
-// finite number"), or nullptr. The one rule of CleanSliceSamples and FindLutInputProblems.
-const char* SampleDefect(const Sample& sample);
+// finite number", a value no surface has: docs/design.md §4), or nullptr. The one rule of
+// CleanSliceSamples and FindLutInputProblems. `negative_allowance` is the slice's
+// (NegativeAllowance; a sample's own 5σ widens it); nullopt leaves the values no surface has
+// unchecked (ResampleOptions::check_measured_values).
+const char* SampleDefect(const Sample& sample, std::optional<double> negative_allowance);
+
+// How far below zero a value of `slice` may lie and still be noise around zero (1/sr):
+// kNegativeFractionOfPeak of the slice's largest plausible value, at least kNegativeFloorPerSr.
+double NegativeAllowance(const Slice& slice);
 
 // Validates the slice's own θin (finite, [0°, 90°)). Throws InvalidArgument.
 void CheckSliceThetaIn(const Slice& slice, std::size_t slice_index);

@@ -1,7 +1,8 @@
 """A stand-in for Unreal Engine 5's `unreal` Python module with the names
 import_measured_brdf.py uses, recording every call into RECORD (dumped to $UNREAL_STUB_LOG as
 JSON at exit) so tests/engines/engine_handoff_checks.py can check what the script asks the
-editor to do. Not Unreal: only enough to run the script."""
+editor to do. Not Unreal: only enough to run the script, but with the API's property names
+(_PROPERTIES): setting or reading one a class does not have fails as in the editor."""
 import atexit
 import json
 import os
@@ -22,17 +23,54 @@ TextureFilter = _enum("TextureFilter", ["TF_DEFAULT", "TF_BILINEAR", "TF_TRILINE
 TextureAddress = _enum("TextureAddress", ["TA_WRAP", "TA_CLAMP", "TA_MIRROR"])
 
 
+# The editor properties each class has in the UE5 Python API reference
+# (dev.epicgames.com/documentation/en-us/unreal-engine/python-api: unreal.AssetImportTask,
+# unreal.Texture, unreal.Texture2D, unreal.VolumeTexture), with the inherited ones of
+# unreal.Texture, as far as an import script may set them. A name outside its class's list is
+# refused as Unreal refuses it, so a misspelt or invented property fails the script here.
+_TEXTURE_PROPERTIES = {"adjust_brightness", "adjust_brightness_curve", "adjust_hue",
+                       "adjust_max_alpha", "adjust_min_alpha", "adjust_rgb_curve",
+                       "adjust_saturation", "adjust_vibrance", "alpha_coverage_thresholds",
+                       "asset_user_data", "chroma_key_color", "chroma_key_texture",
+                       "chroma_key_threshold", "composite_power", "composite_texture",
+                       "composite_texture_mode", "compression_no_alpha", "compression_none",
+                       "compression_quality", "compression_settings", "defer_compression",
+                       "do_scale_mips_for_alpha_coverage", "filter", "flip_green_channel",
+                       "lod_bias", "lod_group", "max_texture_size", "mip_gen_settings",
+                       "mip_load_options", "never_stream", "num_cinematic_mip_levels",
+                       "power_of_two_mode", "preserve_border", "srgb", "use_legacy_gamma",
+                       "virtual_texture_streaming"}
+_PROPERTIES = {
+    "AssetImportTask": {"async_", "automated", "destination_name", "destination_path", "factory",
+                        "filename", "imported_object_paths", "options", "replace_existing",
+                        "replace_existing_settings", "result", "save"},
+    "Texture2D": _TEXTURE_PROPERTIES | {"address_x", "address_y"},
+    "VolumeTexture": _TEXTURE_PROPERTIES | {"address_mode", "source2d_texture",
+                                            "source2d_tile_size_x", "source2d_tile_size_y"},
+    "VolumeTextureFactory": {"create_new", "edit_after_new", "editor_import",
+                             "import_priority", "initial_texture", "supported_class"},
+}
+
+
 class _Object:
     def __init__(self, name):
         self.name = name
         self.props = {}
 
+    def _check(self, key):
+        allowed = _PROPERTIES.get(type(self).__name__)
+        if allowed is not None and key not in allowed:
+            raise Exception(f"Failed to find property '{key}' for attribute '{key}' on "
+                            f"'{type(self).__name__}'")
+
     def set_editor_property(self, key, value):
+        self._check(key)
         self.props[key] = value
         RECORD.append({"object": self.name, "type": type(self).__name__, "set": key,
                        "value": value if isinstance(value, (str, int, float, bool)) else getattr(value, "name", str(value))})
 
     def get_editor_property(self, key):
+        self._check(key)
         return self.props.get(key)
 
 

@@ -36,6 +36,7 @@
 
 #include <array>
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <random>
 #include <span>
@@ -216,5 +217,17 @@ class SimulatedFirmware {
   Exposure row_exposure_;
   std::uint32_t slice_samples_ = 0, slice_clipped_ = 0;
 };
+
+// What defines a capture with the simulator besides the instrument: the settings such a capture
+// records (CaptureRequest::settings) and a resume requires unchanged, written the same way by
+// every host (`brdf capture --device sim`, the Python module's brdf.capture), so a capture one
+// of them started can be resumed by the other. `device` is the instrument spec ("sim"),
+// `material` the virtual sample's name, `exposure` the exposure as the user gave it ("auto",
+// "auto-slice" or milliseconds); numbers are written "%g".
+std::map<std::string, std::string> SimulatedCaptureSettings(const std::string& device,
+                                                            const std::string& material,
+                                                            const SimulatorConfig& config,
+                                                            const CaptureGeometry& geometry,
+                                                            const std::string& exposure);
 
 }  // namespace brdf::device

@@ -52,6 +52,10 @@ struct AtlasMaterial {
   // Fitted models as complete JSON texts, e.g. `--extrapolate auto`'s choice with its GGX fit:
   // the manifest's "fitted_models" of the material, as a LUT sidecar's (sidecar.h).
   std::vector<std::string> fitted_models_json = {};
+  // The blind-spot fill's record (processing::BeyondReportJson: measured_theta_in,
+  // extrapolated_theta_in, method, leave-last-slice-out error), the manifest's "beyond" of the
+  // material, as a LUT sidecar's; empty: no fill recorded.
+  std::string beyond_json = {};
 };
 
 struct Atlas {
@@ -61,7 +65,8 @@ struct Atlas {
   std::vector<std::optional<std::vector<SaturatedCount>>> saturated_samples;  // per material
   std::vector<std::optional<ExtrapolationInfo>> extrapolation;                // per material
   std::vector<std::vector<std::string>> fitted_models_json;                   // per material
-  PackedVolume volume;  // Cm·361 × Rm·181 × K, RGB9E5
+  std::vector<std::string> beyond_json;  // per material (AtlasMaterial::beyond_json)
+  PackedVolume volume;                   // Cm·361 × Rm·181 × K, RGB9E5
   // Set by CompressAtlasBc6h: the same texture as BC6H blocks (the KTX2 and DDS then hold these
   // and the manifest describes them) and each material's certified error over its cell.
   std::optional<Bc6hVolume> bc6h;
@@ -113,6 +118,7 @@ struct AtlasManifestEntry {
   std::optional<ExtrapolationInfo> extrapolation = std::nullopt;
   std::vector<std::string> fitted_models_json = {};              // each a compact JSON text
   std::optional<CertifiedError> certified_error = std::nullopt;  // a compressed atlas's
+  std::string beyond_json = {};  // the "beyond" member as compact JSON text; empty: absent
 };
 struct AtlasManifest {
   std::vector<double> theta_in_deg;

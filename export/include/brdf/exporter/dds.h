@@ -46,6 +46,11 @@ inline constexpr std::size_t kDdsDataOffset = 4 + 124 + 20;
 std::string DdsVolumeHeader(int width, int height, int depth, std::uint32_t dxgi_format,
                             int bytes_per_texel);
 
+// The same header for a single-mip 2D texture (no DDSD_DEPTH, no volume cap, dimension
+// TEXTURE2D): the engine kit's RGBA16F IBL pack (brdf/engines/engine_export.h).
+std::string DdsTexture2dHeader(int width, int height, std::uint32_t dxgi_format,
+                               int bytes_per_texel);
+
 // The whole file in memory. Throws InvalidArgument for an inconsistent volume.
 std::string EncodeDds(const PackedVolume& volume);
 

@@ -40,6 +40,17 @@
 //   MeasuredBrdf([lut,] n, l, v) → f_r                                 (cell (0, 0))
 // [lut,] is `highp sampler3D lut` in GLSL, `Texture3D lut, SamplerState lut_sampler` in HLSL and
 // absent in Godot, whose code reads the uniform `measured_brdf_lut` the .gdshader declares.
+//
+// Image-based lighting (docs/engines.md, "ibl": the split sum of the material's IBL pack,
+// brdf/core/ibl_pack.h), the same in every language; the engine supplies its two probe values:
+//   MeasuredBrdfIblPack([pack,] pack_v, mu, out diffuse, out specular) → α_eq
+//       the material's row of the RGBA16F pack texture (2·IblPack::kRows texels: (D, α_eq),
+//       then (S, residual)) at μ = n·v, two linear fetches at the same μ; pack_v the row's v
+//   MeasuredBrdfIblReflect(n, v) → R = 2(n·v)n − v
+//   MeasuredBrdfIblRadiance(diffuse, specular, irradiance_over_pi, prefiltered) → radiance
+//       = diffuse·irradiance_over_pi + specular·prefiltered (the probe filtered with GGX α_eq)
+// [pack,] is `highp sampler2D pack` in GLSL, `Texture2D pack, SamplerState pack_sampler` in
+// HLSL, and the uniform `measured_brdf_ibl_pack` in Godot.
 #pragma once
 
 #include <string>

@@ -76,6 +76,7 @@ struct SidecarInfo {
   std::optional<ExtrapolationInfo> extrapolation;
   std::optional<std::vector<SaturatedCount>> saturated_samples;  // absent: not recorded
   std::vector<std::string> fitted_models_json;                   // each model as compact JSON text
+  std::string beyond_json;  // the blind-spot fill's "beyond" record, compact; empty: absent
   std::string tool_version;
   std::vector<std::string> files;  // companion file names
 };

@@ -70,6 +70,20 @@ struct FitOptions {
   std::optional<Material> start;
 };
 
+// Under-determined fits (docs/design.md §9): a sample gives one number per colour channel, and
+// a channel's values depend on ParametersPerChannel(model) parameters (its share of the RGB
+// ones plus every scalar one). With fewer than kSamplesPerParameter times that many usable
+// samples the data does not determine the parameters (with as many numbers as unknowns a fit
+// passes through them exactly, whatever the model): FitMaterial still returns the best fit but
+// marks it representable = false and says "N usable samples for P parameters" in its warnings,
+// and ChooseExtrapolationAuto does not use it.
+inline constexpr int kSamplesPerParameter = 2;
+int ParametersPerChannel(Model model);
+int ParameterCount(Model model);  // every scalar, an RGB parameter counted three times
+bool Underdetermined(std::size_t samples_used, Model model);
+// The warning above, or an empty string when the fit is determined.
+std::string UnderdeterminedWarning(std::size_t samples_used, Model model);
+
 // The fitted material (named after the measurement's sample) and its report.
 using FitResult = FittedMaterial;
 
@@ -103,6 +117,9 @@ struct AutoExtrapolationResult {
   double band_rmse = 0;          // RMS error over the band with params, 1/sr
   double band_rmse_clamp = 0;    // the same with p = 1 (clamping), for comparison
   std::optional<FitResult> fit;  // the GGX fit used, when ChooseExtrapolationAuto made it
+  // ChooseExtrapolationAuto: empty, or why the fit was not used (an under-determined fit); the
+  // parameters are then the defaults p = 1, l = 0.5 and band_rmse equals band_rmse_clamp.
+  std::string not_used;
 };
 AutoExtrapolationResult FitExtrapolationToModel(const Measurement& measurement,
                                                 const Material& model);

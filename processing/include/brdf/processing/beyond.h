@@ -64,12 +64,11 @@ std::string_view BeyondMethodName(BeyondMethod method);
 // Throws InvalidArgument quoting `text` and listing the names.
 BeyondMethod ParseBeyondMethod(std::string_view text);
 
-// What the toolchain's commands use unless told otherwise (`--beyond`). kAuto validates best
-// (docs/benchmarks/blindspot.md) but is not the default yet: the tests and shipped checks that
-// assume a 4-slice LUT read as clamped beyond 60° must be updated with it (the list is in
-// docs/benchmarks/blindspot.md). Library callers that leave BeyondOptions as it is get kClamp,
-// the LUT exactly as BuildLut made it before the fill existed.
-inline constexpr BeyondMethod kDefaultBeyondMethod = BeyondMethod::kClamp;
+// What the toolchain's commands use unless told otherwise (`--beyond`): kAuto, the method that
+// validates best (docs/benchmarks/blindspot.md). Library callers that leave BeyondOptions as it
+// is get kClamp, the LUT exactly as BuildLut made it before the fill existed; the commands take
+// sources::DefaultResampleOptions().
+inline constexpr BeyondMethod kDefaultBeyondMethod = BeyondMethod::kAuto;
 inline constexpr int kDefaultBeyondSubdivisions = 2;
 
 struct BeyondOptions {

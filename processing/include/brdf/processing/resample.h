@@ -73,6 +73,12 @@ struct ResampleOptions {
   // extra slices k·Δin up to beyond.max_theta_in_deg. kClamp builds the LUT as before (the
   // measured slices only, §6 band). Not applied to a θin list that is not k·Δin.
   BeyondOptions beyond;
+  // The rule of values no surface has (kMaxFrCosPerSr below, docs/design.md §4) is for
+  // measured values (captures, tables). false for a virtual capture of an evaluable file (a
+  // material, RGL or MERL file, an exported LUT): its values are the model's own, exactly, and a
+  // lobe sharper than the LUT's 1° texels may exceed the limit; the textures then clip it, with
+  // the warning of sources::ClipNote. Finite values and angles are required either way.
+  bool check_measured_values = true;
 
   // Throws InvalidArgument naming the bad option.
   void Validate() const;
@@ -98,6 +104,17 @@ struct ResampleReport {
   std::vector<SliceResampleReport> slices;  // ascending θin, one per measured slice
   BeyondReport beyond;                      // what filled the blind spots
 };
+
+// Values no surface has (docs/design.md §4, "Values no surface has"): a sample not flagged
+// invalid is refused (kBadSamples, like a NaN) when a channel's f_r·max(cosθout, cos 89°) exceeds
+// kMaxFrCosPerSr, or when f_r is negative beyond noise around zero: below −max(allowance, 5σ),
+// the allowance being kNegativeFractionOfPeak of the slice's largest plausible value, at least
+// kNegativeFloorPerSr (σ the sample's own, when recorded).
+inline constexpr double kMaxFrCosPerSr = 1e5;
+inline constexpr double kMinBoundCos = 0.017452406437283512;  // cos 89°
+inline constexpr double kNegativeFloorPerSr = 1e-3;
+inline constexpr double kNegativeFractionOfPeak = 0.01;
+inline constexpr double kNegativeSigmas = 5.0;
 
 // One reason BuildLut refuses a measurement (or, for kDegenerateRange, would build a LUT with no
 // angular information).
@@ -132,8 +149,9 @@ std::vector<LutInputProblem> FindLutInputProblems(const Measurement& measurement
 // Requirements (InvalidArgument otherwise, naming the sample and what is wrong):
 //  - at least one slice; the θin values, in any order, are k·Δin for k = 0…K−1 (uniform,
 //    starting at 0°, no duplicates; within 1e-3°); LUT slice k is θin = k·Δin exactly;
-//  - every slice has at least one valid sample; valid samples have finite values, finite φout
-//    and θout ∈ [−90°, 90°]; some valid sample has θout > 0.
+//  - every slice has at least one valid sample; valid samples have finite values a surface can
+//    have (kMaxFrCosPerSr above), finite φout and θout ∈ [−90°, 90°]; some valid sample has
+//    θout > 0.
 // (FindLutInputProblems lists every violation; BuildLut throws InvalidArgument with the first.)
 // `report`, when not null, receives θb, the methods used and sample counts.
 Lut BuildLut(const Measurement& measurement, const ExtrapolationParams& params = {},

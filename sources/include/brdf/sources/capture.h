@@ -48,7 +48,10 @@ struct CaptureRefusal {
 // structure (slice indices, the end chunk's counts) and of its values
 // (processing::FindLutInputProblems with any θin set: NaN values, angles out of range, duplicate
 // θin, a slice without valid samples, a degenerate measured range). `brdf info`, `convert` and
-// `eval` all apply this one assessment, so they cannot disagree about a capture.
+// `eval` all apply this one assessment, so they cannot disagree about a capture. The verdict,
+// one rule for every command: refused (`refusals`) by every command that reads it; else
+// accepted by all, except that a θin list other than k·Δin is refused by the LUT exports alone
+// (`export_refusals`: convert, atlas), the capture staying evaluable.
 struct CaptureAssessment {
   std::string path;
   BpcReadResult read;  // everything ReadBpc found (intact slices, problems, valid bytes)
@@ -60,8 +63,15 @@ struct CaptureAssessment {
   std::optional<CaptureRefusal> refusal;     // the first of `refusals`, if any
   std::vector<CaptureRefusal> refusals;      // every reason the capture cannot become a LUT
   std::vector<std::string> warnings;         // full sentences starting with the path
+  // Why the LUT textures (`brdf convert`, `brdf atlas`) cannot be made from a capture every
+  // other command accepts: the θin list is not k·Δin from 0° (docs/design.md §5), which only
+  // the exported slices need; evaluating it (eval, preview, fit, brdf-view) interpolates
+  // between any distinct θin. Empty when `refusals` is not.
+  std::vector<CaptureRefusal> export_refusals;
 
+  // Every reading command accepts the capture (usable(), exportable()).
   bool usable() const { return !refusal.has_value(); }
+  bool exportable() const { return usable() && export_refusals.empty(); }
   // read.measurement when usable; throws the refusal's FormatError otherwise.
   const Measurement& UsableMeasurement() const;
 };

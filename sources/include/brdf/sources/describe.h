@@ -9,8 +9,11 @@
 //  - captures: sources::AssessCapture (brdf/sources/capture.h), the damaged-capture rule;
 //  - tables: processing::FindLutInputProblems with any θin set, the rule `eval` applies;
 //  - textures: sources::OpenExportedTexture, the CRC and layout checks every reader makes.
-// "usable" (present for captures and tables) is false exactly when those commands refuse the
-// file, and "refusals" lists why, one line each.
+// "usable" (present for captures and tables) is false exactly when one of those commands
+// refuses the file, and "refusals" lists why, one line each; "evaluable" says whether eval,
+// preview, fit and brdf-view accept it, and for captures "convertible" whether convert and
+// atlas do too (they alone refuse a θin list that is not k·Δin: CaptureAssessment's
+// export_refusals).
 //
 // A library names no commands: where the description offers a remedy (resume a capture, capture
 // an evaluable file, ...), the host phrases it. `phrase` receives the structured remedy

@@ -67,11 +67,21 @@ ExtrapolationChoice ChooseExtrapolation(
     const std::optional<processing::ExtrapolationParams>& command_line,
     std::vector<std::string>* warnings);
 
+// A material file as every command reads it: LoadMaterialFile (brdf/core/models.h), and its
+// "extrapolate" member checked (processing::ExtrapolationFromJson) also by the commands that do
+// not extrapolate (eval, preview, info), so that a file is accepted or refused as a whole by
+// all of them. Throws FormatError / IoError.
+Material LoadMaterialInput(const std::string& path);
+
 // A capture, material file or imported table opened as a measurement ready to resample.
 struct PreparedMeasurement {
   Measurement measurement;
   ExtrapolationChoice extrapolation;
   std::vector<std::string> warnings;
+  // Measured values (a capture, a table), held to the rule of values no surface has
+  // (docs/design.md §4); false for a virtual capture of an evaluable file, whose values are the
+  // model's (ResampleOptions::check_measured_values).
+  bool measured = true;
 };
 // Captures follow the damaged-capture rule (capture.h); material files are captured noise-free
 // on the reference geometry (brdf/core/virtual_capture.h); third-party tables (Zemax,
@@ -193,11 +203,20 @@ struct InputLut {
   std::optional<std::vector<exporter::SaturatedCount>> saturated_samples;  // absent: unknown
   // What filled the blind spots (a resampled input with a fill other than clamp).
   std::optional<processing::BeyondReport> beyond;
+  // The fill's record as JSON text (processing::BeyondReportJson of `beyond`, or an exported
+  // LUT's sidecar's "beyond"): what sidecars and atlas manifests carry; empty: none.
+  std::string beyond_json;
   std::vector<std::string> warnings;
 };
 InputLut LutFromInput(const std::string& path, FileKind kind,
                       const std::optional<processing::ExtrapolationParams>& command_line,
                       const processing::ResampleOptions& resample_options);
+
+// The warning `brdf convert` and `brdf atlas` print when the RGB9E5 textures cannot hold every
+// value of `lut` (a channel below 0 or above 65408 1/sr, clamped by the encoding of
+// docs/design.md §7): how many texel values are clipped and to what; nullopt when none is.
+// LutFromInput appends it to InputLut::warnings for a resampled input.
+std::optional<std::string> ClipNote(const std::string& path, const Lut& lut);
 
 // The samples flagged saturated (kFlagSaturated) in each slice of `m`, in slice order.
 std::vector<exporter::SaturatedCount> CountSaturated(const Measurement& m);
@@ -207,5 +226,11 @@ std::vector<exporter::SaturatedCount> CountSaturated(const Measurement& m);
 // clipped"; nullopt when there are none (or the counts are unknown).
 std::optional<std::string> SaturationNote(
     const std::string& path, const std::optional<std::vector<exporter::SaturatedCount>>& counts);
+
+// The one line `brdf convert` prints for a capture whose fill was validated (three or more
+// measured slices), e.g. "gold.bpc: blind-spot fill model (ggx): the θin 60° slice predicted
+// from the others within 1.2 % (median), 6.9 % (p90)"; nothing without a validation.
+std::optional<std::string> LeaveLastSliceOutNote(const std::string& path,
+                                                 const std::optional<processing::BeyondReport>& b);
 
 }  // namespace brdf::sources

@@ -37,6 +37,10 @@ struct CoverageMap {
   static constexpr int kPhiCells = 360;
   double theta_in_deg = 0;
   std::vector<std::uint8_t> measured;  // kThetaCells × kPhiCells, 1 = a valid sample nearby
+  // A slice the blind-spot fill added (brdf/processing/beyond.h: inserted between measured
+  // slices or extrapolated past the last one): no direction of it was measured, and the
+  // viewer draws it as it draws the §6 band (translucent). `measured` is all 0 then.
+  bool filled = false;
 
   bool MeasuredAt(double theta_out_deg, double phi_out_deg) const;
 };
@@ -54,7 +58,8 @@ struct ViewSource {
 
   // Coverage of the outgoing direction (θout, φout) in degrees for light at (θin, 0). Between
   // two slices a direction is unmeasured when it is unmeasured in either neighbour (the LUT
-  // blends both).
+  // blends both); a filled slice (CoverageMap::filled) counts as extrapolated wherever its
+  // weight is not zero.
   Coverage CoverageAt(double theta_in_deg, double theta_out_deg, double phi_out_deg) const;
   // The channel maximum over every texel of the LUT with θout ≤ 90° (a fixed scale for the
   // legend while θin moves). Channel index 0–2 = R, G, B; 3 = luminance.
@@ -64,12 +69,15 @@ struct ViewSource {
 // A measurement (capture, imported table, noise-free capture of a material) and the LUT that
 // processing::BuildLut made of it, with its report: coverage from the measurement's valid
 // samples (a sample covers the 1° cells within its lattice step, or within 1° for scattered
-// data). Throws InvalidArgument when `report` does not describe `lut`'s slices.
+// data). LUT slices the measurement does not have are the blind-spot fill's (CoverageMap::
+// filled). Throws InvalidArgument when `report` does not describe `lut`'s measured slices.
 ViewSource ViewSourceFromResampled(const Measurement& measurement, Lut lut,
                                    const processing::ResampleReport& report, std::string name);
 
-// ViewSourceFromResampled of BuildLut(measurement, params): resamples it here. Throws what
-// BuildLut throws (InvalidArgument for a measurement it cannot resample).
+// ViewSourceFromResampled of BuildLut(measurement, params) with the commands' blind-spot fill
+// (processing::kDefaultBeyondMethod, kDefaultBeyondSubdivisions: what `brdf convert` does by
+// default): resamples it here. Throws what BuildLut throws (InvalidArgument for a measurement
+// it cannot resample).
 ViewSource ViewSourceFromMeasurement(const Measurement& measurement,
                                      const processing::ExtrapolationParams& params,
                                      std::string name);
@@ -79,8 +87,8 @@ ViewSource ViewSourceFromLut(Lut lut, std::string name, double theta_b_deg = 90)
 
 // Any evaluable BRDF (an analytic material, a fit): the virtual capture on the reference
 // instrument's geometry (brdf::CaptureNoiseFree: θin 0/20/40/60°, θout 0–75°, φout 0–359° at 1°,
-// docs/design.md §1) resampled with the default §6 parameters, i.e. exactly the LUT `brdf
-// convert` would make from that capture.
+// docs/design.md §1) resampled with the default §6 parameters and blind-spot fill, i.e. exactly
+// the LUT `brdf convert` would make from that capture.
 ViewSource ViewSourceFromBrdf(const BrdfSource& source, std::string name);
 
 }  // namespace brdf::viewer

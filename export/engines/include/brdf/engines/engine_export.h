@@ -22,9 +22,11 @@
 //   web/     NAME.ktx2, measured_brdf*.js (ES module: KTX2Loader, ShaderMaterial),
 //            index.html (viewer: ?material=NAME), package.json (three ≥ r180),
 //            MeasuredBrdf*.es300.glsl and MeasuredBrdf*.450.glsl (the lookup as GLSL files)
-//   each     NAME.manifest.json   axes and ranges, texel-centre mapping, units, colour space,
+//   each     NAME_ibl.dds         the IBL pack as an RGBA16F 2D texture (EncodeIblPackDds below)
+//            NAME.manifest.json   axes and ranges, texel-centre mapping, units, colour space,
 //                                 probe texels (index → RGB f_r), the IBL pack under "ibl"
-//                                 (brdf/core/ibl_pack.h; null for atlases), and under "engines"
+//                                 (brdf/core/ibl_pack.h; one per cell for atlases), and under
+//                                 "engines"
 //                                 each folder's files, texture format, orientation per import path
 //                                 and import settings (one text, hard-linked into every engine
 //                                 folder of the conversion)
@@ -56,6 +58,10 @@
 #include "brdf/exporter/lut_export.h"
 #include "brdf/exporter/metadata.h"
 #include "brdf/exporter/packed_volume.h"
+
+namespace brdf {
+struct IblPack;
+}  // namespace brdf
 
 namespace brdf::engines {
 
@@ -145,6 +151,15 @@ std::vector<std::string> WriteAtlasWithEngines(
 std::string Rgba16fBytes(const exporter::PackedVolume& volume);
 // The whole RGBA16F volume DDS (exporter::DdsVolumeHeader with DXGI format 10).
 std::string EncodeRgba16fDds(const exporter::PackedVolume& volume);
+// The IBL packs (brdf/core/ibl_pack.h) of a LUT (one) or of an atlas's cells (in cell order) as
+// a DDS RGBA16F 2D texture (DXGI 10, one mip) of 2·IblPack::kRows texels × packs.size() rows,
+// row m for pack m, row 0 first in the file (at v = 0 without a flip); texel i < kRows of a row
+// holds (D_r, D_g, D_b, α_eq) at μ_i and texel kRows + i holds (S_r, S_g, S_b, fit residual),
+// each float rounded to the nearest half. A linearly filtered, clamp-to-edge fetch at
+// u = clamp(μ·kRows, 0.5, kRows − 0.5)/(2·kRows) (+ 0.5 for S) returns IblPack::At(μ).
+// Throws InvalidArgument for no packs or a pack without kRows rows.
+std::string EncodeIblPackDds(const std::vector<const IblPack*>& packs);
+
 // Binary16 bits of the RGB9E5 channel value mantissa · 2^(exponent − 24) (mantissa 0..511,
 // exponent 0..31; throws InvalidArgument outside). Exact: every such value has at most 9
 // significant bits and lies in [2^−24, 65408], which half represents without rounding

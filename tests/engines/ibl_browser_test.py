@@ -1,0 +1,327 @@
+"""Measured materials under three.js's own reflection probes, in a real browser, against the
+CPU (ctest: ibl_browser, labels browser, integration).
+
+Materials (a subset, to keep the test near a minute): library materials (gold, a GGX metal,
+also the MeshStandardMaterial reference; glossy red plastic; white paper; walnut, a Ward
+lobe), two RGL measurements (a green paint, a blue silk) read
+through the configurable data path (BRDF_DATA_DIR, default ../shared/brdf-data) and the
+real capture data-samples/captures/gold.bpc converted with `--beyond auto` (a 9-slice LUT,
+θin 0–80° every 10°), all by `brdf convert --engine web`. An equirectangular EXR written here
+(a sky, a ground and three soft lights) is the environment.
+
+The browser (tests/node/render_ibl.mjs: headless Chromium on SwiftShader, three.js from npm)
+prefilters that EXR with three's PMREMGenerator and shades a 128² sphere with the shipped
+module's probe term; the references are `brdf preview` of the same exported KTX2 with the same
+map and camera: the true environment-lit image (the rendering integral, the default) and
+`--ibl engine` (the CPU split sum: order-2 SH irradiance and its own GGX-prefiltered pyramid,
+independent of three's PMREM). Pixels: the sphere's pixels whose centre lies at least 1.5
+pixels inside the silhouette (the tessellated sphere's rim is not the ray-traced one).
+Figures per material: relative RMSE = RMS(browser − ref) / RMS(ref) over those pixels and
+channels; p95 = 95th percentile over pixels of |browser − ref| / max(|ref|, 5 % of the mean
+|ref|) (RGB norms).
+
+Asserted:
+  - browser against the CPU split sum: relative RMSE ≤ 2 % and p95 ≤ 6 % for every material
+    (the two implementations of the same split sum agree; both bounds leave room for the two
+    prefilters' different kernels and resolutions);
+  - browser against the truth (the issue's targets): median over the materials of the relative
+    RMSE ≤ 3 % and of the per-material 95th-percentile pixel ≤ 10 % (the 95th percentile of
+    all materials' pixels pooled is printed, not asserted: the rims of the glossy materials,
+    where every split sum is poor, push it above 10 %);
+  - browser against the truth: no worse than 1.25 × the relative RMSE three's
+    MeshStandardMaterial makes on the GGX material (gold) against that material's own truth
+    (`brdf preview gold`) in the same scene;
+  - white furnace (uniform radiance 1): the browser sphere, and `brdf preview --env furnace
+    --ibl engine`, equal the manifest's E(μ) at every pixel's μ = n·v within 0.5 % (for the
+    browser beyond the change of E over μ ± 0.002, the uncertainty of a rasterised pixel's μ,
+    which matters only where E steps between two rows of the pack; the raw maximum is printed);
+  - mutations: the pack with every α_eq 10 % larger, and the pack with E dropped (the weights
+    divided by E = D + S), each rendered by the same page, must break the bound against the CPU
+    split sum for gold (the test fails if they would pass; for rough and diffuse materials a
+    10 % change of α_eq moves the image by less than the bound, which is printed).
+  - an atlas (gold, paper_white) from `brdf atlas --engine web`: its paper cell, read at the
+    cell's origin and the pack's row 1, renders as the single paper LUT within 0.1 % RMSE;
+  - the shipped viewer (index.html?material=gold&env=furnace&ibl=1&lights=0&tonemap=linear
+    &background=0) in a 512 x 512 window: title "ready", canvas over the whole window, the
+    sphere centred and 0.9 of it across, centre pixel sRGB(E(1));
+Reported, not asserted: browser against the truth per material (the split sum's own error,
+largest at the rim of glossy materials), next to the CPU split sum against the truth.
+Usage: ibl_browser_test.py BRDF_TOOL SOURCE_DIR CHROMIUM DATA_DIR [--keep]  (Debian python3)
+"""
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+
+import numpy as np
+import OpenImageIO as oiio
+
+from check_support import FAILURES, expect, run
+
+SIZE = 128
+LIBRARY = ["gold", "plastic_glossy_red", "paper_white", "wood_walnut"]
+RGL = ["chm_mint_rgb", "vch_silk_blue_rgb"]
+CAPTURE = "gold_capture"  # data-samples/captures/gold.bpc, --beyond auto
+GGX_REFERENCE = "gold"
+ATLAS_CELL = "paper_white"  # cell 1 of the atlas "pair" (gold, paper_white)
+ATLAS_RMSE = 0.001
+SPLIT_SUM_RMSE, SPLIT_SUM_P95 = 0.02, 0.06
+FURNACE_TOLERANCE = 0.005
+STANDARD_RATIO = 1.25
+TRUTH_MEDIAN_RMSE, TRUTH_P95 = 0.03, 0.10
+
+
+
+
+def write_environment(path):
+    """A sky over a darker ground, three soft lights (Gaussian, σ 10°, 16°, 25°), float EXR."""
+    w, h = 512, 256
+    j, i = np.mgrid[0:h, 0:w]
+    th = (j + 0.5) / h * np.pi
+    ph = (i + 0.5) / w * 2 * np.pi
+    d = np.stack([np.sin(th) * np.cos(ph), np.sin(th) * np.sin(ph), np.cos(th)], -1)
+    up = d[..., 2:3]
+    img = np.where(up > 0, np.array([0.35, 0.5, 0.8]) * (0.6 + 0.4 * up),
+                   np.array([0.25, 0.2, 0.15]) * (1 + 0.5 * up))
+    for theta, phi, sigma, peak, colour in ((50, 30, 10, 6.0, [1, 0.95, 0.85]),
+                                            (75, -70, 16, 2.5, [0.8, 0.9, 1.0]),
+                                            (100, 160, 25, 1.5, [1, 0.6, 0.4])):
+        a = np.radians([theta, phi])
+        c = np.array([np.sin(a[0]) * np.cos(a[1]), np.sin(a[0]) * np.sin(a[1]), np.cos(a[0])])
+        g = np.arccos(np.clip(d @ c, -1, 1))
+        img = img + peak * np.exp(-0.5 * (g / np.radians(sigma)) ** 2)[..., None] * np.array(colour)
+    out = oiio.ImageOutput.create(path)
+    spec = oiio.ImageSpec(w, h, 3, "float")
+    spec.attribute("compression", "none")
+    out.open(path, spec)
+    out.write_image(img.astype(np.float32))
+    out.close()
+
+
+def read_exr(path):
+    buf = oiio.ImageBuf(path)
+    return buf.get_pixels(oiio.FLOAT).reshape(SIZE, SIZE, -1)[..., :3].astype(np.float64)
+
+
+def read_browser(path):
+    """RGBA32F rows top first, mirrored left-right back into the preview's frame."""
+    return np.fromfile(path, dtype="<f4").reshape(SIZE, SIZE, 4)[:, ::-1, :3].astype(np.float64)
+
+
+# The preview's orthographic camera on +x (docs/preview.md): pixel centres, the unit sphere's
+# diameter over 0.9 of the frame; the normal of each pixel's hit and mu = n.v with v = +x.
+Y, X = np.mgrid[0:SIZE, 0:SIZE]
+SX = ((X + 0.5) / SIZE * 2 - 1) / 0.9
+SY = (1 - (Y + 0.5) / SIZE * 2) / 0.9
+R = np.hypot(SX, SY)
+MASK = R < 1 - 1.5 * 2 / (0.9 * SIZE)
+MU = np.sqrt(np.clip(1 - R ** 2, 0, 1))
+
+
+def pixel_errors(a, ref):
+    d, t = (a - ref)[MASK], ref[MASK]
+    norm = np.linalg.norm(t, axis=1)
+    return np.linalg.norm(d, axis=1) / np.maximum(norm, 0.05 * norm.mean())
+
+
+def metrics(a, ref):
+    d, t = (a - ref)[MASK], ref[MASK]
+    rel_rmse = float(np.sqrt((d ** 2).mean()) / np.sqrt((t ** 2).mean()))
+    return rel_rmse, float(np.percentile(pixel_errors(a, ref), 95))
+
+
+def albedo_at(manifest, mu):
+    """E(mu) as the pack's linear texture returns it (clamped beyond the first and last row)."""
+    table_mu = np.asarray(manifest["ibl"]["mu"])
+    e = np.asarray(manifest["ibl"]["albedo_rgb"])
+    return np.stack([np.interp(mu, table_mu, e[:, c]) for c in range(3)], -1)
+
+
+# How far a pixel's mu can lie from the analytic MU of its centre in the browser (the
+# tessellated sphere's rasterised normals, sub-pixel precision): 0.002 (0.05 px at mid radius).
+MU_UNCERTAINTY = 0.002
+
+
+def furnace_error(image, manifest, mu_uncertainty=0.0):
+    """Max over pixels of |image - E(mu)| / E(mu), less the change of E over +-mu_uncertainty
+    (where E steps between rows, e.g. at a LUT's last measured angle, a pixel's mu matters)."""
+    want = albedo_at(manifest, MU)
+    slope = np.maximum(np.abs(albedo_at(manifest, MU + mu_uncertainty) - want),
+                       np.abs(albedo_at(manifest, MU - mu_uncertainty) - want))[MASK]
+    want = want[MASK]
+    got = image[MASK]
+    excess = np.maximum(np.abs(got - want) - slope, 0.0)
+    return float((excess / np.maximum(want, 1e-3)).max())
+
+
+def check_viewer(png, manifest):
+    """The shipped index.html in a 512 x 512 window (furnace, ibl=1, lights=0, tonemap=linear,
+    background=0): the canvas covers the window (no page-background #111 pixel), the sphere is
+    centred and 0.9 of the window across (its middle row and column), and its centre pixel is
+    sRGB(E(1)) of the manifest within 2/255."""
+    img = oiio.ImageBuf(png).get_pixels(oiio.UINT8)[..., :3].astype(int)
+    h, w = img.shape[:2]
+    expect((h, w) == (512, 512), f"viewer screenshot {w}x{h}")
+    lit = img.max(-1) > 0
+    page = (img == 17).all(-1)
+    expect(not page.any(), f"viewer: {int(page.sum())} pixels show the page, not the canvas")
+    row, col = lit[h // 2], lit[:, w // 2]
+    across = (np.flatnonzero(row)[[0, -1]] if row.any() else np.array([0, -1]))
+    down = (np.flatnonzero(col)[[0, -1]] if col.any() else np.array([0, -1]))
+    centre_x, centre_y = across.mean(), down.mean()
+    diameter = across[1] - across[0] + 1
+    expect(abs(centre_x - (w - 1) / 2) <= 1.5 and abs(centre_y - (h - 1) / 2) <= 1.5,
+           f"viewer: sphere centred at ({centre_x}, {centre_y})")
+    expect(abs(diameter - 0.9 * h) <= 4, f"viewer: sphere {diameter} px across, expected {0.9 * h:.0f}")
+    e = albedo_at(manifest, np.array(1.0))
+    srgb = np.where(e <= 0.0031308, 12.92 * e, 1.055 * np.power(np.clip(e, 0, 1), 1 / 2.4) - 0.055) * 255
+    got = img[h // 2 - 1:h // 2 + 1, w // 2 - 1:w // 2 + 1].reshape(-1, 3).mean(0)
+    expect(np.abs(got - srgb).max() <= 2.0, f"viewer: centre pixel {got} vs sRGB(E(1)) {srgb}")
+    print(f"viewer: title ready, canvas covers the 512x512 window, sphere {diameter} px across centred at "
+          f"({centre_x:.1f}, {centre_y:.1f}), centre {np.round(got, 1)} vs sRGB(E(1)) {np.round(srgb, 1)}")
+
+
+def main():
+    tool, source, chromium, data_dir = sys.argv[1:5]
+    keep = "--keep" in sys.argv
+    data_dir = os.environ.get("BRDF_DATA_DIR", data_dir)
+    work = tempfile.mkdtemp(prefix="brdf_ibl_browser_")
+    started = time.time()
+    env = os.path.join(work, "env.exr")
+    write_environment(env)
+    out = os.path.join(work, "out")
+    rgl = [os.path.join(data_dir, "rgl", n + ".bsdf") for n in RGL]
+    for p in rgl:
+        if not os.path.isfile(p):
+            print(f"FAILED: {p}: missing (set BRDF_DATA_DIR to the brdf-data folder)")
+            return 1
+    # RGL files become noise-free virtual captures at the instrument's geometry (brdf import).
+    captures = []
+    for n, p in zip(RGL, rgl):
+        captures.append(os.path.join(work, n + ".bpc"))
+        run([tool, "import", p, "--out", captures[-1]])
+    run([tool, "convert", *LIBRARY, *captures, "--out", out, "--engine", "web", "--quiet", "--jobs", "2",
+         "--formats", "ktx2"])
+    capture = os.path.join(work, CAPTURE + ".bpc")
+    shutil.copyfile(os.path.join(source, "data-samples", "captures", "gold.bpc"), capture)
+    run([tool, "convert", capture, "--beyond", "auto", "--out", out, "--engine", "web", "--quiet",
+         "--formats", "ktx2"])
+    # An atlas of two library materials: its second cell (paper) must render as paper does.
+    run([tool, "atlas", "gold", ATLAS_CELL, "--out", os.path.join(out, "pair"), "--engine", "web",
+         "--quiet"])
+    names = LIBRARY + RGL + [CAPTURE]
+    manifests = {n: json.load(open(os.path.join(out, "web", n + ".manifest.json"))) for n in names}
+    slices = len(manifests[CAPTURE]["theta_in_deg"])
+    expect(slices != 4, f"{CAPTURE}: --beyond auto gave {slices} slices; the test wants a non-4-slice LUT")
+
+    # The browser: every material, its mutations and the furnace; MeshStandardMaterial on gold.
+    gold = json.load(open(os.path.join(source, "data-samples", "materials", "gold.json")))
+    standard = list(gold["f0"]) + [1.0, float(np.sqrt(gold["alpha"]))]
+    renders = os.path.join(work, "browser")
+    os.makedirs(renders)
+    # The browser runs while the CPU references are computed (same map, camera and KTX2).
+    t0 = time.time()
+    node = subprocess.Popen(
+        ["node", os.path.join(source, "tests", "node", "render_ibl.mjs"), "--web",
+         os.path.join(out, "web"), "--materials", ",".join(names + ["pair:" + ATLAS_CELL]), "--env", env, "--out", renders,
+         "--size", str(SIZE), "--chromium", chromium,
+         "--standard", ",".join(f"{v:.9g}" for v in standard), "--viewer", GGX_REFERENCE],
+        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    refs = os.path.join(work, "refs")
+    os.makedirs(refs)
+    preview = [tool, "preview", "--env", env, "--size", str(SIZE), "--no-background", "--quiet",
+               "--jobs", "2"]
+    for n in names:
+        ktx2 = os.path.join(out, n + ".ktx2")
+        run(preview + [ktx2, "--out", os.path.join(refs, n + ".truth.exr")])
+        run(preview + [ktx2, "--ibl", "engine", "--out", os.path.join(refs, n + ".engine.exr")])
+    run(preview + [GGX_REFERENCE, "--out", os.path.join(refs, "ggx.truth.exr")])
+    furnace_cpu = os.path.join(refs, CAPTURE + ".furnace.exr")
+    run([tool, "preview", os.path.join(out, CAPTURE + ".ktx2"), "--env", "furnace", "--ibl",
+         "engine", "--size", str(SIZE), "--no-background", "--quiet", "--out", furnace_cpu])
+    cpu_s = time.time() - t0
+    log, err = node.communicate(timeout=240)
+    browser_s = time.time() - t0
+    if node.returncode != 0:
+        print(f"FAILED: render_ibl.mjs exited with {node.returncode}\n{log}\n{err[-4000:]}")
+        return 1
+    print("browser:", log.strip().splitlines()[-1][:400])
+
+    rows = []
+    pooled = []  # every material's pixel errors against the truth
+    mutation_caught = {"alpha110": [], "noE": []}
+    for n in names:
+        truth = read_exr(os.path.join(refs, n + ".truth.exr"))
+        engine = read_exr(os.path.join(refs, n + ".engine.exr"))
+        ibl = read_browser(os.path.join(renders, n + ".ibl.f32"))
+        vs_engine = metrics(ibl, engine)
+        vs_truth = metrics(ibl, truth)
+        cpu_truth = metrics(engine, truth)
+        furnace_image = read_browser(os.path.join(renders, n + ".furnace.f32"))
+        furnace = furnace_error(furnace_image, manifests[n], MU_UNCERTAINTY)
+        furnace_raw = furnace_error(furnace_image, manifests[n])
+        rows.append((n, vs_engine, vs_truth, cpu_truth, furnace, furnace_raw))
+        pooled.append(pixel_errors(ibl, truth))
+        expect(vs_engine[0] <= SPLIT_SUM_RMSE and vs_engine[1] <= SPLIT_SUM_P95,
+               f"{n}: browser vs CPU split sum: relative RMSE {vs_engine[0]:.4f} (bound "
+               f"{SPLIT_SUM_RMSE}), p95 {vs_engine[1]:.4f} (bound {SPLIT_SUM_P95})")
+        expect(furnace <= FURNACE_TOLERANCE, f"{n}: white furnace: max relative error {furnace:.5f} against E(mu)")
+        for m in mutation_caught:
+            mm = metrics(read_browser(os.path.join(renders, f"{n}.{m}.f32")), engine)
+            if mm[0] > SPLIT_SUM_RMSE or mm[1] > SPLIT_SUM_P95:
+                mutation_caught[m].append((n, mm))
+    print(f"{'material':22s} {'browser vs CPU split sum':>26s} {'browser vs truth':>20s} "
+          f"{'CPU split sum vs truth':>24s} {'furnace (raw)':>16s}")
+    for n, ve, vt, ct, fu, fr in rows:
+        print(f"{n:22s} {ve[0]:12.4f} {ve[1]:12.4f}  {vt[0]:9.4f} {vt[1]:9.4f}  {ct[0]:11.4f} {ct[1]:11.4f}  {fu:8.5f} ({fr:.5f})")
+    median_rmse = float(np.median([r[2][0] for r in rows]))
+    median_p95 = float(np.median([r[2][1] for r in rows]))
+    pooled_p95 = float(np.percentile(np.concatenate(pooled), 95))
+    print(f"browser vs truth over {len(rows)} materials: median relative RMSE {median_rmse:.4f} "
+          f"(bound {TRUTH_MEDIAN_RMSE}), median of the per-material 95th-percentile pixel "
+          f"{median_p95:.4f} (bound {TRUTH_P95}); 95th percentile of all materials' pixels together "
+          f"{pooled_p95:.4f} (not asserted); browser vs CPU split sum: median relative RMSE "
+          f"{np.median([r[1][0] for r in rows]):.4f}")
+    expect(median_rmse <= TRUTH_MEDIAN_RMSE, f"browser vs truth: median relative RMSE {median_rmse:.4f}")
+    expect(median_p95 <= TRUTH_P95, f"browser vs truth: median 95th-percentile pixel {median_p95:.4f}")
+
+    standard_err = metrics(read_browser(os.path.join(renders, "standard.f32")),
+                           read_exr(os.path.join(refs, "ggx.truth.exr")))
+    ours = dict((r[0], r[2]) for r in rows)[GGX_REFERENCE]
+    print(f"{GGX_REFERENCE}: measured LUT vs its truth {ours[0]:.4f} (p95 {ours[1]:.4f}); three's "
+          f"MeshStandardMaterial vs the GGX material's truth {standard_err[0]:.4f} (p95 "
+          f"{standard_err[1]:.4f}); ratio {ours[0] / standard_err[0]:.3f} (bound {STANDARD_RATIO})")
+    expect(ours[0] <= STANDARD_RATIO * standard_err[0],
+           f"{GGX_REFERENCE}: relative RMSE {ours[0]:.4f} > {STANDARD_RATIO} x MeshStandardMaterial's {standard_err[0]:.4f}")
+
+    cpu_furnace = furnace_error(read_exr(furnace_cpu), manifests[CAPTURE])
+    print(f"{CAPTURE} ({slices} slices): --ibl engine under the white furnace: max relative error {cpu_furnace:.5f}")
+    expect(cpu_furnace <= FURNACE_TOLERANCE, f"--ibl engine furnace: max relative error {cpu_furnace:.5f}")
+
+    check_viewer(os.path.join(renders, "viewer.png"), manifests[GGX_REFERENCE])
+
+    single = read_browser(os.path.join(renders, ATLAS_CELL + ".ibl.f32"))
+    cell = read_browser(os.path.join(renders, f"pair.{ATLAS_CELL}.ibl.f32"))
+    atlas_err = metrics(cell, single)
+    print(f"atlas pair, cell {ATLAS_CELL} (pack row 1): relative RMSE {atlas_err[0]:.6f} against "
+          f"the single LUT's render (bound {ATLAS_RMSE})")
+    expect(atlas_err[0] <= ATLAS_RMSE, f"atlas cell {ATLAS_CELL}: relative RMSE {atlas_err[0]:.6f} against its own LUT")
+
+    for m, caught in mutation_caught.items():
+        print(f"mutation {m}: fails the split-sum bound for {len(caught)} of {len(names)} materials: "
+              + ", ".join(f"{n} {v[0]:.4f}/{v[1]:.4f}" for n, v in caught))
+        expect(any(n == GGX_REFERENCE for n, _ in caught), f"mutation {m} would pass the test for {GGX_REFERENCE}")
+    print(f"times: CPU references {cpu_s:.1f} s and the browser {browser_s:.1f} s (concurrently), "
+          f"total {time.time() - started:.1f} s")
+    if FAILURES or keep:
+        print(f"{len(FAILURES)} check(s) failed; kept {work}")
+        return 1 if FAILURES else 0
+    shutil.rmtree(work, ignore_errors=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
