@@ -546,6 +546,9 @@ std::string DescribeFile(const std::string& file_or_name, const RemedyPhrasing& 
     j = DescribeBpc(file, say);
   } else if (kind == FileKind::kMaterial) {
     j = DescribeMaterial(file);
+  } else if (kind == FileKind::kSidecar && CompactLutOfSidecar(file)) {
+    j = DescribeCompact(*CompactLutOfSidecar(file));
+    j["json_file"] = file;
   } else if (IsExportedLut(kind)) {
     j = DescribeTexture(file);
   } else if (kind == FileKind::kCompactLut) {

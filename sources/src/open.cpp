@@ -349,10 +349,29 @@ OpenedTexture OpenTextureToEvaluate(const std::string& path, const OpenOptions& 
 
 }  // namespace
 
+std::optional<std::string> CompactLutOfSidecar(const std::string& sidecar_path) {
+  const exporter::SidecarInfo s = exporter::ReadSidecar(sidecar_path);
+  if (s.payload_format != "compact_log_grid") return std::nullopt;
+  for (const std::string& f : s.files)
+    if (fs::path(f).extension() == ".brdfc") {
+      const fs::path beside = fs::path(sidecar_path).parent_path() / f;
+      std::error_code ec;
+      if (fs::is_regular_file(beside, ec)) return beside.string();
+    }
+  throw IoError(
+      sidecar_path +
+      ": the compact LUT it describes is missing (looked for the .brdfc in its file list)");
+}
+
 OpenedSource OpenBrdf(const std::string& path_or_name, const OpenOptions& options) {
-  const std::string path = ResolveSource(path_or_name);
+  std::string path = ResolveSource(path_or_name);
   OpenedSource out;
   out.kind = DetectFileKind(path);
+  if (out.kind == FileKind::kSidecar)
+    if (const std::optional<std::string> compact = CompactLutOfSidecar(path)) {
+      path = *compact;  // the sidecar of a compact LUT stands for its .brdfc
+      out.kind = FileKind::kCompactLut;
+    }
   switch (out.kind) {
     case FileKind::kMaterial:
       out.brdf = std::make_unique<AnalyticBrdf>(LoadMaterialInput(path));

@@ -247,6 +247,11 @@ def check_compact(args):
         all_phi = np.concatenate([p_out, r_phi])
         ev = brdf_eval(args.brdf, os.path.join(src, name + ".brdfc"), all_in, all_out, all_phi,
                        work)
+        # The sidecar stands for its .brdfc: the same values.
+        via_sidecar = brdf_eval(args.brdf, os.path.join(src, name + ".json"), all_in[:50],
+                                all_out[:50], all_phi[:50], work)
+        if not np.array_equal(via_sidecar, ev[:50]):
+            fail(f"{name}: brdf eval of the sidecar differs from eval of the .brdfc")
         centre = decoded[ks, js, is_]
         scale_c = np.maximum(np.clip(lut[ks, js, is_], 0, 65504).max(-1), 1e-4 * brightest)
         d = np.abs(ev[:1500] - centre).max(-1) / scale_c

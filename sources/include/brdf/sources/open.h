@@ -157,6 +157,11 @@ struct OpenedSource {
   std::optional<std::string> SphereCoverageNote(const std::string& path) const;
 };
 
+// The .brdfc beside a compact LUT's sidecar (payload format "compact_log_grid"), which `brdf
+// eval` and `brdf info` read in its place; nullopt for any other sidecar. Throws IoError when
+// the .brdfc is missing, FormatError for a damaged sidecar.
+std::optional<std::string> CompactLutOfSidecar(const std::string& sidecar_path);
+
 // Opens any evaluable file: material .json, .bpc capture, .ktx2 / .dds LUT or LUT sidecar,
 // RGL .bsdf, MERL .binary, Zemax / LightTools tables, CSV point clouds and goniometer tables
 // (tables evaluated like a capture; transmission tables mirrored, with a warning). Atlases are
