@@ -435,10 +435,15 @@ Rgb HierarchicalIntegrator::Refine(const Query& q, int level, int i, int j,
       c.j = b;
       c.estimate = Estimate(q, child_level, a, b, side == Side::kStraddles);
       c.forced = child_level > mirror_level_ && ContainsMirror(q.mirror, cell);
-      if (Luminance(c.estimate) > q.large_estimate) c.forced = true;
+      if (std::fabs(Luminance(c.estimate)) > q.large_estimate) c.forced = true;
       for (int ch = 0; ch < 3; ++ch) sum[ch] += c.estimate[ch];
     }
   if (child_level == 0) return sum;
+  // Out of evaluations (HierarchicalSettings::max_evaluations): accepted as it stands.
+  if (q.evaluations >= settings_.max_evaluations) {
+    for (int ch = 0; ch < 3; ++ch) sum[ch] += (sum[ch] - estimate[ch]) / 3.0;
+    return sum;
+  }
   const double difference = std::fabs(Luminance(sum) - Luminance(estimate));
   const bool split_all = difference > q.tolerance * SizeFactorOf(level, i, j);
   Rgb total = {0, 0, 0};
@@ -493,8 +498,10 @@ Rgb HierarchicalIntegrator::Radiance(const Vec3& s, const Vec3& t, const Vec3& n
   if (top == 0 || top_only) {
     total = sum;
   } else {
-    q.tolerance = settings_.tolerance * scale;
-    q.large_estimate = settings_.largest_share * std::max(0.0, Luminance(sum));
+    // The magnitudes, not the signed values: a negative (or NaN) threshold would split every
+    // cell down to the map's pixels.
+    q.tolerance = settings_.tolerance * std::fabs(scale);
+    q.large_estimate = settings_.largest_share * std::fabs(Luminance(sum));
     for (const Top& c : cells) {
       const Rgb v = Refine(q, top, c.i, c.j, c.estimate);
       for (int ch = 0; ch < 3; ++ch) total[ch] += v[ch];

@@ -72,6 +72,13 @@ struct HierarchicalSettings {
   // least this many columns wide (0.7°), so a lobe narrower than a coarse cell cannot fall
   // between the points evaluated.
   int mirror_columns = 512;
+  // At most about this many f_r evaluations per shading point, whatever the values: once a
+  // point has spent them, the cells not yet refined keep their estimate (with the children's
+  // sum where they were compared). The intact captures and materials of the benchmark spend
+  // about 700 on average and a few thousand at most (docs/preview.md, "Bounds"); a source
+  // whose values are noise, or whose image is black at the coarse level, would otherwise refine
+  // every cell down to the map's pixels at every point.
+  std::uint64_t max_evaluations = 16384;
 };
 
 // Outgoing radiance of one shading point by the adaptive quadrature. The frame (s, t, n) is the
@@ -88,8 +95,9 @@ class HierarchicalIntegrator {
         mirror_level_(LevelOf(map, settings.mirror_columns)),
         size_factors_(SizeFactors(map)) {}
 
-  // `scale`: the luminance the tolerance is relative to (the image's mean luminance, so that
-  // the error is bounded relative to it as the benchmark's RMS measures it). `top_only`: the
+  // `scale`: the luminance the tolerance is relative to (the image's mean absolute luminance, so
+  // that the error is bounded relative to it as the benchmark's RMS measures it; its sign is
+  // ignored, so that negated values refine exactly as the intact ones). `top_only`: the
   // top level's estimate alone (no refinement), for finding that scale cheaply.
   // `evaluations` is incremented by the f_r evaluations made.
   Rgb Radiance(const Vec3& s, const Vec3& t, const Vec3& n, const Vec3& wo, double scale,

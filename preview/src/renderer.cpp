@@ -474,8 +474,9 @@ struct PreviewRenderer::Impl {
       return integrator.Radiance(ToMap(s.frame.s), ToMap(s.frame.t), ToMap(s.frame.n), s.wo, scale,
                                  top_only, count);
     };
-    // The scale the tolerances are relative to: the mean object luminance, from the top
-    // level's estimate at about 1000 pixels spread over the object.
+    // The scale the tolerances are relative to: the mean absolute object luminance, from the
+    // top level's estimate at about 1000 pixels spread over the object (absolute, so that the
+    // refinement and its cost do not depend on the values' sign).
     const std::size_t stride = std::max<std::size_t>(1, setup.size() / 1024);
     std::vector<double> sample((setup.size() + stride - 1) / stride, 0.0);
     ParallelChunks(sample.size(), 64, jobs, options.cancel, [&](std::size_t b, std::size_t e) {
@@ -485,7 +486,7 @@ struct PreviewRenderer::Impl {
       counted += count;
     });
     double scale = 0.0;
-    for (double y : sample) scale += std::max(0.0, y);
+    for (double y : sample) scale += std::fabs(y);
     scale /= std::max<std::size_t>(1, sample.size());
     auto compute = [&](std::size_t k, std::uint64_t* count) {
       ++computed_pixels;
