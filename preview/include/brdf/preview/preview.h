@@ -89,7 +89,10 @@ class EnvironmentMap {
   static EnvironmentMap AxisCoded(int width = 256, int height = 128);
 
   // An equirectangular .exr or .hdr file (RGB; alpha and further channels ignored), read in
-  // the orientation above. Throws IoError / FormatError naming the file.
+  // the orientation above. Texels that carry no usable radiance (a NaN, +Inf — a half-float
+  // value beyond 65504, such as a sun, overflows to it —, −Inf or a negative value in any
+  // channel) are taken as black and counted in load_warning(); a map with no usable texel at
+  // all is refused. Throws IoError / FormatError naming the file.
   static EnvironmentMap Load(const std::string& path);
   // "studio", "sky", "furnace", "axes" or a file path. Throws InvalidArgument for an unknown
   // name that is not an existing file either.
@@ -98,6 +101,9 @@ class EnvironmentMap {
   int width() const { return width_; }
   int height() const { return height_; }
   const std::string& name() const { return name_; }
+  // Load(): one line naming the file and how many texels were taken as black and why; empty
+  // when every texel was usable (and for maps not read from a file).
+  const std::string& load_warning() const { return load_warning_; }
   const std::vector<float>& rgb() const { return rgb_; }
   const float* Pixel(int i, int j) const {
     return &rgb_[(static_cast<std::size_t>(j) * width_ + i) * 3];
@@ -111,6 +117,7 @@ class EnvironmentMap {
   int width_ = 0, height_ = 0;
   std::vector<float> rgb_;
   std::string name_;
+  std::string load_warning_;
 };
 
 enum class Shape { kSphere, kPlane, kMesh };
