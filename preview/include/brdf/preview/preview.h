@@ -286,7 +286,9 @@ class PreviewRenderer {
  public:
   // `source`, `environment` and options.mesh must outlive the renderer; `sampler` may be null
   // (built here). Throws InvalidArgument for inconsistent options (sizes < 1, kMesh without a
-  // mesh or with an empty one, kQuadrature on a mesh, fill not in (0, 1], ...).
+  // mesh or with an empty one, kQuadrature on a mesh, fill not in (0, 1], ...) and, before
+  // any work, for a render whose EstimatedPeakBytes exceed the memory this process can still
+  // take (brdf/core/available_memory.h), naming both figures.
   PreviewRenderer(const BrdfSource& source, const EnvironmentMap& environment,
                   PreviewOptions options, std::shared_ptr<const BrdfSampler> sampler = nullptr);
   ~PreviewRenderer();
@@ -312,6 +314,14 @@ class PreviewRenderer {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// An upper bound of the memory a render with these options and this map needs, in bytes: at most
+// about 40 bytes per image pixel kept between passes (the object mask, the object pixels' index
+// and RGB sums, their luminance² and the light's share when they apply) plus the image made at
+// the end (13 bytes a pixel) and a Monte Carlo pass's sums, plus the hierarchical quadrature's
+// map hierarchy (about 100 bytes per map pixel); the map itself is not counted (it exists
+// already). docs/benchmarks/preview-memory.md compares it with measured peaks.
+std::uint64_t EstimatedPeakBytes(const PreviewOptions& options, const EnvironmentMap& environment);
 
 // One call: renders until options' stop rules are met.
 PreviewImage RenderPreview(const BrdfSource& source, const EnvironmentMap& environment,
