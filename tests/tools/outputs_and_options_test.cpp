@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <chrono>
+#include <cstdint>
 #include <regex>
 #include <string>
 #include <vector>
@@ -204,6 +205,47 @@ TEST_F(OutputsAndOptions, AnRglFieldOfRankZeroIsReportedOnOneWholeLine) {
       << r.err;
   EXPECT_NE(r.err.find("got the control character 0x"), std::string::npos) << r.err;
   EXPECT_EQ(r.err.find('\0'), std::string::npos);
+}
+
+// A fit result under --engine-fits that does not parse is named with its line and column; it
+// fails that input (the manifest would otherwise silently lack the fallback asked for), and no
+// file of the input is left behind.
+TEST_F(OutputsAndOptions, ABrokenEngineFitIsNamedWithLineAndColumn) {
+  fs::create_directories(dir_ / "fits");
+  WriteText(dir_ / "fits" / "white.ggx.json",
+            "{\"model\": \"ggx\",\n  \"kd\": [0.1, 0.1, 0.1],, }");
+  const ToolRun r = Run("convert " + Quote(dir_ / "white.json") + " --engine unity --engine-fits " +
+                        Quote(dir_ / "fits") + " --quiet --out " + Quote(dir_ / "o"));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find((dir_ / "fits" / "white.ggx.json").string() +
+                       ": line 2, column 25: expected valid JSON, got ', }'"),
+            std::string::npos)
+      << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "o" / "white.ktx2"));
+}
+
+// A KTX2 level offset near 2^64 is said as stored (length and offset), not as a range whose end
+// wrapped past 2^64 ("bytes 18446744073709551600..1045440").
+TEST_F(OutputsAndOptions, AKtx2LevelOffsetNear2To64IsPrintedAsStored) {
+  ToolRun r = Run("convert " + Quote(dir_ / "white.json") + " --formats ktx2 --quiet --out " +
+                  Quote(dir_ / "k"));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  std::string data = ReadAll(dir_ / "k" / "white.ktx2");
+  // KTX2: 48-byte header, 32-byte index, then level 0's byteOffset (u64) at byte 80.
+  ASSERT_GT(data.size(), 104u);
+  std::uint64_t length = 0;
+  for (int b = 7; b >= 0; --b) length = length << 8 | static_cast<unsigned char>(data[88 + b]);
+  const std::uint64_t offset = ~std::uint64_t{0} - 15;  // 2^64 − 16, aligned
+  for (int b = 0; b < 8; ++b) data[80 + b] = static_cast<char>(offset >> (8 * b));
+  WriteText(dir_ / "bad.ktx2", data);
+  r = Run("info " + Quote(dir_ / "bad.ktx2"));
+  EXPECT_EQ(r.exit_code, 1);
+  ASSERT_EQ(r.ErrLines().size(), 1u) << r.err;
+  EXPECT_NE(r.err.find(": byte 80: expected the level 0 image inside the file (" +
+                       std::to_string(data.size()) + " bytes), got " + std::to_string(length) +
+                       " bytes from offset 18446744073709551600"),
+            std::string::npos)
+      << r.err;
 }
 
 }  // namespace
