@@ -218,12 +218,7 @@ struct PreviewRenderer::Impl {
 
     const std::size_t pixels = static_cast<std::size_t>(o.width) * o.height;
     object.assign(pixels, 0);
-    std::vector<std::uint8_t> wanted;
-    if (!o.pixel_subset.empty()) {
-      wanted.assign(pixels, 0);
-      for (std::uint32_t p : o.pixel_subset)
-        if (p < pixels) wanted[p] = 1;
-    }
+    const std::vector<std::uint8_t> wanted = WantedPixels();
     ParallelChunks(static_cast<std::size_t>(o.height), 8, jobs, nullptr,
                    [&](std::size_t y0, std::size_t y1) {
                      PixelSetup s;
@@ -258,6 +253,17 @@ struct PreviewRenderer::Impl {
                           options.estimator != Estimator::kHierarchical &&
                           options.estimator != Estimator::kEngineSplitSum;
     if (sampling) sum_sq.assign(hits, 0.0);
+  }
+
+  // PreviewOptions::pixel_subset as a mask over the image's pixels (empty: every pixel).
+  std::vector<std::uint8_t> WantedPixels() const {
+    std::vector<std::uint8_t> wanted;
+    if (options.pixel_subset.empty()) return wanted;
+    const std::size_t pixels = static_cast<std::size_t>(options.width) * options.height;
+    wanted.assign(pixels, 0);
+    for (std::uint32_t p : options.pixel_subset)
+      if (p < pixels) wanted[p] = 1;
+    return wanted;
   }
 
   // The camera ray through image pixel p (its direction in `dir`) and what it hits.
@@ -790,12 +796,7 @@ struct PreviewRenderer::Impl {
     // The background where the rays miss (looked up again: it is the map's radiance, no
     // integral), the directional light's share and the passes' mean where they hit.
     if (options.show_background) {
-      std::vector<std::uint8_t> wanted;
-      if (!options.pixel_subset.empty()) {
-        wanted.assign(pixels, 0);
-        for (std::uint32_t p : options.pixel_subset)
-          if (p < pixels) wanted[p] = 1;
-      }
+      const std::vector<std::uint8_t> wanted = WantedPixels();
       ParallelChunks(static_cast<std::size_t>(options.height), 8, jobs, nullptr,
                      [&](std::size_t y0, std::size_t y1) {
                        PixelSetup s;
