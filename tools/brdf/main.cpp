@@ -79,7 +79,7 @@ CLI::Validator WholeNumberIn(long long lo, long long hi) {
         }
         return "expected a whole number from " + range + ", got '" + text + "'";
       },
-      "INT in [" + range + "]");
+      "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
 }
 
 // A finite number as typed, within [lo, hi] (or (lo, hi) when `open`), with its unit: "nan",
@@ -99,7 +99,7 @@ CLI::Validator NumberWithin(double lo, double hi, bool open, const std::string& 
         }
         return "expected a number in " + range + ", got '" + text + "'";
       },
-      "NUMBER in " + range);
+      range);
 }
 
 // A finite number as typed ("nan" and "inf" refused), with its unit.
@@ -115,7 +115,7 @@ CLI::Validator FiniteNumber(const std::string& unit) {
         return "expected a finite number" + (unit.empty() ? std::string() : " of " + unit) +
                ", got '" + text + "'";
       },
-      "NUMBER");
+      "");  // the help keeps the option's type and default ("--noise FLOAT=1")
 }
 
 // --engine: a list of engine names; an empty value (`--engine ''`, which wrote nothing) is
