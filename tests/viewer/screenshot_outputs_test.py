@@ -1,7 +1,8 @@
 """brdf-view --screenshot checks its outputs before any work and says why in one line, without
 VTK's log lines or terminal colours: a missing folder, a name that is not .png (a .jpg name got
 PNG bytes), /dev/null (it created /dev/null.json), an existing PNG without --force, and a
---size beyond the limit said as a size (it was "expected WIDTHxHEIGHT")."""
+--size beyond the limit said as a size (it was "expected WIDTHxHEIGHT"); a file that does not
+load is named once."""
 import os
 import subprocess
 import sys
@@ -56,6 +57,14 @@ with tempfile.TemporaryDirectory() as d:
     with open(existing, "rb") as f:
         if f.read() != b"not replaced":
             failures.append("an existing PNG was replaced without --force")
+
+    # A file that does not load: its name said once (it was "bad.json: bad.json: member ...").
+    bad = os.path.join(d, "bad.json")
+    with open(bad, "w") as f:
+        f.write('{"model": "bogus"}')
+    code, err = run([bad, "--screenshot", os.path.join(d, "bad.png")])
+    if code != 1 or err.count(bad) != 1 or "member 'model'" not in err:
+        failures.append(f"load error: exit {code}, {err!r}")
 
 for f in failures:
     print("FAIL:", f)
