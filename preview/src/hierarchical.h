@@ -75,9 +75,9 @@ struct HierarchicalSettings {
   // At most about this many f_r evaluations per shading point, whatever the values: once a
   // point has spent them, the cells not yet refined keep their estimate (with the children's
   // sum where they were compared). The intact captures and materials of the benchmark spend
-  // about 700 on average and a few thousand at most (docs/robustness.md, issue 20 finding 2); a source
-  // whose values are noise, or whose image is black at the coarse level, would otherwise refine
-  // every cell down to the map's pixels at every point.
+  // about 700 on average and a few thousand at most (docs/robustness.md, issue 20 finding 2); a
+  // source whose values are noise, or whose image is black at the coarse level, would otherwise
+  // refine every cell down to the map's pixels at every point.
   std::uint64_t max_evaluations = 16384;
 };
 
