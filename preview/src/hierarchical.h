@@ -42,17 +42,39 @@ class MapHierarchy {
   };
 
   // Levels are halved (rounding up) until the top level is at most `top_columns` wide. Built on
-  // `jobs` threads (the cells do not depend on it).
+  // `jobs` threads (the cells do not depend on it). `map` must outlive the hierarchy (level 0 is
+  // read from it).
   MapHierarchy(const EnvironmentMap& map, int top_columns, int jobs = 1);
 
   int levels() const { return static_cast<int>(width_.size()); }
   int width(int level) const { return width_[level]; }
   int height(int level) const { return height_[level]; }
-  const Cell& At(int level, int i, int j) const {
+  // Level 0 (the map's pixels, three quarters of all cells) is not stored: its cells are made
+  // from the map's pixel and per-row and per-column terms when asked for, so the hierarchy costs
+  // about 21 bytes per map pixel instead of 85 (docs/benchmarks/preview-memory.md).
+  Cell At(int level, int i, int j) const {
+    if (level == 0) return Pixel(i, j);
     return cells_[level][static_cast<std::size_t>(j) * width_[level] + i];
+  }
+  void Prefetch(int level, int i, int j) const {
+    if (level == 0)
+      __builtin_prefetch(map_->Pixel(i, j));
+    else
+      __builtin_prefetch(&cells_[level][static_cast<std::size_t>(j) * width_[level] + i]);
   }
 
  private:
+  Cell Pixel(int i, int j) const;
+  struct Row {  // θ terms of a level-0 row (hierarchical.cpp)
+    double band, sin_sq, sin_cos, sin_centre, cos_centre;
+    float sin_radius, cos_radius;
+  };
+  struct Column {  // φ terms of a level-0 column
+    double d_phi, d_sin, d_cos, sin_centre, cos_centre;
+  };
+  const EnvironmentMap* map_;
+  std::vector<Row> rows_;
+  std::vector<Column> columns_;
   std::vector<int> width_, height_;
   std::vector<std::unique_ptr<Cell[]>> cells_;
 };

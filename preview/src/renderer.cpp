@@ -895,9 +895,10 @@ std::uint64_t EstimatedPeakBytes(const PreviewOptions& options, const Environmen
   std::uint64_t bytes = pixels * per_pixel;
   const std::uint64_t map_pixels =
       static_cast<std::uint64_t>(environment.width()) * environment.height();
-  // The hierarchy: 64-byte cells, 4/3 of a cell per map pixel over all levels, and the 64-byte
-  // sums of the level being built (a quarter of a pixel's).
-  if (e == Estimator::kHierarchical) bytes += map_pixels * (64 * 4 / 3 + 16);
+  // The hierarchy: 64-byte cells, 1/3 of a cell per map pixel over the stored levels (level 0
+  // is made from the map when asked for), and the 64-byte sums of the level being built (a
+  // quarter of a pixel's).
+  if (e == Estimator::kHierarchical) bytes += map_pixels * (64 / 3 + 16);
   if (e == Estimator::kEngineSplitSum) bytes += map_pixels * 24;  // the prefiltered pyramid
   if (options.pixel_subset.size() > 0) bytes += pixels;           // the subset's mask
   return bytes;

@@ -319,7 +319,7 @@ class PreviewRenderer {
 // about 40 bytes per image pixel kept between passes (the object mask, the object pixels' index
 // and RGB sums, their luminance² and the light's share when they apply) plus the image made at
 // the end (13 bytes a pixel) and a Monte Carlo pass's sums, plus the hierarchical quadrature's
-// map hierarchy (about 100 bytes per map pixel); the map itself is not counted (it exists
+// map hierarchy (about 37 bytes per map pixel); the map itself is not counted (it exists
 // already). docs/benchmarks/preview-memory.md compares it with measured peaks.
 std::uint64_t EstimatedPeakBytes(const PreviewOptions& options, const EnvironmentMap& environment);
 
