@@ -530,6 +530,14 @@ Metadata Capture(Driver& driver, const CapturePlan& plan, const CaptureCallbacks
       if (std::fabs(plan.theta_in_deg[j] - t) <= kThetaMatchDeg)
         throw InvalidArgument("θin " + ShortNumberText(t) + "° is listed twice");
   }
+  // A fixed exposure the instrument cannot take is the user's mistake, said before anything is
+  // measured (the firmware would refuse it too, in its own words).
+  const float lo = info.geometry.min_exposure_ms, hi = info.geometry.max_exposure_ms;
+  if (plan.exposure.mode == ExposureMode::kFixed && hi > 0 &&
+      !(plan.exposure.exposure_ms >= lo && plan.exposure.exposure_ms <= hi))
+    throw InvalidArgument("exposure: expected a fixed time from " + ShortNumberText(lo) + " to " +
+                          ShortNumberText(hi) + " ms (the range of " + info.identity.model +
+                          "), got " + ShortNumberText(plan.exposure.exposure_ms) + " ms");
   if (callbacks.on_connected) callbacks.on_connected(info);
   WithRetries(driver, callbacks, [&] { driver.SetExposure(plan.exposure); });
   const bool restored = callbacks.restore_calibration && callbacks.restore_calibration(driver);

@@ -342,9 +342,9 @@ void SimulatedFirmware::Handle(const Frame& frame) {
         if (s.mode == ExposureMode::kFixed &&
             !(s.exposure_ms >= m.min_exposure_ms && s.exposure_ms <= m.max_exposure_ms)) {
           SendError(ErrorCode::kBadArgument, frame.type,
-                    "exposure " + std::to_string(s.exposure_ms) + " ms outside [" +
-                        std::to_string(m.min_exposure_ms) + ", " +
-                        std::to_string(m.max_exposure_ms) + "] ms");
+                    "exposure " + ShortNumberText(s.exposure_ms) + " ms outside [" +
+                        ShortNumberText(m.min_exposure_ms) + ", " +
+                        ShortNumberText(m.max_exposure_ms) + "] ms");
           return;
         }
         exposure_ = s;

@@ -359,7 +359,8 @@ LoadedTexture ParseKtx2(const std::uint8_t* data, std::size_t size, const std::s
     if (offset > size || length > size - offset)
       throw FormatError(file, BytePosition(at),
                         fmt::format("{} inside the file ({} bytes)", what, size),
-                        fmt::format("bytes {}..{}", offset, offset + length));
+                        // Length and offset as stored: their sum may wrap past 2^64.
+                        fmt::format("{} bytes from offset {}", length, offset));
   };
   check_range(dfd_offset, dfd_length, kHeaderEnd, "the Data Format Descriptor");
   if (bc6h) {

@@ -2,6 +2,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <string>
 #include <utility>
 #include <vector>
@@ -272,10 +273,54 @@ EnvironmentMap EnvironmentMap::Load(const std::string& path) {
   if (image.width != 2 * image.height)
     throw FormatError(path, "image size", "an equirectangular map (width = 2 × height)",
                       std::to_string(image.width) + " × " + std::to_string(image.height));
-  for (float& v : image.rgb)
-    if (!std::isfinite(v) || v < 0.0f) v = 0.0f;  // negative or NaN texels carry no light
-  return EnvironmentMap(image.width, image.height, std::move(image.rgb),
-                        std::filesystem::path(path).filename().string());
+  // Texels with a NaN, an infinity or a negative value in any channel carry no usable light:
+  // they are taken as black, counted by kind and reported in one line; a map made of nothing
+  // else lights nothing and is refused rather than rendered black.
+  std::size_t nan = 0, positive_inf = 0, negative_inf = 0, negative = 0, bad = 0;
+  const std::size_t texels = image.rgb.size() / 3;
+  for (std::size_t t = 0; t < texels; ++t) {
+    float* px = &image.rgb[3 * t];
+    // Counted by the first unusable channel's kind.
+    bool usable = true;
+    for (int c = 0; c < 3 && usable; ++c) {
+      const float v = px[c];
+      usable = false;
+      if (std::isnan(v))
+        ++nan;
+      else if (v == std::numeric_limits<float>::infinity())
+        ++positive_inf;
+      else if (v == -std::numeric_limits<float>::infinity())
+        ++negative_inf;
+      else if (v < 0.0f)
+        ++negative;
+      else
+        usable = true;
+    }
+    if (usable) continue;
+    ++bad;
+    px[0] = px[1] = px[2] = 0.0f;
+  }
+  std::string kinds;
+  auto kind = [&](std::size_t n, const char* what) {
+    if (n == 0) return;
+    kinds += (kinds.empty() ? "" : ", ") + std::to_string(n) + " " + what;
+  };
+  kind(nan, "NaN");
+  kind(positive_inf, "+Inf (a half-float value beyond 65504 overflows to +Inf)");
+  kind(negative_inf, "-Inf");
+  kind(negative, "negative");
+  const std::string of = std::to_string(bad) + " of " + std::to_string(texels) + " texels";
+  if (bad == texels)
+    throw FormatError(path, "pixel data", "texels with a finite radiance >= 0",
+                      "none: all " + std::to_string(texels) +
+                          " hold NaN, infinite or negative values (" + kinds + ")");
+  EnvironmentMap map(image.width, image.height, std::move(image.rgb),
+                     std::filesystem::path(path).filename().string());
+  if (bad > 0)
+    map.load_warning_ = path + ": warning: " + of +
+                        " hold NaN, infinite or negative values and are taken as black (" + kinds +
+                        ")";
+  return map;
 }
 
 EnvironmentMap EnvironmentMap::FromName(const std::string& name_or_path) {

@@ -106,7 +106,31 @@ constexpr std::size_t kRowsPerChunk = 4;
 
 }  // namespace
 
-MapHierarchy::MapHierarchy(const EnvironmentMap& map, int top_columns, int jobs) {
+MapHierarchy::Cell MapHierarchy::Pixel(int i, int j) const {
+  const float* px = map_->Pixel(i, j);
+  const Row& row = rows_[j];
+  const Column& column = columns_[i];
+  const double solid_angle = row.band * column.d_phi;
+  const double y = Luminance({px[0], px[1], px[2]});
+  const Vec3 m =
+      Vec3{row.sin_sq * column.d_sin, row.sin_sq * column.d_cos, row.sin_cos * column.d_phi} * y;
+  Cell cell;
+  for (int c = 0; c < 3; ++c)
+    cell.radiance_solid_angle[c] = static_cast<float>(px[c] * solid_angle);
+  Store(cell.luminance_moment, m);
+  cell.luminance = static_cast<float>(y * solid_angle);
+  cell.solid_angle = static_cast<float>(solid_angle);
+  const Vec3 axis = {row.sin_centre * column.cos_centre, row.sin_centre * column.sin_centre,
+                     row.cos_centre};
+  Store(cell.axis, axis);
+  cell.sin_radius = row.sin_radius;
+  cell.cos_radius = row.cos_radius;
+  const double length = Length(m);
+  Store(cell.centroid, length > 0.0 ? m * (1.0 / length) : Load(cell.axis));
+  return cell;
+}
+
+MapHierarchy::MapHierarchy(const EnvironmentMap& map, int top_columns, int jobs) : map_(&map) {
   const int w0 = map.width(), h0 = map.height();
   width_.push_back(w0);
   height_.push_back(h0);
@@ -184,26 +208,43 @@ MapHierarchy::MapHierarchy(const EnvironmentMap& map, int top_columns, int jobs)
     // Cell (i, j) of this level covers map pixels [i·2^level, (i+1)·2^level) clipped.
     const int span = 1 << level;
     const std::vector<CellAxis> rows = Axis(theta, h, span), columns = Axis(phi, w, span);
+    if (level == 0) {
+      // Not stored (At): the per-row and per-column terms its cells are made of. The bounding
+      // cone of a row's cells is the same in every column up to rounding, far inside the cone's
+      // margin (ConeCache), so it is taken once per row, from column 0.
+      for (int j = 0; j < h; ++j) {
+        ConeCache cache;
+        Cell probe;
+        SetCone(theta, phi, rows[j], columns[0], &cache, &probe);
+        rows_.push_back({band[j], sin_sq[j], sin_cos[j], rows[j].sin_centre, rows[j].cos_centre,
+                         probe.sin_radius, probe.cos_radius});
+      }
+      for (int i = 0; i < w; ++i)
+        columns_.push_back(
+            {d_phi[i], d_sin[i], d_cos[i], columns[i].sin_centre, columns[i].cos_centre});
+      continue;
+    }
     cells_[level] = std::make_unique_for_overwrite<Cell[]>(count);
     Cell* cells = cells_[level].get();
-    ParallelChunks(
-        static_cast<std::size_t>(h), kRowsPerChunk, jobs, nullptr,
-        [&](std::size_t b, std::size_t e) {
-          for (std::size_t j = b; j < e; ++j) {
-            ConeCache cache;
-            for (int i = 0; i < w; ++i) {
-              const Sums s = level == 0 ? pixel_sums(i, static_cast<int>(j)) : sums[j * w + i];
-              Cell& cell = cells[j * w + i];
-              for (int c = 0; c < 3; ++c) cell.radiance_solid_angle[c] = static_cast<float>(s.e[c]);
-              Store(cell.luminance_moment, s.m);
-              cell.luminance = static_cast<float>(s.y);
-              cell.solid_angle = static_cast<float>(s.solid_angle);
-              SetCone(theta, phi, rows[j], columns[i], &cache, &cell);
-              const double length = Length(s.m);
-              Store(cell.centroid, length > 0.0 ? s.m * (1.0 / length) : Load(cell.axis));
-            }
-          }
-        });
+    ParallelChunks(static_cast<std::size_t>(h), kRowsPerChunk, jobs, nullptr,
+                   [&](std::size_t b, std::size_t e) {
+                     for (std::size_t j = b; j < e; ++j) {
+                       ConeCache cache;
+                       for (int i = 0; i < w; ++i) {
+                         const Sums s = sums[j * w + i];
+                         Cell& cell = cells[j * w + i];
+                         for (int c = 0; c < 3; ++c)
+                           cell.radiance_solid_angle[c] = static_cast<float>(s.e[c]);
+                         Store(cell.luminance_moment, s.m);
+                         cell.luminance = static_cast<float>(s.y);
+                         cell.solid_angle = static_cast<float>(s.solid_angle);
+                         SetCone(theta, phi, rows[j], columns[i], &cache, &cell);
+                         const double length = Length(s.m);
+                         Store(cell.centroid,
+                               length > 0.0 ? s.m * (1.0 / length) : Load(cell.axis));
+                       }
+                     }
+                   });
     below = std::move(sums);
   }
 }
@@ -338,8 +379,7 @@ void HierarchicalIntegrator::Clip(const Query& q, int level, int i, int j, int s
   const std::size_t begin = q.leaves->size();
   const int wd = map_.width(level - 1), hd = map_.height(level - 1);
   for (int b = 2 * j; b < std::min(2 * j + 2, hd); ++b)  // as in Refine()
-    for (int a = 2 * i; a < std::min(2 * i + 2, wd); ++a)
-      __builtin_prefetch(&map_.At(level - 1, a, b));
+    for (int a = 2 * i; a < std::min(2 * i + 2, wd); ++a) map_.Prefetch(level - 1, a, b);
   for (int b = 2 * j; b < std::min(2 * j + 2, hd); ++b)
     for (int a = 2 * i; a < std::min(2 * i + 2, wd); ++a) Clip(q, level - 1, a, b, stop);
   q.ranges->Insert(ClipRanges::Key(level, i, j), begin, q.leaves->size());
@@ -423,8 +463,7 @@ Rgb HierarchicalIntegrator::Refine(const Query& q, int level, int i, int j,
   // The children lie in two map rows far apart; asking for all four lines first overlaps their
   // cache misses with each other and with the first child's BRDF evaluation.
   for (int b = 2 * j; b < std::min(2 * j + 2, hd); ++b)
-    for (int a = 2 * i; a < std::min(2 * i + 2, wd); ++a)
-      __builtin_prefetch(&map_.At(child_level, a, b));
+    for (int a = 2 * i; a < std::min(2 * i + 2, wd); ++a) map_.Prefetch(child_level, a, b);
   for (int b = 2 * j; b < std::min(2 * j + 2, hd); ++b)
     for (int a = 2 * i; a < std::min(2 * i + 2, wd); ++a) {
       const MapHierarchy::Cell& cell = map_.At(child_level, a, b);
@@ -435,10 +474,15 @@ Rgb HierarchicalIntegrator::Refine(const Query& q, int level, int i, int j,
       c.j = b;
       c.estimate = Estimate(q, child_level, a, b, side == Side::kStraddles);
       c.forced = child_level > mirror_level_ && ContainsMirror(q.mirror, cell);
-      if (Luminance(c.estimate) > q.large_estimate) c.forced = true;
+      if (std::fabs(Luminance(c.estimate)) > q.large_estimate) c.forced = true;
       for (int ch = 0; ch < 3; ++ch) sum[ch] += c.estimate[ch];
     }
   if (child_level == 0) return sum;
+  // Out of evaluations (HierarchicalSettings::max_evaluations): accepted as it stands.
+  if (q.evaluations >= settings_.max_evaluations) {
+    for (int ch = 0; ch < 3; ++ch) sum[ch] += (sum[ch] - estimate[ch]) / 3.0;
+    return sum;
+  }
   const double difference = std::fabs(Luminance(sum) - Luminance(estimate));
   const bool split_all = difference > q.tolerance * SizeFactorOf(level, i, j);
   Rgb total = {0, 0, 0};
@@ -493,8 +537,10 @@ Rgb HierarchicalIntegrator::Radiance(const Vec3& s, const Vec3& t, const Vec3& n
   if (top == 0 || top_only) {
     total = sum;
   } else {
-    q.tolerance = settings_.tolerance * scale;
-    q.large_estimate = settings_.largest_share * std::max(0.0, Luminance(sum));
+    // The magnitudes, not the signed values: a negative (or NaN) threshold would split every
+    // cell down to the map's pixels.
+    q.tolerance = settings_.tolerance * std::fabs(scale);
+    q.large_estimate = settings_.largest_share * std::fabs(Luminance(sum));
     for (const Top& c : cells) {
       const Rgb v = Refine(q, top, c.i, c.j, c.estimate);
       for (int ch = 0; ch < 3; ++ch) total[ch] += v[ch];

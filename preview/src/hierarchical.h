@@ -42,17 +42,39 @@ class MapHierarchy {
   };
 
   // Levels are halved (rounding up) until the top level is at most `top_columns` wide. Built on
-  // `jobs` threads (the cells do not depend on it).
+  // `jobs` threads (the cells do not depend on it). `map` must outlive the hierarchy (level 0 is
+  // read from it).
   MapHierarchy(const EnvironmentMap& map, int top_columns, int jobs = 1);
 
   int levels() const { return static_cast<int>(width_.size()); }
   int width(int level) const { return width_[level]; }
   int height(int level) const { return height_[level]; }
-  const Cell& At(int level, int i, int j) const {
+  // Level 0 (the map's pixels, three quarters of all cells) is not stored: its cells are made
+  // from the map's pixel and per-row and per-column terms when asked for, so the hierarchy costs
+  // about 21 bytes per map pixel instead of 85 (docs/benchmarks/preview-memory.md).
+  Cell At(int level, int i, int j) const {
+    if (level == 0) return Pixel(i, j);
     return cells_[level][static_cast<std::size_t>(j) * width_[level] + i];
+  }
+  void Prefetch(int level, int i, int j) const {
+    if (level == 0)
+      __builtin_prefetch(map_->Pixel(i, j));
+    else
+      __builtin_prefetch(&cells_[level][static_cast<std::size_t>(j) * width_[level] + i]);
   }
 
  private:
+  Cell Pixel(int i, int j) const;
+  struct Row {  // θ terms of a level-0 row (hierarchical.cpp)
+    double band, sin_sq, sin_cos, sin_centre, cos_centre;
+    float sin_radius, cos_radius;
+  };
+  struct Column {  // φ terms of a level-0 column
+    double d_phi, d_sin, d_cos, sin_centre, cos_centre;
+  };
+  const EnvironmentMap* map_;
+  std::vector<Row> rows_;
+  std::vector<Column> columns_;
   std::vector<int> width_, height_;
   std::vector<std::unique_ptr<Cell[]>> cells_;
 };
@@ -72,6 +94,13 @@ struct HierarchicalSettings {
   // least this many columns wide (0.7°), so a lobe narrower than a coarse cell cannot fall
   // between the points evaluated.
   int mirror_columns = 512;
+  // At most about this many f_r evaluations per shading point, whatever the values: once a
+  // point has spent them, the cells not yet refined keep their estimate (with the children's
+  // sum where they were compared). An intact capture (gold, simulated, 128²) spends about 700
+  // per integrated point on average (docs/robustness.md, issue 20 finding 2); a source whose
+  // values are noise, or whose image is black at the coarse level, would otherwise refine every
+  // cell down to the map's pixels at every point (about 260 000 for a 1024 × 512 map).
+  std::uint64_t max_evaluations = 16384;
 };
 
 // Outgoing radiance of one shading point by the adaptive quadrature. The frame (s, t, n) is the
@@ -88,8 +117,9 @@ class HierarchicalIntegrator {
         mirror_level_(LevelOf(map, settings.mirror_columns)),
         size_factors_(SizeFactors(map)) {}
 
-  // `scale`: the luminance the tolerance is relative to (the image's mean luminance, so that
-  // the error is bounded relative to it as the benchmark's RMS measures it). `top_only`: the
+  // `scale`: the luminance the tolerance is relative to (the image's mean absolute luminance, so
+  // that the error is bounded relative to it as the benchmark's RMS measures it; its sign is
+  // ignored, so that negated values refine exactly as the intact ones). `top_only`: the
   // top level's estimate alone (no refinement), for finding that scale cheaply.
   // `evaluations` is incremented by the f_r evaluations made.
   Rgb Radiance(const Vec3& s, const Vec3& t, const Vec3& n, const Vec3& wo, double scale,

@@ -1,6 +1,7 @@
 // The preview integrator (preview.h): camera rays, the per-pixel estimators, progressive
 // accumulation and the deterministic quadrature.
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -9,6 +10,7 @@
 #include <memory>
 #include <vector>
 
+#include "brdf/core/available_memory.h"
 #include "brdf/core/error.h"
 #include "brdf/preview/preview.h"
 #include "hierarchical.h"
@@ -53,13 +55,14 @@ constexpr int kHierarchyTopColumns = 16;
 // The image size PreviewOptions::image_tolerance is stated for.
 constexpr double kImageToleranceSize = 512.0;
 
-// What a camera ray through a pixel found, computed once per renderer.
+// What a camera ray through a pixel found. Traced again wherever it is needed rather than kept
+// per pixel (168 bytes a pixel, most of a preview's memory): a ray cast is cheap next to the
+// estimate it serves, and it gives the same numbers every time.
 struct PixelSetup {
   Vec3 position;
   Vec3 geometric_normal;
   Frame frame;
-  Vec3 wo;      // towards the camera, local frame
-  Rgb fixed{};  // background (misses) or the directional light's contribution (hits)
+  Vec3 wo;  // towards the camera, local frame
 };
 
 // The fraction of a deterministic pass done, counted by the workers (one relaxed atomic add per
@@ -119,12 +122,18 @@ struct PreviewRenderer::Impl {
   double cos_rotation = 1.0, sin_rotation = 0.0;
   int jobs = 1;
 
+  // Per image pixel, what is kept between passes is at most about 40 bytes (docs/benchmarks/
+  // preview-memory.md): the object mask, the object pixels' index and sums; the background is
+  // looked up again when the image is made, and the pixel set-up (PixelSetup) traced again.
   std::vector<std::uint8_t> object;         // per image pixel
-  std::vector<Rgb> fixed;                   // per image pixel: background or directional light
   std::vector<std::uint32_t> object_index;  // image pixel of each object pixel
-  std::vector<PixelSetup> setup;            // per object pixel
+  std::vector<std::array<float, 3>> light;  // per object pixel: the directional light's share
   std::vector<double> sum;                  // per object pixel, RGB
-  std::vector<double> sum_sq;               // per object pixel, luminance²
+  std::vector<double> sum_sq;               // per object pixel, luminance² (Monte Carlo only)
+  // The camera (SetUpPixels).
+  bool perspective = false;
+  Vec3 eye{}, forward{}, right{}, up{};
+  double aspect = 1.0, tan_half = 0.0, ortho_half_height = 1.0;
   int passes = 0;
   bool exact = false;  // quadrature or light-only: one pass is the answer
   double seconds = 0.0;
@@ -189,84 +198,104 @@ struct PreviewRenderer::Impl {
     cos_rotation = std::cos(rot);
     sin_rotation = std::sin(rot);
     const Vec3 c = SphericalDirectionDeg(o.camera.theta_deg, o.camera.phi_deg);
-    const Vec3 forward = c * -1.0;
-    Vec3 right = detail::Cross(forward, Vec3{0, 0, 1});
+    forward = c * -1.0;
+    right = detail::Cross(forward, Vec3{0, 0, 1});
     if (detail::Length(right) < 1e-9) {  // looking straight down or up: keep φ's sense
       const double phi = DegToRad(o.camera.phi_deg);
       right = {-std::sin(phi), std::cos(phi), 0.0};
     }
     right = Normalize(right);
-    const Vec3 up = detail::Cross(right, forward);
-    const double aspect = static_cast<double>(o.width) / o.height;
-    const bool perspective = o.camera.projection == Camera::Projection::kPerspective;
+    up = detail::Cross(right, forward);
+    aspect = static_cast<double>(o.width) / o.height;
+    perspective = o.camera.projection == Camera::Projection::kPerspective;
     const double half_fov = DegToRad(o.camera.fov_deg) * 0.5;
     // The unit bounding sphere's diameter spans `fill` of the frame height.
-    const double ortho_half_height = 1.0 / o.camera.fill;
+    ortho_half_height = 1.0 / o.camera.fill;
     const double distance =
         perspective ? 1.0 / std::sin(std::atan(std::tan(half_fov) * o.camera.fill)) : 10.0;
-    const double tan_half = std::tan(half_fov);
-    const Vec3 eye = c * distance;
-    Vec3 light_dir{};
-    if (o.light) light_dir = SphericalDirectionDeg(o.light->theta_deg, o.light->phi_deg);
+    tan_half = std::tan(half_fov);
+    eye = c * distance;
 
     const std::size_t pixels = static_cast<std::size_t>(o.width) * o.height;
     object.assign(pixels, 0);
-    fixed.assign(pixels, Rgb{0, 0, 0});
-    // The hits of each image row, in order of x (a per-pixel array would be cleared and copied
-    // serially, most of it for misses).
-    std::vector<std::vector<PixelSetup>> row_hits(static_cast<std::size_t>(o.height));
-    std::vector<std::uint8_t> wanted;
-    if (!o.pixel_subset.empty()) {
-      wanted.assign(pixels, 0);
-      for (std::uint32_t p : o.pixel_subset)
-        if (p < pixels) wanted[p] = 1;
-    }
-    ParallelChunks(
-        static_cast<std::size_t>(o.height), 8, jobs, nullptr, [&](std::size_t y0, std::size_t y1) {
-          for (std::size_t y = y0; y < y1; ++y)
-            for (int x = 0; x < o.width; ++x) {
-              const double sx = ((x + 0.5) / o.width * 2.0 - 1.0) * aspect;
-              const double sy = 1.0 - (y + 0.5) / o.height * 2.0;
-              Vec3 origin, dir;
-              if (perspective) {
-                origin = eye;
-                dir = Normalize(forward + right * (sx * tan_half) + up * (sy * tan_half));
-              } else {
-                origin = eye + right * (sx * ortho_half_height) + up * (sy * ortho_half_height);
-                dir = forward;
-              }
-              const std::size_t p = y * o.width + x;
-              if (!wanted.empty() && !wanted[p]) continue;
-              detail::Hit hit;
-              if (!scene.Intersect(origin, dir, &hit)) {
-                if (o.show_background) fixed[p] = environment.Radiance(ToMap(dir));
-                continue;
-              }
-              object[p] = 1;
-              PixelSetup& s = row_hits[y].emplace_back();
-              s.position = hit.position;
-              s.geometric_normal = hit.geometric_normal;
-              s.frame = Frame::FromNormal(hit.normal);
-              s.wo = s.frame.ToLocal(dir * -1.0);
-              if (o.light && Dot(light_dir, hit.geometric_normal) > 0.0) {
-                const Vec3 wi = s.frame.ToLocal(light_dir);
-                if (wi.z > 0.0 && !scene.Occluded(ShadowOrigin(s), light_dir)) {
-                  const Rgb f = source.Eval(wi, s.wo);
-                  for (int k = 0; k < 3; ++k) fixed[p][k] = o.light->irradiance[k] * f[k] * wi.z;
-                }
-              }
-            }
-        });
+    const std::vector<std::uint8_t> wanted = WantedPixels();
+    ParallelChunks(static_cast<std::size_t>(o.height), 8, jobs, nullptr,
+                   [&](std::size_t y0, std::size_t y1) {
+                     PixelSetup s;
+                     Vec3 dir;
+                     for (std::size_t p = y0 * o.width; p < y1 * o.width; ++p)
+                       if ((wanted.empty() || wanted[p]) && Trace(p, &s, &dir)) object[p] = 1;
+                   });
     std::size_t hits = 0;
-    for (const auto& row : row_hits) hits += row.size();
+    for (std::uint8_t b : object) hits += b;
     object_index.reserve(hits);
-    setup.reserve(hits);
     for (std::size_t p = 0; p < pixels; ++p)
       if (object[p]) object_index.push_back(static_cast<std::uint32_t>(p));
-    for (const auto& row : row_hits) setup.insert(setup.end(), row.begin(), row.end());
-    sum.assign(setup.size() * 3, 0.0);
-    sum_sq.assign(setup.size(), 0.0);
+    if (o.light) {
+      const Vec3 light_dir = SphericalDirectionDeg(o.light->theta_deg, o.light->phi_deg);
+      light.assign(hits, {0.0f, 0.0f, 0.0f});
+      ParallelChunks(hits, 256, jobs, nullptr, [&](std::size_t b, std::size_t e) {
+        for (std::size_t k = b; k < e; ++k) {
+          const PixelSetup s = SetupOf(k);
+          if (!(Dot(light_dir, s.geometric_normal) > 0.0)) continue;
+          const Vec3 wi = s.frame.ToLocal(light_dir);
+          if (wi.z > 0.0 && !scene.Occluded(ShadowOrigin(s), light_dir)) {
+            const Rgb f = source.Eval(wi, s.wo);
+            for (int ch = 0; ch < 3; ++ch)
+              light[k][ch] = static_cast<float>(o.light->irradiance[ch] * f[ch] * wi.z);
+          }
+        }
+      });
+    }
+    sum.assign(hits * 3, 0.0);
+    const bool sampling = options.environment_lighting &&
+                          options.estimator != Estimator::kQuadrature &&
+                          options.estimator != Estimator::kHierarchical &&
+                          options.estimator != Estimator::kEngineSplitSum;
+    if (sampling) sum_sq.assign(hits, 0.0);
   }
+
+  // PreviewOptions::pixel_subset as a mask over the image's pixels (empty: every pixel).
+  std::vector<std::uint8_t> WantedPixels() const {
+    std::vector<std::uint8_t> wanted;
+    if (options.pixel_subset.empty()) return wanted;
+    const std::size_t pixels = static_cast<std::size_t>(options.width) * options.height;
+    wanted.assign(pixels, 0);
+    for (std::uint32_t p : options.pixel_subset)
+      if (p < pixels) wanted[p] = 1;
+    return wanted;
+  }
+
+  // The camera ray through image pixel p (its direction in `dir`) and what it hits.
+  bool Trace(std::size_t p, PixelSetup* s, Vec3* dir) const {
+    const PreviewOptions& o = options;
+    const std::size_t x = p % o.width, y = p / o.width;
+    const double sx = ((x + 0.5) / o.width * 2.0 - 1.0) * aspect;
+    const double sy = 1.0 - (y + 0.5) / o.height * 2.0;
+    Vec3 origin;
+    if (perspective) {
+      origin = eye;
+      *dir = Normalize(forward + right * (sx * tan_half) + up * (sy * tan_half));
+    } else {
+      origin = eye + right * (sx * ortho_half_height) + up * (sy * ortho_half_height);
+      *dir = forward;
+    }
+    detail::Hit hit;
+    if (!scene.Intersect(origin, *dir, &hit)) return false;
+    s->position = hit.position;
+    s->geometric_normal = hit.geometric_normal;
+    s->frame = Frame::FromNormal(hit.normal);
+    s->wo = s->frame.ToLocal(*dir * -1.0);
+    return true;
+  }
+  // The set-up of object pixel k (SetUpPixels found that its ray hits).
+  PixelSetup SetupOf(std::size_t k) const {
+    PixelSetup s;
+    Vec3 dir;
+    Trace(object_index[k], &s, &dir);
+    return s;
+  }
+  std::size_t ObjectPixels() const { return object_index.size(); }
 
   static Vec3 ShadowOrigin(const PixelSetup& s) { return s.position + s.geometric_normal * 1e-6; }
 
@@ -280,8 +309,7 @@ struct PreviewRenderer::Impl {
     return {radiance[0] * f[0] * wi.z, radiance[1] * f[1] * wi.z, radiance[2] * f[2] * wi.z};
   }
 
-  Rgb EstimateOnce(std::size_t k, int pass, const Kronecker& sequence) const {
-    const PixelSetup& s = setup[k];
+  Rgb EstimateOnce(std::size_t k, const PixelSetup& s, int pass, const Kronecker& sequence) const {
     const std::uint64_t key = Mix(options.seed ^ Mix(object_index[k]));
     std::array<double, 5> u;
     for (int d = 0; d < 5; ++d) {
@@ -361,14 +389,16 @@ struct PreviewRenderer::Impl {
     static const Kronecker kSequence;
     std::vector<double> call_sum(sum.size(), 0.0), call_sq(sum_sq.size(), 0.0);
     const int first = passes;
-    ParallelChunks(setup.size(), 128, jobs, cancel, [&](std::size_t b, std::size_t e) {
-      for (std::size_t k = b; k < e; ++k)
+    ParallelChunks(ObjectPixels(), 128, jobs, cancel, [&](std::size_t b, std::size_t e) {
+      for (std::size_t k = b; k < e; ++k) {
+        const PixelSetup s = SetupOf(k);
         for (int n = 0; n < count; ++n) {
-          const Rgb v = EstimateOnce(k, first + n, kSequence);
+          const Rgb v = EstimateOnce(k, s, first + n, kSequence);
           for (int ch = 0; ch < 3; ++ch) call_sum[3 * k + ch] += v[ch];
           const double l = Luminance(v);
           call_sq[k] += l * l;
         }
+      }
     });
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (cancel != nullptr && cancel->load()) return 0;
@@ -382,12 +412,12 @@ struct PreviewRenderer::Impl {
   void SplitSum() {
     const detail::SplitSumLighting lighting(environment);
     const IblPack& pack = *options.engine_ibl;
-    PassFraction progress(options, setup.size(), pass_start);
+    PassFraction progress(options, ObjectPixels(), pass_start);
     ParallelChunks(
-        setup.size(), 64, jobs, options.cancel,
+        ObjectPixels(), 64, jobs, options.cancel,
         [&](std::size_t b, std::size_t e) {
           for (std::size_t k = b; k < e; ++k) {
-            const PixelSetup& s = setup[k];
+            const PixelSetup s = SetupOf(k);
             const double mu = std::clamp(s.wo.z, 0.0, 1.0);
             const Vec3 n = s.frame.n;
             const Vec3 wo = s.frame.ToWorld(s.wo);
@@ -405,51 +435,65 @@ struct PreviewRenderer::Impl {
     progress.Finish();
   }
 
-  // Σ over map pixels (split n × n, midpoint rule in solid angle) of L · f · cos · ΔΩ.
+  // Σ over map pixels (split n × n, midpoint rule in solid angle) of L · f · cos · ΔΩ. The
+  // directions are made from per-row and per-column sines and cosines as they are needed (a
+  // table of all of them held 48 bytes per map pixel and subdivision², 6 GB for a 1024 × 512
+  // map at 16 subdivisions); the products are SphericalDirection's, in the same order.
   void Quadrature() {
-    struct Direction {
-      Vec3 w;
-      Rgb radiance_solid_angle;
-    };
-    std::vector<Direction> dirs;
     const int n = options.quadrature_subdivisions;
     const int width = environment.width(), height = environment.height();
+    struct SubRow {
+      double sin_theta, cos_theta, solid_angle;
+    };
+    std::vector<SubRow> rows;
     for (int j = 0; j < height; ++j)
       for (int a = 0; a < n; ++a) {
         const double t0 = (j + static_cast<double>(a) / n) * kPi / height;
         const double t1 = (j + static_cast<double>(a + 1) / n) * kPi / height;
         const double theta = 0.5 * (t0 + t1);
-        const double solid_angle = (std::cos(t0) - std::cos(t1)) * 2.0 * kPi / (width * n);
-        for (int i = 0; i < width; ++i) {
-          const float* px = environment.Pixel(i, j);
-          if (px[0] == 0.0f && px[1] == 0.0f && px[2] == 0.0f) continue;
-          for (int b = 0; b < n; ++b) {
-            const double phi = (i + (b + 0.5) / n) * 2.0 * kPi / width;
-            dirs.push_back({FromMap(SphericalDirection(theta, phi)),
-                            {px[0] * solid_angle, px[1] * solid_angle, px[2] * solid_angle}});
-          }
-        }
+        rows.push_back({std::sin(theta), std::cos(theta),
+                        (std::cos(t0) - std::cos(t1)) * 2.0 * kPi / (width * n)});
+      }
+    std::vector<double> sin_phi, cos_phi;
+    for (int i = 0; i < width; ++i)
+      for (int b = 0; b < n; ++b) {
+        const double phi = (i + (b + 0.5) / n) * 2.0 * kPi / width;
+        sin_phi.push_back(std::sin(phi));
+        cos_phi.push_back(std::cos(phi));
       }
     std::atomic<std::uint64_t> counted{0};
-    PassFraction progress(options, setup.size(), pass_start);
+    PassFraction progress(options, ObjectPixels(), pass_start);
     ParallelChunks(
-        setup.size(), 16, jobs, options.cancel,
-        [&](std::size_t b, std::size_t e) {
+        ObjectPixels(), 16, jobs, options.cancel,
+        [&](std::size_t b0, std::size_t e0) {
           std::uint64_t count = 0;
-          for (std::size_t k = b; k < e; ++k) {
-            const PixelSetup& s = setup[k];
+          for (std::size_t k = b0; k < e0; ++k) {
+            const PixelSetup s = SetupOf(k);
             Rgb total = {0, 0, 0};
-            for (const Direction& d : dirs) {
-              const Vec3 wi = s.frame.ToLocal(d.w);
-              if (!(wi.z > 0.0)) continue;
-              const Rgb f = source.Eval(wi, s.wo);
-              ++count;
-              for (int ch = 0; ch < 3; ++ch) total[ch] += d.radiance_solid_angle[ch] * f[ch] * wi.z;
-            }
+            for (int j = 0; j < height; ++j)
+              for (int a = 0; a < n; ++a) {
+                const SubRow& row = rows[static_cast<std::size_t>(j) * n + a];
+                for (int i = 0; i < width; ++i) {
+                  const float* px = environment.Pixel(i, j);
+                  if (px[0] == 0.0f && px[1] == 0.0f && px[2] == 0.0f) continue;
+                  const Rgb e = {px[0] * row.solid_angle, px[1] * row.solid_angle,
+                                 px[2] * row.solid_angle};
+                  for (int b = 0; b < n; ++b) {
+                    const std::size_t c = static_cast<std::size_t>(i) * n + b;
+                    const Vec3 w = FromMap(
+                        {row.sin_theta * cos_phi[c], row.sin_theta * sin_phi[c], row.cos_theta});
+                    const Vec3 wi = s.frame.ToLocal(w);
+                    if (!(wi.z > 0.0)) continue;
+                    const Rgb f = source.Eval(wi, s.wo);
+                    ++count;
+                    for (int ch = 0; ch < 3; ++ch) total[ch] += e[ch] * f[ch] * wi.z;
+                  }
+                }
+              }
             for (int ch = 0; ch < 3; ++ch) sum[3 * k + ch] = total[ch];
           }
           counted += count;
-          progress.Add(e - b);
+          progress.Add(e0 - b0);
         },
         progress.Reporter());
     progress.Finish();
@@ -470,14 +514,15 @@ struct PreviewRenderer::Impl {
         hierarchy, approximation ? *approximation : source, settings);
     std::atomic<std::uint64_t> counted{0}, computed_pixels{0};
     auto radiance = [&](std::size_t k, double scale, bool top_only, std::uint64_t* count) {
-      const PixelSetup& s = setup[k];
+      const PixelSetup s = SetupOf(k);
       return integrator.Radiance(ToMap(s.frame.s), ToMap(s.frame.t), ToMap(s.frame.n), s.wo, scale,
                                  top_only, count);
     };
-    // The scale the tolerances are relative to: the mean object luminance, from the top
-    // level's estimate at about 1000 pixels spread over the object.
-    const std::size_t stride = std::max<std::size_t>(1, setup.size() / 1024);
-    std::vector<double> sample((setup.size() + stride - 1) / stride, 0.0);
+    // The scale the tolerances are relative to: the mean absolute object luminance, from the
+    // top level's estimate at about 1000 pixels spread over the object (absolute, so that the
+    // refinement and its cost do not depend on the values' sign).
+    const std::size_t stride = std::max<std::size_t>(1, ObjectPixels() / 1024);
+    std::vector<double> sample((ObjectPixels() + stride - 1) / stride, 0.0);
     ParallelChunks(sample.size(), 64, jobs, options.cancel, [&](std::size_t b, std::size_t e) {
       std::uint64_t count = 0;
       for (std::size_t k = b; k < e; ++k)
@@ -485,7 +530,7 @@ struct PreviewRenderer::Impl {
       counted += count;
     });
     double scale = 0.0;
-    for (double y : sample) scale += std::max(0.0, y);
+    for (double y : sample) scale += std::fabs(y);
     scale /= std::max<std::size_t>(1, sample.size());
     auto compute = [&](std::size_t k, std::uint64_t* count) {
       ++computed_pixels;
@@ -497,10 +542,10 @@ struct PreviewRenderer::Impl {
     const int block = options.image_block;
     // Progress counts the object pixels of finished blocks (the lattice pass before them is
     // about 1/block² of the work).
-    PassFraction progress(options, setup.size(), pass_start);
+    PassFraction progress(options, ObjectPixels(), pass_start);
     if (block <= 1) {
       ParallelChunks(
-          setup.size(), 64, jobs, options.cancel,
+          ObjectPixels(), 64, jobs, options.cancel,
           [&](std::size_t b, std::size_t e) {
             std::uint64_t count = 0;
             for (std::size_t k = b; k < e; ++k) store(k, compute(k, &count));
@@ -518,8 +563,16 @@ struct PreviewRenderer::Impl {
     for (std::size_t k = 0; k < object_index.size(); ++k)
       index[object_index[k]] = static_cast<std::int32_t>(k);
     auto object_at = [&](int x, int y) { return index[static_cast<std::size_t>(y) * width + x]; };
+    // The value of each object pixel, computed or interpolated, is kept in `sum` (image pixel
+    // g is object pixel index[g]).
+    auto value = [&](std::size_t g) -> double* {
+      return &sum[3 * static_cast<std::size_t>(index[g])];
+    };
+    auto load = [&](std::size_t g) {
+      const double* v = value(g);
+      return Rgb{v[0], v[1], v[2]};
+    };
     // Phase 1: every object pixel on the lattice x, y ≡ 0 (mod block).
-    std::vector<Rgb> value(object.size(), Rgb{0, 0, 0});
     const int lattice_rows = (height + block - 1) / block;
     ParallelChunks(static_cast<std::size_t>(lattice_rows), 1, jobs, options.cancel,
                    [&](std::size_t b, std::size_t e) {
@@ -527,8 +580,7 @@ struct PreviewRenderer::Impl {
                      for (std::size_t r = b; r < e; ++r) {
                        const int y = static_cast<int>(r) * block;
                        for (int x = 0; x < width; x += block)
-                         if (const int k = object_at(x, y); k >= 0)
-                           value[static_cast<std::size_t>(y) * width + x] = compute(k, &count);
+                         if (const int k = object_at(x, y); k >= 0) store(k, compute(k, &count));
                      }
                      counted += count;
                    });
@@ -550,14 +602,25 @@ struct PreviewRenderer::Impl {
                                           0);
     for (std::uint32_t p : object_index)
       ++block_pixels[p / width / block * block_columns + p % width / block];
-    std::vector<Rgb> integrated(object.size(), Rgb{0, 0, 0});
-    std::vector<std::uint8_t> has_integral(object.size(), 0);
+    // Only pixels on the lattice's lines (x or y ≡ 0 mod block) are shared between blocks, so
+    // only they keep their integral here: a row of slots per lattice row, then a column of slots
+    // per lattice column for the pixels not on a lattice row.
+    const std::size_t row_slots = static_cast<std::size_t>(lattice_rows) * width;
+    std::vector<Rgb> integrated(row_slots + static_cast<std::size_t>(block_columns) * height,
+                                Rgb{0, 0, 0});
+    std::vector<std::uint8_t> has_integral(integrated.size(), 0);
+    auto slot = [&](int x, int y) -> std::size_t {
+      if (y % block == 0) return static_cast<std::size_t>(y / block) * width + x;
+      if (x % block == 0) return row_slots + static_cast<std::size_t>(x / block) * height + y;
+      return std::size_t(-1);
+    };
     for (int c = 0; c < block_columns; ++c)
       for (int r = 0; r < lattice_rows; ++r)
         if (const std::size_t g = static_cast<std::size_t>(r) * block * width + c * block;
             index[g] >= 0) {
-          integrated[g] = value[g];
-          has_integral[g] = 1;
+          const std::size_t q = slot(c * block, r * block);
+          integrated[q] = load(g);
+          has_integral[q] = 1;
         }
     for (int pass = 0; pass < 4; ++pass) {
       const int row_parity = pass / 2, column_parity = pass % 2;
@@ -587,18 +650,23 @@ struct PreviewRenderer::Impl {
               for (int dy : {0, block})
                 for (int dx : {0, block})
                   if (inside(dx, dy)) {
-                    at(dx, dy) = value[static_cast<std::size_t>(y0 + dy) * width + x0 + dx];
+                    at(dx, dy) = load(static_cast<std::size_t>(y0 + dy) * width + x0 + dx);
                     known[dy * side + dx] = 1;
                   }
-              // The integral at (dx, dy), from `integrated` when another block or an earlier step
-              // integrated it.
+              // The integral at (dx, dy), from `integrated` when another block integrated it (a
+              // pixel inside the block is integrated at most once, `known` says when).
+              Rgb fresh;
               auto integral = [&](int dx, int dy) -> const Rgb& {
-                const std::size_t g = static_cast<std::size_t>(y0 + dy) * width + x0 + dx;
-                if (!has_integral[g]) {
-                  integrated[g] = compute(object_at(x0 + dx, y0 + dy), &count);
-                  has_integral[g] = 1;
+                const std::size_t q = slot(x0 + dx, y0 + dy);
+                if (q == std::size_t(-1)) {
+                  fresh = compute(object_at(x0 + dx, y0 + dy), &count);
+                  return fresh;
                 }
-                return integrated[g];
+                if (!has_integral[q]) {
+                  integrated[q] = compute(object_at(x0 + dx, y0 + dy), &count);
+                  has_integral[q] = 1;
+                }
+                return integrated[q];
               };
               auto computed = [&](int dx, int dy) -> const Rgb& {
                 if (known[dy * side + dx] != 1) {
@@ -687,7 +755,8 @@ struct PreviewRenderer::Impl {
                 for (int dx = 0; dx < block; ++dx) {
                   if ((dx == 0 && dy == 0) || !inside(dx, dy)) continue;  // lattice corner, or off
                   const Rgb v = known[dy * side + dx] ? at(dx, dy) : integral(dx, dy);
-                  value[static_cast<std::size_t>(y0 + dy) * width + x0 + dx] = v;
+                  double* out = value(static_cast<std::size_t>(y0 + dy) * width + x0 + dx);
+                  for (int ch = 0; ch < 3; ++ch) out[ch] = v[ch];
                 }
             }
             counted += count;
@@ -697,23 +766,22 @@ struct PreviewRenderer::Impl {
           progress.Reporter());
     }
     progress.Finish();
-    for (std::size_t k = 0; k < object_index.size(); ++k) store(k, value[object_index[k]]);
     evaluations = counted;
     computed_count = computed_pixels;
   }
 
   double RelativeRms() const {
     if (exact) return 0.0;
-    if (passes < 4 || setup.empty()) return std::numeric_limits<double>::infinity();
+    if (passes < 4 || object_index.empty()) return std::numeric_limits<double>::infinity();
     const double n = passes;
     double variance = 0.0, mean = 0.0;
-    for (std::size_t k = 0; k < setup.size(); ++k) {
+    for (std::size_t k = 0; k < ObjectPixels(); ++k) {
       const double l = Luminance({sum[3 * k] / n, sum[3 * k + 1] / n, sum[3 * k + 2] / n});
       mean += l;
       variance += std::max(0.0, (sum_sq[k] / n - l * l) / (n - 1.0));  // of the mean
     }
-    mean /= static_cast<double>(setup.size());
-    variance /= static_cast<double>(setup.size());
+    mean /= static_cast<double>(ObjectPixels());
+    variance /= static_cast<double>(ObjectPixels());
     if (!(mean > 0.0)) return variance > 0.0 ? std::numeric_limits<double>::infinity() : 0.0;
     return std::sqrt(variance) / mean;
   }
@@ -725,16 +793,33 @@ struct PreviewRenderer::Impl {
     const std::size_t pixels = object.size();
     image.rgb.assign(pixels * 3, 0.0f);
     image.object = object;
-    for (std::size_t p = 0; p < pixels; ++p)
-      for (int ch = 0; ch < 3; ++ch) image.rgb[3 * p + ch] = static_cast<float>(fixed[p][ch]);
+    // The background where the rays miss (looked up again: it is the map's radiance, no
+    // integral), the directional light's share and the passes' mean where they hit.
+    if (options.show_background) {
+      const std::vector<std::uint8_t> wanted = WantedPixels();
+      ParallelChunks(static_cast<std::size_t>(options.height), 8, jobs, nullptr,
+                     [&](std::size_t y0, std::size_t y1) {
+                       PixelSetup s;
+                       Vec3 dir;
+                       for (std::size_t p = y0 * options.width; p < y1 * options.width; ++p) {
+                         if (object[p] || (!wanted.empty() && !wanted[p])) continue;
+                         Trace(p, &s, &dir);
+                         const Rgb c = environment.Radiance(ToMap(dir));
+                         for (int ch = 0; ch < 3; ++ch)
+                           image.rgb[3 * p + ch] = static_cast<float>(c[ch]);
+                       }
+                     });
+    }
+    for (std::size_t k = 0; k < light.size(); ++k)
+      for (int ch = 0; ch < 3; ++ch) image.rgb[3 * object_index[k] + ch] = light[k][ch];
     if (passes > 0 && options.environment_lighting)
-      for (std::size_t k = 0; k < setup.size(); ++k)
+      for (std::size_t k = 0; k < ObjectPixels(); ++k)
         for (int ch = 0; ch < 3; ++ch)
           image.rgb[3 * object_index[k] + ch] += static_cast<float>(sum[3 * k + ch] / passes);
     image.samples_per_pixel = passes;
     image.estimator = options.estimator;
     image.brdf_evaluations = evaluations;
-    image.computed_pixels = exact ? (computed_count > 0 ? computed_count : setup.size()) : 0;
+    image.computed_pixels = exact ? (computed_count > 0 ? computed_count : ObjectPixels()) : 0;
     image.evaluated_as = evaluated_as;
     image.relative_rms_estimate = RelativeRms();
     image.seconds = seconds;
@@ -754,6 +839,18 @@ PreviewRenderer::PreviewRenderer(const BrdfSource& source, const EnvironmentMap&
     impl_->options.estimator =
         impl_->options.shape == Shape::kSphere ? Estimator::kHierarchical : Estimator::kMis;
   impl_->Validate();
+  // Refused before any work rather than killed half-way by the kernel.
+  if (const auto available = QueryAvailableMemory()) {
+    const std::uint64_t needed = EstimatedPeakBytes(impl_->options, environment);
+    if (needed > available->bytes)
+      throw InvalidArgument("preview: a " + std::to_string(impl_->options.width) + " × " +
+                            std::to_string(impl_->options.height) + " image under a " +
+                            std::to_string(environment.width()) + " × " +
+                            std::to_string(environment.height()) + " map needs about " +
+                            MemoryText(needed) + " of memory, more than the " +
+                            MemoryText(available->bytes) + " this process can take (" +
+                            available->limited_by + "); a smaller image would fit");
+  }
   impl_->jobs = ResolveJobs(impl_->options.jobs);
   const bool sampling = impl_->options.environment_lighting &&
                         impl_->options.estimator != Estimator::kQuadrature &&
@@ -774,6 +871,37 @@ PreviewImage PreviewRenderer::Image() const { return impl_->Image(); }
 double PreviewRenderer::EstimatedRelativeRms() const { return impl_->RelativeRms(); }
 const std::shared_ptr<const BrdfSampler>& PreviewRenderer::sampler() const {
   return impl_->sampler;
+}
+
+std::uint64_t EstimatedPeakBytes(const PreviewOptions& options, const EnvironmentMap& environment) {
+  Estimator e = options.estimator;
+  if (options.engine_ibl != nullptr) e = Estimator::kEngineSplitSum;
+  if (e == Estimator::kAuto)
+    e = options.shape == Shape::kSphere ? Estimator::kHierarchical : Estimator::kMis;
+  const bool sampling = options.environment_lighting && e != Estimator::kQuadrature &&
+                        e != Estimator::kHierarchical && e != Estimator::kEngineSplitSum;
+  // Per image pixel, every pixel counted as an object pixel (an upper bound): the mask (1),
+  // the object index (4), the RGB sums (24), the image made at the end (13).
+  std::uint64_t per_pixel = 1 + 4 + 24 + 13;
+  if (options.light) per_pixel += 12;
+  if (sampling) per_pixel += 8 + 32;  // luminance², and one call's sums while it runs
+  if (e == Estimator::kHierarchical) {
+    per_pixel += 4;  // image pixel → object pixel
+    // The integrals kept on the block lattice's lines: 25 bytes for 2/block of the pixels.
+    per_pixel += 50 / std::max(1, options.image_block);
+  }
+  const std::uint64_t pixels = static_cast<std::uint64_t>(std::max(0, options.width)) *
+                               static_cast<std::uint64_t>(std::max(0, options.height));
+  std::uint64_t bytes = pixels * per_pixel;
+  const std::uint64_t map_pixels =
+      static_cast<std::uint64_t>(environment.width()) * environment.height();
+  // The hierarchy: 64-byte cells, 1/3 of a cell per map pixel over the stored levels (level 0
+  // is made from the map when asked for), and the 64-byte sums of the level being built (a
+  // quarter of a pixel's).
+  if (e == Estimator::kHierarchical) bytes += map_pixels * (64 / 3 + 16);
+  if (e == Estimator::kEngineSplitSum) bytes += map_pixels * 24;  // the prefiltered pyramid
+  if (options.pixel_subset.size() > 0) bytes += pixels;           // the subset's mask
+  return bytes;
 }
 
 Camera DefaultCamera(Shape shape) {

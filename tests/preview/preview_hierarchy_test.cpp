@@ -112,7 +112,8 @@ TEST(PreviewHierarchy, CellIntegralsMatchQuadrature) {
 
 TEST(PreviewHierarchy, BoundingConesHoldTheirCellsTightly) {
   const int w0 = 37, h0 = 19;
-  const MapHierarchy hierarchy(UnevenMap(w0, h0), 4, 2);
+  const EnvironmentMap map = UnevenMap(w0, h0);  // outlives the hierarchy, which reads it
+  const MapHierarchy hierarchy(map, 4, 2);
   for (int level = 0; level < hierarchy.levels(); ++level) {
     const int span = 1 << level;
     for (int j = 0; j < hierarchy.height(level); ++j)

@@ -206,8 +206,11 @@ TEST(ExtrapolationJson, RejectsBadContentNamingIt) {
   ExpectJsonError(R"({"extrapolate": {"p": 0.2, "L": 0.3}})", "\"L\"");
   ExpectJsonError(R"({"extrapolate": {"p": "0.2"}})", "extrapolate.p");
   ExpectJsonError(R"({"extrapolate": [0.2, 0.3]})", "'extrapolate'");
-  ExpectJsonError(R"({"extrapolate": {"p": -0.2}})", "p >= 0");
-  ExpectJsonError(R"({"extrapolate": {"l": 1.5}})", "parameter l");
+  ExpectJsonError(R"({"extrapolate": {"p": -0.2}})",
+                  "member 'extrapolate.p': expected a finite number >= 0");
+  ExpectJsonError(
+      R"({"extrapolate": {"l": 1.5}})",
+      "member 'extrapolate.l': expected a number in [0, 1] (docs/design.md §6), got 1.5");
   ExpectJsonError(R"([1, 2])", "a JSON object");
   try {
     ExtrapolationFromJson(R"({"extrapolate": {"p": 0.2,, }})", "mat.json");

@@ -41,8 +41,9 @@ std::string ParseSize(const std::string& text, int* width, int* height) {
   const std::string bad = "expected WIDTHxHEIGHT in pixels (e.g. 960x720), got '" + text + "'";
   if (x == std::string::npos || x == 0 || x + 1 >= text.size()) return bad;
   const std::string w = text.substr(0, x), h = text.substr(x + 1);
+  // Up to nine digits, so that 100000x100000 is refused for its size, not its form.
   auto digits = [](const std::string& s) {
-    return s.size() <= 5 &&
+    return !s.empty() && s.size() <= 9 &&
            std::all_of(s.begin(), s.end(), [](char c) { return c >= '0' && c <= '9'; });
   };
   if (!digits(w) || !digits(h)) return bad;
@@ -212,7 +213,11 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     if (e.get_exit_code() == 0) return app.exit(e);
-    std::fprintf(stderr, "brdf-view: %s\nRun 'brdf-view --help' for usage.\n", e.what());
+    // One line, like every other error (CLI11's own message may hold newlines).
+    std::string what = e.what();
+    for (char& c : what)
+      if (c == '\n') c = ' ';
+    std::fprintf(stderr, "brdf-view: %s (see 'brdf-view --help')\n", what.c_str());
     return 2;
   }
 
@@ -234,7 +239,16 @@ int main(int argc, char** argv) {
   if (!screenshot.empty()) setenv("LP_NUM_THREADS", "0", /*overwrite=*/0);
 
   if (!screenshot.empty()) {
-    // The overwrite rule of every writing command (brdf/core/file_util.h), before any work.
+    // The picture is written as PNG, so only a .png name is taken (a .jpg name got PNG bytes).
+    const std::string ext = std::filesystem::path(screenshot).extension().string();
+    if (ext != ".png" && ext != ".PNG") {
+      std::fprintf(stderr, "brdf-view: error: --screenshot: expected a .png file name, got '%s'\n",
+                   screenshot.c_str());
+      return Finish(1);
+    }
+    // The overwrite rule of every writing command (brdf/core/file_util.h), before any work: it
+    // also refuses a missing or unwritable folder, a name beyond NAME_MAX and a target that is
+    // not a regular file (`--screenshot /dev/null` would have written /dev/null.json).
     try {
       brdf::CheckWritableOutputs({screenshot, screenshot + ".json"}, force);
     } catch (const brdf::Error& e) {

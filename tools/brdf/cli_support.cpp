@@ -101,14 +101,14 @@ void CreateOutputFolder(const std::string& folder) {
 }
 
 void CheckOutputPath(const std::string& out, const std::string& input, const char* extension,
-                     bool force, const char* option) {
+                     bool force, const char* option, bool folders_created) {
   if (LowerExtension(out) != extension)
     throw InvalidArgument(std::string(option) + ": expected a file name ending in " + extension +
                           ", got '" + out + "'");
   std::error_code ec;
   if (fs::equivalent(out, input, ec))
     throw InvalidArgument(std::string(option) + ": '" + out + "' is the input file itself");
-  ReportRemovedTemporaries(CheckWritableOutput(out, force));
+  ReportRemovedTemporaries(CheckWritableOutputs({out}, force, folders_created));
 }
 
 void ReportRemovedTemporaries(const std::vector<std::string>& removed) {

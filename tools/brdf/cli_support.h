@@ -31,10 +31,11 @@ std::string LowerExtension(const std::string& path);
 // Checks an output path before any work is done: it must end in `extension` (".bpc"), must
 // not be the input file itself, and must not exist unless `force` (a .bpc or .csv in the way
 // may be a measurement nobody can repeat; brdf::CheckWritableOutput, the rule of every
-// writing command). `option` names the option in messages ("--out"). Throws InvalidArgument,
+// writing command; `folders_created`: the command creates the output's folder itself, as
+// `fit` does). `option` names the option in messages ("--out"). Throws InvalidArgument,
 // OutputExistsError or IoError.
 void CheckOutputPath(const std::string& out, const std::string& input, const char* extension,
-                     bool force, const char* option = "--out");
+                     bool force, const char* option = "--out", bool folders_created = false);
 
 // Creates `folder` and its parents (nothing for an empty path); throws IoError naming it when
 // that fails ("x: cannot create the output folder: Not a directory").

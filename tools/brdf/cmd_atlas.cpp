@@ -72,7 +72,8 @@ int RunAtlas(const AtlasOptions& options) {
     std::vector<std::string> checked = outputs;
     for (std::string& p : engines::EngineOutputsToCheck(engine_dir, {}, engine_set))
       checked.push_back(std::move(p));
-    ReportRemovedTemporaries(CheckWritableOutputs(checked, options.force));
+    ReportRemovedTemporaries(
+        CheckWritableOutputs(checked, options.force, /*folders_created=*/true));
   }
   std::vector<BatchFailure> failures = found.failures;
   for (const BatchFailure& f : failures)

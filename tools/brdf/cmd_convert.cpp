@@ -144,7 +144,8 @@ int RunConvert(const ConvertOptions& options) {
     }
     for (std::string& p : engines::EngineOutputsToCheck(out_dir.string(), names, engine_set))
       outputs.push_back(std::move(p));
-    ReportRemovedTemporaries(CheckWritableOutputs(outputs, options.force));
+    ReportRemovedTemporaries(
+        CheckWritableOutputs(outputs, options.force, /*folders_created=*/true));
   }
 
   const std::size_t total = found.inputs.size() + found.failures.size();

@@ -208,7 +208,9 @@ int RunFit(const FitCommandOptions& options) {
     for (const FitInput& in : inputs) names.push_back(in.name);
     const std::vector<std::string> outputs = files.Paths(names, models);
     if (files.single) {
-      CheckOutputPath(options.out, inputs.front().path, ".json", options.force);
+      // fit creates the output's folder (CreateOutputFolder below), so a missing one is fine.
+      CheckOutputPath(options.out, inputs.front().path, ".json", options.force, "--out",
+                      /*folders_created=*/true);
     } else {
       std::set<std::string> input_paths;
       for (const FitInput& in : inputs) input_paths.insert(Identity(in.path));
@@ -217,7 +219,8 @@ int RunFit(const FitCommandOptions& options) {
           if (input_paths.count(Identity(output_of(in, m))))
             throw InvalidArgument(output_of(in, m) + ": the result of " + in.path +
                                   " would overwrite an input; choose another --out");
-      ReportRemovedTemporaries(CheckWritableOutputs(outputs, options.force));
+      ReportRemovedTemporaries(
+          CheckWritableOutputs(outputs, options.force, /*folders_created=*/true));
     }
   }
   // The folder the results go to exists before any fit runs (the parent of a .json --out).

@@ -266,6 +266,7 @@ int RunPreview(const PreviewCommandOptions& cli) {
   // The overwrite rule of every writing command, checked before any rendering work.
   ReportRemovedTemporaries(CheckWritableOutput(cli.out, cli.force));
   const preview::EnvironmentMap map = preview::EnvironmentMap::FromName(cli.env);
+  if (!map.load_warning().empty()) std::fprintf(stderr, "%s\n", map.load_warning().c_str());
 
   std::optional<processing::ExtrapolationParams> extrapolate;
   if (!cli.extrapolate.empty()) extrapolate = ParseExtrapolationOption(cli.extrapolate);

@@ -1,6 +1,7 @@
 // `brdf`: the command-line face of brdf-toolchain. This is the only translation unit that
 // sees CLI11; each subcommand parses into an options struct and calls its Run* function.
 #include <CLI/CLI.hpp>
+#include <cmath>
 #include <cstdio>
 #include <exception>
 #include <string>
@@ -61,6 +62,71 @@ CLI::Validator WholeNumberAtLeast(long long min) {
         return expected + ", got '" + text + "'";
       },
       "INT>=" + std::to_string(min));
+}
+
+// A whole number in [lo, hi] as typed: "0", "2.5", "abc" and "" are refused with the value and
+// the range quoted in plain numbers (CLI::Range printed "Value 0 not in range 1 to 8192", and
+// for a double range "%f" figures).
+CLI::Validator WholeNumberIn(long long lo, long long hi) {
+  const std::string range = std::to_string(lo) + " to " + std::to_string(hi);
+  return CLI::Validator(
+      [lo, hi, range](std::string& text) -> std::string {
+        try {
+          std::size_t used = 0;
+          const long long v = std::stoll(text, &used);
+          if (used == text.size() && v >= lo && v <= hi) return {};
+        } catch (const std::exception&) {
+        }
+        return "expected a whole number from " + range + ", got '" + text + "'";
+      },
+      "[" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+}
+
+// A finite number as typed, within [lo, hi] (or (lo, hi) when `open`), with its unit: "nan",
+// "inf", "abc" and values outside are refused with the value quoted.
+CLI::Validator NumberWithin(double lo, double hi, bool open, const std::string& unit) {
+  char bounds[80];
+  std::snprintf(bounds, sizeof bounds, open ? "(%g, %g)" : "[%g, %g]", lo, hi);
+  const std::string range = bounds + (unit.empty() ? std::string() : " " + unit);
+  return CLI::Validator(
+      [lo, hi, open, range](std::string& text) -> std::string {
+        try {
+          std::size_t used = 0;
+          const double v = std::stod(text, &used);
+          const bool inside = open ? (v > lo && v < hi) : (v >= lo && v <= hi);
+          if (used == text.size() && std::isfinite(v) && inside) return {};
+        } catch (const std::exception&) {
+        }
+        return "expected a number in " + range + ", got '" + text + "'";
+      },
+      range);
+}
+
+// A finite number as typed ("nan" and "inf" refused), with its unit.
+CLI::Validator FiniteNumber(const std::string& unit) {
+  return CLI::Validator(
+      [unit](std::string& text) -> std::string {
+        try {
+          std::size_t used = 0;
+          const double v = std::stod(text, &used);
+          if (used == text.size() && std::isfinite(v)) return {};
+        } catch (const std::exception&) {
+        }
+        return "expected a finite number" + (unit.empty() ? std::string() : " of " + unit) +
+               ", got '" + text + "'";
+      },
+      "");  // the help keeps the option's type and default ("--noise FLOAT=1")
+}
+
+// --engine: a list of engine names; an empty value (`--engine ''`, which wrote nothing) is
+// refused like an unknown name (the names themselves are checked by engines::ParseEngines).
+CLI::Validator EngineList() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        if (!text.empty()) return {};
+        return "expected unity, unreal, godot, web or all (comma separated), got ''";
+      },
+      "LIST");
 }
 
 // A number in (lo, hi] as typed, with its unit: "abc", "0" and "95" are refused with the value
@@ -193,7 +259,7 @@ int main(int argc, char** argv) {
       ->add_option("--beyond-subdivide", eval.beyond_subdivide,
                    "Captures: as 'brdf convert --beyond-subdivide'")
       ->capture_default_str()
-      ->check(CLI::Range(1, 20));
+      ->check(WholeNumberIn(1, 20));
   eval_cmd->footer(
       "Captures are interpolated as 'brdf convert' resamples them; exported LUTs are sampled "
       "as a GPU samples the 3D texture (centre-exact coordinates, trilinear, clamp-to-edge). "
@@ -246,20 +312,24 @@ int main(int argc, char** argv) {
   capture_cmd
       ->add_option("--theta-out-max", capture.geometry.theta_out_max_deg,
                    "Largest detector polar angle, degrees (sim)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(FiniteNumber("degrees"));
   capture_cmd
       ->add_option("--theta-out-step", capture.geometry.theta_out_step_deg,
                    "Detector polar step, degrees (sim)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(FiniteNumber("degrees"));
   capture_cmd
       ->add_option("--phi-out-step", capture.geometry.phi_out_step_deg,
                    "Detector azimuth step, degrees (sim)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(FiniteNumber("degrees"));
   capture_cmd
       ->add_option("--noise", capture.noise,
                    "Detector noise level: 1 = reference instrument, 0 = ideal detector "
                    "(noise-free, unsaturated signal)")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(FiniteNumber(""));
   capture_cmd->add_option("--seed", capture.seed, "Seed of the simulated detector noise")
       ->capture_default_str()
       ->check(CLI::Validator(
@@ -298,6 +368,7 @@ int main(int argc, char** argv) {
   capture_cmd
       ->add_option("--sim-pace-ms", capture.sim_pace_ms,
                    "Testing: real time the simulated firmware spends per detector row, ms")
+      ->check(FiniteNumber("ms"))
       ->group("Testing");
   capture_cmd->callback([&] { exit_code = brdf::cli::RunCapture(capture); });
 
@@ -370,7 +441,7 @@ int main(int argc, char** argv) {
                    "one divided by this (2: 10 deg slices 0-80 for the reference instrument, "
                    "filtering follows grazing highlights; 1: the measured step)")
       ->capture_default_str()
-      ->check(CLI::Range(1, 20));
+      ->check(WholeNumberIn(1, 20));
   convert_cmd->add_option("--formats", convert.formats, "Comma-separated outputs to write")
       ->capture_default_str();
   convert_cmd->add_option("--exr-type", convert.exr_type, kExrTypeHelp)
@@ -404,11 +475,13 @@ int main(int argc, char** argv) {
   convert_cmd->add_flag("--force", convert.force,
                         "Overwrite outputs that already exist in --out (without it nothing is "
                         "converted when any output exists)");
-  convert_cmd->add_option(
-      "--engine", convert.engines,
-      "Also write engine hand-off folders DIR/<engine>/ (importer, shader code, manifest, "
-      "texture in the engine's format, IBL pack NAME_ibl.dds): unity, unreal, godot, web "
-      "(comma separated) or all");
+  convert_cmd
+      ->add_option(
+          "--engine", convert.engines,
+          "Also write engine hand-off folders DIR/<engine>/ (importer, shader code, manifest, "
+          "texture in the engine's format, IBL pack NAME_ibl.dds): unity, unreal, godot, web "
+          "(comma separated) or all")
+      ->check(EngineList());
   convert_cmd->add_option("--engine-fits", convert.engine_fits,
                           "With --engine: folder of `brdf fit` results (NAME.MODEL.json); each "
                           "manifest carries NAME's fits, with their errors, as fallback material");
@@ -464,9 +537,11 @@ int main(int argc, char** argv) {
   atlas_cmd->add_flag("--quiet", atlas.quiet, "No progress bar");
   atlas_cmd->add_flag("--force", atlas.force,
                       "Overwrite PREFIX.ktx2, .dds, .exr, .json if any already exists");
-  atlas_cmd->add_option("--engine", atlas.engines,
-                        "Also write engine hand-off folders beside the prefix: unity, unreal, "
-                        "godot, web (comma separated) or all");
+  atlas_cmd
+      ->add_option("--engine", atlas.engines,
+                   "Also write engine hand-off folders beside the prefix: unity, unreal, "
+                   "godot, web (comma separated) or all")
+      ->check(EngineList());
   atlas_cmd->footer(
       "Materials are placed in input order (folders sorted by file name). All must share one "
       "theta_in list; materials with different sets are refused by name. Nothing is written "
@@ -626,21 +701,22 @@ int main(int argc, char** argv) {
   preview_cmd
       ->add_option("--env-rotate", preview.env_rotation_deg,
                    "Turn the map about the up axis, degrees")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(FiniteNumber("degrees"));
   preview_cmd->add_option("--mesh", preview.mesh, "Object: sphere, plane, or a .ply/.obj file")
       ->capture_default_str();
   preview_cmd->add_option("--size", preview.size, "Image width and height in pixels")
       ->capture_default_str()
-      ->check(CLI::Range(1, 8192));
+      ->check(WholeNumberIn(1, 8192));
   auto* preview_spp =
       preview_cmd->add_option("--spp", preview.spp, "Monte Carlo passes per pixel (selects mis)")
           ->capture_default_str()
-          ->check(CLI::Range(1, 1 << 20));
+          ->check(WholeNumberIn(1, 1 << 20));
   preview_cmd
       ->add_option("--rms", preview.rms,
                    "Instead of --spp: Monte Carlo until the estimated relative RMS error is below "
                    "this (e.g. 0.01)")
-      ->check(CLI::Range(1e-6, 1.0))
+      ->check(NumberWithin(1e-6, 1.0, /*open=*/false, ""))
       ->excludes(preview_spp);
   preview_cmd
       ->add_option("--light", preview.light,
@@ -652,11 +728,14 @@ int main(int argc, char** argv) {
                    "Camera position THETA,PHI seen from the object (default 90,0; 60,0 for the "
                    "plane, which 90,0 sees edge-on)")
       ->check(AnglePairValidator());
-  preview_cmd->add_option("--fov", preview.fov_deg,
-                          "Perspective camera with this vertical field of view, degrees "
-                          "(default: orthographic)");
+  preview_cmd
+      ->add_option("--fov", preview.fov_deg,
+                   "Perspective camera with this vertical field of view, degrees, in (0, 170) "
+                   "(default: orthographic)")
+      ->check(NumberWithin(0, 170, /*open=*/true, "degrees"));
   preview_cmd->add_option("--exposure", preview.exposure_ev, "PNG exposure in stops")
-      ->capture_default_str();
+      ->capture_default_str()
+      ->check(FiniteNumber("stops"));
   preview_cmd->add_option("--tone-map", preview.tone_map, "PNG tone curve after exposure")
       ->capture_default_str()
       ->check(CLI::IsMember({"clamp", "reinhard"}));
@@ -674,17 +753,17 @@ int main(int argc, char** argv) {
       ->add_option("--subdivisions", preview.subdivisions,
                    "quadrature: each map pixel split N × N (midpoint rule)")
       ->capture_default_str()
-      ->check(CLI::Range(1, 16));
+      ->check(WholeNumberIn(1, 16));
   preview_cmd
       ->add_option("--sample-pixels", preview.sample_pixels,
                    "Render only N object pixels spread evenly over the image, the rest black "
                    "(references with the slow estimators)")
-      ->check(CLI::Range(1, 1 << 26));
+      ->check(WholeNumberIn(1, 1 << 26));
   preview_cmd->add_option("--extrapolate", preview.extrapolate,
                           "Captures: grazing extrapolation P,L (docs/design.md §6)");
   preview_cmd->add_option("--jobs", preview.jobs, "Worker threads")
       ->capture_default_str()
-      ->check(CLI::PositiveNumber);
+      ->check(WholeNumberAtLeast(1));
   preview_cmd->add_option("--seed", preview.seed, "Random seed")->capture_default_str();
   preview_cmd->add_option("--out", preview.out, "Output image (.exr or .png)")->required();
   preview_cmd->add_flag("--no-background", preview.no_background,

@@ -254,7 +254,10 @@ ViewerResult App::Run() {
   ViewerResult result;
   if (!primary_.error.empty()) {
     result.ok = false;
-    result.message = primary_.path + ": " + primary_.error;
+    // The readers' messages already start with the file's name; it is said once.
+    const std::string& error = primary_.error;
+    result.message =
+        error.rfind(primary_.path + ":", 0) == 0 ? error : primary_.path + ": " + error;
   }
   if (headless) {
     if (mode_ == Mode::kPreview && !preview_ && result.ok) {

@@ -94,15 +94,47 @@ std::vector<std::string> RemoveStaleTemporaries(const std::string& dir) {
   return removed;
 }
 
+void CheckOutputName(const std::string& path, bool folders_created) {
+  if (path.empty()) throw IoError("an output file name is empty");
+  if (path.size() > kMaxPathBytes)
+    throw IoError(path.substr(0, 60) + "...: the output's path is " + std::to_string(path.size()) +
+                  " bytes long; a path may have at most " + std::to_string(kMaxPathBytes) +
+                  " bytes (PATH_MAX)");
+  const fs::path p(path);
+  const std::string name = p.filename().string();
+  if (name.size() > kMaxNameBytes)
+    throw IoError(path + ": the file name is " + std::to_string(name.size()) +
+                  " bytes long; a file name may have at most " + std::to_string(kMaxNameBytes) +
+                  " bytes (NAME_MAX)");
+  for (const fs::path& part : p)
+    if (part.string().size() > kMaxNameBytes)
+      throw IoError(path + ": the folder name " + part.string().substr(0, 40) + "... is " +
+                    std::to_string(part.string().size()) + " bytes long; a name may have at most " +
+                    std::to_string(kMaxNameBytes) + " bytes (NAME_MAX)");
+  std::string folder = p.has_parent_path() ? p.parent_path().string() : std::string(".");
+  struct stat st {};
+  // Folders the command creates itself: the nearest one that exists must take them.
+  while (folders_created && ::stat(folder.c_str(), &st) != 0 && errno == ENOENT) {
+    const fs::path up = fs::path(folder).parent_path();
+    folder = up.empty() ? std::string(".") : up.string();
+  }
+  if (::stat(folder.c_str(), &st) != 0)
+    throw IoError(path + ": cannot write into the folder " + folder + ": " + ErrnoText());
+  if (!S_ISDIR(st.st_mode)) throw IoError(path + ": " + folder + " is not a folder");
+  if (::access(folder.c_str(), W_OK | X_OK) != 0)
+    throw IoError(path + ": cannot write into the folder " + folder + ": " + ErrnoText());
+}
+
 OutputExistsError::OutputExistsError(std::vector<std::string> paths)
     : IoError(ExistsMessage(paths), Remedy{RemedyKind::kForceOverwrite,
                                            paths.size() == 1 ? paths.front() : std::string()}),
       paths_(std::move(paths)) {}
 
-std::vector<std::string> CheckWritableOutputs(const std::vector<std::string>& paths,
-                                              bool overwrite) {
+std::vector<std::string> CheckWritableOutputs(const std::vector<std::string>& paths, bool overwrite,
+                                              bool folders_created) {
   std::vector<std::string> existing;
   for (const std::string& p : paths) {
+    CheckOutputName(p, folders_created);
     if (const std::string kind = NonRegularKind(p); !kind.empty())
       throw IoError(p + ": exists and is " + kind + ", not a file; choose another output name");
     std::error_code ec;

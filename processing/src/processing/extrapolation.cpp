@@ -126,11 +126,14 @@ std::optional<ExtrapolationParams> ExtrapolationFromJson(std::string_view json_t
                         std::string(value.type_name()) + " " + value.dump());
     *target = value.get<double>();
   }
-  try {
-    params.Validate();
-  } catch (const InvalidArgument& e) {
-    throw FormatError(file, "member 'extrapolate'", "p >= 0 and l in [0, 1]", e.what());
-  }
+  // Said per member, as a position, what was expected and the value (not Validate()'s sentence
+  // after "expected p >= 0 and l in [0, 1], got").
+  if (!(std::isfinite(params.p) && params.p >= 0.0))
+    throw FormatError(file, "member 'extrapolate.p'", "a finite number >= 0 (docs/design.md §6)",
+                      ExactNumberText(params.p));
+  if (!(params.l >= 0.0 && params.l <= 1.0))
+    throw FormatError(file, "member 'extrapolate.l'", "a number in [0, 1] (docs/design.md §6)",
+                      ExactNumberText(params.l));
   return params;
 }
 

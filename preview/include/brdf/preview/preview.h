@@ -89,7 +89,10 @@ class EnvironmentMap {
   static EnvironmentMap AxisCoded(int width = 256, int height = 128);
 
   // An equirectangular .exr or .hdr file (RGB; alpha and further channels ignored), read in
-  // the orientation above. Throws IoError / FormatError naming the file.
+  // the orientation above. Texels that carry no usable radiance (a NaN, +Inf — a half-float
+  // value beyond 65504, such as a sun, overflows to it —, −Inf or a negative value in any
+  // channel) are taken as black and counted in load_warning(); a map with no usable texel at
+  // all is refused. Throws IoError / FormatError naming the file.
   static EnvironmentMap Load(const std::string& path);
   // "studio", "sky", "furnace", "axes" or a file path. Throws InvalidArgument for an unknown
   // name that is not an existing file either.
@@ -98,6 +101,9 @@ class EnvironmentMap {
   int width() const { return width_; }
   int height() const { return height_; }
   const std::string& name() const { return name_; }
+  // Load(): one line naming the file and how many texels were taken as black and why; empty
+  // when every texel was usable (and for maps not read from a file).
+  const std::string& load_warning() const { return load_warning_; }
   const std::vector<float>& rgb() const { return rgb_; }
   const float* Pixel(int i, int j) const {
     return &rgb_[(static_cast<std::size_t>(j) * width_ + i) * 3];
@@ -111,6 +117,7 @@ class EnvironmentMap {
   int width_ = 0, height_ = 0;
   std::vector<float> rgb_;
   std::string name_;
+  std::string load_warning_;
 };
 
 enum class Shape { kSphere, kPlane, kMesh };
@@ -279,7 +286,9 @@ class PreviewRenderer {
  public:
   // `source`, `environment` and options.mesh must outlive the renderer; `sampler` may be null
   // (built here). Throws InvalidArgument for inconsistent options (sizes < 1, kMesh without a
-  // mesh or with an empty one, kQuadrature on a mesh, fill not in (0, 1], ...).
+  // mesh or with an empty one, kQuadrature on a mesh, fill not in (0, 1], ...) and, before
+  // any work, for a render whose EstimatedPeakBytes exceed the memory this process can still
+  // take (brdf/core/available_memory.h), naming both figures.
   PreviewRenderer(const BrdfSource& source, const EnvironmentMap& environment,
                   PreviewOptions options, std::shared_ptr<const BrdfSampler> sampler = nullptr);
   ~PreviewRenderer();
@@ -305,6 +314,14 @@ class PreviewRenderer {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+// An upper bound of the memory a render with these options and this map needs, in bytes: at most
+// about 40 bytes per image pixel kept between passes (the object mask, the object pixels' index
+// and RGB sums, their luminance² and the light's share when they apply) plus the image made at
+// the end (13 bytes a pixel) and a Monte Carlo pass's sums, plus the hierarchical quadrature's
+// map hierarchy (about 37 bytes per map pixel); the map itself is not counted (it exists
+// already). docs/benchmarks/preview-memory.md compares it with measured peaks.
+std::uint64_t EstimatedPeakBytes(const PreviewOptions& options, const EnvironmentMap& environment);
 
 // One call: renders until options' stop rules are met.
 PreviewImage RenderPreview(const BrdfSource& source, const EnvironmentMap& environment,

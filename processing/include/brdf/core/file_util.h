@@ -34,14 +34,26 @@ class OutputExistsError : public IoError {
   std::vector<std::string> paths_;
 };
 
-// Checks `paths` (all the outputs of one command): throws OutputExistsError listing those that
-// exist when !overwrite, and IoError "<path>: exists and is a folder (or FIFO, device, ...), not
-// a file" for an existing non-regular path whatever `overwrite` says. Symbolic links are
+// The limits of an output's name on Linux: NAME_MAX bytes per file name, PATH_MAX bytes for
+// the whole path.
+inline constexpr std::size_t kMaxNameBytes = 255, kMaxPathBytes = 4095;
+
+// Throws IoError naming `path` when it cannot be created: a file or folder name longer than
+// kMaxNameBytes or a path longer than kMaxPathBytes, a folder that does not exist, is not a
+// folder, or cannot be written into (errno's reason). `folders_created`: the command creates
+// the missing folders itself (convert's and atlas's engine folders), so the nearest existing
+// one is checked instead. Checks no file, only its place.
+void CheckOutputName(const std::string& path, bool folders_created = false);
+
+// Checks `paths` (all the outputs of one command): CheckOutputName for each, then throws
+// OutputExistsError listing those that exist when !overwrite, and IoError "<path>: exists and
+// is a folder (or FIFO, device, ...), not a file" for an existing non-regular path whatever
+// `overwrite` says. Symbolic links are
 // followed (a link to a regular file counts as that file). Then removes the temporary files
 // that killed runs left in the outputs' folders (RemoveStaleTemporaries) and returns their
 // paths, for the caller to report.
-std::vector<std::string> CheckWritableOutputs(const std::vector<std::string>& paths,
-                                              bool overwrite);
+std::vector<std::string> CheckWritableOutputs(const std::vector<std::string>& paths, bool overwrite,
+                                              bool folders_created = false);
 inline std::vector<std::string> CheckWritableOutput(const std::string& path, bool overwrite) {
   return CheckWritableOutputs({path}, overwrite);
 }

@@ -1,6 +1,7 @@
 // Tensor file ("tensor_file\0") parsing and writing: see brdf/core/rgl.h and the format notes
 // in ../shared/brdf-data/README.md.
 #include <bit>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <set>
@@ -136,6 +137,18 @@ TensorFile TensorFile::Parse(std::vector<std::uint8_t> bytes, std::string file) 
     if (!detail::IsValidUtf8(f.name))
       throw FormatError(out.file_, BytePosition(name_at), "a UTF-8 field name",
                         "invalid UTF-8 bytes in field " + std::to_string(k) + "'s name");
+    // A name with control characters (a NUL ends the message that quotes it) is what a field
+    // count, rank or shape that lies makes of the bytes after it: said as such, by byte.
+    for (std::size_t c = 0; c < f.name.size(); ++c)
+      if (static_cast<unsigned char>(f.name[c]) < 0x20 || f.name[c] == 0x7f) {
+        char hex[8];
+        std::snprintf(hex, sizeof hex, "0x%02x", static_cast<unsigned char>(f.name[c]));
+        throw FormatError(out.file_, BytePosition(name_at + c),
+                          "a field name of printable characters (field " + std::to_string(k) +
+                              " of " + std::to_string(count) +
+                              "; the previous field's rank or shape may be wrong)",
+                          std::string("the control character ") + hex);
+      }
     if (names.contains(f.name))
       throw FormatError(out.file_, BytePosition(name_at), "unique field names",
                         "a second field " + Quoted(f.name));
