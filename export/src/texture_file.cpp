@@ -70,9 +70,13 @@ void FinishLoadedTexture(LoadedTexture& t) {
     t.theta_in_deg = m.theta_in_deg;
     t.theta_in_from_metadata = true;
   } else if (t.theta_in_deg.size() != static_cast<std::size_t>(t.volume.depth)) {
-    // No metadata: docs/design.md §5's reference spacing, θin,k = k·20°.
+    // No metadata: the layouts the toolchain writes (docs/design.md §5): the reference
+    // spacing θin,k = k·20° while it stays within 0–80° (K ≤ 5), else the filled LUT's 0–80°
+    // in K − 1 equal steps (K = 9: every 10°, the default of the blind-spot fill).
     t.theta_in_deg.clear();
-    for (int k = 0; k < t.volume.depth; ++k) t.theta_in_deg.push_back(20.0 * k);
+    const int depth = t.volume.depth;
+    const double step = depth <= 5 ? 20.0 : 80.0 / (depth - 1);
+    for (int k = 0; k < depth; ++k) t.theta_in_deg.push_back(step * k);
     t.theta_in_from_metadata = false;
   }
   t.lut = Lut();

@@ -267,9 +267,10 @@ OpenedTexture OpenExportedTexture(const std::string& path) {
                                                 beside.empty() ? path + " (manifest)" : beside);
     out.checksum_verified = true;
   } else {
-    out.warnings.push_back(path + ": warning: no sidecar recorded or found beside it: θin " +
-                           DegList(out.texture.theta_in_deg) +
-                           "° assumed (k·20°) and the checksum not verified");
+    out.warnings.push_back(
+        path + ": warning: no sidecar recorded or found beside it: θin " +
+        DegList(out.texture.theta_in_deg) +
+        "° assumed (the toolchain's layout for that slice count) and the checksum not verified");
   }
   return out;
 }

@@ -144,7 +144,7 @@ TEST_F(FitCommand, OptionsAreRecordedInTheReport) {
 TEST_F(FitCommand, ExtrapolateAutoIsRecordedByConvertAndAtlas) {
   WriteText(dir_ / "g.json", R"({"model":"ggx","kd":0.05,"f0":[0.6,0.5,0.4],"alpha":0.2})");
   const ToolRun c = Run("convert " + Quote(dir_ / "g.json") + " --out " + Quote(dir_ / "luts") +
-                        " --extrapolate auto --formats ktx2,json --quiet");
+                        " --extrapolate auto --beyond clamp --formats ktx2,json --quiet");
   ASSERT_EQ(c.exit_code, 0) << c.err;
   const Json sidecar = Json::parse(ReadAll(dir_ / "luts" / "g.json"));
   ASSERT_EQ(sidecar["fitted_models"].size(), 1u);

@@ -63,7 +63,8 @@ TEST_F(HostileInputs, JsonNumberBeyondDoubleNamesItsPosition) {
 // was read with "<stem>.json" beside it as its sidecar, i.e. with itself: the refusal quoted the
 // JSON library ("[json.exception.parse_error.101] ... last read: 'D'") and called the file an
 // "embedded sidecar", which a DDS cannot have. It is a DDS without a sidecar: its θin list is
-// the k·20° the design assumes, here equal to what convert's own sidecar records.
+// the layout docs/design.md §5 assumes for its slice count (9 slices of the default blind-spot
+// fill: 0–80° every 10°), here equal to what convert's own sidecar records.
 TEST_F(HostileInputs, DdsUnderAJsonNameIsNotItsOwnSidecar) {
   ASSERT_EQ(Run("convert " + Quote(kGoldMaterial) + " --quiet --formats dds,json --out " +
                 Quote(dir_ / "lut"))
@@ -76,7 +77,8 @@ TEST_F(HostileInputs, DdsUnderAJsonNameIsNotItsOwnSidecar) {
   const auto recorded = nlohmann::json::parse(ReadAll(dir_ / "lut" / "gold.json"));
   const auto described = nlohmann::json::parse(info.out);
   EXPECT_EQ(described["theta_in_deg"], recorded["theta_in_deg"]) << info.out;
-  EXPECT_EQ(described["theta_in_deg"], nlohmann::json::parse("[0, 20, 40, 60]"));
+  EXPECT_EQ(described["theta_in_deg"],
+            nlohmann::json::parse("[0, 10, 20, 30, 40, 50, 60, 70, 80]"));
   EXPECT_EQ(Run("eval " + Quote(wrong) + " --in 30,0 --out 30,180").exit_code, 0);
 }
 

@@ -46,7 +46,8 @@ struct LoadedTexture {
   // read beside a DDS file (errors in it name that file); empty for embedded metadata.
   std::string metadata_file;
   // The θin list (degrees) from the embedded metadata or a sidecar found beside a DDS file;
-  // otherwise k·20° (docs/design.md §5's Δin) with theta_in_from_metadata = false.
+  // otherwise the toolchain's layout for the slice count (k·20° for K ≤ 5, else 0–80° in
+  // K − 1 equal steps; docs/design.md §5) with theta_in_from_metadata = false.
   std::vector<double> theta_in_deg;
   bool theta_in_from_metadata = false;
   // The decoded LUT when the texture is a single 361 × 181 × K LUT; empty (no slices) for an
