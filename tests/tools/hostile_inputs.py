@@ -32,8 +32,9 @@ command that blocks without computing) and an address-space cap (4 GiB) and is c
     member / chunk / field / level / slice / row it is in;
   - agreement: `info` exit 1 => `eval` and `convert` refuse; `info` exit 0 => `eval` and
     `convert` succeed unless `info` printed a warning; `eval` prints finite values; the θin
-    list `info --json` reports equals the one in convert's sidecar (a run where that check
-    could not be made is a finding too);
+    list `info --json` reports equals the measured one in convert's sidecar (its "beyond"
+    record's, when the LUT carries filled slices; a run where that check could not be made is a
+    finding too);
   - accounting: every lie a seed's rules describe produced a file that was run (a rule whose
     pattern no longer matches its seed is a finding); the summary counts the lies per seed.
 A summary prints the count of files and runs; each finding prints one line and the exit code
@@ -1083,7 +1084,13 @@ def check_agreement(variant, results, work, index, findings):
                                os.path.splitext(os.path.basename(variant.path))[0] + ".json")
         info_theta = theta_list_of_info(out)
         try:
-            conv_theta = [round(float(x), 6) for x in json.load(open(sidecar))["theta_in_deg"]]
+            recorded = json.load(open(sidecar))
+            # With the blind-spot fill the LUT's slices are the measured ones plus filled ones;
+            # the sidecar's "beyond" record lists the measured θin, which is what info reports.
+            beyond = recorded.get("beyond")
+            measured = beyond.get("measured_theta_in") if isinstance(beyond, dict) else None
+            conv_theta = [round(float(x), 6)
+                          for x in (measured if measured is not None else recorded["theta_in_deg"])]
         except (OSError, ValueError, KeyError, TypeError):
             findings.append(f"{where}: convert succeeded but its sidecar {sidecar} is unreadable")
             return
