@@ -9,22 +9,12 @@ namespace py = pybind11;
 
 namespace brdf::python {
 
-namespace {
-
-// "40, 60": the slices a remedy names, spelled as capture metadata spells angles.
-std::string DegList(const std::vector<double>& values) {
-  std::string out;
-  for (double v : values) out += (out.empty() ? "" : ", ") + ShortNumberText(v);
-  return out;
-}
-
-}  // namespace
-
 std::string PythonRemedyText(const Remedy& remedy) {
   const std::string& f = remedy.file;
-  const std::string missing = remedy.theta_in_deg.empty()
-                                  ? std::string()
-                                  : " (it captures θin " + DegList(remedy.theta_in_deg) + "°)";
+  const std::string missing =
+      remedy.theta_in_deg.empty()
+          ? std::string()
+          : " (it captures θin " + ShortNumberListText(remedy.theta_in_deg) + "°)";
   switch (remedy.kind) {
     case RemedyKind::kNone:
       return {};

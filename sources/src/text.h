@@ -12,9 +12,7 @@ namespace brdf::sources::detail {
 inline std::string Deg(double v) { return ShortNumberText(v); }
 
 inline std::string DegList(const std::vector<double>& values) {
-  std::string out;
-  for (double v : values) out += (out.empty() ? "" : ", ") + Deg(v);
-  return out;
+  return ShortNumberListText(values);
 }
 
 }  // namespace brdf::sources::detail

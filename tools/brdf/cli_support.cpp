@@ -7,31 +7,19 @@
 
 #include "brdf/core/error.h"
 #include "brdf/core/file_util.h"
+#include "brdf/core/text_format.h"
 #include "brdf/sources/capture.h"
 
 namespace brdf::cli {
 
 namespace fs = std::filesystem;
 
-namespace {
-
-std::string DegList(const std::vector<double>& values) {
-  std::string out;
-  for (double v : values) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%g", v);
-    out += (out.empty() ? "" : ", ") + std::string(buf);
-  }
-  return out;
-}
-
-}  // namespace
-
 std::string RemedyText(const Remedy& remedy, const std::string& command) {
   const std::string& f = remedy.file;
-  const std::string missing = remedy.theta_in_deg.empty()
-                                  ? std::string()
-                                  : " (it captures θin " + DegList(remedy.theta_in_deg) + "°)";
+  const std::string missing =
+      remedy.theta_in_deg.empty()
+          ? std::string()
+          : " (it captures θin " + ShortNumberListText(remedy.theta_in_deg) + "°)";
   switch (remedy.kind) {
     case RemedyKind::kNone:
       return {};

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "brdf/core/error.h"
+#include "brdf/core/text_format.h"
 #include "brdf/sources/capture.h"
 #include "brdf/sources/material_library.h"
 #include "cli_support.h"
@@ -13,14 +14,9 @@
 namespace brdf::cli {
 namespace {
 
+// "0, 20, 40", or "none" for a repair that kept or misses no slice.
 std::string DegList(const std::vector<double>& values) {
-  std::string out;
-  for (double v : values) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%g", v);
-    out += (out.empty() ? "" : ", ") + std::string(buf);
-  }
-  return out.empty() ? "none" : out;
+  return values.empty() ? "none" : ShortNumberListText(values);
 }
 
 }  // namespace

@@ -22,4 +22,10 @@ std::string Hex32Text(std::uint32_t value) {
 std::string ExactNumberText(double value) { return Format("%.17g", value); }
 std::string ShortNumberText(double value) { return Format("%g", value); }
 
+std::string ShortNumberListText(const std::vector<double>& values) {
+  std::string out;
+  for (double v : values) out += (out.empty() ? "" : ", ") + ShortNumberText(v);
+  return out;
+}
+
 }  // namespace brdf

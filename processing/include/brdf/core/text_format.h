@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 namespace brdf {
 
@@ -20,5 +21,9 @@ std::string ExactNumberText(double value);
 // records them. A resumed capture compares these texts with the file's, so the spelling is part
 // of the .bpc format.
 std::string ShortNumberText(double value);
+
+// "0, 20, 40": a list of such numbers (θin slices in messages and remedies), comma separated;
+// empty for an empty list.
+std::string ShortNumberListText(const std::vector<double>& values);
 
 }  // namespace brdf
