@@ -63,9 +63,9 @@ void WriteDds(const std::string& path, const Bc6hVolume& volume);
 
 // Reads and validates a DDS file of this format. θin comes from `theta_in_deg` when given
 // (must have depth entries), else the assumed layout of texture_file.h
-// (theta_in_from_metadata = false); ReadTextureFile looks for the sidecar instead. Throws IoError / FormatError ("expected DXGI format 67
-// (DXGI_FORMAT_R9G9B9E5_SHAREDEXP) or 95 (DXGI_FORMAT_BC6H_UF16), got unsupported DXGI format
-// 71").
+// (theta_in_from_metadata = false); ReadTextureFile looks for the sidecar instead. Throws IoError /
+// FormatError ("expected DXGI format 67 (DXGI_FORMAT_R9G9B9E5_SHAREDEXP) or 95
+// (DXGI_FORMAT_BC6H_UF16), got unsupported DXGI format 71").
 LoadedTexture ReadDds(const std::string& path, const std::vector<double>& theta_in_deg = {});
 LoadedTexture ParseDds(const std::uint8_t* data, std::size_t size, const std::string& file,
                        const std::vector<double>& theta_in_deg = {});
