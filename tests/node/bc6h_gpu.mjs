@@ -17,10 +17,12 @@ for (let i = 2; i < process.argv.length; i += 2) args[process.argv[i].slice(2)] 
 for (const required of ['ktx2', 'out'])
   if (!args[required]) { console.error(`bc6h_gpu: --${required} is required`); process.exit(2); }
 const ktx2 = readFileSync(resolve(args.ktx2));
+const webglPageScript = readFileSync(new URL('./webgl_page.js', import.meta.url));
 const chromium = args.chromium || 'chromium';
 const deadline = Date.now() + 240000;
 
-const page = `<!doctype html><canvas id="c" width="4" height="4"></canvas><script>
+const page = `<!doctype html><canvas id="c" width="4" height="4"></canvas>
+<script src="/webgl_page.js"></script><script>
 window.readAll = async () => {
   const bytes = new Uint8Array(await (await fetch('/texture.ktx2')).arrayBuffer());
   const dv = new DataView(bytes.buffer);
@@ -44,32 +46,12 @@ window.readAll = async () => {
                           bytes.subarray(offset, offset + length));
   const err = gl.getError();
   if (err !== gl.NO_ERROR) throw new Error('compressedTexImage3D: GL error 0x' + err.toString(16));
-  const vs = '#version 300 es\\nin vec2 p; void main() { gl_Position = vec4(p, 0.0, 1.0); }';
   const fs = '#version 300 es\\nprecision highp float; precision highp sampler3D;\\n' +
     'uniform sampler3D lut; uniform int slice; out vec4 color;\\n' +
     'void main() { color = vec4(texelFetch(lut, ivec3(int(gl_FragCoord.x), int(gl_FragCoord.y), slice), 0).rgb, 1.0); }';
-  const compile = (type, src) => { const s = gl.createShader(type); gl.shaderSource(s, src); gl.compileShader(s);
-    if (!gl.getShaderParameter(s, gl.COMPILE_STATUS)) throw new Error(gl.getShaderInfoLog(s)); return s; };
-  const prog = gl.createProgram();
-  gl.attachShader(prog, compile(gl.VERTEX_SHADER, vs));
-  gl.attachShader(prog, compile(gl.FRAGMENT_SHADER, fs));
-  gl.linkProgram(prog);
-  if (!gl.getProgramParameter(prog, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(prog));
-  gl.useProgram(prog);
-  const buf = gl.createBuffer();
-  gl.bindBuffer(gl.ARRAY_BUFFER, buf);
-  gl.bufferData(gl.ARRAY_BUFFER, new Float32Array([-1, -1, 3, -1, -1, 3]), gl.STATIC_DRAW);
-  const loc = gl.getAttribLocation(prog, 'p');
-  gl.enableVertexAttribArray(loc);
-  gl.vertexAttribPointer(loc, 2, gl.FLOAT, false, 0, 0);
-  const rt = gl.createTexture();
-  gl.bindTexture(gl.TEXTURE_2D, rt);
-  gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA32F, w, h);
-  const fb = gl.createFramebuffer();
-  gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
-  gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, rt, 0);
-  if (gl.checkFramebufferStatus(gl.FRAMEBUFFER) !== gl.FRAMEBUFFER_COMPLETE) throw new Error('incomplete RGBA32F target');
-  gl.viewport(0, 0, w, h);
+  const prog = webglPage.program(gl, webglPage.fullScreenVertexShader, fs);
+  webglPage.fullScreenTriangle(gl, prog);
+  webglPage.floatTarget(gl, w, h);
   gl.activeTexture(gl.TEXTURE0);
   gl.bindTexture(gl.TEXTURE_3D, tex);
   gl.uniform1i(gl.getUniformLocation(prog, 'lut'), 0);
@@ -84,15 +66,13 @@ window.readAll = async () => {
   }
   const e2 = gl.getError();
   if (e2 !== gl.NO_ERROR) throw new Error('GL error 0x' + e2.toString(16));
-  const u8 = new Uint8Array(out.buffer);
-  let s = '';
-  for (let i = 0; i < u8.length; i += 0x8000) s += String.fromCharCode.apply(null, u8.subarray(i, i + 0x8000));
-  return { w, h, d, renderer: gl.getParameter(gl.RENDERER), data: btoa(s) };
+  return { w, h, d, renderer: gl.getParameter(gl.RENDERER), data: webglPage.base64(out) };
 };
 </script>`;
 
 const server = createServer((req, res) => {
   if (req.url === '/texture.ktx2') { res.writeHead(200, { 'Content-Type': 'application/octet-stream' }); res.end(ktx2); }
+  else if (req.url === '/webgl_page.js') { res.writeHead(200, { 'Content-Type': 'text/javascript' }); res.end(webglPageScript); }
   else if (req.url === '/') { res.writeHead(200, { 'Content-Type': 'text/html' }); res.end(page); }
   else { res.writeHead(404); res.end(); }
 });

@@ -20,10 +20,12 @@ const files = {
   '/decoder.glsl': readFileSync(resolve(args.glsl)),
   '/pairs.f32': readFileSync(resolve(args.pairs)),
 };
+const webglPageScript = readFileSync(new URL('./webgl_page.js', import.meta.url));
 const chromium = args.chromium || 'chromium';
 const deadline = Date.now() + 240000;
 
-const page = `<!doctype html><canvas id="c" width="4" height="4"></canvas><script>
+const page = `<!doctype html><canvas id="c" width="4" height="4"></canvas>
+<script src="/webgl_page.js"></script><script>
 // The .brdfc container (docs/formats/compact.md), little-endian.
 function parseCompact(buf) {
   const dv = new DataView(buf);
@@ -106,7 +108,6 @@ window.runAll = async () => {
   const pairTex = new Float32Array(2 * W * H * 3);
   pairTex.set(pairs);
   texture(3, gl.RGB32F, gl.RGB, gl.FLOAT, 2 * W, H, pairTex);
-  const vs = '#version 300 es\\nin vec2 p; void main() { gl_Position = vec4(p, 0.0, 1.0); }';
   const fs = decoder + '\\nuniform highp sampler2D pairs; out vec4 color;\\n' +
     'void main() {\\n' +
     '  ivec2 p = ivec2(gl_FragCoord.xy);\\n' +
@@ -114,14 +115,7 @@ window.runAll = async () => {
     '  vec3 v = texelFetch(pairs, ivec2(2 * p.x + 1, p.y), 0).rgb;\\n' +
     '  color = vec4(MeasuredBrdf(vec3(0.0, 0.0, 1.0), l, v), 1.0);\\n' +
     '}\\n';
-  const compile = (type, src) => { const s = gl.createShader(type); gl.shaderSource(s, src); gl.compileShader(s);
-    if (!gl.getShaderParameter(s, gl.COMPILE_STATUS)) throw new Error(gl.getShaderInfoLog(s)); return s; };
-  const prog = gl.createProgram();
-  gl.attachShader(prog, compile(gl.VERTEX_SHADER, vs));
-  gl.attachShader(prog, compile(gl.FRAGMENT_SHADER, fs));
-  gl.linkProgram(prog);
-  if (!gl.getProgramParameter(prog, gl.LINK_STATUS)) throw new Error(gl.getProgramInfoLog(prog));
-  gl.useProgram(prog);
+  const prog = webglPage.program(gl, webglPage.fullScreenVertexShader, fs);
   const uni = (name) => gl.getUniformLocation(prog, name);
   gl.uniform1i(uni('measured_brdf_compact_grid'), 0);
   gl.uniform1i(uni('measured_brdf_compact_rows'), 1);
@@ -129,21 +123,9 @@ window.runAll = async () => {
   gl.uniform1i(uni('pairs'), 3);
   gl.uniform1f(uni('measured_brdf_compact_scale'), lut.scale);
   gl.uniform1f(uni('measured_brdf_compact_epsilon'), lut.epsilon);
-  const buf = gl.createBuffer();
-  gl.bindBuffer(gl.ARRAY_BUFFER, buf);
-  gl.bufferData(gl.ARRAY_BUFFER, new Float32Array([-1, -1, 3, -1, -1, 3]), gl.STATIC_DRAW);
-  const loc = gl.getAttribLocation(prog, 'p');
-  gl.enableVertexAttribArray(loc);
-  gl.vertexAttribPointer(loc, 2, gl.FLOAT, false, 0, 0);
-  const rt = gl.createTexture();
-  gl.activeTexture(gl.TEXTURE4);
-  gl.bindTexture(gl.TEXTURE_2D, rt);
-  gl.texStorage2D(gl.TEXTURE_2D, 1, gl.RGBA32F, W, H);
-  const fb = gl.createFramebuffer();
-  gl.bindFramebuffer(gl.FRAMEBUFFER, fb);
-  gl.framebufferTexture2D(gl.FRAMEBUFFER, gl.COLOR_ATTACHMENT0, gl.TEXTURE_2D, rt, 0);
-  if (gl.checkFramebufferStatus(gl.FRAMEBUFFER) !== gl.FRAMEBUFFER_COMPLETE) throw new Error('incomplete RGBA32F target');
-  gl.viewport(0, 0, W, H);
+  webglPage.fullScreenTriangle(gl, prog);
+  gl.activeTexture(gl.TEXTURE4);  // units 0-3 hold the decoder's textures and the pairs
+  webglPage.floatTarget(gl, W, H);
   gl.drawArrays(gl.TRIANGLES, 0, 3);
   const px = new Float32Array(W * H * 4);
   gl.readPixels(0, 0, W, H, gl.RGBA, gl.FLOAT, px);
@@ -151,15 +133,13 @@ window.runAll = async () => {
   if (e2 !== gl.NO_ERROR) throw new Error('GL error 0x' + e2.toString(16));
   const out = new Float32Array(n * 3);
   for (let i = 0; i < n; i++) for (let c = 0; c < 3; c++) out[i * 3 + c] = px[i * 4 + c];
-  const u8 = new Uint8Array(out.buffer);
-  let s = '';
-  for (let i = 0; i < u8.length; i += 0x8000) s += String.fromCharCode.apply(null, u8.subarray(i, i + 0x8000));
-  return { n, K, renderer: gl.getParameter(gl.RENDERER), data: btoa(s) };
+  return { n, K, renderer: gl.getParameter(gl.RENDERER), data: webglPage.base64(out) };
 };
 </script>`;
 
 const server = createServer((req, res) => {
   if (files[req.url]) { res.writeHead(200, { 'Content-Type': 'application/octet-stream' }); res.end(files[req.url]); }
+  else if (req.url === '/webgl_page.js') { res.writeHead(200, { 'Content-Type': 'text/javascript' }); res.end(webglPageScript); }
   else if (req.url === '/') { res.writeHead(200, { 'Content-Type': 'text/html' }); res.end(page); }
   else { res.writeHead(404); res.end(); }
 });
