@@ -910,6 +910,19 @@ Camera DefaultCamera(Shape shape) {
   return camera;
 }
 
+void SelectShape(const std::string& name, Mesh* mesh, PreviewOptions* options) {
+  if (name == "sphere") {
+    options->shape = Shape::kSphere;
+  } else if (name == "plane") {
+    options->shape = Shape::kPlane;
+  } else {
+    *mesh = LoadMesh(name);
+    options->shape = Shape::kMesh;
+    options->mesh = mesh;
+  }
+  options->camera = DefaultCamera(options->shape);
+}
+
 PreviewImage RenderPreview(const BrdfSource& source, const EnvironmentMap& environment,
                            const PreviewOptions& options) {
   PreviewRenderer renderer(source, environment, options);

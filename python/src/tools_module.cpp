@@ -246,16 +246,7 @@ std::pair<py::array_t<float>, std::vector<std::string>> Preview(const std::strin
   options.seed = a.seed;
   options.environment_rotation_deg = a.env_rotation_deg;
   preview::Mesh mesh;
-  if (a.mesh == "sphere") {
-    options.shape = preview::Shape::kSphere;
-  } else if (a.mesh == "plane") {
-    options.shape = preview::Shape::kPlane;
-  } else {
-    mesh = preview::LoadMesh(a.mesh);
-    options.shape = preview::Shape::kMesh;
-    options.mesh = &mesh;
-  }
-  options.camera = preview::DefaultCamera(options.shape);
+  preview::SelectShape(a.mesh, &mesh, &options);
   for (const auto& [value, which] : {std::pair{a.view, "view"}, std::pair{a.light, "light"}})
     if (value && !(value->first >= 0 && value->first <= 180 && std::isfinite(value->second)))
       throw InvalidArgument(std::string(which) +

@@ -232,16 +232,7 @@ int RunPreview(const PreviewCommandOptions& cli) {
   options.environment_rotation_deg = cli.env_rotation_deg;
   double a = 0, b = 0;
   preview::Mesh mesh;
-  if (cli.mesh == "sphere") {
-    options.shape = preview::Shape::kSphere;
-  } else if (cli.mesh == "plane") {
-    options.shape = preview::Shape::kPlane;
-  } else {
-    mesh = preview::LoadMesh(cli.mesh);
-    options.shape = preview::Shape::kMesh;
-    options.mesh = &mesh;
-  }
-  options.camera = preview::DefaultCamera(options.shape);
+  preview::SelectShape(cli.mesh, &mesh, &options);
   if (!cli.view.empty()) {
     if (!ParsePair(cli.view, &a, &b) || a < 0 || a > 180)
       throw InvalidArgument("--view: expected THETA,PHI in degrees with THETA in [0, 180], got '" +

@@ -255,6 +255,11 @@ struct PreviewOptions {
   const IblPack* engine_ibl = nullptr;
 };
 
+// The object of a preview by the name the commands take: "sphere", "plane", or a mesh file
+// (LoadMesh into *mesh, which must outlive the render). Sets options->shape, options->mesh and
+// the default camera for that shape (DefaultCamera).
+void SelectShape(const std::string& name, Mesh* mesh, PreviewOptions* options);
+
 // A linear HDR image and what produced it.
 struct PreviewImage {
   int width = 0, height = 0;
