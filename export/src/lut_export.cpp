@@ -106,17 +106,19 @@ LutExportResult ExportLut(const std::string& out_dir, const Lut& lut, const Pack
   if (options.max_error > 0) {
     // The smallest representation meeting the bound: compact, else BC6H, else RGB9E5.
     const double bound = options.max_error;
-    compact = BuildCompactLut(lut, theta_b, bound, options.jobs);
+    if (options.max_error_allows_compact)
+      compact = BuildCompactLut(lut, theta_b, bound, options.jobs);
     const std::uint64_t bc6h_bytes = static_cast<std::uint64_t>((Lut::kWidth + 3) / 4) *
                                      ((Lut::kHeight + 3) / 4) * 16 * lut.slices();
-    if (compact->met_target && compact->error.bytes < bc6h_bytes) {
+    const bool compact_met = compact && compact->met_target;
+    if (compact_met && compact->error.bytes < bc6h_bytes) {
       chosen = LutCompression::kCompact;
     } else {
       compressed = CompressLutBc6h(lut, theta_b, options.jobs);
       if (compressed->error.measured.max <= bound) {
         chosen = LutCompression::kBc6h;
         compact.reset();
-      } else if (compact->met_target) {
+      } else if (compact_met) {
         chosen = LutCompression::kCompact;
         compressed.reset();
       } else {
@@ -195,6 +197,7 @@ LutExportResult ExportLut(const std::string& out_dir, const Lut& lut, const Pack
     WriteFileAtomically(path(".json"), sidecar);
     result.written.push_back(path(".json"));
   }
+  if (compressed) result.bc6h = std::move(compressed->blocks);
   return result;
 }
 

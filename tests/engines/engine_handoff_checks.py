@@ -15,6 +15,18 @@
     diffuse_rgb, alpha_eq at mu_i; texel 64 + i: specular_rgb, fit_residual), identical in
     every engine folder.
   - `brdf fit` output passed with --engine-fits is the manifest's fallback material, as written.
+  - The BC6H hand-off (`--engine all --compress bc6h`): the Unreal and Godot DDS are DXGI 95
+    volumes of 364 × 184 × K (the padded size) holding the KTX2's blocks; Unity's importer
+    uploads those blocks as RGB_BC6H_UFloat 364 × 184 × K; the 2D forms (Unity
+    NAME_flipbook.exr, Unreal NAME_tiles.exr, Godot NAME_slices.exr) are 364 × 184 tiles whose
+    every texel is the numpy BC6H decode (tests/python/bc6h_oracle.py) of the blocks, padding
+    included; the import settings keep the block format under each engine's documented names
+    (Unity TextureImporterSettings / TextureImporterPlatformSettings through the stubs: Texture3D,
+    flipbook columns × rows, sRGB off, no mipmaps, no NPOT scale, clamp, Standalone override
+    BC6H, no crunch; Unreal TC_HDR_COMPRESSED, no mips, tiles 364 × 184; Godot compress/mode 2
+    (VRAM Compressed), high_quality (BC6H), hdr_compression 2, no mipmaps); every shader is
+    the *_bc6h one. `--compress compact --engine` is refused; `--max-error` with --engine picks
+    BC6H or RGB9E5, never the compact form.
 Usage: engine_handoff_checks.py BRDF_TOOL SOURCE_DIR MCS MONO   (Debian /usr/bin/python3)
 """
 import configparser
@@ -229,6 +241,146 @@ def check_fits(tool, mat, work):
     print(f"--engine-fits: the brdf fit result (lambert, rmse {fit['fit']['rmse']:.4g}) is the manifest's fallback material as written")
 
 
+def padded_bc6h_decode(payload, width, height, depth):
+    """Every texel of the blocks, padding included: (depth, 4·ceil(h/4), 4·ceil(w/4), 3)."""
+    sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
+    import bc6h_oracle
+    bw, bh = (width + 3) // 4, (height + 3) // 4
+    halves = np.zeros((depth, 4 * bh, 4 * bw, 3), dtype=np.uint16)
+    for z in range(depth):
+        for by in range(bh):
+            for bx in range(bw):
+                at = ((z * bh + by) * bw + bx) * 16
+                halves[z, 4 * by:4 * by + 4, 4 * bx:4 * bx + 4] = np.array(
+                    bc6h_oracle.decode_block(payload[at:at + 16]), dtype=np.uint16).reshape(4, 4, 3)
+    return halves.view(np.float16).astype(np.float64)
+
+
+def read_exr(path):
+    import OpenImageIO as oiio  # Debian python3-openimageio
+    inp = oiio.ImageInput.open(path)
+    expect(inp is not None, f"{path}: OpenImageIO cannot open it")
+    if inp is None:
+        return None
+    pixels = np.asarray(inp.read_image("float"), dtype=np.float64)
+    inp.close()
+    return pixels[..., :3]
+
+
+def check_bc6h(tool, mat, mcs, mono, work):
+    out = os.path.join(work, "out_bc6h")
+    run([tool, "convert", mat, "--out", out, "--engine", "all", "--compress", "bc6h", "--quiet",
+         "--formats", "ktx2,json", "--beyond", "clamp"])
+    name = "gold_like"
+    data = open(os.path.join(out, name + ".ktx2"), "rb").read()
+    vk_format, _, width, height, depth = struct.unpack_from("<5I", data, 12)
+    offset, length = struct.unpack_from("<QQ", data, 80)
+    payload = data[offset:offset + length]
+    expect((vk_format, width, height, depth) == (131, 361, 181, 4), f"BC6H KTX2 header {vk_format} {width}x{height}x{depth}")
+    for folder in ("unreal", "godot"):
+        d = parse_dds(os.path.join(out, folder, name + ".dds"))
+        expect(d["fourcc"] == b"DX10" and d["dxgi"] == 95 and d["dimension"] == 4 and d["mips"] == 1,
+               f"{folder} BC6H DDS header {d['fourcc']} dxgi {d['dxgi']} dimension {d['dimension']}")
+        expect((d["width"], d["height"], d["depth"]) == (364, 184, 4), f"{folder} BC6H DDS size {d['width']}x{d['height']}x{d['depth']}")
+        expect(d["data"] == payload, f"{folder} BC6H DDS holds other bytes than the KTX2's blocks")
+    print("BC6H unreal/godot DDS: DXGI 95 volumes 364x184x4, 1 mip, the KTX2's blocks")
+    for folder, suffix in (("unity", ".hlsl"), ("unreal", ".ush"), ("godot", ".gdshader"), ("web", ".js")):
+        shaders = sorted(f for f in os.listdir(os.path.join(out, folder)) if f.endswith(suffix))
+        expect(shaders == [("MeasuredBrdf_bc6h" if folder in ("unity", "unreal") else "measured_brdf_bc6h") + suffix],
+               f"BC6H {folder} shaders {shaders}")
+    # Unity: the importer on the BC6H .brdf3d.
+    exe = os.path.join(work, "driver.exe")  # compiled by check_unity
+    prefix = os.path.join(work, "unity_bc6h")
+    run([mono, exe, os.path.join(out, "unity", name + ".brdf3d"), prefix])
+    info = json.load(open(prefix + ".json"))
+    expect(info["errors"] == [] and (info.get("width"), info.get("height"), info.get("depth")) == (364, 184, 4)
+           and info.get("format") == "RGB_BC6H_UFloat" and info.get("wrap") == "Clamp"
+           and info.get("filter") == "Bilinear" and info.get("applied") and not info.get("mipmaps_updated"),
+           f"unity BC6H import {info}")
+    expect(open(prefix + ".bin", "rb").read() == payload, "unity uploads other bytes than the KTX2's blocks")
+    # The 2D forms: block-aligned tiles of the decoded blocks.
+    decoded = padded_bc6h_decode(payload, width, height, depth)
+    for folder, file in (("unity", name + "_flipbook.exr"), ("unreal", name + "_tiles.exr"),
+                         ("godot", name + "_slices.exr")):
+        img = read_exr(os.path.join(out, folder, file))
+        if img is None:
+            continue
+        expect(img.shape == (2 * 184, 2 * 364, 3), f"{folder} {file}: {img.shape}, expected 2 x 2 tiles of 364 x 184")
+        if img.shape == (2 * 184, 2 * 364, 3):
+            tiles = np.stack([img[(k // 2) * 184:(k // 2 + 1) * 184, (k % 2) * 364:(k % 2 + 1) * 364] for k in range(4)])
+            expect(np.array_equal(tiles, decoded), f"{folder} {file}: texels differ from the BC6H decode by "
+                   f"{np.abs(tiles - decoded).max()}")
+    print("BC6H 2D forms: unity _flipbook.exr, unreal _tiles.exr, godot _slices.exr are 2 x 2 tiles of "
+          "364 x 184, every texel (padding included) the numpy decode of the blocks")
+    run([mono, exe, "flipbook", "Assets/MeasuredBrdf/" + name + "_flipbook.exr", "728", "368", prefix + "_flipbook"])
+    fb = json.load(open(prefix + "_flipbook.json"))
+    want = {"errors": [], "textureShape": "Texture3D", "flipbookColumns": 2, "flipbookRows": 2,
+            "sRGBTexture": False, "mipmapEnabled": False, "npotScale": "None", "wrapMode": "Clamp",
+            "filterMode": "Bilinear", "alphaSource": "None", "textureCompression": "CompressedHQ",
+            "crunchedCompression": False,
+            "standalone": {"name": "Standalone", "overridden": True, "format": "BC6H",
+                           "textureCompression": "Compressed", "crunchedCompression": False,
+                           "maxTextureSize": 8192}}
+    expect(fb == want, f"unity flipbook import settings {fb}")
+    run([mono, exe, "flipbook", "Assets/x_flipbook.exr", "730", "368", prefix + "_odd"])
+    odd = json.load(open(prefix + "_odd.json"))
+    expect(len(odd["errors"]) == 1 and "730 x 368" in odd["errors"][0] and odd["textureShape"] == "Texture2D",
+           f"unity flipbook of a size that is not whole tiles: {odd}")
+    print("BC6H unity: importer uploads the blocks as RGB_BC6H_UFloat 364x184x4; the flipbook "
+          "postprocessor sets Texture3D 2 x 2, sRGB off, no mips, NPOT None, clamp, bilinear, "
+          "CompressedHQ without crunch, Standalone override BC6H")
+    # Unreal: TC_HDR_COMPRESSED on both routes, tiles 364 x 184.
+    script = os.path.join(out, "unreal", "import_measured_brdf.py")
+    stubs = os.path.join(os.path.dirname(os.path.abspath(__file__)), "stubs")
+    for route in ([], ["--tiles"]):
+        log = os.path.join(work, "unreal_bc6h%s.json" % ("_tiles" if route else ""))
+        run([sys.executable, script] + route, env=dict(os.environ, PYTHONPATH=stubs, UNREAL_STUB_LOG=log))
+        sets = {}
+        for r in json.load(open(log)):
+            if "set" in r:
+                sets.setdefault(r["type"], {})[r["set"]] = r["value"]
+        vol = sets.get("VolumeTexture", {})
+        expect(vol.get("srgb") is False and vol.get("compression_settings") == "TextureCompressionSettings.TC_HDR_COMPRESSED"
+               and vol.get("mip_gen_settings") == "TextureMipGenSettings.TMGS_NO_MIPMAPS",
+               f"unreal BC6H volume settings {vol}")
+        if route:
+            expect(vol.get("source2d_tile_size_x") == 364 and vol.get("source2d_tile_size_y") == 184,
+                   f"unreal BC6H tile size {vol}")
+            tex = sets.get("Texture2D", {})
+            expect(tex.get("compression_settings") == "TextureCompressionSettings.TC_HDR_COMPRESSED"
+                   and tex.get("srgb") is False, f"unreal BC6H tiles texture {tex}")
+    print("BC6H unreal script: both routes TC_HDR_COMPRESSED, sRGB off, no mips; tiles 364x184")
+    # Godot: VRAM Compressed, high quality (BC6H), HDR always, no mipmaps.
+    cp = configparser.ConfigParser()
+    text = open(os.path.join(out, "godot", name + "_slices.exr.import")).read()
+    cp.read_string("\n".join(l for l in text.splitlines() if not l.startswith(";")))
+    params = dict(cp["params"])
+    expect(cp["remap"]["importer"] == '"3d_texture"' and params.get("compress/mode") == "2"
+           and params.get("compress/high_quality") == "true" and params.get("compress/hdr_compression") == "2"
+           and params.get("mipmaps/generate") == "false" and params.get("slices/horizontal") == "2"
+           and params.get("slices/vertical") == "2", f"godot BC6H import {params}")
+    print("BC6H godot: .import compress/mode 2 (VRAM Compressed), high_quality, hdr_compression 2, "
+          "no mipmaps, 2 x 2 slices")
+    # --compress compact has no engine kit; --max-error with --engine never picks it.
+    bad = subprocess.run([tool, "convert", mat, "--out", os.path.join(work, "compact_bad"),
+                          "--engine", "all", "--compress", "compact"], capture_output=True, text=True)
+    expect(bad.returncode == 1 and bad.stderr.count("\n") == 1 and "no engine kit samples the compact form" in bad.stderr
+           and not os.path.exists(os.path.join(work, "compact_bad", "web")),
+           f"--compress compact --engine: exit {bad.returncode}, {bad.stderr!r}")
+    for bound, form in (("0.05", "bc6h_ufloat"), ("0.0001", "rgb9e5")):
+        me = os.path.join(work, "max_error_" + form)
+        run([tool, "convert", mat, "--out", me, "--engine", "all", "--max-error", bound, "--quiet",
+             "--formats", "ktx2,json", "--beyond", "clamp"])
+        side = json.load(open(os.path.join(me, name + ".json")))
+        manifest = json.load(open(os.path.join(me, "web", name + ".manifest.json")))
+        expect(side["compression"]["format"] == form and manifest["texture"]["block_format"] ==
+               ("bc6h_ufloat" if form != "rgb9e5" else "none")
+               and not os.path.exists(os.path.join(me, name + ".brdfc")),
+               f"--max-error {bound} --engine: {side['compression']['format']}, manifest {manifest['texture']}")
+    print("--compress compact --engine refused in one line; --max-error 0.05 / 0.0001 with --engine: "
+          "BC6H / RGB9E5 (no compact form)")
+
+
 def main():
     tool, source, mcs, mono = sys.argv[1:5]
     work = tempfile.mkdtemp(prefix="brdf_engine_checks_")
@@ -249,6 +401,7 @@ def main():
     check_fits(tool, mat, work)
     words, want = check_dds(out, "gold_like")
     check_unity(out, "gold_like", mcs, mono, work, words, want)
+    check_bc6h(tool, mat, mcs, mono, work)
     check_unreal(out, work)
     check_godot(out, "gold_like")
     check_ibl_pack(out, "gold_like", ["unity", "unreal", "godot", "web"])

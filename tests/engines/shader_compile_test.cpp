@@ -66,7 +66,8 @@ class ShaderCompile : public ::testing::Test {
     EXPECT_EQ(Glslang(args, &log), 0) << what << ":\n" << log;
   }
   // A LUT converted with every engine, as `brdf convert --engine all` writes it.
-  fs::path ExportAll(const std::vector<double>& theta_in_deg) {
+  // bc6h: the BC6H form (--compress bc6h), whose shaders address 364 x 184 slices.
+  fs::path ExportAll(const std::vector<double>& theta_in_deg, bool bc6h = false) {
     Lut lut;
     lut.Resize(theta_in_deg.size());
     lut.theta_in_deg = theta_in_deg;
@@ -74,9 +75,11 @@ class ShaderCompile : public ::testing::Test {
     exporter::TextureMetadata meta;
     meta.name = "m";
     meta.source = "test";
-    const fs::path out = dir_ / ("out" + std::to_string(theta_in_deg.size()));
+    const fs::path out = dir_ / ("out" + std::to_string(theta_in_deg.size()) + (bc6h ? "b" : ""));
     fs::create_directories(out);
-    engines::ExportLutWithEngines(out.string(), lut, meta, {}, engines::ParseEngines("all"));
+    exporter::LutExportOptions options;
+    if (bc6h) options.compression = exporter::LutCompression::kBc6h;
+    engines::ExportLutWithEngines(out.string(), lut, meta, options, engines::ParseEngines("all"));
     return out;
   }
   fs::path dir_;
@@ -87,6 +90,8 @@ const std::vector<ShaderLutLayout> kLayouts = {
     {10, 15, 3, 361, 181},  // another θin list
     {0, 1, 1, 361, 181},    // a single slice
     {0, 20, 4, 1083, 362},  // an atlas of 3 × 2 cells
+    {0, 20, 4, 364, 184},   // BC6H: slices padded to whole blocks
+    {0, 10, 9, 364, 184},   // BC6H of the default 9-slice fill
 };
 
 TEST_F(ShaderCompile, GlslFilesCompileAsGlslEs300And450) {
@@ -137,6 +142,16 @@ TEST_F(ShaderCompile, ShippedWebGlslFilesCompile) {
   ExpectCompiles("-S frag " + (out / "web/MeasuredBrdf.450.glsl").string(), "web 450 file");
   ExpectCompiles("-S frag " + (out / "web/MeasuredBrdf.compact.es300.glsl").string(),
                  "web compact decoder (GLSL ES 3.00)");
+  const fs::path bc6h = ExportAll({0, 20, 40, 60}, true);
+  ExpectCompiles("-S frag " + (bc6h / "web/MeasuredBrdf_bc6h.es300.glsl").string(),
+                 "BC6H web es300 file");
+  ExpectCompiles("-S frag " + (bc6h / "web/MeasuredBrdf_bc6h.450.glsl").string(),
+                 "BC6H web 450 file");
+  const std::string bc6h_js = Read(bc6h / "web/measured_brdf_bc6h.js");
+  // The module's lookup addresses the padded texture WebGL creates.
+  EXPECT_NE(bc6h_js.find("MEASURED_BRDF_TEXELS_U = 364.0;"), std::string::npos);
+  EXPECT_NE(bc6h_js.find("MEASURED_BRDF_TEXELS_V = 184.0;"), std::string::npos);
+  EXPECT_NE(bc6h_js.find("export const TEXTURE_SIZE = [364, 184, 4];"), std::string::npos);
   // The ES module embeds the same GLSL body.
   const std::string js = Read(out / "web/measured_brdf.js");
   const std::string body =
@@ -183,7 +198,9 @@ float4 SampleSkyTexture(float3 texCoord, float lod, int sliceIndex) {
 TEST_F(ShaderCompile, UnityIblFunctionsCompileForUrpAndHdrp) {
   for (const std::vector<double>& thetas :
        {std::vector<double>{0, 20, 40, 60}, {0, 10, 20, 30, 40, 50, 60, 70, 80}}) {
-    const fs::path out = ExportAll(thetas);
+    for (const bool bc6h : {false, true}) {  // RGB9E5 and the BC6H form (364 x 184)
+      SCOPED_TRACE(bc6h ? "BC6H" : "RGB9E5");
+      const fs::path out = ExportAll(thetas, bc6h);
     std::string include;
     for (const auto& e : fs::directory_iterator(out / "unity"))
       if (e.path().extension() == ".hlsl") include = e.path().filename().string();
@@ -206,11 +223,14 @@ float4 main(float3 n : TEXCOORD0, float3 v : TEXCOORD1) : SV_Target {
                      std::string("Unity ") + pipeline + " IBL in " + include);
     }
   }
+  }
 }
 
 TEST_F(ShaderCompile, UnityIncludeCompilesForShaderGraphAndBuiltInPipeline) {
   for (const std::vector<double>& thetas : {std::vector<double>{0, 20, 40, 60}, {10, 25, 40}}) {
-    const fs::path out = ExportAll(thetas);
+    for (const bool bc6h : {false, true}) {  // RGB9E5 and the BC6H form (364 x 184)
+      SCOPED_TRACE(bc6h ? "BC6H" : "RGB9E5");
+      const fs::path out = ExportAll(thetas, bc6h);
     std::string include;
     for (const auto& e : fs::directory_iterator(out / "unity"))
       if (e.path().extension() == ".hlsl") include = e.path().filename().string();
@@ -238,18 +258,21 @@ float4 main(float3 n : TEXCOORD0, float3 l : TEXCOORD1, float3 v : TEXCOORD2) : 
     ExpectCompiles("-D -V -e main -S frag -o " + (dir_ / "u.spv").string() + " " + file,
                    "Unity include " + include);
   }
+  }
 }
 
 TEST_F(ShaderCompile, UnrealUshCompilesInACustomNodeAsTheCommentSays) {
-  const fs::path out = ExportAll({0, 20, 40, 60});
-  const std::string ush = Read(out / "unreal/MeasuredBrdf.ush");
+  for (const bool bc6h : {false, true}) {  // RGB9E5 and the BC6H form (364 x 184)
+    SCOPED_TRACE(bc6h ? "BC6H" : "RGB9E5");
+    const fs::path out = ExportAll({0, 20, 40, 60}, bc6h);
+  const std::string ush = Read(out / (bc6h ? "unreal/MeasuredBrdf_bc6h.ush" : "unreal/MeasuredBrdf.ush"));
   // The Custom node's code line, as the include tells the artist to type it.
   std::smatch m;
   ASSERT_TRUE(std::regex_search(ush, m, std::regex(R"(// Code:\s+(return [^\n]+;))"))) << ush;
   // Unreal passes a TextureObject input "Lut" as Texture3D Lut and SamplerState LutSampler and
   // wraps the code in a function (MaterialTemplate.ush: CustomExpressionN).
   const std::string harness =
-      "#include \"MeasuredBrdf.ush\"\n"
+      "#include \"" + std::string(bc6h ? "MeasuredBrdf_bc6h.ush" : "MeasuredBrdf.ush") + "\"\n"
       "float3 CustomExpression0(Texture3D Lut, SamplerState LutSampler, float3 N, float3 L, float3 "
       "V) {\n  " +
       m[1].str() + "\n}\n" + R"(
@@ -262,10 +285,13 @@ float4 main(float3 n : TEXCOORD0, float3 l : TEXCOORD1, float3 v : TEXCOORD2) : 
   std::ofstream(file) << harness;
   ExpectCompiles("-D -V -e main -S frag -o " + (dir_ / "ue.spv").string() + " " + file,
                  "Unreal Custom node");
+  }
 }
 
 TEST_F(ShaderCompile, UnrealIblCustomNodeCompilesAsTheCommentSays) {
-  const fs::path out = ExportAll({0, 10, 20, 30, 40, 50, 60, 70, 80});
+  for (const bool bc6h : {false, true}) {  // RGB9E5 and the BC6H form (364 x 184)
+    SCOPED_TRACE(bc6h ? "BC6H" : "RGB9E5");
+    const fs::path out = ExportAll({0, 10, 20, 30, 40, 50, 60, 70, 80}, bc6h);
   std::string ush;
   for (const auto& e : fs::directory_iterator(out / "unreal"))
     if (e.path().extension() == ".ush") ush = e.path().filename().string();
@@ -302,13 +328,16 @@ float4 main(float3 n : TEXCOORD0, float3 v : TEXCOORD1) : SV_Target {
   std::ofstream(file) << harness;
   ExpectCompiles("-D -V -e main -S frag -o " + (dir_ / "ue_ibl.spv").string() + " " + file,
                  "Unreal IBL Custom node");
+  }
 }
 
 // Godot's shading language is GLSL ES 3.0 plus a header, uniform hints and built-ins; strip
 // exactly those and the rest must be valid GLSL ES 3.00.
 TEST_F(ShaderCompile, GodotShaderIsValidOnceGodotsAdditionsAreReplaced) {
-  const fs::path out = ExportAll({0, 20, 40, 60});
-  std::string src = Read(out / "godot/measured_brdf.gdshader");
+  for (const bool bc6h : {false, true}) {  // RGB9E5 and the BC6H form (364 x 184)
+    SCOPED_TRACE(bc6h ? "BC6H" : "RGB9E5");
+    const fs::path out = ExportAll({0, 20, 40, 60}, bc6h);
+  std::string src = Read(out / (bc6h ? "godot/measured_brdf_bc6h.gdshader" : "godot/measured_brdf.gdshader"));
   ASSERT_NE(src.find("shader_type spatial;"), std::string::npos);
   ASSERT_NE(src.find("void light()"), std::string::npos);
   src = std::regex_replace(src, std::regex(R"(shader_type spatial;)"), "");
@@ -331,6 +360,7 @@ TEST_F(ShaderCompile, GodotShaderIsValidOnceGodotsAdditionsAreReplaced) {
       "EMISSION, 1.0); }\n";
   ExpectCompiles("-S frag " + Write("godot.frag", builtins + src + tail),
                  "Godot shader as GLSL ES");
+  }
 }
 
 }  // namespace

@@ -179,6 +179,61 @@ def es_harnesses(out, work):
     return result
 
 
+def bc6h_hand_off(tool, source, chromium, work, mat, angles, nlv, exact_angles, exact_nlv, check):
+    """The BC6H hand-off (`--engine all --compress bc6h`): the web module creates the 3D texture
+    at 364 × 184 × K (WebGL's multiple-of-4 rule for BPTC) from the KTX2's blocks, and every
+    shipped shader of the BC6H form addresses it with 364 and 184 in place of 361 and 181. The
+    same pairs (plus pairs at the φd = 0° seam and in the last θd rows, 170–179.6°) through the
+    module's GLSL (MeasuredBrdfCell and MeasuredBrdfTangent), the Unity HLSL, the Unreal .ush,
+    the GLSL 4.50 file and the Godot shader of the BC6H folders, against `brdf eval` of the same
+    BC6H KTX2 (which reads the blocks as a GPU decodes them), to the tolerance of the RGB9E5
+    path; the probe texels against the numpy BC6H decoder."""
+    out = os.path.join(work, "bc6h_out")
+    run([tool, "convert", mat, "--out", out, "--engine", "all", "--compress", "bc6h", "--quiet",
+         "--formats", "ktx2,json"])
+    ktx2 = os.path.join(out, "ggx_blue.ktx2")
+    seam_angles, seam_nlv = os.path.join(work, "seam_angles.txt"), os.path.join(work, "seam_nlv.txt")
+    run([sys.executable, check, "gen-seam", seam_angles, seam_nlv])
+    b_angles, b_nlv = os.path.join(work, "bc6h_angles.txt"), os.path.join(work, "bc6h_nlv.txt")
+    for dst, parts in ((b_angles, (angles, seam_angles)), (b_nlv, (nlv, seam_nlv))):
+        with open(dst, "w") as f:
+            for part in parts:
+                f.write(open(part).read())
+    for a, e in ((b_angles, "bc6h_eval.txt"), (exact_angles, "bc6h_exact_eval.txt")):
+        with open(os.path.join(work, e), "w") as f:
+            f.write(run([tool, "eval", ktx2, "--pairs", a]))
+    b_work = os.path.join(work, "bc6h_work")
+    os.makedirs(b_work)
+    harnesses = es_harnesses(out, b_work)
+    for folder, suffix in (("unity", ".hlsl"), ("unreal", ".ush"), ("godot", ".gdshader"),
+                           ("web", ".js")):
+        names = [f for f in os.listdir(os.path.join(out, folder)) if f.endswith(suffix)]
+        if names != [n for n in names if n.endswith("_bc6h" + suffix)] or not names:
+            print(f"FAILED: the BC6H {folder} folder ships {names}, expected *_bc6h{suffix}")
+            sys.exit(1)
+    result = os.path.join(work, "bc6h_result")
+    os.makedirs(result)
+    run(["node", os.path.join(source, "tests/node/render_web.mjs"), "--web",
+         os.path.join(out, "web"), "--material", "ggx_blue", "--out", result, "--size", "64",
+         "--pairs", b_nlv, "--exact", exact_nlv,
+         "--es-harness", ",".join(f"{k}={v}" for k, v in harnesses.items()),
+         "--chromium", chromium])
+    size = json.load(open(os.path.join(result, "image.json")))["texture"]["size"]
+    if size[:2] != [364, 184]:
+        print(f"FAILED: the web module created the BC6H texture at {size}, expected 364 x 184")
+        sys.exit(1)
+    # (The sidecar's texel_convention.glsl addresses the file's 361 × 181: it is for APIs that
+    # create the texture at its true size, not for WebGL.)
+    langs = ["glsl", "tangent"] + list(harnesses)
+    return subprocess.run([sys.executable, check, "check", "--result", result, "--ktx2",
+                           os.path.join(out, "web", "ggx_blue.ktx2"), "--manifest",
+                           os.path.join(out, "web", "ggx_blue.manifest.json"), "--langs",
+                           ",".join(langs), "--eval", os.path.join(work, "bc6h_eval.txt"),
+                           "--angles", b_angles,
+                           "--exact-eval", os.path.join(work, "bc6h_exact_eval.txt"),
+                           "--exact-angles", exact_angles], capture_output=True, text=True)
+
+
 def main():
     tool, source = sys.argv[1], sys.argv[2]
     chromium = sys.argv[3] if len(sys.argv) > 3 else "chromium"
@@ -267,6 +322,10 @@ def main():
     print("atlas cell lambert_orange: " + (a.stdout + a.stderr).strip().replace("\n", "\natlas: "))
     if a.returncode != 0:
         r = a
+    b = bc6h_hand_off(tool, source, chromium, work, mat, angles, nlv, exact_angles, exact_nlv, check)
+    print("BC6H hand-off: " + (b.stdout + b.stderr).strip().replace("\n", "\nBC6H: "))
+    if b.returncode != 0:
+        r = b
     if r.returncode == 0:
         shutil.rmtree(work, ignore_errors=True)
     else:

@@ -30,6 +30,7 @@ Prints one line per check with the figures; exits 1 when a check fails.
 """
 import json
 import math
+import os
 import struct
 import sys
 
@@ -150,6 +151,26 @@ def ktx2_words(path):
     return words.reshape(depth, height, width)
 
 
+def ktx2_texel_reader(path):
+    """texel(x, y, z) → RGB of the KTX2's level 0: RGB9E5 words (vkFormat 123) or BC6H blocks
+    (131, 4 × 4 texels per 16 bytes, slices padded to whole blocks), decoded independently."""
+    data = open(path, "rb").read()
+    (vk_format,) = struct.unpack_from("<I", data, 12)
+    if vk_format == 123:
+        words = ktx2_words(path)
+        return lambda x, y, z: decode_rgb9e5(words[z, y, x])
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import bc6h_oracle
+    width, height, depth, payload, _ = bc6h_oracle.read_ktx2_bc6h(path)
+    bw, bh = (width + 3) // 4, (height + 3) // 4
+
+    def texel(x, y, z):
+        at = ((z * bh + y // 4) * bw + x // 4) * 16
+        halves = bc6h_oracle.decode_block(payload[at:at + 16])[(y % 4) * 4 + x % 4]
+        return np.array(halves, dtype=np.uint16).view(np.float16).astype(np.float64)
+    return texel
+
+
 FILLED_PAIRS = 100
 
 
@@ -239,6 +260,48 @@ def gen_exact(angles_out, nlv_out):
                 b.write(" ".join(f"{x:.9f}" for x in (*n, *l, *v)) + "\n")
 
 
+def seam_angles():
+    """(θin, φin, θout, φout) in degrees where a lookup addressed with the wrong texture width
+    or height reads other texels most plainly: φd within 1° of the 0°/360° seam (the last
+    columns, next to the BC6H padding) at several θd and θin, and θd 170–179.6° (the last rows),
+    which only a grazing light with a grazing view near backscatter reaches. Built in the
+    specular frame: v_local = S(θin)·ω_d (S is its own inverse), kept when above the horizon."""
+    out = []
+    for t_in in (20.0, 45.0, 70.0):
+        for t_d in (5.0, 30.0, 60.0):
+            for p_d in (0.2, 0.7, 359.3, 359.8):
+                out.append((t_in, t_d, p_d))
+    for t_in in (86.0, 88.0, 89.0, 89.5):
+        for t_d in (170.0, 174.0, 177.0, 179.0, 179.6):
+            for p_d in (170.0, 180.0, 190.0):
+                out.append((t_in, t_d, p_d))
+    result = []
+    for t_in, t_d, p_d in out:
+        c, s_ = math.cos(t_in * DEG), math.sin(t_in * DEG)
+        w = spherical(t_d * DEG, p_d * DEG)
+        v = np.array([-c * w[0] - s_ * w[2], -w[1], -s_ * w[0] + c * w[2]])
+        if v[2] <= 1e-3:
+            continue
+        t_out = math.degrees(math.atan2(math.hypot(v[0], v[1]), v[2]))
+        p_out = math.degrees(math.atan2(v[1], v[0])) % 360.0
+        result.append((t_in, 0.0, t_out, p_out))
+    return result
+
+
+def gen_seam(angles_out, nlv_out, seed=5):
+    rng = np.random.default_rng(seed)
+    rows = seam_angles()
+    with open(angles_out, "w") as a, open(nlv_out, "w") as b:
+        for t_i, p_i, t_o, p_o in rows:
+            q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+            n = q @ np.array([0.0, 0.0, 1.0])
+            l = q @ spherical(t_i * DEG, p_i * DEG)
+            v = q @ spherical(t_o * DEG, p_o * DEG)
+            a.write(f"{t_i:.9f} {p_i:.9f} {t_o:.9f} {p_o:.9f}\n")
+            b.write(" ".join(f"{x:.9f}" for x in (*n, *l, *v)) + "\n")
+    print(f"{len(rows)} seam and last-row pairs")
+
+
 def compare_pairs(name, cpu, gpu, angles, by_category):
     """Prints the max and median relative difference of gpu against cpu; False when above 1e-4."""
     if gpu.shape != cpu.shape:
@@ -290,13 +353,14 @@ def check(argv):
     theta0, delta, k = theta[0], theta[1] - theta[0], len(theta)
     ok = True
 
-    # Probes.
-    words = ktx2_words(opts["ktx2"])
+    # Probes: the texel the KTX2 holds, RGB9E5 decoded here or BC6H by the numpy decoder of
+    # tests/python/bc6h_oracle.py (written from the specification).
+    texel = ktx2_texel_reader(opts["ktx2"])
     probes = json.load(open(f"{res}/probes.json"))
     worst_fetch = worst_filtered = 0.0
     for p in probes:
         x, y, z = p["index"]
-        expect = decode_rgb9e5(words[z, y, x])
+        expect = texel(x, y, z)
         if not np.array_equal(np.asarray(p["manifest"]), expect):
             print(f"FAIL probe {p['index']}: manifest {p['manifest']} != KTX2 texel {expect.tolist()}")
             ok = False
@@ -394,6 +458,9 @@ def check(argv):
 def main():
     if len(sys.argv) >= 2 and sys.argv[1] == "gen-pairs":
         gen_pairs(int(sys.argv[2]), int(sys.argv[3]), sys.argv[4], sys.argv[5])
+        return 0
+    if len(sys.argv) >= 2 and sys.argv[1] == "gen-seam":
+        gen_seam(sys.argv[2], sys.argv[3])
         return 0
     if len(sys.argv) >= 2 and sys.argv[1] == "gen-exact":
         gen_exact(sys.argv[2], sys.argv[3])

@@ -101,11 +101,14 @@ int RunConvert(const ConvertOptions& options) {
   export_options.compression = exporter::ParseLutCompression(options.compress);
   export_options.max_error = options.max_error;
   const engines::EngineSet engine_set = engines::ParseEngines(options.engines);
-  if ((export_options.compression != exporter::LutCompression::kNone || options.max_error > 0) &&
+  if (export_options.compression == exporter::LutCompression::kCompact && !(options.max_error > 0) &&
       engine_set.Any())
-    throw InvalidArgument(std::string(options.max_error > 0 ? "--max-error" : "--compress") +
-                          ": the engine hand-offs (--engine) are written as RGB9E5 only so far; "
-                          "write them in a separate run without it");
+    throw InvalidArgument(
+        "--compress compact: no engine kit samples the compact form; with --engine use "
+        "--compress bc6h, --max-error (BC6H or RGB9E5 per material), or no --compress");
+  // The engine folders may be written as BC6H (they then add unity/NAME_flipbook.exr).
+  const bool engine_bc6h =
+      export_options.compression == exporter::LutCompression::kBc6h || options.max_error > 0;
   if (!options.engine_fits.empty()) {
     if (!engine_set.Any())
       throw InvalidArgument("--engine-fits: goes with --engine (the fits go into its manifests)");
@@ -142,7 +145,8 @@ int RunConvert(const ConvertOptions& options) {
         outputs.push_back(std::move(p));
       names.push_back(in.name);
     }
-    for (std::string& p : engines::EngineOutputsToCheck(out_dir.string(), names, engine_set))
+    for (std::string& p :
+         engines::EngineOutputsToCheck(out_dir.string(), names, engine_set, engine_bc6h))
       outputs.push_back(std::move(p));
     ReportRemovedTemporaries(
         CheckWritableOutputs(outputs, options.force, /*folders_created=*/true));
@@ -196,7 +200,8 @@ int RunConvert(const ConvertOptions& options) {
         metadata.beyond_json = built.beyond_json;
         std::vector<std::string> outputs =
             exporter::LutExportPaths(out_dir.string(), in.name, export_options);
-        for (std::string& p : engines::EngineOutputPaths(out_dir.string(), in.name, engine_set))
+        for (std::string& p :
+             engines::EngineOutputPaths(out_dir.string(), in.name, engine_set, engine_bc6h))
           outputs.push_back(std::move(p));
         const OutputGuard guard(std::move(outputs));
         try {

@@ -456,7 +456,9 @@ int main(int argc, char** argv) {
                    "4x smaller), or compact (NAME.brdfc in their place: an adaptive log grid, "
                    "20-600x smaller, built to a measured-range max error of 2 %, read by the "
                    "engine kit's compact GLSL decoder); the sidecar records the error against "
-                   "the float LUT: max, p99 and median over the measured and the filled range")
+                   "the float LUT: max, p99 and median over the measured and the filled range. "
+                   "With --engine, bc6h writes the engine folders as BC6H too (364x184 slices); "
+                   "compact is refused there")
       ->capture_default_str()
       ->check(CLI::IsMember({"none", "bc6h", "compact"}));
   convert_cmd
@@ -464,7 +466,8 @@ int main(int argc, char** argv) {
                    "Largest relative error allowed on the measured range (a fraction, e.g. "
                    "0.01): per input, the smallest of compact, BC6H and RGB9E5 that meets it is "
                    "written (RGB9E5 with a warning when none does) and reported with its bytes "
-                   "and error; overrides --compress")
+                   "and error; overrides --compress. With --engine: BC6H or RGB9E5 only (no "
+                   "engine kit samples the compact form), the engine folders in the same form")
       ->check(CLI::Range(1e-6, 0.999999));
   convert_cmd
       ->add_option("--jobs", convert.jobs,

@@ -19,7 +19,9 @@
 #include "brdf/core/file_util.h"
 #include "brdf/core/ibl_pack.h"
 #include "brdf/core/lut_brdf.h"
+#include "brdf/exporter/bc6h.h"
 #include "brdf/exporter/dds.h"
+#include "brdf/exporter/half.h"
 #include "brdf/exporter/exr.h"
 #include "brdf/exporter/ktx2.h"
 #include "brdf/exporter/rgb9e5.h"
@@ -74,18 +76,20 @@ std::string NumberTag(double v) {
   return s;
 }
 
-// The per-material file names of one engine folder (shared files excluded).
+// The per-material file names of one engine folder (shared files excluded). `bc6h`: the BC6H
+// form, whose Unity folder also holds the block-aligned flipbook EXR.
 struct MaterialFiles {
   std::string texture, manifest, tiles, tiles_import, ibl;
 };
 
-MaterialFiles FilesOf(Engine e, const std::string& name) {
+MaterialFiles FilesOf(Engine e, const std::string& name, bool bc6h = false) {
   MaterialFiles f;
   f.manifest = name + ".manifest.json";
   f.ibl = name + "_ibl.dds";
   switch (e) {
     case Engine::kUnity:
       f.texture = name + ".brdf3d";
+      if (bc6h) f.tiles = name + "_flipbook.exr";
       break;
     case Engine::kUnreal:
       f.texture = name + ".dds";
@@ -121,6 +125,54 @@ std::string ShaderFile(Engine e, const exporter::ShaderLutLayout& layout) {
     }
   }
   return stem;
+}
+
+// The BC6H blocks decoded over the whole padded size (BlocksWide·4 × BlocksHigh·4 × depth, RGB
+// floats, x fastest): what a texture created at that size returns for every texel, the padding
+// (repeats of the nearest edge texel before encoding) included.
+std::vector<float> DecodePaddedBc6h(const exporter::Bc6hVolume& v) {
+  const int bw = v.BlocksWide(), bh = v.BlocksHigh(), pw = 4 * bw, ph = 4 * bh;
+  std::vector<float> out(static_cast<std::size_t>(pw) * ph * v.depth * 3);
+  for (int z = 0; z < v.depth; ++z)
+    for (int by = 0; by < bh; ++by)
+      for (int bx = 0; bx < bw; ++bx) {
+        const exporter::Bc6hHalfTexels t =
+            exporter::DecodeBc6hBlock(&v.bytes[v.BlockOffset(4 * bx, 4 * by, z)]);
+        for (int i = 0; i < 16; ++i) {
+          const std::size_t at =
+              ((static_cast<std::size_t>(z) * ph + 4 * by + i / 4) * pw + 4 * bx + i % 4) * 3;
+          for (int c = 0; c < 3; ++c) out[at + c] = exporter::HalfToFloat(t[i][c]);
+        }
+      }
+  return out;
+}
+
+// The same blocks recorded at the padded size (the engine folders' BC6H DDS files): a
+// 364 × 184 × K texture whose padding texels repeat the LUT's edge texels.
+exporter::Bc6hVolume AtPaddedSize(const exporter::Bc6hVolume& v) {
+  exporter::Bc6hVolume padded = v;
+  padded.width = 4 * v.BlocksWide();
+  padded.height = 4 * v.BlocksHigh();
+  return padded;
+}
+
+// The 2D form of the BC6H hand-off: the decoded padded slices as C × R tiles of the padded
+// size (tile k = slice k, row-major from the top left, tiles past the last slice black), so
+// every 4 × 4 block of the image lies inside one tile, as in the 3D texture.
+exporter::FloatImage PaddedBc6hComposite(const Handoff& h, const std::vector<float>& decoded) {
+  const int pw = h.layout.texture_width, ph = h.layout.texture_height;
+  exporter::FloatImage image;
+  image.width = h.composite.columns * pw;
+  image.height = h.composite.rows * ph;
+  image.rgb.assign(static_cast<std::size_t>(image.width) * image.height * 3, 0.0f);
+  for (int k = 0; k < h.layout.slices; ++k) {
+    const int x0 = h.composite.CellColumn(k) * pw, y0 = h.composite.CellRow(k) * ph;
+    for (int y = 0; y < ph; ++y) {
+      const float* src = &decoded[((static_cast<std::size_t>(k) * ph + y) * pw) * 3];
+      std::copy(src, src + static_cast<std::size_t>(pw) * 3, image.Pixel(x0, y0 + y));
+    }
+  }
+  return image;
 }
 
 ordered_json AxesJson(const Handoff& h) {
@@ -179,14 +231,27 @@ ordered_json ProbeJson(const Handoff& h) {
       ij.push_back({best_i, best_j});
       for (const auto& [i, j] : ij) {
         const int x = cell.x0 + i, y = cell.y0 + j;
-        const auto c = exporter::DecodeRgb9e5(vol.words[vol.Index(x, y, k)]);
+        std::array<float, 3> c{};
+        if (h.bc6h) {
+          // What a fetch of the BC6H texture returns (the peak was found in the RGB9E5 words).
+          const std::size_t at =
+              ((static_cast<std::size_t>(k) * h.layout.texture_height + y) *
+                   h.layout.texture_width +
+               x) *
+              3;
+          c = {h.bc6h_decoded[at], h.bc6h_decoded[at + 1], h.bc6h_decoded[at + 2]};
+        } else {
+          c = exporter::DecodeRgb9e5(vol.words[vol.Index(x, y, k)]);
+        }
         probes.push_back(
             {{"material", cell.name},
              {"index", {x, y, k}},
              {"phi_d_deg", i},
              {"theta_d_deg", j},
              {"theta_in_deg", h.layout.theta_in0_deg + k * h.layout.delta_in_deg},
-             {"uvw", {(x + 0.5) / vol.width, (y + 0.5) / vol.height, (k + 0.5) / vol.depth}},
+             {"uvw",
+              {(x + 0.5) / h.layout.texture_width, (y + 0.5) / h.layout.texture_height,
+               (k + 0.5) / vol.depth}},
              {"rgb", {c[0], c[1], c[2]}}});
       }
     }
@@ -194,10 +259,116 @@ ordered_json ProbeJson(const Handoff& h) {
   return probes;
 }
 
+// The "engines" member of the BC6H form: every texture BC6H_UF16, created at the padded size.
+ordered_json Bc6hEngineSectionJson(Engine e, const Handoff& h, const MaterialFiles& f) {
+  const int pw = h.layout.texture_width, ph = h.layout.texture_height, k = h.layout.slices;
+  ordered_json files = {
+      {"texture", f.texture}, {"shader", ShaderFile(e, h.layout)}, {"manifest", f.manifest}};
+  ordered_json orientation, import;
+  std::string versions, format;
+  const std::string padded = fmt::format(
+      "created at {} x {} x {} (the 91 x 46 blocks of each slice; the padding texels repeat the "
+      "edge texels, the shader addresses with {} and {})",
+      pw, ph, k, pw, ph);
+  const std::string tiles = fmt::format(
+      "{} x {} tiles of {} x {} texels (block-aligned: texels 0..360 x 0..180 the LUT, the rest "
+      "clamped repeats), row-major, top-left first, slice k in tile k; the BC6H texels decoded",
+      h.composite.columns, h.composite.rows, pw, ph);
+  const ordered_json tiles_json = {{"tile_width", pw},
+                                   {"tile_height", ph},
+                                   {"columns", h.composite.columns},
+                                   {"rows", h.composite.rows}};
+  switch (e) {
+    case Engine::kUnity:
+      versions = "Unity 2021.3 LTS to Unity 6 (URP, HDRP Shader Graph; built-in pipeline)";
+      files["importer"] = "Editor/MeasuredBrdfImporter.cs";
+      files["flipbook"] = f.tiles;
+      format = "GraphicsFormat.RGB_BC6H_UFloat from the KTX2 (vkFormat 131), " + padded;
+      orientation["scripted_importer"] =
+          "file block rows uploaded in file order, row 0 (theta_d = 0) at v = 0, slice 0 at "
+          "w = 0; no flip";
+      orientation["flipbook_2d"] = f.tiles + ": " + tiles +
+                                   "; imported by MeasuredBrdfFlipbookPostprocessor (in the "
+                                   "importer file) as a Texture3D of those tiles";
+      import = {{"flipbook",
+                 {{"file", f.tiles},
+                  {"texture_shape", "Texture3D"},
+                  {"columns", h.composite.columns},
+                  {"rows", h.composite.rows},
+                  {"npot_scale", "None"},
+                  {"srgb", false},
+                  {"mipmaps", false},
+                  {"wrap", "Clamp"},
+                  {"filter", "Bilinear"},
+                  {"format", "BC6H"},
+                  {"texture_compression", "CompressedHQ"},
+                  {"crunched", false}}}};
+      break;
+    case Engine::kUnreal:
+      versions = "Unreal Engine 5.1 to 5.5";
+      files["import_script"] = "import_measured_brdf.py";
+      files["tiles"] = f.tiles;
+      format = "DDS DXGI_FORMAT_BC6H_UF16 (95), volume, one mip, " + padded;
+      orientation["volume_dds"] =
+          "DDS texel (x, y, z) = Volume Texture texel (x, y, z); row 0 (theta_d = 0) first, at "
+          "v = 0; no flip";
+      orientation["tiles_2d"] = f.tiles + ": " + tiles + " (Source2DTileSizeX/Y)";
+      import = {{"srgb", false},
+                // The Python API's member name (unreal.TextureCompressionSettings), which the
+                // import script reads: TC_HDR_Compressed, "HDR Compressed (RGB, BC6H, DX11)".
+                {"compression_settings", "TC_HDR_COMPRESSED"},
+                {"mip_gen_settings", "TMGS_NoMipmaps"},
+                {"address_mode", "TA_Clamp"},
+                {"filter", "TF_Bilinear"},
+                {"tiles", tiles_json}};
+      break;
+    case Engine::kGodot:
+      versions = "Godot 4.2 to 4.5 (BC6H 3D DDS: 4.4 and later; sliced EXR: every 4.x)";
+      files["tiles"] = f.tiles;
+      files["tiles_import"] = f.tiles_import;
+      format = "DDS DXGI_FORMAT_BC6H_UF16 (95), volume, one mip, " + padded;
+      orientation["bc6h_dds"] =
+          "DDS texel (x, y, z) = Texture3D texel (x, y, z); row 0 (theta_d = 0) first, at v = 0; "
+          "no flip";
+      orientation["sliced_exr"] = f.tiles + ": " + tiles + " (slices/horizontal, slices/vertical)";
+      import = {{"slices_horizontal", h.composite.columns},
+                {"slices_vertical", h.composite.rows},
+                {"compress_mode", "VRAM Compressed"},
+                {"high_quality", true},
+                {"hdr_compression", "Always"},
+                {"mipmaps", false},
+                {"sampler", "filter_linear, repeat_disable"}};
+      break;
+    case Engine::kWeb:
+      versions = fmt::format("three.js r{} (0.{}.0) or later, WebGL 2 with EXT_texture_compression_bptc",
+                             detail::kMinimumThreeRevision, detail::kMinimumThreeRevision);
+      files["viewer"] = "index.html?material=" + h.name;
+      format = fmt::format(
+          "KTX2 vkFormat 131 (VK_FORMAT_BC6H_UFLOAT_BLOCK), {} x {} x {} in the file; "
+          "loadMeasuredBrdfTexture {} (WebGL creates BPTC textures only at multiples of 4)",
+          h.volume->width, h.volume->height, k, padded);
+      orientation["webgl"] =
+          "KTX2 blocks uploaded as stored (compressedTexImage3D, COMPRESSED_RGB_BPTC_UNSIGNED_FLOAT); "
+          "row 0 (theta_d = 0) at v = 0";
+      import = {{"min_filter", "LinearFilter"},
+                {"mag_filter", "LinearFilter"},
+                {"wrap", "ClampToEdgeWrapping"},
+                {"color_space", "NoColorSpace"}};
+      break;
+  }
+  return ordered_json{{"folder", FolderOf(e)},
+                      {"engine_versions", versions},
+                      {"files", files},
+                      {"texture_format", format},
+                      {"orientation", orientation},
+                      {"import", import}};
+}
+
 // What one engine's folder holds and how it imports (a member of "engines" in the manifest).
 ordered_json EngineSectionJson(Engine e, const Handoff& h) {
   const exporter::PackedVolume& vol = *h.volume;
-  const MaterialFiles f = FilesOf(e, h.name);
+  const MaterialFiles f = FilesOf(e, h.name, h.bc6h != nullptr);
+  if (h.bc6h) return Bc6hEngineSectionJson(e, h, f);
   ordered_json files = {
       {"texture", f.texture}, {"shader", ShaderFile(e, h.layout)}, {"manifest", f.manifest}};
   ordered_json texture;
@@ -338,10 +509,12 @@ std::string ManifestJson(const Handoff& h, const std::vector<Engine>& engines) {
       {"source", h.source},
       {"atlas", h.atlas},
       {"texture",
-       {{"width", vol.width},
-        {"height", vol.height},
+       {{"width", h.layout.texture_width},
+        {"height", h.layout.texture_height},
         {"depth", vol.depth},
         {"mip_levels", 1},
+        {"block_format", h.bc6h ? "bc6h_ufloat" : "none"},
+        {"lut_texels", {vol.width, vol.height}},
         {"colour_space", "linear Rec.709 RGB; sample without sRGB decode"},
         {"sampler", "linear (trilinear), clamp-to-edge on u, v and w, no mipmaps"}}},
       {"theta_in_deg", h.theta_in_deg},
@@ -349,8 +522,9 @@ std::string ManifestJson(const Handoff& h, const std::vector<Engine>& engines) {
       {"texel_centre_mapping",
        {{"centre_exact", exporter::TexelCentreFormula()},
         {"cell", fmt::format("u = (x0 + phi_d/1deg + 0.5)/{}, v = (y0 + theta_d/1deg + 0.5)/{}, "
-                             "clamped to the cell's outer texel centres",
-                             vol.width, vol.height)},
+                             "clamped to the cell's outer texel centres{}",
+                             h.layout.texture_width, h.layout.texture_height,
+                             h.bc6h ? " (BC6H: the padded size, in place of 361 and 181)" : "")},
         {"published", exporter::PublishedFormula()}}},
       {"units",
        "f_r in 1/sr, linear Rec.709 RGB, not multiplied by cos(theta); radiance = f_r * "
@@ -425,7 +599,7 @@ std::vector<std::string> StageEngineFolder(Engine e, const fs::path& dir, const 
   if (!fs::is_directory(dir))
     throw IoError(dir.string() + ": cannot create the engine folder" +
                   (ec ? ": " + ec.message() : std::string()));
-  const MaterialFiles f = FilesOf(e, h.name);
+  const MaterialFiles f = FilesOf(e, h.name, h.bc6h != nullptr);
   const std::string shader = ShaderFile(e, h.layout);
   std::vector<std::string> written;
   const auto path_of = [&](const std::string& file) { return (dir / file).string(); };
@@ -440,6 +614,21 @@ std::vector<std::string> StageEngineFolder(Engine e, const fs::path& dir, const 
   // half-float one written here.
   const auto tiles = [&](const std::string& file) {
     const std::string path = path_of(file);
+    if (h.bc6h) {
+      // The block-aligned tiles of the BC6H form (never the regular 361 × 181 composite).
+      exporter::WriteExr(
+          path, PaddedBc6hComposite(h, h.bc6h_decoded),
+          exporter::ExrOptions(exporter::ExrPixelType::kHalf, exporter::ExrCompression::kZip),
+          {{"brdf:theta_in_deg", exporter::FormatThetaList(h.theta_in_deg)},
+           {"brdf:layout",
+            fmt::format("{} x {} tiles of {} x {} (the LUT's 361 x 181 texels, then clamped "
+                        "repeats to whole 4 x 4 blocks), row-major, top-left first; BC6H texels",
+                        h.composite.columns, h.composite.rows, h.layout.texture_width,
+                        h.layout.texture_height)},
+           {"brdf:texel_convention", exporter::TexelCentreFormula()}});
+      written.push_back(path);
+      return;
+    }
     if (staged.Link(src.exr_path, path)) return;
     exporter::WriteExr(
         path, src.composite(),
@@ -454,6 +643,7 @@ std::vector<std::string> StageEngineFolder(Engine e, const fs::path& dir, const 
   switch (e) {
     case Engine::kUnity:
       linked(f.texture, src.ktx2_path, src.ktx2_bytes);
+      if (h.bc6h) tiles(f.tiles);
       shared("Editor/MeasuredBrdfImporter.cs", [&] {
         std::error_code dir_ec;
         fs::create_directories(dir / "Editor", dir_ec);
@@ -463,15 +653,22 @@ std::vector<std::string> StageEngineFolder(Engine e, const fs::path& dir, const 
       break;
     case Engine::kUnreal:
       tiles(f.tiles);
-      staged.WriteWith(path_of(f.texture),
-                       [&](StagedFiles::Writer& w) { WriteRgba16fDds(w, *h.volume); });
+      if (h.bc6h)
+        staged.Write(path_of(f.texture), exporter::EncodeDds(AtPaddedSize(*h.bc6h)));
+      else
+        staged.WriteWith(path_of(f.texture),
+                         [&](StagedFiles::Writer& w) { WriteRgba16fDds(w, *h.volume); });
       shared(shader, [&] { return detail::UnrealUsh(h.layout); });
       shared("import_measured_brdf.py", [] { return detail::UnrealImportPython(); });
       break;
     case Engine::kGodot:
-      linked(f.texture, src.dds_path, [&] { return exporter::EncodeDds(*h.volume); });
+      if (h.bc6h)
+        staged.Write(path_of(f.texture), exporter::EncodeDds(AtPaddedSize(*h.bc6h)));
+      else
+        linked(f.texture, src.dds_path, [&] { return exporter::EncodeDds(*h.volume); });
       tiles(f.tiles);
-      staged.Write(path_of(f.tiles_import), detail::GodotSlicesImport(h, f.tiles));
+      staged.Write(path_of(f.tiles_import), h.bc6h ? detail::GodotSlicesImportBc6h(h, f.tiles)
+                                                   : detail::GodotSlicesImport(h, f.tiles));
       shared(shader, [&] { return detail::GodotShader(h.layout); });
       break;
     case Engine::kWeb:
@@ -530,10 +727,16 @@ namespace detail {
 std::string ShaderStem(const exporter::ShaderLutLayout& l) {
   const bool reference_slices = l.slices == 4 && l.delta_in_deg == 20 && l.theta_in0_deg == 0;
   const bool single = l.texture_width == 361 && l.texture_height == 181;
+  // A single BC6H LUT, padded to whole blocks (an atlas is a multiple of 361 × 181).
+  const bool bc6h = l.texture_width == 364 && l.texture_height == 184;
   if (reference_slices && single) return "MeasuredBrdf";
+  if (reference_slices && bc6h) return "MeasuredBrdf_bc6h";
   std::string s = fmt::format("MeasuredBrdf_{}x{}from{}", l.slices, NumberTag(l.delta_in_deg),
                               NumberTag(l.theta_in0_deg));
-  if (!single) s += fmt::format("_{}x{}", l.texture_width, l.texture_height);
+  if (bc6h)
+    s += "_bc6h";
+  else if (!single)
+    s += fmt::format("_{}x{}", l.texture_width, l.texture_height);
   return s;
 }
 
@@ -572,11 +775,11 @@ std::vector<std::string> EngineFolderNames(const EngineSet& engines) {
 }
 
 std::vector<std::string> EngineOutputPaths(const std::string& out_dir, const std::string& name,
-                                           const EngineSet& engines) {
+                                           const EngineSet& engines, bool bc6h) {
   std::vector<std::string> paths;
   const fs::path base(out_dir);
   for (Engine e : Selected(engines)) {
-    const MaterialFiles f = FilesOf(e, name);
+    const MaterialFiles f = FilesOf(e, name, bc6h);
     for (const std::string* file : {&f.texture, &f.tiles, &f.tiles_import, &f.ibl, &f.manifest})
       if (!file->empty()) paths.push_back((base / FolderOf(e) / *file).string());
   }
@@ -637,10 +840,11 @@ bool IsManagedSharedFile(const std::string& path) {
 
 std::vector<std::string> EngineOutputsToCheck(const std::string& out_dir,
                                               const std::vector<std::string>& names,
-                                              const EngineSet& engines) {
+                                              const EngineSet& engines, bool bc6h) {
   std::vector<std::string> paths;
   for (const std::string& name : names)
-    for (std::string& p : EngineOutputPaths(out_dir, name, engines)) paths.push_back(std::move(p));
+    for (std::string& p : EngineOutputPaths(out_dir, name, engines, bc6h))
+      paths.push_back(std::move(p));
   for (Engine e : Selected(engines))
     for (std::string& p : SharedFileCandidates(e, fs::path(out_dir) / FolderOf(e))) {
       std::error_code ec;
@@ -659,7 +863,17 @@ EngineExportResult ExportLutWithEngines(const std::string& out_dir, const Lut& l
                                         const std::vector<FittedMaterial>& fits) {
   EngineExportResult result;
   const exporter::PackedVolume packed = exporter::PackLut(lut);
-  result.lut = exporter::ExportLut(out_dir, lut, packed, metadata, options);
+  exporter::LutExportOptions lut_options = options;
+  if (engines.Any()) {
+    // No engine kit samples the compact form (the web kit ships its GLSL decoder, but no
+    // loader): --max-error picks BC6H or RGB9E5 for the hand-offs.
+    if (options.max_error <= 0 && options.compression == exporter::LutCompression::kCompact)
+      throw InvalidArgument(
+          "--compress compact: no engine kit samples the compact form; with --engine use "
+          "--compress bc6h, --max-error (BC6H or RGB9E5), or no --compress");
+    lut_options.max_error_allows_compact = false;
+  }
+  result.lut = exporter::ExportLut(out_dir, lut, packed, metadata, lut_options);
   if (!engines.Any()) return result;
   Handoff h;
   h.name = metadata.name;
@@ -667,6 +881,13 @@ EngineExportResult ExportLutWithEngines(const std::string& out_dir, const Lut& l
   h.volume = &packed;
   h.theta_in_deg = lut.theta_in_deg;
   h.layout = exporter::LutShaderLayout(lut.theta_in_deg);
+  if (result.lut.bc6h) {
+    h.bc6h = &*result.lut.bc6h;
+    h.bc6h_decoded = DecodePaddedBc6h(*h.bc6h);
+    h.layout.texture_width = 4 * h.bc6h->BlocksWide();
+    h.layout.texture_height = 4 * h.bc6h->BlocksHigh();
+    metadata.certified_error = result.lut.certified_error;
+  }
   h.cells = {{metadata.name, 0, 0}};
   h.composite = exporter::SquareishGrid(lut.slices());
   h.fitted_models_json = metadata.fitted_models_json;
@@ -682,6 +903,10 @@ EngineExportResult ExportLutWithEngines(const std::string& out_dir, const Lut& l
   src.dds_path = main_file(options.formats.dds, ".dds");
   src.exr_path = main_file(options.formats.exr, ".exr");
   src.ktx2_bytes = [&] {
+    if (h.bc6h)
+      return exporter::EncodeKtx2(
+          *h.bc6h,
+          {{"brdf.sidecar", exporter::SidecarJson(*h.bc6h, lut.theta_in_deg, metadata)}});
     return exporter::EncodeKtx2(
         packed, {{"brdf.sidecar", exporter::SidecarJson(packed, lut.theta_in_deg, metadata)}});
   };

@@ -7,6 +7,7 @@
 
 #include "brdf/core/fitted_material.h"
 #include "brdf/core/ibl_pack.h"
+#include "brdf/exporter/bc6h.h"
 #include "brdf/exporter/exr.h"
 #include "brdf/exporter/packed_volume.h"
 #include "brdf/exporter/shader_code.h"
@@ -25,6 +26,12 @@ struct Handoff {
   std::string source;  // where the values came from
   bool atlas = false;
   const exporter::PackedVolume* volume = nullptr;
+  // The BC6H form (`--compress bc6h`, or BC6H chosen by `--max-error`): every texture of the
+  // hand-off holds these blocks (or their decoded texels), created at the padded size
+  // BlocksWide·4 × BlocksHigh·4 (364 × 184, the size WebGL requires and the 2D tiles keep
+  // block-aligned); `layout` then has that size. Null: RGB9E5 / RGBA16F.
+  const exporter::Bc6hVolume* bc6h = nullptr;
+  std::vector<float> bc6h_decoded;  // with bc6h: its texels at the padded size, RGB, x fastest
   std::vector<double> theta_in_deg;
   exporter::ShaderLutLayout layout;
   std::vector<HandoffCell> cells;
@@ -37,7 +44,9 @@ struct Handoff {
 };
 
 // "MeasuredBrdf" for the reference layout (θin 0, 20, 40, 60, a single 361 × 181 LUT), else
-// "MeasuredBrdf_<K>x<Δin>from<θin,0>" (+ "_<W>x<H>" for an atlas), with '.' in numbers as 'p'.
+// "MeasuredBrdf_<K>x<Δin>from<θin,0>" (+ "_<W>x<H>" for an atlas), with '.' in numbers as 'p';
+// a single BC6H LUT (364 × 184, padded to whole blocks) adds "_bc6h" ("MeasuredBrdf_bc6h" for
+// the reference layout).
 std::string ShaderStem(const exporter::ShaderLutLayout& layout);
 
 // Unity (2021.3 LTS to Unity 6).
@@ -49,6 +58,9 @@ std::string UnrealImportPython();
 // Godot 4.
 std::string GodotShader(const exporter::ShaderLutLayout& layout);
 std::string GodotSlicesImport(const Handoff& handoff, const std::string& exr_file);
+// The sliced EXR of the BC6H form: VRAM Compressed, high quality (BC6H on desktop), HDR
+// compression always, no mipmaps.
+std::string GodotSlicesImportBc6h(const Handoff& handoff, const std::string& exr_file);
 // three.js (r180 or later).
 std::string WebModuleJs(const exporter::ShaderLutLayout& layout);
 // The viewer reads NAME.manifest.json first and imports the module it names, so one index.html

@@ -17,8 +17,14 @@ std::string UnityImporterCs() {
 // linear (no sRGB), clamp on all axes, bilinear (trilinear across the 3 axes of a 3D texture),
 // no mipmaps. Row 0 of the file (theta_d = 0) is uploaded first, i.e. at v = 0, slice 0
 // (theta_in of the first slice) at w = 0 - no flip, the shader's coordinates assume this.
+// A BC6H LUT (`--compress bc6h`, vkFormat 131) keeps its blocks: GraphicsFormat.RGB_BC6H_UFloat,
+// created at the padded size (91 x 46 blocks = 364 x 184 per slice; the padding repeats the edge
+// texels), which the MeasuredBrdf*_bc6h.hlsl shaders address.
+// MeasuredBrdfFlipbookPostprocessor (below) imports the BC6H hand-off's <name>_flipbook.exr
+// (364 x 184 tiles) as a Texture3D kept as BC6H.
 using System;
 using System.IO;
+using UnityEditor;
 using UnityEditor.AssetImporters;
 using UnityEngine;
 using UnityEngine.Experimental.Rendering;
@@ -27,6 +33,7 @@ using UnityEngine.Experimental.Rendering;
 public sealed class MeasuredBrdfImporter : ScriptedImporter
 {
     const uint VkFormatE5B9G9R9UFloatPack32 = 123;
+    const uint VkFormatBc6hUFloatBlock = 131;
     static readonly byte[] Ktx2Identifier = { 0xAB, 0x4B, 0x54, 0x58, 0x20, 0x32, 0x30, 0xBB, 0x0D, 0x0A, 0x1A, 0x0A };
 
     public bool forceHalfFallback = false;
@@ -43,6 +50,28 @@ public sealed class MeasuredBrdfImporter : ScriptedImporter
         int width = (int)U32(bytes, 20), height = (int)U32(bytes, 24), depth = (int)U32(bytes, 28);
         long offset = (long)U64(bytes, 80);
         int texels = width * height * depth;
+        if (U32(bytes, 12) == VkFormatBc6hUFloatBlock)
+        {
+            if (!SystemInfo.IsFormatSupported(GraphicsFormat.RGB_BC6H_UFloat, FormatUsage.Sample))
+            {
+                ctx.LogImportError(ctx.assetPath + ": this platform does not sample BC6H; use the RGB9E5 hand-off (brdf convert without --compress)");
+                return;
+            }
+            int length = (int)U64(bytes, 88);
+            var blocks = new byte[length];
+            Buffer.BlockCopy(bytes, (int)offset, blocks, 0, length);
+            var bc6h = new Texture3D((width + 3) / 4 * 4, (height + 3) / 4 * 4, depth,
+                                     GraphicsFormat.RGB_BC6H_UFloat, TextureCreationFlags.None);
+            bc6h.name = Path.GetFileNameWithoutExtension(ctx.assetPath);
+            bc6h.wrapMode = TextureWrapMode.Clamp;
+            bc6h.filterMode = FilterMode.Bilinear;
+            bc6h.anisoLevel = 0;
+            bc6h.SetPixelData(blocks, 0, 0);
+            bc6h.Apply(false, false);
+            ctx.AddObjectToAsset("lut", bc6h);
+            ctx.SetMainObject(bc6h);
+            return;
+        }
 
         bool e5 = !forceHalfFallback &&
                   SystemInfo.IsFormatSupported(GraphicsFormat.E5B9G9R9_UFloatPack32, FormatUsage.Sample);
@@ -83,13 +112,18 @@ public sealed class MeasuredBrdfImporter : ScriptedImporter
         if (b.Length < 104) return "file of " + b.Length + " bytes is too short for a KTX2 header";
         for (int i = 0; i < 12; ++i)
             if (b[i] != Ktx2Identifier[i]) return "byte " + i + ": not a KTX 2.0 file";
-        if (U32(b, 12) != VkFormatE5B9G9R9UFloatPack32)
-            return "byte 12: expected vkFormat 123 (E5B9G9R9_UFLOAT_PACK32), got " + U32(b, 12);
+        uint format = U32(b, 12);
+        if (format != VkFormatE5B9G9R9UFloatPack32 && format != VkFormatBc6hUFloatBlock)
+            return "byte 12: expected vkFormat 123 (E5B9G9R9_UFLOAT_PACK32) or 131 (BC6H_UFLOAT_BLOCK), got " + format;
         if (U32(b, 28) < 1) return "byte 28: expected a 3D texture (pixelDepth >= 1), got 0";
         if (U32(b, 44) != 0) return "byte 44: expected no supercompression, got scheme " + U32(b, 44);
         ulong texels = (ulong)U32(b, 20) * U32(b, 24) * U32(b, 28);
+        // BC6H: 16 bytes per 4 x 4 block, slices padded to whole blocks.
+        ulong expected = format == VkFormatBc6hUFloatBlock
+            ? (ulong)((U32(b, 20) + 3) / 4) * ((U32(b, 24) + 3) / 4) * U32(b, 28) * 16
+            : texels * 4;
         ulong offset = U64(b, 80), length = U64(b, 88);
-        if (length != texels * 4) return "byte 88: expected level 0 of " + texels * 4 + " bytes, got " + length;
+        if (length != expected) return "byte 88: expected level 0 of " + expected + " bytes, got " + length;
         if (offset + length > (ulong)b.Length) return "byte 80: level 0 runs past the end of the file";
         return null;
     }
@@ -102,6 +136,50 @@ public sealed class MeasuredBrdfImporter : ScriptedImporter
     static ulong U64(byte[] b, long at)
     {
         return U32(b, at) | ((ulong)U32(b, at + 4) << 32);
+    }
+}
+
+// The 2D route of the BC6H hand-off: <name>_flipbook.exr holds the K slices as tiles of
+// 364 x 184 texels (the LUT's 361 x 181, then clamped repeats to whole 4 x 4 blocks), row-major
+// from the top left. Imported as a Texture3D of those tiles (Texture Shape 3D, Columns x Rows
+// from the image size), linear (sRGB off), no mipmaps, no NPOT scaling, clamp, bilinear, and
+// kept as BC6H: the default platform compresses in high quality without crunch, and the
+// Standalone (desktop) override sets the format BC6H, so each 4 x 4 block lies inside one slice.
+public sealed class MeasuredBrdfFlipbookPostprocessor : AssetPostprocessor
+{
+    public const int TileWidth = 364, TileHeight = 184;
+
+    void OnPreprocessTexture()
+    {
+        if (!assetPath.EndsWith("_flipbook.exr", StringComparison.Ordinal)) return;
+        var importer = (TextureImporter)assetImporter;
+        int width, height;
+        importer.GetSourceTextureWidthAndHeight(out width, out height);
+        if (width % TileWidth != 0 || height % TileHeight != 0)
+        {
+            Debug.LogError(assetPath + ": " + width + " x " + height + " texels is not whole tiles of " + TileWidth + " x " + TileHeight);
+            return;
+        }
+        var settings = new TextureImporterSettings();
+        importer.ReadTextureSettings(settings);
+        settings.textureShape = TextureImporterShape.Texture3D;
+        settings.flipbookColumns = width / TileWidth;
+        settings.flipbookRows = height / TileHeight;
+        settings.sRGBTexture = false;
+        settings.mipmapEnabled = false;
+        settings.npotScale = TextureImporterNPOTScale.None;
+        settings.wrapMode = TextureWrapMode.Clamp;
+        settings.filterMode = FilterMode.Bilinear;
+        settings.alphaSource = TextureImporterAlphaSource.None;
+        importer.SetTextureSettings(settings);
+        importer.textureCompression = TextureImporterCompression.CompressedHQ;
+        importer.crunchedCompression = false;
+        var desktop = importer.GetPlatformTextureSettings("Standalone");
+        desktop.overridden = true;
+        desktop.format = TextureImporterFormat.BC6H;
+        desktop.maxTextureSize = 8192;
+        desktop.crunchedCompression = false;
+        importer.SetPlatformTextureSettings(desktop);
     }
 }
 )~~";
@@ -216,7 +294,9 @@ std::string UnrealUsh(const exporter::ShaderLutLayout& layout) {
   return R"~~(// Measured BRDF for an Unreal Engine 5 Custom material node, generated by )~~" +
          exporter::BrdfToolWriter() + R"~~(.
 // Targets UE 5.1 to 5.5. Texture: the Volume Texture import_measured_brdf.py makes (RGBA16F
-// DDS, or built from the 2D tiles): sRGB off, TC_HDR, no mips, clamp.
+// DDS, or built from the 2D tiles): sRGB off, TC_HDR, no mips, clamp. The BC6H hand-off
+// (MeasuredBrdf*_bc6h.ush): a BC6H volume DDS or 364 x 184 tiles, TC_HDR_COMPRESSED (BC6H), its
+// 364 x 184 slices addressed here.
 //
 // Make this file reachable as a virtual shader path, e.g. copy it to <Project>/Shaders/ and
 // map that folder in a module's StartupModule():
@@ -266,10 +346,12 @@ std::string UnrealImportPython() {
 # editor's Python console or: UnrealEditor-Cmd <project> -run=pythonscript -script="import_measured_brdf.py"
 #
 # Imports every <name>.dds of this folder that has a <name>.manifest.json beside it as a Volume
-# Texture (the DDS importer accepts RGBA16F volumes, DXGI format 10), or with --tiles builds the
-# Volume Texture from the 2D tiled EXR (<name>_tiles.exr, tile size from the manifest:
-# 361 x 181 for one LUT). Either way: sRGB off, compression TC_HDR, no mips, clamp, bilinear,
-# never streamed. Rows are imported as stored (theta_d = 0 first, at v = 0); tiles are read
+# Texture (the DDS importer accepts RGBA16F volumes, DXGI format 10, and BC6H ones, 95), or with
+# --tiles builds the Volume Texture from the 2D tiled EXR (<name>_tiles.exr, tile size from the
+# manifest: 361 x 181 for one LUT, 364 x 184 for the BC6H hand-off, whose tiles are padded to
+# whole 4 x 4 blocks). Either way: sRGB off, the manifest's compression (TC_HDR for RGBA16F,
+# TC_HDR_COMPRESSED, i.e. BC6H, for the BC6H hand-off), no mips, clamp, bilinear, never
+# streamed. Rows are imported as stored (theta_d = 0 first, at v = 0); tiles are read
 # row-major, top-left first, which is the slice order of the EXR.
 import json
 import os
@@ -295,9 +377,10 @@ def _import(filename, destination):
     return unreal.load_asset(paths[0])
 
 
-def _linear_hdr(texture):
+def _linear_hdr(texture, compression="TC_HDR"):
     texture.set_editor_property("srgb", False)
-    texture.set_editor_property("compression_settings", unreal.TextureCompressionSettings.TC_HDR)
+    texture.set_editor_property("compression_settings",
+                                getattr(unreal.TextureCompressionSettings, compression))
     texture.set_editor_property("mip_gen_settings", unreal.TextureMipGenSettings.TMGS_NO_MIPMAPS)
     texture.set_editor_property("filter", unreal.TextureFilter.TF_BILINEAR)
     texture.set_editor_property("never_stream", True)
@@ -311,19 +394,20 @@ def _clamp(texture):
         texture.set_editor_property("address_y", unreal.TextureAddress.TA_CLAMP)
 
 
-def import_volume_dds(dds_path, destination=DESTINATION):
-    """Imports an RGBA16F volume DDS as a Volume Texture with the LUT's sampler settings."""
+def import_volume_dds(dds_path, destination=DESTINATION, compression="TC_HDR"):
+    """Imports a volume DDS (RGBA16F or BC6H) as a Volume Texture with the LUT's settings."""
     texture = _import(dds_path, destination)
-    _linear_hdr(texture)
+    _linear_hdr(texture, compression)
     _clamp(texture)
     unreal.EditorAssetLibrary.save_loaded_asset(texture)
     return texture
 
 
-def build_volume_from_tiles(exr_path, tile_x, tile_y, destination=DESTINATION):
+def build_volume_from_tiles(exr_path, tile_x, tile_y, destination=DESTINATION,
+                            compression="TC_HDR"):
     """Imports the tiled EXR as a 2D texture and builds a Volume Texture from its tiles."""
     source = _import(exr_path, destination)
-    _linear_hdr(source)
+    _linear_hdr(source, compression)
     _clamp(source)
     name = os.path.splitext(os.path.basename(exr_path))[0] + "_volume"
     factory = unreal.VolumeTextureFactory()
@@ -332,7 +416,7 @@ def build_volume_from_tiles(exr_path, tile_x, tile_y, destination=DESTINATION):
     volume.set_editor_property("source2d_texture", source)
     volume.set_editor_property("source2d_tile_size_x", tile_x)
     volume.set_editor_property("source2d_tile_size_y", tile_y)
-    _linear_hdr(volume)
+    _linear_hdr(volume, compression)
     _clamp(volume)
     unreal.EditorAssetLibrary.save_loaded_asset(volume)
     return volume
@@ -348,12 +432,15 @@ def main(argv):
             manifest = json.load(f)
         section = manifest["engines"]["unreal"]
         files = section["files"]
+        compression = section["import"]["compression_settings"]
         if tiles:
             tile = section["import"]["tiles"]
             imported.append(build_volume_from_tiles(os.path.join(HERE, files["tiles"]),
-                                                    tile["tile_width"], tile["tile_height"]))
+                                                    tile["tile_width"], tile["tile_height"],
+                                                    compression=compression))
         else:
-            imported.append(import_volume_dds(os.path.join(HERE, files["texture"])))
+            imported.append(import_volume_dds(os.path.join(HERE, files["texture"]),
+                                              compression=compression))
     unreal.log("measured BRDF: imported %d texture(s)" % len(imported))
     return imported
 

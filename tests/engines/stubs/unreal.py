@@ -17,7 +17,10 @@ def _enum(name, members):
     return cls
 
 
-TextureCompressionSettings = _enum("TextureCompressionSettings", ["TC_DEFAULT", "TC_HDR"])
+# Members as the UE5 Python API lists them (unreal.TextureCompressionSettings: TC_HDR = 6,
+# TC_HDR_COMPRESSED = 10, "HDR Compressed (RGB, BC6H, DX11)").
+TextureCompressionSettings = _enum("TextureCompressionSettings",
+                                   ["TC_DEFAULT", "TC_HDR", "TC_HDR_COMPRESSED"])
 TextureMipGenSettings = _enum("TextureMipGenSettings", ["TMGS_FROM_TEXTURE_GROUP", "TMGS_NO_MIPMAPS"])
 TextureFilter = _enum("TextureFilter", ["TF_DEFAULT", "TF_BILINEAR", "TF_TRILINEAR"])
 TextureAddress = _enum("TextureAddress", ["TA_WRAP", "TA_CLAMP", "TA_MIRROR"])

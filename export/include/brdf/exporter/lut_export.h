@@ -44,6 +44,9 @@ struct LutExportOptions {
   // written (RGB9E5, the most precise, when none is); the choice goes into the result and the
   // sidecar. With kCompact alone, the compact form's target (default kCompactDefaultMaxError).
   double max_error = 0;
+  // false: max_error picks from BC6H and RGB9E5 only (the engine kits, which cannot sample the
+  // compact form: brdf/engines/engine_export.h).
+  bool max_error_allows_compact = true;
 };
 
 struct LutExportResult {
@@ -53,6 +56,8 @@ struct LutExportResult {
   std::optional<CertifiedError> certified_error;  // set when compressed or chosen by max_error
   LutCompression chosen = LutCompression::kNone;  // the representation written
   bool met_max_error = true;  // false: even the chosen one misses max_error (or the compact target)
+  // The BC6H blocks the KTX2 and DDS hold, when chosen is kBc6h (for the engine hand-offs).
+  std::optional<Bc6hVolume> bc6h;
 };
 
 // The files ExportLut writes for `name` into `out_dir` with `formats`, in its order (ktx2, dds,

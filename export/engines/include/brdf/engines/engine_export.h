@@ -30,6 +30,13 @@
 //                                 each folder's files, texture format, orientation per import path
 //                                 and import settings (one text, hard-linked into every engine
 //                                 folder of the conversion)
+// The BC6H form (options.compression kBc6h, or BC6H chosen by max_error; docs/engines.md, "BC6H
+// hand-off"): the KTX2 / .brdf3d hold the BC6H blocks, the Unreal and Godot NAME.dds are BC6H
+// volumes (DXGI 95) recorded at the padded size 364 × 184 × K, the 2D forms (unity/
+// NAME_flipbook.exr, unreal/NAME_tiles.exr, godot/NAME_slices.exr) are 364 × 184 tiles of the
+// decoded blocks, import settings keep BC6H, and the shaders (MeasuredBrdf*_bc6h.*) address
+// 364 × 184. No engine kit samples the compact form: ExportLutWithEngines refuses kCompact with
+// engines and lets max_error choose between BC6H and RGB9E5 only.
 // Shader files carry the LUT layout in their constants; they are named MeasuredBrdf.* for the
 // reference layout (θin 0, 20, 40, 60, one material) and MeasuredBrdf_<tag>.* otherwise, so
 // materials of one layout share one file and different layouts never overwrite each other.
@@ -116,9 +123,10 @@ std::vector<FittedMaterial> ReadFitResults(const std::string& fits_dir, const st
 // InvalidArgument for another model.
 std::string GltfFromUnrealDefaultLit(const FittedMaterial& fit);
 
-// The files the engine folders would receive for `name` (for collision checks and cleanup).
+// The files the engine folders would receive for `name` (for collision checks and cleanup);
+// `bc6h`: the BC6H form may be written (it adds unity/NAME_flipbook.exr).
 std::vector<std::string> EngineOutputPaths(const std::string& out_dir, const std::string& name,
-                                           const EngineSet& engines);
+                                           const EngineSet& engines, bool bc6h = false);
 
 // What `--engine` must submit to brdf::CheckWritableOutputs (the one overwrite rule,
 // brdf/core/file_util.h) before any work, for a run writing the materials (or atlas stems)
@@ -132,7 +140,7 @@ std::vector<std::string> EngineOutputPaths(const std::string& out_dir, const std
 // listed too, so CheckWritableOutputs refuses them even with --force.
 std::vector<std::string> EngineOutputsToCheck(const std::string& out_dir,
                                               const std::vector<std::string>& names,
-                                              const EngineSet& engines);
+                                              const EngineSet& engines, bool bc6h = false);
 
 // The one call `brdf atlas` makes: exporter::WriteAtlas(prefix, ...), then the engine folders
 // beside the prefix (<dir of prefix>/<engine>/<stem of prefix>.*), with shaders addressing
