@@ -202,15 +202,15 @@ def bc6h_hand_off(tool, source, chromium, work, mat, angles, nlv, exact_angles, 
     for a, e in ((b_angles, "bc6h_eval.txt"), (exact_angles, "bc6h_exact_eval.txt")):
         with open(os.path.join(work, e), "w") as f:
             f.write(run([tool, "eval", ktx2, "--pairs", a]))
-    b_work = os.path.join(work, "bc6h_work")
-    os.makedirs(b_work)
-    harnesses = es_harnesses(out, b_work)
     for folder, suffix in (("unity", ".hlsl"), ("unreal", ".ush"), ("godot", ".gdshader"),
                            ("web", ".js")):
         names = [f for f in os.listdir(os.path.join(out, folder)) if f.endswith(suffix)]
         if names != [n for n in names if n.endswith("_bc6h" + suffix)] or not names:
             print(f"FAILED: the BC6H {folder} folder ships {names}, expected *_bc6h{suffix}")
             sys.exit(1)
+    b_work = os.path.join(work, "bc6h_work")
+    os.makedirs(b_work)
+    harnesses = es_harnesses(out, b_work)
     result = os.path.join(work, "bc6h_result")
     os.makedirs(result)
     run(["node", os.path.join(source, "tests/node/render_web.mjs"), "--web",
@@ -231,7 +231,9 @@ def bc6h_hand_off(tool, source, chromium, work, mat, angles, nlv, exact_angles, 
                            ",".join(langs), "--eval", os.path.join(work, "bc6h_eval.txt"),
                            "--angles", b_angles,
                            "--exact-eval", os.path.join(work, "bc6h_exact_eval.txt"),
-                           "--exact-angles", exact_angles], capture_output=True, text=True)
+                           "--exact-angles", exact_angles,
+                           "--sidecar", os.path.join(out, "ggx_blue.json")],
+                          capture_output=True, text=True)
 
 
 def main():

@@ -302,8 +302,16 @@ def gen_seam(angles_out, nlv_out, seed=5):
     print(f"{len(rows)} seam and last-row pairs")
 
 
-def compare_pairs(name, cpu, gpu, angles, by_category):
-    """Prints the max and median relative difference of gpu against cpu; False when above 1e-4."""
+# Exact directions where one direction has several texels: the pole (mirror view, θd = 0: every
+# column of row 0) and the seam and plane of incidence (view at the horizon in it: φd 0 or 360°,
+# columns 0 and 360). RGB9E5 keeps those texels equal; BC6H encodes them in different blocks,
+# so two readings of one direction may differ by up to twice the certified max error.
+AMBIGUOUS = ("mirror view", "view at the horizon")
+
+
+def compare_pairs(name, cpu, gpu, angles, by_category, ambiguous_tolerance=None):
+    """Prints the max and median relative difference of gpu against cpu; False when above 1e-4
+    (with ambiguous_tolerance: that bound for the exact categories in AMBIGUOUS)."""
     if gpu.shape != cpu.shape:
         print(f"FAIL {name}: {gpu.shape} values, brdf eval gave {cpu.shape}")
         return False
@@ -329,14 +337,22 @@ def compare_pairs(name, cpu, gpu, angles, by_category):
     print(line)
     # Same texels, same coordinates: only float32 angle math and the GPU's filter weights differ
     # from the double-precision CPU lookup (measured: up to 4.6e-6, the HLSL paths).
-    if rel.max() <= 1e-4:
+    limit = np.full(len(cpu), 1e-4)
+    if by_category and ambiguous_tolerance is not None:
+        cats = [exact_category(*a) for a in angles]
+        amb = np.array([c in AMBIGUOUS for c in cats])
+        limit[amb] = ambiguous_tolerance
+        print(f"{name}: pole and seam directions ({int(amb.sum())} pairs, BC6H) within "
+              f"{ambiguous_tolerance:.3g}: max {worst_per_pair[amb].max():.3g}; the other "
+              f"{int((~amb).sum())} within 1e-4: max {worst_per_pair[~amb].max():.3g}")
+    if np.all(worst_per_pair <= limit):
         return True
-    bad = np.nonzero(worst_per_pair > 1e-4)[0]
+    bad = np.nonzero(worst_per_pair > limit)[0]
     for i in bad[:6]:
         print(f"FAIL {name}: pair {i + 1} (θin {angles[i][0]:g}, φin {angles[i][1]:g}, θout "
               f"{angles[i][2]:g}, φout {angles[i][3]:g}): GPU {gpu[i]} vs eval {cpu[i]}")
     if len(bad) > 6:
-        print(f"FAIL {name}: {len(bad) - 6} more pairs differ by more than 1e-4")
+        print(f"FAIL {name}: {len(bad) - 6} more pairs differ by more than their bound")
     return False
 
 
@@ -440,6 +456,11 @@ def check(argv):
     # shader path the browser ran (--langs), against `brdf eval` of the same LUT. Godot's light()
     # returns radiance, f_r · max(n·l, 0) with a white light, so eval is multiplied by cos θin.
     langs = opts["langs"].split(",") if "langs" in opts else []
+    # BC6H (--sidecar of the BC6H file): twice the certified max error over both ranges.
+    ambiguous = None
+    if "sidecar" in opts:
+        cert = json.load(open(opts["sidecar"]))["compression"]["certified_error"]
+        ambiguous = 2 * max(cert["measured"]["max"], cert["filled"]["max"])
     for prefix, eval_key, angles_key in (("pairs", "eval", "angles"),
                                          ("exact", "exact-eval", "exact-angles")):
         if eval_key not in opts:
@@ -451,7 +472,7 @@ def check(argv):
             gpu = np.loadtxt(f"{res}/{prefix}_{lang}.txt", ndmin=2)
             expect = cpu * cos_in if lang == "godot" else cpu
             ok = compare_pairs(f"{prefix} ({lang})", expect, gpu, angles.tolist(),
-                               prefix == "exact") and ok
+                               prefix == "exact", ambiguous) and ok
     return 0 if ok else 1
 
 
