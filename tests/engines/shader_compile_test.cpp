@@ -201,15 +201,15 @@ TEST_F(ShaderCompile, UnityIblFunctionsCompileForUrpAndHdrp) {
     for (const bool bc6h : {false, true}) {  // RGB9E5 and the BC6H form (364 x 184)
       SCOPED_TRACE(bc6h ? "BC6H" : "RGB9E5");
       const fs::path out = ExportAll(thetas, bc6h);
-    std::string include;
-    for (const auto& e : fs::directory_iterator(out / "unity"))
-      if (e.path().extension() == ".hlsl") include = e.path().filename().string();
-    ASSERT_FALSE(include.empty());
-    for (const auto& [pipeline, stand_ins, function] :
-         {std::tuple{"urp", kUrpStandIns, "MeasuredBrdfIbl_float"},
-          std::tuple{"hdrp", kHdrpStandIns, "MeasuredBrdfIbl_float"}}) {
-      const std::string harness = std::string(kUnityStandIns) + stand_ins + "#include \"" +
-                                  include + "\"\n" + R"(
+      std::string include;
+      for (const auto& e : fs::directory_iterator(out / "unity"))
+        if (e.path().extension() == ".hlsl") include = e.path().filename().string();
+      ASSERT_FALSE(include.empty());
+      for (const auto& [pipeline, stand_ins, function] :
+           {std::tuple{"urp", kUrpStandIns, "MeasuredBrdfIbl_float"},
+            std::tuple{"hdrp", kHdrpStandIns, "MeasuredBrdfIbl_float"}}) {
+        const std::string harness = std::string(kUnityStandIns) + stand_ins + "#include \"" +
+                                    include + "\"\n" + R"(
 Texture2D g_pack; SamplerState g_pack_sampler;
 float4 main(float3 n : TEXCOORD0, float3 v : TEXCOORD1) : SV_Target {
   UnityTexture2D t; t.tex = g_pack; t.samplerstate = g_pack_sampler;
@@ -217,12 +217,12 @@ float4 main(float3 n : TEXCOORD0, float3 v : TEXCOORD1) : SV_Target {
   return float4(o, 1.0);
 }
 )";
-      const std::string file = (out / "unity" / (std::string(pipeline) + ".hlsl")).string();
-      std::ofstream(file) << harness;
-      ExpectCompiles("-D -V -e main -S frag -o " + (dir_ / "ibl.spv").string() + " " + file,
-                     std::string("Unity ") + pipeline + " IBL in " + include);
+        const std::string file = (out / "unity" / (std::string(pipeline) + ".hlsl")).string();
+        std::ofstream(file) << harness;
+        ExpectCompiles("-D -V -e main -S frag -o " + (dir_ / "ibl.spv").string() + " " + file,
+                       std::string("Unity ") + pipeline + " IBL in " + include);
+      }
     }
-  }
   }
 }
 
@@ -231,13 +231,13 @@ TEST_F(ShaderCompile, UnityIncludeCompilesForShaderGraphAndBuiltInPipeline) {
     for (const bool bc6h : {false, true}) {  // RGB9E5 and the BC6H form (364 x 184)
       SCOPED_TRACE(bc6h ? "BC6H" : "RGB9E5");
       const fs::path out = ExportAll(thetas, bc6h);
-    std::string include;
-    for (const auto& e : fs::directory_iterator(out / "unity"))
-      if (e.path().extension() == ".hlsl") include = e.path().filename().string();
-    ASSERT_FALSE(include.empty());
-    const std::string harness = std::string(kUnityStandIns) +
-                                "#define MEASURED_BRDF_BUILTIN_LIGHTING\n#include \"" + include +
-                                "\"\n" + R"(
+      std::string include;
+      for (const auto& e : fs::directory_iterator(out / "unity"))
+        if (e.path().extension() == ".hlsl") include = e.path().filename().string();
+      ASSERT_FALSE(include.empty());
+      const std::string harness = std::string(kUnityStandIns) +
+                                  "#define MEASURED_BRDF_BUILTIN_LIGHTING\n#include \"" + include +
+                                  "\"\n" + R"(
 Texture3D g_lut; SamplerState g_lut_sampler;
 float4 main(float3 n : TEXCOORD0, float3 l : TEXCOORD1, float3 v : TEXCOORD2) : SV_Target {
   UnityTexture3D t; t.tex = g_lut; t.samplerstate = g_lut_sampler;
@@ -253,11 +253,11 @@ float4 main(float3 n : TEXCOORD0, float3 l : TEXCOORD1, float3 v : TEXCOORD2) : 
   return float4(a + b + c + d + e.rgb, 1.0);
 }
 )";
-    const std::string file = (out / "unity" / "harness.hlsl").string();
-    std::ofstream(file) << harness;
-    ExpectCompiles("-D -V -e main -S frag -o " + (dir_ / "u.spv").string() + " " + file,
-                   "Unity include " + include);
-  }
+      const std::string file = (out / "unity" / "harness.hlsl").string();
+      std::ofstream(file) << harness;
+      ExpectCompiles("-D -V -e main -S frag -o " + (dir_ / "u.spv").string() + " " + file,
+                     "Unity include " + include);
+    }
   }
 }
 
@@ -265,26 +265,29 @@ TEST_F(ShaderCompile, UnrealUshCompilesInACustomNodeAsTheCommentSays) {
   for (const bool bc6h : {false, true}) {  // RGB9E5 and the BC6H form (364 x 184)
     SCOPED_TRACE(bc6h ? "BC6H" : "RGB9E5");
     const fs::path out = ExportAll({0, 20, 40, 60}, bc6h);
-  const std::string ush = Read(out / (bc6h ? "unreal/MeasuredBrdf_bc6h.ush" : "unreal/MeasuredBrdf.ush"));
-  // The Custom node's code line, as the include tells the artist to type it.
-  std::smatch m;
-  ASSERT_TRUE(std::regex_search(ush, m, std::regex(R"(// Code:\s+(return [^\n]+;))"))) << ush;
-  // Unreal passes a TextureObject input "Lut" as Texture3D Lut and SamplerState LutSampler and
-  // wraps the code in a function (MaterialTemplate.ush: CustomExpressionN).
-  const std::string harness =
-      "#include \"" + std::string(bc6h ? "MeasuredBrdf_bc6h.ush" : "MeasuredBrdf.ush") + "\"\n"
-      "float3 CustomExpression0(Texture3D Lut, SamplerState LutSampler, float3 N, float3 L, float3 "
-      "V) {\n  " +
-      m[1].str() + "\n}\n" + R"(
+    const std::string ush =
+        Read(out / (bc6h ? "unreal/MeasuredBrdf_bc6h.ush" : "unreal/MeasuredBrdf.ush"));
+    // The Custom node's code line, as the include tells the artist to type it.
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(ush, m, std::regex(R"(// Code:\s+(return [^\n]+;))"))) << ush;
+    // Unreal passes a TextureObject input "Lut" as Texture3D Lut and SamplerState LutSampler and
+    // wraps the code in a function (MaterialTemplate.ush: CustomExpressionN).
+    const std::string harness = "#include \"" +
+                                std::string(bc6h ? "MeasuredBrdf_bc6h.ush" : "MeasuredBrdf.ush") +
+                                "\"\n"
+                                "float3 CustomExpression0(Texture3D Lut, SamplerState LutSampler, "
+                                "float3 N, float3 L, float3 "
+                                "V) {\n  " +
+                                m[1].str() + "\n}\n" + R"(
 Texture3D Material_Texture3D_0; SamplerState Material_Texture3D_0Sampler;
 float4 main(float3 n : TEXCOORD0, float3 l : TEXCOORD1, float3 v : TEXCOORD2) : SV_Target {
   return float4(CustomExpression0(Material_Texture3D_0, Material_Texture3D_0Sampler, n, l, v), 1.0);
 }
 )";
-  const std::string file = (out / "unreal" / "harness.hlsl").string();
-  std::ofstream(file) << harness;
-  ExpectCompiles("-D -V -e main -S frag -o " + (dir_ / "ue.spv").string() + " " + file,
-                 "Unreal Custom node");
+    const std::string file = (out / "unreal" / "harness.hlsl").string();
+    std::ofstream(file) << harness;
+    ExpectCompiles("-D -V -e main -S frag -o " + (dir_ / "ue.spv").string() + " " + file,
+                   "Unreal Custom node");
   }
 }
 
@@ -292,19 +295,19 @@ TEST_F(ShaderCompile, UnrealIblCustomNodeCompilesAsTheCommentSays) {
   for (const bool bc6h : {false, true}) {  // RGB9E5 and the BC6H form (364 x 184)
     SCOPED_TRACE(bc6h ? "BC6H" : "RGB9E5");
     const fs::path out = ExportAll({0, 10, 20, 30, 40, 50, 60, 70, 80}, bc6h);
-  std::string ush;
-  for (const auto& e : fs::directory_iterator(out / "unreal"))
-    if (e.path().extension() == ".ush") ush = e.path().filename().string();
-  ASSERT_FALSE(ush.empty());
-  const std::string text = Read(out / "unreal" / ush);
-  std::smatch m;
-  ASSERT_TRUE(
-      std::regex_search(text, m, std::regex(R"(// Code:\s+(return MeasuredBrdfIblUnreal[^\n]+;))")))
-      << text;
-  // Stand-ins for what Unreal's base pass gives a material (ReflectionEnvironmentShared.ush,
-  // the View uniform buffer), and the Custom node's Additional Define.
-  const std::string harness =
-      std::string(R"(
+    std::string ush;
+    for (const auto& e : fs::directory_iterator(out / "unreal"))
+      if (e.path().extension() == ".ush") ush = e.path().filename().string();
+    ASSERT_FALSE(ush.empty());
+    const std::string text = Read(out / "unreal" / ush);
+    std::smatch m;
+    ASSERT_TRUE(std::regex_search(
+        text, m, std::regex(R"(// Code:\s+(return MeasuredBrdfIblUnreal[^\n]+;))")))
+        << text;
+    // Stand-ins for what Unreal's base pass gives a material (ReflectionEnvironmentShared.ush,
+    // the View uniform buffer), and the Custom node's Additional Define.
+    const std::string harness =
+        std::string(R"(
 struct FViewStandIn { float4 SkyLightColor; };
 static const FViewStandIn View = { float4(1, 1, 1, 1) };
 TextureCube SkyCube; SamplerState SkyCubeSampler;
@@ -315,19 +318,19 @@ float3 GetSkyLightReflection(float3 ReflectionVector, float Roughness, out float
 }
 #define MEASURED_BRDF_UNREAL_SKY 1
 #include ")") +
-      ush + "\"\n" +
-      "float3 CustomExpression1(Texture2D IblPack, SamplerState IblPackSampler, float IblRow, "
-      "float3 N, float3 V) {\n  " +
-      m[1].str() + "\n}\n" + R"(
+        ush + "\"\n" +
+        "float3 CustomExpression1(Texture2D IblPack, SamplerState IblPackSampler, float IblRow, "
+        "float3 N, float3 V) {\n  " +
+        m[1].str() + "\n}\n" + R"(
 Texture2D Material_Texture2D_0; SamplerState Material_Texture2D_0Sampler;
 float4 main(float3 n : TEXCOORD0, float3 v : TEXCOORD1) : SV_Target {
   return float4(CustomExpression1(Material_Texture2D_0, Material_Texture2D_0Sampler, 0.5, n, v), 1.0);
 }
 )";
-  const std::string file = (out / "unreal" / "ibl_harness.hlsl").string();
-  std::ofstream(file) << harness;
-  ExpectCompiles("-D -V -e main -S frag -o " + (dir_ / "ue_ibl.spv").string() + " " + file,
-                 "Unreal IBL Custom node");
+    const std::string file = (out / "unreal" / "ibl_harness.hlsl").string();
+    std::ofstream(file) << harness;
+    ExpectCompiles("-D -V -e main -S frag -o " + (dir_ / "ue_ibl.spv").string() + " " + file,
+                   "Unreal IBL Custom node");
   }
 }
 
@@ -337,29 +340,32 @@ TEST_F(ShaderCompile, GodotShaderIsValidOnceGodotsAdditionsAreReplaced) {
   for (const bool bc6h : {false, true}) {  // RGB9E5 and the BC6H form (364 x 184)
     SCOPED_TRACE(bc6h ? "BC6H" : "RGB9E5");
     const fs::path out = ExportAll({0, 20, 40, 60}, bc6h);
-  std::string src = Read(out / (bc6h ? "godot/measured_brdf_bc6h.gdshader" : "godot/measured_brdf.gdshader"));
-  ASSERT_NE(src.find("shader_type spatial;"), std::string::npos);
-  ASSERT_NE(src.find("void light()"), std::string::npos);
-  src = std::regex_replace(src, std::regex(R"(shader_type spatial;)"), "");
-  src = std::regex_replace(src, std::regex(R"(render_mode [^;]+;)"), "");
-  src = std::regex_replace(
-      src, std::regex(R"(uniform (sampler3D|sampler2D|samplerCube) (\w+) : [^;]+;)"),
-      "uniform highp $1 $2;");
-  // GLSL ES has no uniform initialisers; Godot's are defaults the material starts from.
-  src = std::regex_replace(src, std::regex(R"(uniform float (\w+) = [^;]+;)"), "uniform float $1;");
-  src = std::regex_replace(src, std::regex(R"(void fragment\(\))"), "void godot_fragment()");
-  src = std::regex_replace(src, std::regex(R"(void light\(\))"), "void godot_light()");
-  const std::string builtins =
-      "#version 300 es\nprecision highp float;\n"
-      "vec3 ALBEDO; float METALLIC; float SPECULAR; float ROUGHNESS;\n"
-      "vec3 NORMAL; vec3 LIGHT; vec3 VIEW; vec3 LIGHT_COLOR; float ATTENUATION;\n"
-      "vec3 DIFFUSE_LIGHT; vec3 SPECULAR_LIGHT; vec3 EMISSION; mat4 INV_VIEW_MATRIX;\n";
-  const std::string tail =
-      "out vec4 color;\nvoid main() { godot_fragment(); godot_light(); color = vec4(DIFFUSE_LIGHT "
-      "+ "
-      "EMISSION, 1.0); }\n";
-  ExpectCompiles("-S frag " + Write("godot.frag", builtins + src + tail),
-                 "Godot shader as GLSL ES");
+    std::string src =
+        Read(out / (bc6h ? "godot/measured_brdf_bc6h.gdshader" : "godot/measured_brdf.gdshader"));
+    ASSERT_NE(src.find("shader_type spatial;"), std::string::npos);
+    ASSERT_NE(src.find("void light()"), std::string::npos);
+    src = std::regex_replace(src, std::regex(R"(shader_type spatial;)"), "");
+    src = std::regex_replace(src, std::regex(R"(render_mode [^;]+;)"), "");
+    src = std::regex_replace(
+        src, std::regex(R"(uniform (sampler3D|sampler2D|samplerCube) (\w+) : [^;]+;)"),
+        "uniform highp $1 $2;");
+    // GLSL ES has no uniform initialisers; Godot's are defaults the material starts from.
+    src =
+        std::regex_replace(src, std::regex(R"(uniform float (\w+) = [^;]+;)"), "uniform float $1;");
+    src = std::regex_replace(src, std::regex(R"(void fragment\(\))"), "void godot_fragment()");
+    src = std::regex_replace(src, std::regex(R"(void light\(\))"), "void godot_light()");
+    const std::string builtins =
+        "#version 300 es\nprecision highp float;\n"
+        "vec3 ALBEDO; float METALLIC; float SPECULAR; float ROUGHNESS;\n"
+        "vec3 NORMAL; vec3 LIGHT; vec3 VIEW; vec3 LIGHT_COLOR; float ATTENUATION;\n"
+        "vec3 DIFFUSE_LIGHT; vec3 SPECULAR_LIGHT; vec3 EMISSION; mat4 INV_VIEW_MATRIX;\n";
+    const std::string tail =
+        "out vec4 color;\nvoid main() { godot_fragment(); godot_light(); color = "
+        "vec4(DIFFUSE_LIGHT "
+        "+ "
+        "EMISSION, 1.0); }\n";
+    ExpectCompiles("-S frag " + Write("godot.frag", builtins + src + tail),
+                   "Godot shader as GLSL ES");
   }
 }
 

@@ -101,8 +101,8 @@ int RunConvert(const ConvertOptions& options) {
   export_options.compression = exporter::ParseLutCompression(options.compress);
   export_options.max_error = options.max_error;
   const engines::EngineSet engine_set = engines::ParseEngines(options.engines);
-  if (export_options.compression == exporter::LutCompression::kCompact && !(options.max_error > 0) &&
-      engine_set.Any())
+  if (export_options.compression == exporter::LutCompression::kCompact &&
+      !(options.max_error > 0) && engine_set.Any())
     throw InvalidArgument(
         "--compress compact: no engine kit samples the compact form; with --engine use "
         "--compress bc6h, --max-error (BC6H or RGB9E5 per material), or no --compress");

@@ -21,8 +21,8 @@
 #include "brdf/core/lut_brdf.h"
 #include "brdf/exporter/bc6h.h"
 #include "brdf/exporter/dds.h"
-#include "brdf/exporter/half.h"
 #include "brdf/exporter/exr.h"
+#include "brdf/exporter/half.h"
 #include "brdf/exporter/ktx2.h"
 #include "brdf/exporter/rgb9e5.h"
 #include "brdf/exporter/shader_code.h"
@@ -234,25 +234,23 @@ ordered_json ProbeJson(const Handoff& h) {
         std::array<float, 3> c{};
         if (h.bc6h) {
           // What a fetch of the BC6H texture returns (the peak was found in the RGB9E5 words).
-          const std::size_t at =
-              ((static_cast<std::size_t>(k) * h.layout.texture_height + y) *
-                   h.layout.texture_width +
-               x) *
-              3;
+          const std::size_t at = ((static_cast<std::size_t>(k) * h.layout.texture_height + y) *
+                                      h.layout.texture_width +
+                                  x) *
+                                 3;
           c = {h.bc6h_decoded[at], h.bc6h_decoded[at + 1], h.bc6h_decoded[at + 2]};
         } else {
           c = exporter::DecodeRgb9e5(vol.words[vol.Index(x, y, k)]);
         }
-        probes.push_back(
-            {{"material", cell.name},
-             {"index", {x, y, k}},
-             {"phi_d_deg", i},
-             {"theta_d_deg", j},
-             {"theta_in_deg", h.layout.theta_in0_deg + k * h.layout.delta_in_deg},
-             {"uvw",
-              {(x + 0.5) / h.layout.texture_width, (y + 0.5) / h.layout.texture_height,
-               (k + 0.5) / vol.depth}},
-             {"rgb", {c[0], c[1], c[2]}}});
+        probes.push_back({{"material", cell.name},
+                          {"index", {x, y, k}},
+                          {"phi_d_deg", i},
+                          {"theta_d_deg", j},
+                          {"theta_in_deg", h.layout.theta_in0_deg + k * h.layout.delta_in_deg},
+                          {"uvw",
+                           {(x + 0.5) / h.layout.texture_width, (y + 0.5) / h.layout.texture_height,
+                            (k + 0.5) / vol.depth}},
+                          {"rgb", {c[0], c[1], c[2]}}});
       }
     }
   }
@@ -290,19 +288,21 @@ ordered_json Bc6hEngineSectionJson(Engine e, const Handoff& h, const MaterialFil
       orientation["flipbook_2d"] = f.tiles + ": " + tiles +
                                    "; imported by MeasuredBrdfFlipbookPostprocessor (in the "
                                    "importer file) as a Texture3D of those tiles";
-      import = {{"flipbook",
-                 {{"file", f.tiles},
-                  {"texture_shape", "Texture3D"},
-                  {"columns", h.composite.columns},
-                  {"rows", h.composite.rows},
-                  {"npot_scale", "None"},
-                  {"srgb", false},
-                  {"mipmaps", false},
-                  {"wrap", "Clamp"},
-                  {"filter", "Bilinear"},
-                  {"format", "BC6H"},
-                  {"texture_compression", "CompressedHQ"},
-                  {"crunched", false}}}};
+      import = {
+          { "flipbook",
+            { {"file", f.tiles},
+              {"texture_shape", "Texture3D"},
+              {"columns", h.composite.columns},
+              {"rows", h.composite.rows},
+              {"npot_scale", "None"},
+              {"srgb", false},
+              {"mipmaps", false},
+              {"wrap", "Clamp"},
+              {"filter", "Bilinear"},
+              {"format", "BC6H"},
+              {"texture_compression", "CompressedHQ"},
+              { "crunched",
+                false } } }};
       break;
     case Engine::kUnreal:
       versions = "Unreal Engine 5.1 to 5.5";
@@ -320,7 +320,8 @@ ordered_json Bc6hEngineSectionJson(Engine e, const Handoff& h, const MaterialFil
                 {"mip_gen_settings", "TMGS_NoMipmaps"},
                 {"address_mode", "TA_Clamp"},
                 {"filter", "TF_Bilinear"},
-                {"tiles", tiles_json}};
+                { "tiles",
+                  tiles_json }};
       break;
     case Engine::kGodot:
       versions = "Godot 4.2 to 4.5 (BC6H 3D DDS: 4.4 and later; sliced EXR: every 4.x)";
@@ -337,31 +338,32 @@ ordered_json Bc6hEngineSectionJson(Engine e, const Handoff& h, const MaterialFil
                 {"high_quality", true},
                 {"hdr_compression", "Always"},
                 {"mipmaps", false},
-                {"sampler", "filter_linear, repeat_disable"}};
+                { "sampler",
+                  "filter_linear, repeat_disable" }};
       break;
     case Engine::kWeb:
-      versions = fmt::format("three.js r{} (0.{}.0) or later, WebGL 2 with EXT_texture_compression_bptc",
-                             detail::kMinimumThreeRevision, detail::kMinimumThreeRevision);
+      versions =
+          fmt::format("three.js r{} (0.{}.0) or later, WebGL 2 with EXT_texture_compression_bptc",
+                      detail::kMinimumThreeRevision, detail::kMinimumThreeRevision);
       files["viewer"] = "index.html?material=" + h.name;
       format = fmt::format(
           "KTX2 vkFormat 131 (VK_FORMAT_BC6H_UFLOAT_BLOCK), {} x {} x {} in the file; "
           "loadMeasuredBrdfTexture {} (WebGL creates BPTC textures only at multiples of 4)",
           h.volume->width, h.volume->height, k, padded);
       orientation["webgl"] =
-          "KTX2 blocks uploaded as stored (compressedTexImage3D, COMPRESSED_RGB_BPTC_UNSIGNED_FLOAT); "
+          "KTX2 blocks uploaded as stored (compressedTexImage3D, "
+          "COMPRESSED_RGB_BPTC_UNSIGNED_FLOAT); "
           "row 0 (theta_d = 0) at v = 0";
       import = {{"min_filter", "LinearFilter"},
                 {"mag_filter", "LinearFilter"},
                 {"wrap", "ClampToEdgeWrapping"},
-                {"color_space", "NoColorSpace"}};
+                { "color_space",
+                  "NoColorSpace" }};
       break;
   }
-  return ordered_json{{"folder", FolderOf(e)},
-                      {"engine_versions", versions},
-                      {"files", files},
-                      {"texture_format", format},
-                      {"orientation", orientation},
-                      {"import", import}};
+  return ordered_json{
+      {"folder", FolderOf(e)},    {"engine_versions", versions}, {"files", files},
+      {"texture_format", format}, {"orientation", orientation},  {"import", import}};
 }
 
 // What one engine's folder holds and how it imports (a member of "engines" in the manifest).
@@ -905,8 +907,7 @@ EngineExportResult ExportLutWithEngines(const std::string& out_dir, const Lut& l
   src.ktx2_bytes = [&] {
     if (h.bc6h)
       return exporter::EncodeKtx2(
-          *h.bc6h,
-          {{"brdf.sidecar", exporter::SidecarJson(*h.bc6h, lut.theta_in_deg, metadata)}});
+          *h.bc6h, {{"brdf.sidecar", exporter::SidecarJson(*h.bc6h, lut.theta_in_deg, metadata)}});
     return exporter::EncodeKtx2(
         packed, {{"brdf.sidecar", exporter::SidecarJson(packed, lut.theta_in_deg, metadata)}});
   };

@@ -135,7 +135,8 @@ slices/vertical={r}
 namespace {
 
 // loadMeasuredBrdfTexture of the web module: KTX2Loader for RGB9E5, WebGL directly for BC6H.
-constexpr std::string_view kRgb9e5Loader = R"~~(// Loads the LUT as a Data3DTexture with the sampler the lookup assumes. KTX2Loader leaves
+constexpr std::string_view kRgb9e5Loader =
+    R"~~(// Loads the LUT as a Data3DTexture with the sampler the lookup assumes. KTX2Loader leaves
 // uncompressed textures on NearestFilter; linear filtering is set here explicitly.
 export async function loadMeasuredBrdfTexture(url, renderer) {
   if (parseInt(THREE.REVISION, 10) < MINIMUM_THREE_REVISION)
@@ -160,7 +161,8 @@ export async function loadMeasuredBrdfTexture(url, renderer) {
 }
 
 )~~";
-constexpr std::string_view kBc6hLoader = R"~~(// Loads the BC6H LUT (KTX2 vkFormat 131, `brdf convert --compress bc6h`) as a compressed 3D
+constexpr std::string_view kBc6hLoader =
+    R"~~(// Loads the BC6H LUT (KTX2 vkFormat 131, `brdf convert --compress bc6h`) as a compressed 3D
 // texture. WebGL creates BPTC textures only at level-0 sizes that are multiples of 4, so the
 // texture is created at the padded size (the file's 91 x 46 blocks per slice: 364 x 184 x K,
 // docs/design.md section 7), which the lookup in this module addresses (TEXTURE_SIZE); the
