@@ -192,8 +192,13 @@ def gen_pairs(count, seed, angles_out, nlv_out):
                                 rng.uniform(76.0, 88.0, FILLED_PAIRS)])
     phi_in = rng.uniform(0.0, 360.0, count + FILLED_PAIRS)
     phi_out = rng.uniform(0.0, 360.0, count + FILLED_PAIRS)
+    write_pairs(zip(theta_in, phi_in, theta_out, phi_out), rng, angles_out, nlv_out)
+
+
+def write_pairs(rows, rng, angles_out, nlv_out):
+    """Each (θin, φin, θout, φout) as an angles line and as n, l, v in a random frame."""
     with open(angles_out, "w") as a, open(nlv_out, "w") as b:
-        for t_i, p_i, t_o, p_o in zip(theta_in, phi_in, theta_out, phi_out):
+        for t_i, p_i, t_o, p_o in rows:
             q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
             n = q @ np.array([0.0, 0.0, 1.0])
             l = q @ spherical(t_i * DEG, p_i * DEG)
@@ -289,16 +294,8 @@ def seam_angles():
 
 
 def gen_seam(angles_out, nlv_out, seed=5):
-    rng = np.random.default_rng(seed)
     rows = seam_angles()
-    with open(angles_out, "w") as a, open(nlv_out, "w") as b:
-        for t_i, p_i, t_o, p_o in rows:
-            q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
-            n = q @ np.array([0.0, 0.0, 1.0])
-            l = q @ spherical(t_i * DEG, p_i * DEG)
-            v = q @ spherical(t_o * DEG, p_o * DEG)
-            a.write(f"{t_i:.9f} {p_i:.9f} {t_o:.9f} {p_o:.9f}\n")
-            b.write(" ".join(f"{x:.9f}" for x in (*n, *l, *v)) + "\n")
+    write_pairs(rows, np.random.default_rng(seed), angles_out, nlv_out)
     print(f"{len(rows)} seam and last-row pairs")
 
 

@@ -669,8 +669,7 @@ std::vector<std::string> StageEngineFolder(Engine e, const fs::path& dir, const 
       else
         linked(f.texture, src.dds_path, [&] { return exporter::EncodeDds(*h.volume); });
       tiles(f.tiles);
-      staged.Write(path_of(f.tiles_import), h.bc6h ? detail::GodotSlicesImportBc6h(h, f.tiles)
-                                                   : detail::GodotSlicesImport(h, f.tiles));
+      staged.Write(path_of(f.tiles_import), detail::GodotSlicesImport(h, f.tiles));
       shared(shader, [&] { return detail::GodotShader(h.layout); });
       break;
     case Engine::kWeb:

@@ -57,10 +57,9 @@ std::string UnrealUsh(const exporter::ShaderLutLayout& layout);
 std::string UnrealImportPython();
 // Godot 4.
 std::string GodotShader(const exporter::ShaderLutLayout& layout);
+// The sliced EXR's import settings: VRAM Uncompressed; for the BC6H form (handoff.bc6h) VRAM
+// Compressed, high quality (BC6H on desktop), HDR compression always. No mipmaps either way.
 std::string GodotSlicesImport(const Handoff& handoff, const std::string& exr_file);
-// The sliced EXR of the BC6H form: VRAM Compressed, high quality (BC6H on desktop), HDR
-// compression always, no mipmaps.
-std::string GodotSlicesImportBc6h(const Handoff& handoff, const std::string& exr_file);
 // three.js (r180 or later).
 std::string WebModuleJs(const exporter::ShaderLutLayout& layout);
 // The viewer reads NAME.manifest.json first and imports the module it names, so one index.html
