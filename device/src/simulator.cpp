@@ -102,7 +102,8 @@ FaultPlan ParseFaultPlan(std::string_view spec) {
       {"timeout", FaultType::kTimeout},          {"corrupt", FaultType::kCorrupt},
       {"duplicate", FaultType::kDuplicate},      {"reorder", FaultType::kReorder},
       {"lamp", FaultType::kLampFailure},         {"contact", FaultType::kSampleContact},
-      {"overtemp", FaultType::kOverTemperature}, {"halt", FaultType::kEndpointHalt}};
+      {"overtemp", FaultType::kOverTemperature}, {"halt", FaultType::kEndpointHalt},
+      {"hold", FaultType::kHold}};
   std::string names;
   for (const auto& [name, type] : kNames) names += (names.empty() ? "" : ", ") + std::string(name);
   FaultPlan plan;
@@ -248,9 +249,13 @@ void SimulatedFirmware::Send(MessageType type, const std::vector<std::uint8_t>& 
     streaming_ = false;
     return;
   }
-  if (f.Has(FaultType::kTimeout, n)) {
+  if (f.Has(FaultType::kTimeout, n) || f.Has(FaultType::kHold, n)) {
     hung_ = true;
     streaming_ = false;
+    if (f.Has(FaultType::kHold, n)) {
+      held_ = true;
+      if (config_.on_hold) config_.on_hold(n);
+    }
     return;
   }
   for (const auto& [fault, code, text] :
@@ -308,6 +313,10 @@ void SimulatedFirmware::Handle(const Frame& frame) {
   if (hung_) {
     if (type != MessageType::kAbort) return;
     hung_ = false;  // the host's ABORT wakes a hung firmware
+    if (held_) {
+      held_ = false;
+      if (config_.on_hold_released) config_.on_hold_released();
+    }
   }
   if (streaming_) {
     if (type == MessageType::kAbort) {

@@ -9,12 +9,16 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
+#include <cstdio>
+#include <chrono>
 #include <filesystem>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "brdf/core/bpc.h"
+#include "brdf/device/cancel.h"
 #include "brdf/device/capture_session.h"
 #include "brdf/device/usb_transport.h"
 #include "brdf/device_emulation/emulated_usb.h"
@@ -272,6 +276,9 @@ struct FaultCase {
   std::string message;     // in the message (kFailed) or in a retry notice (kFinished)
   InstrumentProblem problem = InstrumentProblem::kNone;
   bool usb_only = false;  // transport-level fault
+  // A hold (FaultType::kHold) whose start raises the session's cancel: the user's Ctrl-C at a
+  // chosen frame, with no race against real time.
+  bool cancel_at_hold = false;
 };
 
 // Frames the firmware sends on the coarse 5° grid: 8 before the first slice, 18 per slice,
@@ -294,6 +301,8 @@ std::vector<FaultCase> FaultCases() {
        InstrumentProblem::kSampleNotInContact},
       {"overtemp", plan(FaultType::kOverTemperature, 30), O::kFailed, "temperature",
        InstrumentProblem::kOverTemperature},
+      {"cancel", plan(FaultType::kHold, 30), O::kInterrupted, "cancelled",
+       InstrumentProblem::kNone, false, true},
   };
 }
 
@@ -340,6 +349,12 @@ TEST_P(FaultsOver, EveryFaultGivesItsOutcomeAndResumeGivesTheUninterruptedCaptur
     SCOPED_TRACE(k.name);
     SimulatorConfig faulty = clean;
     faulty.faults = k.plan;
+    CancelSignal cancel;
+    std::atomic<bool> released{false};
+    if (k.cancel_at_hold) {
+      faulty.on_hold = [&](std::uint64_t) { cancel.Raise(); };
+      faulty.on_hold_released = [&] { released.store(true); };
+    }
     const CaptureRequest request = Request(k.name);
     std::vector<std::string> retries;
     SessionEvents events;
@@ -348,12 +363,17 @@ TEST_P(FaultsOver, EveryFaultGivesItsOutcomeAndResumeGivesTheUninterruptedCaptur
     std::uint64_t halts = 0;
     {
       std::unique_ptr<Instrument> inst = Make(GetParam(), faulty);
-      r = RunCaptureSession(request, inst->link(), events);
+      r = RunCaptureSession(request, inst->link(), events, &cancel);
       if (inst->emulated) halts = inst->emulated->halts_cleared();
     }
     EXPECT_EQ(r.outcome, k.outcome) << r.message;
     EXPECT_EQ(r.problem, k.problem) << r.message;
-    if (k.outcome == CaptureOutcome::kFailed) {
+    if (k.cancel_at_hold) {
+      EXPECT_TRUE(cancel.raised());
+      EXPECT_TRUE(released.load()) << "the cancel did not send ABORT to the instrument";
+      EXPECT_TRUE(retries.empty()) << retries[0];
+    }
+    if (k.outcome != CaptureOutcome::kFinished) {
       EXPECT_NE(r.message.find(k.message), std::string::npos) << r.message;
       EXPECT_EQ(r.next, NextStep::kResume);
       EXPECT_EQ(r.slices_saved, 1u) << r.message;
@@ -387,6 +407,63 @@ TEST_P(FaultsOver, EveryFaultGivesItsOutcomeAndResumeGivesTheUninterruptedCaptur
     }
     const Measurement got = LoadBpc(request.out_path);
     ExpectSameValues(got.slices, expected.slices);
+  }
+}
+
+// The bound of capture_session.h: a cancel ends a read waiting for a silent instrument within
+// kCancelStepMs on USB and HID (at once on the loopback), not after the read's timeout, and the
+// ABORT it sends reaches the instrument. The firmware holds its answer to IDENTIFY; the hold's
+// start raises the cancel, so the read is waiting on a silent link when it is raised.
+TEST_P(FaultsOver, ACancelEndsAReadOfASilentInstrumentWithinTheCancelStep) {
+  SimulatorConfig c = Config(LibraryMaterial("gold"), 1, 5, 5);
+  c.faults = FaultPlan{{Fault{FaultType::kHold, 1}}};
+  CancelSignal cancel;
+  std::atomic<bool> released{false};
+  c.on_hold = [&](std::uint64_t) { cancel.Raise(); };
+  c.on_hold_released = [&] { released.store(true); };
+  std::unique_ptr<Instrument> inst = Make(GetParam(), c);
+  DriverOptions options;
+  options.timeout_ms = 5000;
+  Driver driver(inst->link(), options);
+  driver.SetCancelFlag(&cancel);
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    driver.Connect();
+    ADD_FAILURE() << "Connect returned although the instrument holds its answer";
+  } catch (const DriverFault& e) {
+    EXPECT_EQ(e.kind(), FaultKind::kCancelled) << e.what();
+  }
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  EXPECT_TRUE(released.load()) << "the cancel did not send ABORT to the instrument";
+  // kCancelStepMs (50 ms) plus the ABORT's round trip; half the timeout leaves a loaded machine
+  // its slack and still fails a read that waits out its 5 s.
+  EXPECT_LT(ms, options.timeout_ms / 2.0);
+  std::printf("cancel honoured after %.1f ms\n", ms);
+}
+
+// A silent instrument over real libusb and hidapi: the read returns nothing after the timeout
+// (not before), and the driver reports a timeout. The firmware never answers IDENTIFY until
+// ABORT, so nothing else can be late.
+TEST_P(FaultsOver, ASilentInstrumentTimesOutAfterTheReplyTimeout) {
+  SimulatorConfig c = Config(LibraryMaterial("gold"), 1, 5, 5);
+  c.faults = FaultPlan{{Fault{FaultType::kTimeout, 1}}};
+  std::unique_ptr<Instrument> inst = Make(GetParam(), c);
+  DriverOptions options;
+  options.timeout_ms = 300;
+  Driver driver(inst->link(), options);
+  const auto t0 = std::chrono::steady_clock::now();
+  try {
+    driver.Connect();
+    ADD_FAILURE() << "Connect returned although the instrument is silent";
+  } catch (const DriverFault& e) {
+    EXPECT_EQ(e.kind(), FaultKind::kTimeout) << e.what();
+  }
+  const double ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  // The loopback runs on virtual time; USB and HID wait the timeout out.
+  if (GetParam() != Link::kLoopback) {
+    EXPECT_GE(ms, options.timeout_ms - 1.0);
   }
 }
 
