@@ -13,8 +13,10 @@
 #include <cstdio>
 #include <chrono>
 #include <filesystem>
+#include <future>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "brdf/core/bpc.h"
@@ -440,6 +442,46 @@ TEST_P(FaultsOver, ACancelEndsAReadOfASilentInstrumentWithinTheCancelStep) {
   // its slack and still fails a read that waits out its 5 s.
   EXPECT_LT(ms, options.timeout_ms / 2.0);
   std::printf("cancel honoured after %.1f ms\n", ms);
+}
+
+// A cancel from another thread while the read waits on a held firmware: the read waits for it
+// (it is not a timeout, so nothing is retried), and the ABORT it sends ends the hold. The hold's
+// start is the one event the cancelling thread waits for; the 100 ms after it only make sure the
+// read is already waiting (a read that did not wait would time out at once and retry).
+TEST_P(FaultsOver, ACancelFromAnotherThreadEndsTheHoldWithoutARetry) {
+  SimulatorConfig c = Config(LibraryMaterial("gold"), 1, 5, 5, /*seed=*/11);
+  c.faults = FaultPlan{{Fault{FaultType::kHold, 30}}};
+  CancelSignal cancel;
+  std::promise<void> hold_started;
+  std::atomic<bool> released{false}, held{false};
+  c.on_hold = [&](std::uint64_t) {
+    held.store(true);
+    hold_started.set_value();
+  };
+  c.on_hold_released = [&] { released.store(true); };
+  std::thread canceller([&, started = hold_started.get_future()]() mutable {
+    started.wait();
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    cancel.Raise();
+  });
+  CaptureRequest request = Request("held");
+  std::vector<std::string> retries;
+  SessionEvents events;
+  events.on_retry = [&](const std::string& m) { retries.push_back(m); };
+  CaptureSessionResult r;
+  {
+    std::unique_ptr<Instrument> inst = Make(GetParam(), c);
+    r = RunCaptureSession(request, inst->link(), events, &cancel);
+  }
+  if (!held.load()) hold_started.set_value();  // (a capture that never held: fails below)
+  canceller.join();
+  EXPECT_TRUE(held.load());
+  EXPECT_EQ(r.outcome, CaptureOutcome::kInterrupted) << r.message;
+  EXPECT_NE(r.message.find("cancelled"), std::string::npos) << r.message;
+  EXPECT_TRUE(retries.empty()) << retries[0];
+  EXPECT_TRUE(released.load()) << "the cancel did not send ABORT to the instrument";
+  EXPECT_EQ(r.slices_saved, 1u);
+  EXPECT_EQ(ReadBpc(request.out_path).measurement.slices.size(), 1u);
 }
 
 // A silent instrument over real libusb and hidapi: the read returns nothing after the timeout
