@@ -98,11 +98,16 @@ bool FaultPlan::HasFirmwareFaults() const {
 
 FaultPlan ParseFaultPlan(std::string_view spec) {
   static constexpr std::pair<std::string_view, FaultType> kNames[] = {
-      {"disconnect", FaultType::kDisconnect},    {"stall", FaultType::kStall},
-      {"timeout", FaultType::kTimeout},          {"corrupt", FaultType::kCorrupt},
-      {"duplicate", FaultType::kDuplicate},      {"reorder", FaultType::kReorder},
-      {"lamp", FaultType::kLampFailure},         {"contact", FaultType::kSampleContact},
-      {"overtemp", FaultType::kOverTemperature}, {"halt", FaultType::kEndpointHalt},
+      {"disconnect", FaultType::kDisconnect},
+      {"stall", FaultType::kStall},
+      {"timeout", FaultType::kTimeout},
+      {"corrupt", FaultType::kCorrupt},
+      {"duplicate", FaultType::kDuplicate},
+      {"reorder", FaultType::kReorder},
+      {"lamp", FaultType::kLampFailure},
+      {"contact", FaultType::kSampleContact},
+      {"overtemp", FaultType::kOverTemperature},
+      {"halt", FaultType::kEndpointHalt},
       {"hold", FaultType::kHold}};
   std::string names;
   for (const auto& [name, type] : kNames) names += (names.empty() ? "" : ", ") + std::string(name);

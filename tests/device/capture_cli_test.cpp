@@ -334,7 +334,8 @@ TEST_F(CaptureCli, SignalAbortsTheScanAndLeavesAResumableFile) {
     // The hold is waited out until the signal, never read as a timeout and retried.
     EXPECT_EQ(log.find("measuring again"), std::string::npos) << log;
     EXPECT_NE(log.find("cancelled"), std::string::npos) << log;
-    EXPECT_NE(log.find("1 of 4 slices are saved in " + out + "; run the same command with "
+    EXPECT_NE(log.find("1 of 4 slices are saved in " + out +
+                       "; run the same command with "
                        "--resume"),
               std::string::npos)
         << log;

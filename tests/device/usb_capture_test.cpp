@@ -10,8 +10,8 @@
 
 #include <algorithm>
 #include <atomic>
-#include <cstdio>
 #include <chrono>
+#include <cstdio>
 #include <filesystem>
 #include <future>
 #include <memory>
@@ -303,8 +303,8 @@ std::vector<FaultCase> FaultCases() {
        InstrumentProblem::kSampleNotInContact},
       {"overtemp", plan(FaultType::kOverTemperature, 30), O::kFailed, "temperature",
        InstrumentProblem::kOverTemperature},
-      {"cancel", plan(FaultType::kHold, 30), O::kInterrupted, "cancelled",
-       InstrumentProblem::kNone, false, true},
+      {"cancel", plan(FaultType::kHold, 30), O::kInterrupted, "cancelled", InstrumentProblem::kNone,
+       false, true},
   };
 }
 

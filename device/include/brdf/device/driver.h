@@ -188,7 +188,7 @@ class Driver {
   std::size_t last_frame_size_ = 0;
   std::size_t duplicates_dropped_ = 0;
   const CancelSignal* cancel_ = nullptr;
-  bool aborting_ = false;  // in Abort or Recover: a cancel is not acted on twice
+  bool aborting_ = false;    // in Abort or Recover: a cancel is not acted on twice
   std::string last_damage_;  // first damaged frame since the last good one, to explain a loss
   bool connected_ = false;
   InstrumentInfo info_;
