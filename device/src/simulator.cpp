@@ -242,8 +242,39 @@ std::size_t SimulatedFirmware::Transmit(std::span<std::uint8_t> out) {
 void SimulatedFirmware::Send(MessageType type, const std::vector<std::uint8_t>& payload) {
   if (!link_up_ || stalled_ || hung_) return;
   ++frames_sent_;
-  const FaultPlan& f = config_.faults;
   const std::uint64_t n = frames_sent_;
+  if (type == MessageType::kSliceBegin)
+    stream_frame_ = 1;
+  else if (type == MessageType::kRowData || type == MessageType::kSliceEnd)
+    ++stream_frame_;
+  else
+    stream_frame_ = 0;
+  // The faults that apply to this frame, by type: frame-numbered ones at frame n, slice-relative
+  // ones at their frame of the first stream at their θin.
+  const std::vector<Fault>& faults = config_.faults.faults;
+  slice_fault_fired_.resize(faults.size(), false);
+  std::uint32_t firing = 0;
+  for (std::size_t i = 0; i < faults.size(); ++i) {
+    const Fault& fault = faults[i];
+    bool hit = false;
+    if (!fault.in_slice_theta_in_deg) {
+      hit = fault.at == n;
+    } else if (!slice_fault_fired_[i] && stream_frame_ == fault.at &&
+               std::fabs(*fault.in_slice_theta_in_deg - slice_theta_in_deg_) <= 1e-4f) {
+      hit = true;
+      // Damage to one transfer happens once; a failed lamp, a lost contact or an overheated
+      // detector stays so, for every stream at that θin (a host that missed the error report
+      // meets it again).
+      slice_fault_fired_[i] = fault.type != FaultType::kLampFailure &&
+                              fault.type != FaultType::kSampleContact &&
+                              fault.type != FaultType::kOverTemperature;
+    }
+    if (hit) firing |= 1u << static_cast<unsigned>(fault.type);
+  }
+  struct {
+    std::uint32_t bits;
+    bool Has(FaultType t, std::uint64_t) const { return (bits >> static_cast<unsigned>(t)) & 1u; }
+  } const f{firing};
   if (f.Has(FaultType::kDisconnect, n)) {
     link_up_ = false;
     streaming_ = false;

@@ -283,10 +283,17 @@ struct FaultCase {
   bool cancel_at_hold = false;
 };
 
-// Frames the firmware sends on the coarse 5° grid: 8 before the first slice, 18 per slice,
-// so frame 30 is a ROW_DATA of the second slice.
+// Each firmware fault is placed at the 4th frame of the stream at θin 20° (its SLICE_BEGIN is the
+// 1st): a ROW_DATA of the second slice, frame 30 of an undisturbed capture on the coarse 5° grid
+// (8 set-up frames, 18 per slice). Counted within that stream, not from the first frame, the
+// place does not move when a loaded machine makes an earlier step be measured again (a HID
+// report hidapi dropped, a reply later than the timeout): such a retry sends frames of its own.
 std::vector<FaultCase> FaultCases() {
-  auto plan = [](FaultType t, std::uint64_t n) { return FaultPlan{{Fault{t, n}}}; };
+  auto plan = [](FaultType t, std::uint64_t n) {
+    Fault f{t, n};
+    if (t != FaultType::kEndpointHalt) f = Fault{t, 4, 20.0f};
+    return FaultPlan{{f}};
+  };
   using O = CaptureOutcome;
   return {
       {"corrupt", plan(FaultType::kCorrupt, 30), O::kFinished, "CRC-32"},
@@ -321,14 +328,19 @@ class FaultsOver : public ::testing::TestWithParam<Link> {
   }
   void TearDown() override { std::filesystem::remove_all(dir_); }
 
-  CaptureRequest Request(const std::string& name) const {
+  // Real time for USB and HID: a short reply timeout keeps the cases quick whose instrument goes
+  // silent (timeout, stall), the driver's default (5 s) the others, so that on a loaded machine
+  // a late reply is not taken for a fault.
+  CaptureRequest Request(const std::string& name, int timeout_ms = 5000) const {
     CaptureRequest r;
     r.out_path = dir_ + "/" + name + ".bpc";
     r.theta_in_deg = {0, 20, 40, 60};
     r.sample_name = "gold";
     r.settings["seed"] = "11";
-    // Real time for USB and HID: a short reply timeout keeps the timeout cases quick.
-    r.driver.timeout_ms = 400;
+    r.driver.timeout_ms = timeout_ms;
+    // hidapi keeps 30 input reports and drops the oldest when a loaded host falls behind: the
+    // driver measures the step again, which must not use up the retries a fault case counts on.
+    if (GetParam() == Link::kHidapi) r.driver.retries = 8;
     return r;
   }
 
@@ -357,7 +369,8 @@ TEST_P(FaultsOver, EveryFaultGivesItsOutcomeAndResumeGivesTheUninterruptedCaptur
       faulty.on_hold = [&](std::uint64_t) { cancel.Raise(); };
       faulty.on_hold_released = [&] { released.store(true); };
     }
-    const CaptureRequest request = Request(k.name);
+    const bool silent = k.name == "timeout" || k.name == "stall";
+    const CaptureRequest request = Request(k.name, silent ? 400 : 5000);
     std::vector<std::string> retries;
     SessionEvents events;
     events.on_retry = [&](const std::string& m) { retries.push_back(m); };
@@ -373,7 +386,9 @@ TEST_P(FaultsOver, EveryFaultGivesItsOutcomeAndResumeGivesTheUninterruptedCaptur
     if (k.cancel_at_hold) {
       EXPECT_TRUE(cancel.raised());
       EXPECT_TRUE(released.load()) << "the cancel did not send ABORT to the instrument";
-      EXPECT_TRUE(retries.empty()) << retries[0];
+      if (GetParam() != Link::kHidapi) {
+        EXPECT_TRUE(retries.empty()) << retries[0];
+      }
     }
     if (k.outcome != CaptureOutcome::kFinished) {
       EXPECT_NE(r.message.find(k.message), std::string::npos) << r.message;
@@ -393,8 +408,11 @@ TEST_P(FaultsOver, EveryFaultGivesItsOutcomeAndResumeGivesTheUninterruptedCaptur
       EXPECT_TRUE(rr.resumed);
     } else {
       if (!k.message.empty()) {
+        // The fault's own retry (after any a loaded machine caused before it).
         ASSERT_FALSE(retries.empty());
-        EXPECT_NE(retries[0].find(k.message), std::string::npos) << retries[0];
+        EXPECT_TRUE(std::any_of(retries.begin(), retries.end(), [&](const std::string& m) {
+          return m.find(k.message) != std::string::npos;
+        })) << retries[0];
       }
       // A duplicated frame is dropped, not retried. (Over HID a retry can still happen on a
       // loaded machine: hidapi keeps only 30 input reports and drops the oldest when the host
@@ -450,7 +468,7 @@ TEST_P(FaultsOver, ACancelEndsAReadOfASilentInstrumentWithinTheCancelStep) {
 // read is already waiting (a read that did not wait would time out at once and retry).
 TEST_P(FaultsOver, ACancelFromAnotherThreadEndsTheHoldWithoutARetry) {
   SimulatorConfig c = Config(LibraryMaterial("gold"), 1, 5, 5, /*seed=*/11);
-  c.faults = FaultPlan{{Fault{FaultType::kHold, 30}}};
+  c.faults = FaultPlan{{Fault{FaultType::kHold, 4, 20.0f}}};
   CancelSignal cancel;
   std::promise<void> hold_started;
   std::atomic<bool> released{false}, held{false};
@@ -478,7 +496,10 @@ TEST_P(FaultsOver, ACancelFromAnotherThreadEndsTheHoldWithoutARetry) {
   EXPECT_TRUE(held.load());
   EXPECT_EQ(r.outcome, CaptureOutcome::kInterrupted) << r.message;
   EXPECT_NE(r.message.find("cancelled"), std::string::npos) << r.message;
-  EXPECT_TRUE(retries.empty()) << retries[0];
+  // (Over HID a loaded host can lose a report, which is measured again: see the duplicate case.)
+  if (GetParam() != Link::kHidapi) {
+    EXPECT_TRUE(retries.empty()) << retries[0];
+  }
   EXPECT_TRUE(released.load()) << "the cancel did not send ABORT to the instrument";
   EXPECT_EQ(r.slices_saved, 1u);
   EXPECT_EQ(ReadBpc(request.out_path).measurement.slices.size(), 1u);

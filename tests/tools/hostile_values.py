@@ -23,8 +23,9 @@ give it, written down here from the rule of docs/design.md §4 and §9 and docs/
 
 `export-csv` copies every sample (a CSV can hold any finite number): it accepts the value classes
 and says, in a warning naming slice and sample, what the other commands refuse. The readers are
-info, eval, convert, atlas, preview, fit, export-csv (captures), import (the CSV) and, when the
-pass is given the viewer (--viewer), brdf-view drawing the lobe off screen.
+info, eval, convert, atlas, preview, fit, export-csv (captures), import (the CSV), when the pass
+is given the viewer (--viewer) brdf-view drawing the lobe off screen, and when it is given the
+Python module (--python-path) brdf.open(FILE).eval_deg (the verdict of eval).
 
 Bad map texels (issue 20, finding 7) are classes of environment maps, read by every command
 that reads a map: `brdf preview --env` and, when the pass is given the Python module's folder
@@ -226,16 +227,41 @@ def command_line(command, vc, out):
     }[command]
 
 
-def check_class(tool, vc, work, findings, counts, viewer=""):
+# The Python module's reader: brdf.open(FILE) evaluated as `brdf eval FILE --in 30,0 --out
+# 30,180`; exit 1 with the exception's message on stderr when it refuses.
+PYTHON_EVAL = """
+import sys
+import brdf
+try:
+    brdf.open(sys.argv[1]).eval_deg(30, 0, 30, 180)
+except Exception as e:
+    print(f"{type(e).__name__}: {e}", file=sys.stderr)
+    sys.exit(1)
+"""
+
+
+def python_env(python_path):
+    return dict(os.environ, PYTHONPATH=python_path, OPENBLAS_NUM_THREADS="1",
+                PYTHONDONTWRITEBYTECODE="1")
+
+
+def check_class(tool, vc, work, findings, counts, viewer="", python_path=""):
     out = os.path.join(work, "values-out", vc.name)
     os.makedirs(out)
     results = {}
-    commands = [c for c in vc.expected if c != "brdf-view" or viewer]
+    expected = dict(vc.expected)
+    if python_path and "eval" in expected:
+        expected["python-open"] = expected["eval"]
+    commands = [c for c in expected if c != "brdf-view" or viewer]
     commands += ["convert-auto"] if vc.auto_defaults else []
     for command in commands:
-        program = viewer if command == "brdf-view" else tool
-        code, stdout, stderr, cpu, rss = run_measured(program, command_line(command, vc, out),
-                                                      work)
+        if command == "python-open":
+            code, stdout, stderr, cpu, rss = run_measured(
+                "/usr/bin/python3", ["-c", PYTHON_EVAL, vc.path], work, python_env(python_path))
+        else:
+            program = viewer if command == "brdf-view" else tool
+            code, stdout, stderr, cpu, rss = run_measured(
+                program, command_line(command, vc, out), work)
         results[command] = (code, stdout, stderr, cpu, rss)
         counts[command] = counts.get(command, 0) + 1
         where = f"value class {vc.name} {command}"
@@ -249,7 +275,7 @@ def check_class(tool, vc, work, findings, counts, viewer=""):
                             f"{PEAK_RSS_BYTES / 2**20:.0f} MiB")
         hi.check_run(hi.Variant(hi.Seed(os.path.basename(vc.path), vc.path, "values", []),
                                 vc.name, vc.path), command, code, stdout, stderr, findings)
-        want = vc.expected.get(command, 0)
+        want = expected.get(command, 0)
         if code != want:
             findings.append(f"{where}: exit code {code}, the verdict is {want}: "
                             f"{stderr.strip()[:300]}")
@@ -419,10 +445,7 @@ def check_maps(tool, work, python_path, findings, counts):
             runs["python-preview"] = [python, ["-c", PYTHON_PREVIEW, path]]
         results = {}
         for command, (program, args) in runs.items():
-            env = None
-            if command == "python-preview":
-                env = dict(os.environ, PYTHONPATH=python_path, OPENBLAS_NUM_THREADS="1",
-                           PYTHONDONTWRITEBYTECODE="1")
+            env = python_env(python_path) if command == "python-preview" else None
             code, stdout, stderr, cpu, rss = run_measured(program, args, mdir, env)
             results[command] = (code, stdout, stderr, cpu, rss)
             counts[command] = counts.get(command, 0) + 1
@@ -501,7 +524,7 @@ def run(tool, seeds_dir, work, table=False, python_path="", viewer=""):
             print(f"map class {name} {codes} (slowest {cpu:.2f} s CPU, peak RSS "
                   f"{rss / 2**20:.0f} MiB)")
     for vc in make_classes(tool, seeds_dir, work):
-        results = check_class(tool, vc, work, findings, counts, viewer)
+        results = check_class(tool, vc, work, findings, counts, viewer, python_path)
         runs += len(results)
         if table:
             codes = " ".join(f"{c}={r[0]}" for c, r in results.items())

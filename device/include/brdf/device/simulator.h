@@ -39,6 +39,7 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <random>
 #include <span>
 #include <string>
@@ -112,6 +113,12 @@ enum class FaultType {
 struct Fault {
   FaultType type = FaultType::kCorrupt;
   std::uint64_t at = 0;  // frame number N (kEndpointHalt: IN transfer number N), ≥ 1
+  // When set (a firmware fault only): N counts the frames of the first slice stream at this θin
+  // instead (its SLICE_BEGIN is frame 1), so the fault lands at the same place in the capture
+  // however often earlier steps were measured again (a retry after a frame the host lost sends
+  // frames of its own, which shift every later frame number). The instrument errors (lamp,
+  // contact, over-temperature) then apply to every stream at that θin: the state persists.
+  std::optional<float> in_slice_theta_in_deg;
 };
 
 struct FaultPlan {
@@ -215,6 +222,8 @@ class SimulatedFirmware {
   bool stalled_ = false;
   bool hung_ = false;                     // kTimeout, kHold: silent until ABORT
   bool held_ = false;                     // kHold
+  std::uint64_t stream_frame_ = 0;        // frames of the slice stream, SLICE_BEGIN = 1
+  std::vector<bool> slice_fault_fired_;   // per fault: a slice-relative fault fires once
   std::vector<std::uint8_t> held_frame_;  // kReorder: frame N, sent after frame N+1
   ExposureSetting exposure_;
   std::mt19937_64 rng_;
