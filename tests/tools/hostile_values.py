@@ -396,7 +396,8 @@ def write_map(path, fmt, edit):
         raise SystemExit(f"hostile_values: cannot write {path} with OpenImageIO")
     out.write_image(px)
     out.close()
-    stored = px.astype(np.float16).astype(np.float32) if fmt == "half" else px
+    with np.errstate(over="ignore"):  # the overflow to +Inf is the point
+        stored = px.astype(np.float16).astype(np.float32) if fmt == "half" else px
     kinds = dict.fromkeys(MAP_KINDS, 0)
     bad = 0
     for texel in stored.reshape(-1, 3):
@@ -463,7 +464,11 @@ def check_maps(tool, work, python_path, findings, counts):
                 findings.append(f"{where}: exit code {code}, the verdict is {want}: "
                                 f"{(stderr or stdout).strip()[:300]}")
             if command == "preview-env":
-                hi.check_run(hi.Variant(hi.Seed(name + ".exr", path, "values", []), name, path),
+                # The pass's checks of every run (one line, the file named, no library words),
+                # without its position rule for damaged bytes: these maps are intact files whose
+                # values are wrong as a whole, which the line counts instead.
+                hi.check_run(hi.Variant(hi.Seed(name + ".exr", path, "values", []), name, path,
+                                        special=True),
                              command, code, stdout, stderr, findings)
                 lines = [line for line in stderr.split("\n") if line.strip()]
                 if len(lines) != 1:
