@@ -157,8 +157,7 @@ std::string GeometryText(const GeometryInfo& g) {
 }
 
 CaptureSessionResult RunCaptureSession(const CaptureRequest& request, Transport& link,
-                                       const SessionEvents& events,
-                                       const std::atomic<bool>* cancel) {
+                                       const SessionEvents& events, const CancelSignal* cancel) {
   const std::string& path = request.out_path;
   if (!EndsWithBpc(path))
     throw InvalidArgument("the capture file must be a .bpc file, got '" + path + "'");

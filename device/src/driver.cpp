@@ -13,6 +13,7 @@
 #include "brdf/core/error.h"
 #include "brdf/core/geometry.h"
 #include "brdf/core/text_format.h"
+#include "brdf/device/cancel.h"
 
 namespace brdf::device {
 namespace {
@@ -85,6 +86,38 @@ void SqrtInPlace(std::span<double> v) {
 Driver::Driver(Transport& transport, DriverOptions options)
     : transport_(transport), options_(std::move(options)) {}
 
+void Driver::SetCancelFlag(const CancelSignal* cancel) {
+  cancel_ = cancel;
+  transport_.SetCancel(cancel);
+}
+
+bool Driver::cancelled() const { return cancel_ != nullptr && cancel_->raised(); }
+
+Driver::~Driver() {
+  if (cancel_ != nullptr) transport_.SetCancel(nullptr);
+}
+
+// While ABORT's acknowledgement is awaited (Abort, Recover) a raised cancel is not acted on
+// again, and the transport's reads wait their whole timeout: the acknowledgement is what a
+// cancel waits for.
+class Driver::AbortScope {
+ public:
+  explicit AbortScope(Driver& d) : d_(d), old_(d.aborting_) {
+    d_.aborting_ = true;
+    if (d_.cancel_ != nullptr) d_.transport_.SetCancel(nullptr);
+  }
+  ~AbortScope() {
+    d_.aborting_ = old_;
+    if (!old_ && d_.cancel_ != nullptr) d_.transport_.SetCancel(d_.cancel_);
+  }
+  AbortScope(const AbortScope&) = delete;
+  AbortScope& operator=(const AbortScope&) = delete;
+
+ private:
+  Driver& d_;
+  bool old_;
+};
+
 void Driver::Fail(FaultKind kind, const std::string& what) const {
   throw DriverFault(kind, transport_.Description() + ": " + what);
 }
@@ -147,6 +180,12 @@ Frame Driver::NextFrame(std::string_view waiting_for, bool check_sequence) {
       throw DriverFault(FaultKind::kDisconnected, e.what());
     }
     if (n == 0) {
+      // A read that ended early for the cancel (or timed out after it): stop the scan.
+      if (cancelled() && !aborting_) {
+        Abort();
+        Fail(FaultKind::kCancelled, "capture cancelled while waiting for " +
+                                        std::string(waiting_for) + "; the scan was stopped");
+      }
       if (!last_damage_.empty())
         Fail(FaultKind::kDamagedFrame,
              "damaged frame while waiting for " + std::string(waiting_for) + ": " + last_damage_);
@@ -412,13 +451,13 @@ Slice Driver::MeasureSlice(double theta_in_deg, SliceReport* report) {
 }
 
 void Driver::Abort() {
+  const AbortScope aborting(*this);
   Send(MessageType::kAbort, {});
   for (;;) {
     const Frame f = NextFrame("ACK of ABORT");
     const auto type = static_cast<MessageType>(f.type);
-    if (type == MessageType::kRowData || type == MessageType::kSliceEnd ||
-        type == MessageType::kSliceBegin)
-      continue;  // the rest of the stream that was already on its way
+    if (type != MessageType::kAck && type != MessageType::kError)
+      continue;  // the rest of a stream, or a reply, that was already on its way
     if (type != MessageType::kAck) ThrowInstrumentError(f, MessageType::kAbort);
     return;
   }
@@ -428,6 +467,7 @@ void Driver::Recover() {
   // Whatever was in flight is suspect: forget the buffered bytes and the sequence, then wait
   // for the acknowledgement of a fresh ABORT, skipping anything else (the tail of a stream, a
   // late reply, an error about the damaged request).
+  const AbortScope aborting(*this);
   reader_.Clear();
   last_damage_.clear();
   Send(MessageType::kAbort, {});

@@ -1,4 +1,5 @@
 #include "brdf/core/error.h"
+#include "brdf/device/cancel.h"
 #include "brdf/device/simulator.h"
 #include "brdf/device/transport.h"
 
@@ -14,6 +15,8 @@ std::size_t LoopbackTransport::Read(std::span<std::uint8_t> buffer, int /*timeou
   const std::size_t n = firmware_.Transmit(buffer);
   if (n == 0 && !firmware_.link_up())
     throw DeviceError(Description() + ": the instrument disconnected (read failed)");
+  // A held firmware answers nothing until ABORT, which the host sends once it is cancelled.
+  if (n == 0 && firmware_.held() && cancel_ != nullptr) cancel_->Wait(-1);
   return n;
 }
 

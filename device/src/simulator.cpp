@@ -98,11 +98,17 @@ bool FaultPlan::HasFirmwareFaults() const {
 
 FaultPlan ParseFaultPlan(std::string_view spec) {
   static constexpr std::pair<std::string_view, FaultType> kNames[] = {
-      {"disconnect", FaultType::kDisconnect},    {"stall", FaultType::kStall},
-      {"timeout", FaultType::kTimeout},          {"corrupt", FaultType::kCorrupt},
-      {"duplicate", FaultType::kDuplicate},      {"reorder", FaultType::kReorder},
-      {"lamp", FaultType::kLampFailure},         {"contact", FaultType::kSampleContact},
-      {"overtemp", FaultType::kOverTemperature}, {"halt", FaultType::kEndpointHalt}};
+      {"disconnect", FaultType::kDisconnect},
+      {"stall", FaultType::kStall},
+      {"timeout", FaultType::kTimeout},
+      {"corrupt", FaultType::kCorrupt},
+      {"duplicate", FaultType::kDuplicate},
+      {"reorder", FaultType::kReorder},
+      {"lamp", FaultType::kLampFailure},
+      {"contact", FaultType::kSampleContact},
+      {"overtemp", FaultType::kOverTemperature},
+      {"halt", FaultType::kEndpointHalt},
+      {"hold", FaultType::kHold}};
   std::string names;
   for (const auto& [name, type] : kNames) names += (names.empty() ? "" : ", ") + std::string(name);
   FaultPlan plan;
@@ -236,8 +242,39 @@ std::size_t SimulatedFirmware::Transmit(std::span<std::uint8_t> out) {
 void SimulatedFirmware::Send(MessageType type, const std::vector<std::uint8_t>& payload) {
   if (!link_up_ || stalled_ || hung_) return;
   ++frames_sent_;
-  const FaultPlan& f = config_.faults;
   const std::uint64_t n = frames_sent_;
+  if (type == MessageType::kSliceBegin)
+    stream_frame_ = 1;
+  else if (type == MessageType::kRowData || type == MessageType::kSliceEnd)
+    ++stream_frame_;
+  else
+    stream_frame_ = 0;
+  // The faults that apply to this frame, by type: frame-numbered ones at frame n, slice-relative
+  // ones at their frame of the first stream at their θin.
+  const std::vector<Fault>& faults = config_.faults.faults;
+  slice_fault_fired_.resize(faults.size(), false);
+  std::uint32_t firing = 0;
+  for (std::size_t i = 0; i < faults.size(); ++i) {
+    const Fault& fault = faults[i];
+    bool hit = false;
+    if (!fault.in_slice_theta_in_deg) {
+      hit = fault.at == n;
+    } else if (!slice_fault_fired_[i] && stream_frame_ == fault.at &&
+               std::fabs(*fault.in_slice_theta_in_deg - slice_theta_in_deg_) <= 1e-4f) {
+      hit = true;
+      // Damage to one transfer happens once; a failed lamp, a lost contact or an overheated
+      // detector stays so, for every stream at that θin (a host that missed the error report
+      // meets it again).
+      slice_fault_fired_[i] = fault.type != FaultType::kLampFailure &&
+                              fault.type != FaultType::kSampleContact &&
+                              fault.type != FaultType::kOverTemperature;
+    }
+    if (hit) firing |= 1u << static_cast<unsigned>(fault.type);
+  }
+  struct {
+    std::uint32_t bits;
+    bool Has(FaultType t, std::uint64_t) const { return (bits >> static_cast<unsigned>(t)) & 1u; }
+  } const f{firing};
   if (f.Has(FaultType::kDisconnect, n)) {
     link_up_ = false;
     streaming_ = false;
@@ -248,9 +285,13 @@ void SimulatedFirmware::Send(MessageType type, const std::vector<std::uint8_t>& 
     streaming_ = false;
     return;
   }
-  if (f.Has(FaultType::kTimeout, n)) {
+  if (f.Has(FaultType::kTimeout, n) || f.Has(FaultType::kHold, n)) {
     hung_ = true;
     streaming_ = false;
+    if (f.Has(FaultType::kHold, n)) {
+      held_ = true;
+      if (config_.on_hold) config_.on_hold(n);
+    }
     return;
   }
   for (const auto& [fault, code, text] :
@@ -308,6 +349,10 @@ void SimulatedFirmware::Handle(const Frame& frame) {
   if (hung_) {
     if (type != MessageType::kAbort) return;
     hung_ = false;  // the host's ABORT wakes a hung firmware
+    if (held_) {
+      held_ = false;
+      if (config_.on_hold_released) config_.on_hold_released();
+    }
   }
   if (streaming_) {
     if (type == MessageType::kAbort) {

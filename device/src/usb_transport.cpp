@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <chrono>
 #include <cstdio>
 #include <cstring>
 #include <cwchar>
@@ -16,6 +17,7 @@
 #include <system_error>
 
 #include "brdf/core/error.h"
+#include "brdf/device/cancel.h"
 #include "brdf/device/driver.h"
 
 namespace brdf::device {
@@ -50,6 +52,31 @@ bool Matches(const DeviceSpec& spec, std::uint16_t vid, std::uint16_t pid, bool 
 class CountingTransport : public Transport {
  public:
   TransportStats stats;
+  void SetCancel(const CancelSignal* cancel) override { cancel_ = cancel; }
+
+ protected:
+  // Runs `attempt(wait_ms)` (one transfer waiting at most wait_ms; true when it ended with
+  // bytes, an error or anything but a plain timeout) until it does so or `timeout_ms` passed:
+  // in one wait without a cancel, in steps of at most kCancelStepMs with one, stopping at the
+  // first step that ends with the cancel raised (usb_transport.h).
+  template <class Attempt>
+  void WaitInSteps(int timeout_ms, Attempt attempt) const {
+    if (cancel_ == nullptr || timeout_ms <= kCancelStepMs) {
+      attempt(timeout_ms);
+      return;
+    }
+    using Clock = std::chrono::steady_clock;
+    const Clock::time_point deadline = Clock::now() + std::chrono::milliseconds(timeout_ms);
+    for (;;) {
+      const auto left =
+          std::chrono::duration_cast<std::chrono::milliseconds>(deadline - Clock::now()).count();
+      const int wait = static_cast<int>(std::clamp<long long>(left, 1, kCancelStepMs));
+      if (attempt(wait) || cancel_->raised() || left <= kCancelStepMs) return;
+    }
+  }
+
+ private:
+  const CancelSignal* cancel_ = nullptr;
 };
 
 // ---- libusb ----------------------------------------------------------------------------
@@ -169,18 +196,21 @@ class LibusbTransport final : public CountingTransport {
       std::vector<std::uint8_t>& bytes = inbox_.Refill();
       bytes.resize(model_.bulk_read_bytes);
       int got = 0, halts = 0;
-      for (;;) {
-        const int r = libusb_bulk_transfer(handle_, model_.bulk_in_endpoint, bytes.data(),
-                                           static_cast<int>(bytes.size()), &got, timeout_ms);
-        ++stats.transfers_in;
-        if (r == 0 || (r == LIBUSB_ERROR_TIMEOUT)) break;
-        if (r == LIBUSB_ERROR_PIPE && halts++ < kMaxHaltRetries) {
-          ClearHalt(model_.bulk_in_endpoint);
-          continue;
+      WaitInSteps(timeout_ms, [&](int wait_ms) {
+        for (;;) {
+          const int r = libusb_bulk_transfer(handle_, model_.bulk_in_endpoint, bytes.data(),
+                                             static_cast<int>(bytes.size()), &got, wait_ms);
+          ++stats.transfers_in;
+          if (r == 0) return true;
+          if (r == LIBUSB_ERROR_TIMEOUT) return got > 0;
+          if (r == LIBUSB_ERROR_PIPE && halts++ < kMaxHaltRetries) {
+            ClearHalt(model_.bulk_in_endpoint);
+            continue;
+          }
+          bytes.clear();
+          Throw(r, "read");
         }
-        bytes.clear();
-        Throw(r, "read");
-      }
+      });
       bytes.resize(static_cast<std::size_t>(std::max(got, 0)));
       if (bytes.empty()) return 0;
     }
@@ -263,8 +293,12 @@ class HidTransport final : public CountingTransport {
     if (inbox_.Empty()) {
       std::vector<std::uint8_t>& bytes = inbox_.Refill();
       report_.resize(model_.hid_report_bytes);
-      const int r = hid_read_timeout(dev_, report_.data(), report_.size(), timeout_ms);
-      ++stats.transfers_in;
+      int r = 0;
+      WaitInSteps(timeout_ms, [&](int wait_ms) {
+        r = hid_read_timeout(dev_, report_.data(), report_.size(), wait_ms);
+        ++stats.transfers_in;
+        return r != 0;
+      });
       if (r < 0)
         throw DeviceError(description_ + ": the instrument disconnected (read failed: " +
                           Narrow(hid_error(dev_)) + ")");

@@ -279,6 +279,8 @@ std::pair<py::array_t<float>, std::vector<std::string>> Preview(const std::strin
   py::array_t<float> out({static_cast<py::ssize_t>(image.height),
                           static_cast<py::ssize_t>(image.width), py::ssize_t{3}});
   std::copy(image.rgb.begin(), image.rgb.end(), out.mutable_data());
+  // The map's bad texels (NaN, ±Inf, negative) in the words `brdf preview` prints.
+  if (!map.load_warning().empty()) opened.warnings.push_back(map.load_warning());
   return {std::move(out), std::move(opened.warnings)};
 }
 
@@ -325,7 +327,8 @@ py::dict Capture(const CaptureArguments& a) {
   // Ctrl-C: while the session runs (on a worker thread, without the GIL) this thread checks
   // Python's signals every 20 ms; a KeyboardInterrupt sets `cancel`, the session stops after
   // the slice in progress (the file stays a valid unfinished capture) and is re-raised here.
-  std::atomic<bool> cancel{false}, done{false};
+  device::CancelSignal cancel;
+  std::atomic<bool> done{false};
   bool interrupted_by_user = false;
   device::CaptureSessionResult r;
   std::exception_ptr error;
@@ -345,7 +348,7 @@ py::dict Capture(const CaptureArguments& a) {
       const py::gil_scoped_acquire gil;
       if (PyErr_CheckSignals() != 0) {  // the exception stays set on this thread
         interrupted_by_user = true;
-        cancel.store(true);
+        cancel.Raise();
       }
     }
     session.join();

@@ -24,6 +24,7 @@ files (empty, FIFO, folder, /dev/zero, /dev/null, a sparse 3 GiB file with a val
 Every command that reads such a file runs under a CPU-time limit (10 s of user + system time,
 RLIMIT_CPU: the machine's load does not count), a generous wall-clock limit (60 s, for a
 command that blocks without computing) and an address-space cap (4 GiB) and is checked for:
+  - peak resident memory (the kernel's ru_maxrss of that run) at most 1 GiB;
   - no signal, no timeout, exit code 0, 1 (error) or 2 (command line), never 3 (internal error);
   - positive control: every command accepts each seed's valid file (exit 0);
   - on failure: stderr is one line that names the file, with no C++ identifiers (`::`), no
@@ -56,12 +57,18 @@ import struct
 import subprocess
 import sys
 import tempfile
+import threading
 import time
 import zlib
 
 CPU_LIMIT_S = 10   # user + system seconds per command (RLIMIT_CPU)
 TIMEOUT_S = 60     # wall clock per command: only for a command that waits without computing
 ADDRESS_SPACE_BYTES = 4 << 30
+# Peak resident memory per command. The reading commands peak at 14–64 MiB on the pass's small
+# files (info 14, convert 23, preview 37 on the intact capture; info of a capture builds the
+# filled LUT, about 100 MB); 1 GiB leaves room for a slow machine's allocator and still catches
+# memory that grows with a lying count or a value rather than with what the file holds.
+PEAK_RSS_BYTES = 1 << 30
 SEED = 20261201
 
 FORBIDDEN = [
@@ -635,7 +642,10 @@ class Variant:
 READERS = ["info", "eval", "convert"]
 
 
-def run_tool(tool, args, cwd):
+def run_measured(tool, args, cwd, env=None):
+    """(exit code or "timeout", stdout, stderr, CPU seconds, peak RSS bytes, wall seconds) of one
+    run under the pass's limits: RLIMIT_AS, RLIMIT_CPU and the wall clock. CPU time (user +
+    system) and peak RSS are the kernel's for that one child (wait4's rusage)."""
     def limits():
         resource.setrlimit(resource.RLIMIT_AS, (ADDRESS_SPACE_BYTES, ADDRESS_SPACE_BYTES))
         # SIGXCPU at the soft limit, SIGKILL a second later (check_run names both).
@@ -644,17 +654,35 @@ def run_tool(tool, args, cwd):
         os.setsid()
 
     start = time.monotonic()
-    proc = subprocess.Popen([tool] + args, cwd=cwd, stdin=subprocess.DEVNULL,
-                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, preexec_fn=limits)
-    try:
-        out, err = proc.communicate(timeout=TIMEOUT_S)
-        code = proc.returncode
-    except subprocess.TimeoutExpired:
-        os.killpg(proc.pid, 9)
-        out, err = proc.communicate()
-        code = "timeout"
-    return code, out.decode("utf-8", "replace"), err.decode("utf-8", "replace"), \
-        time.monotonic() - start
+    with tempfile.TemporaryFile() as out_f, tempfile.TemporaryFile() as err_f:
+        proc = subprocess.Popen([tool] + args, cwd=cwd, stdin=subprocess.DEVNULL, stdout=out_f,
+                                stderr=err_f, preexec_fn=limits, env=env)
+        timed_out = []
+
+        def kill():
+            timed_out.append(True)
+            try:
+                os.killpg(proc.pid, 9)
+            except ProcessLookupError:
+                pass
+
+        timer = threading.Timer(TIMEOUT_S, kill)
+        timer.start()
+        _, status, usage = os.wait4(proc.pid, 0)
+        timer.cancel()
+        proc.returncode = os.waitstatus_to_exitcode(status)  # reaped here, not by Popen
+        out_f.seek(0)
+        err_f.seek(0)
+        code = "timeout" if timed_out else proc.returncode
+        return (code, out_f.read().decode("utf-8", "replace"),
+                err_f.read().decode("utf-8", "replace"), usage.ru_utime + usage.ru_stime,
+                usage.ru_maxrss * 1024, time.monotonic() - start)
+
+
+def run_tool(tool, args, cwd):
+    """(exit code or "timeout", stdout, stderr, peak RSS bytes) of one run (run_measured)."""
+    code, out, err, _, rss, _ = run_measured(tool, args, cwd)
+    return code, out, err, rss
 
 
 def must(tool, args, cwd):
@@ -1132,6 +1160,11 @@ def main():
                         help="print each file's exit codes and first stderr line")
     parser.add_argument("--data-default", default="",
                         help="the build's BRDF_DATA_DIR, used when the variable is not set")
+    parser.add_argument("--viewer", default="",
+                        help="brdf-view, which then reads the value classes too")
+    parser.add_argument("--python-path", default="",
+                        help="the folder holding the Python module brdf: its brdf.preview reads "
+                             "the bad-texel maps too")
     args = parser.parse_args()
     data_dir = (os.environ.get("BRDF_DATA_DIR") or args.data_default or
                 os.path.join(args.source_dir, "..", "shared", "brdf-data"))
@@ -1159,9 +1192,12 @@ def main():
             i, v = item
             results, local = {}, []
             for command, cmd in command_lines(v, work, i, args.source_dir):
-                code, out, err, _ = run_tool(args.tool, cmd, work)
+                code, out, err, rss = run_tool(args.tool, cmd, work)
                 results[command] = (code, out, err)
                 check_run(v, command, code, out, err, local)
+                if rss > PEAK_RSS_BYTES:
+                    local.append(f"{v.seed.name} [{v.label}] {command}: peak RSS "
+                                 f"{rss / 2**20:.0f} MiB > {PEAK_RSS_BYTES / 2**20:.0f} MiB")
             check_agreement(v, results, work, i, local)
             return v, results, local
 
@@ -1183,7 +1219,8 @@ def main():
         if re.search(args.only, "value class"):
             import hostile_values
             value_findings, value_runs, value_counts = hostile_values.run(
-                args.tool, os.path.join(work, "seeds"), work, args.table)
+                args.tool, os.path.join(work, "seeds"), work, args.table, args.python_path,
+                args.viewer)
             findings += value_findings
             runs += value_runs
             for command, n in value_counts.items():

@@ -22,68 +22,51 @@ give it, written down here from the rule of docs/design.md §4 and §9 and docs/
   material-bad-extrapolate  gold.json, "extrapolate": p = −1     every reader
 
 `export-csv` copies every sample (a CSV can hold any finite number): it accepts the value classes
-and says, in a warning naming slice and sample, what the other commands refuse.
+and says, in a warning naming slice and sample, what the other commands refuse. The readers are
+info, eval, convert, atlas, preview, fit, export-csv (captures), import (the CSV), when the pass
+is given the viewer (--viewer) brdf-view drawing the lobe off screen, and when it is given the
+Python module (--python-path) brdf.open(FILE).eval_deg (the verdict of eval).
+
+Bad map texels (issue 20, finding 7) are classes of environment maps, read by every command
+that reads a map: `brdf preview --env` and, when the pass is given the Python module's folder
+(--python-path), the module's brdf.preview(env=...). (`brdf-view` lights with its built-in
+studio map only and reads no map file.) Each map is a 64 × 32 EXR written by OpenImageIO with
+numpy; the expected count and kinds come from the array as stored in the file (a half-float EXR
+holds float16, where 1e6 is +Inf), counted by the first channel of a texel that is not a finite
+value >= 0, in channel order (docs/robustness.md, finding 7):
+
+  class              texels                                     verdict
+  map-nan            3 NaN                                      accepted, one warning line
+  map-inf            2 +Inf, 2 -Inf                             accepted, one warning line
+  map-negative       4 negative (−1e-3 … −3)                    accepted, one warning line
+  map-half-sun       a 2 × 2 sun of 1e6 in a half-float EXR     accepted, the warning names the
+                                                                half-float overflow
+  map-mixed          NaN, ±Inf and negative texels together     accepted, one warning line
+  map-all-inf        every texel +Inf (half-float)              refused in one line naming the
+                                                                file, "all 2048 hold"
 
 Every run is also held to the pass's bounds: at most CPU_LIMIT_S (10 s) of CPU time, TIMEOUT_S of
 wall time, and PEAK_RSS_BYTES of peak resident memory (ru_maxrss and ru_utime + ru_stime of that
-one child, from wait4). Bad map texels (NaN, ±Inf,
-negative, an all-Inf map) are the environment-map reader's class and are checked with that
-fix (issue 20, finding 7), not here.
+one child, from wait4).
 """
 
 import json
+import math
 import os
+import re
 import shutil
 import struct
-import subprocess
-import tempfile
-import threading
 
 import hostile_inputs as hi
 
-# The reading commands peak at 14–64 MiB of resident memory on these small files (info 14,
-# convert 23, preview 37 on the intact capture); a quarter of the pass's address-space limit
-# leaves room for a slow machine's allocator and still catches memory that grows with a value
-# rather than with the file.
-PEAK_RSS_BYTES = 1 << 30
-# 10 s of CPU per run (the pass's CPU_LIMIT_S where it has one, enforced with RLIMIT_CPU), and its
-# wall-clock limit for a run that waits without computing.
-CPU_LIMIT_S = getattr(hi, "CPU_LIMIT_S", 10)
+PEAK_RSS_BYTES = hi.PEAK_RSS_BYTES
+CPU_LIMIT_S = hi.CPU_LIMIT_S
 
 
-def run_measured(tool, args, cwd):
+def run_measured(tool, args, cwd, env=None):
     """(exit code or "timeout", stdout, stderr, CPU seconds, peak RSS bytes) of one run, under
-    the pass's address-space, CPU and wall-clock limits."""
-    with tempfile.TemporaryFile() as out_f, tempfile.TemporaryFile() as err_f:
-        def limits():
-            import resource
-            resource.setrlimit(resource.RLIMIT_AS, (hi.ADDRESS_SPACE_BYTES, hi.ADDRESS_SPACE_BYTES))
-            resource.setrlimit(resource.RLIMIT_CORE, (0, 0))
-            resource.setrlimit(resource.RLIMIT_CPU, (CPU_LIMIT_S, CPU_LIMIT_S + 1))
-            os.setsid()
-
-        proc = subprocess.Popen([tool] + args, cwd=cwd, stdin=subprocess.DEVNULL, stdout=out_f,
-                                stderr=err_f, preexec_fn=limits)
-        timed_out = []
-
-        def kill():
-            timed_out.append(True)
-            try:
-                os.killpg(proc.pid, 9)
-            except ProcessLookupError:
-                pass
-
-        timer = threading.Timer(hi.TIMEOUT_S, kill)
-        timer.start()
-        _, status, usage = os.wait4(proc.pid, 0)
-        timer.cancel()
-        proc.returncode = os.waitstatus_to_exitcode(status)  # reaped here, not by Popen
-        cpu = usage.ru_utime + usage.ru_stime
-        out_f.seek(0)
-        err_f.seek(0)
-        code = "timeout" if timed_out else proc.returncode
-        return (code, out_f.read().decode("utf-8", "replace"),
-                err_f.read().decode("utf-8", "replace"), cpu, usage.ru_maxrss * 1024)
+    the pass's address-space, CPU and wall-clock limits (hostile_inputs.run_measured)."""
+    return hi.run_measured(tool, args, cwd, env)[:5]
 
 
 # ---------------------------------------------------------------------------------------------
@@ -154,11 +137,11 @@ def keep_one_per_slice(_, records):
 
 
 REFUSED_BY_ALL = {"info": 1, "eval": 1, "convert": 1, "atlas": 1, "preview": 1, "fit": 1,
-                  "export-csv": 0}
+                  "export-csv": 0, "brdf-view": 1}
 ACCEPTED_BY_ALL = {"info": 0, "eval": 0, "convert": 0, "atlas": 0, "preview": 0, "fit": 0,
-                   "export-csv": 0}
+                   "export-csv": 0, "brdf-view": 0}
 CONVERT_ONLY = {"info": 1, "eval": 0, "convert": 1, "atlas": 1, "preview": 0, "fit": 0,
-                "export-csv": 0}
+                "export-csv": 0, "brdf-view": 0}
 
 
 class ValueClass:
@@ -198,7 +181,8 @@ def make_classes(tool, seeds_dir, work):
     path = os.path.join(vdir, "csv-one-row.csv")
     open(path, "w").write("\n".join(one_row))
     classes.append(ValueClass("csv-one-row", path,
-                              {"info": 0, "eval": 0, "preview": 0, "fit": 0, "import": 0},
+                              {"info": 0, "eval": 0, "preview": 0, "fit": 0, "import": 0,
+                               "brdf-view": 0},
                               fit_warns=True))
 
     for name, theta_in in (("theta-in-30", "30"), ("theta-in-10-30-50", "10,30,50")):
@@ -215,7 +199,7 @@ def make_classes(tool, seeds_dir, work):
     json.dump(gold, open(path, "w"))
     classes.append(ValueClass("material-bad-extrapolate", path,
                               {"info": 1, "eval": 1, "convert": 1, "atlas": 1, "preview": 1,
-                               "fit": 1}))
+                               "fit": 1, "brdf-view": 1}))
     return classes
 
 
@@ -238,16 +222,46 @@ def command_line(command, vc, out):
                 "--out", os.path.join(out, "f.json")],
         "export-csv": ["export-csv", p, "--out", os.path.join(out, "e.csv")],
         "import": ["import", p, "--out", os.path.join(out, "i.bpc")],
+        # brdf-view's lobe, drawn off screen (it starts its own Xvfb when there is no display).
+        "brdf-view": [p, "--screenshot", os.path.join(out, "v.png"), "--size", "64x64"],
     }[command]
 
 
-def check_class(tool, vc, work, findings, counts):
+# The Python module's reader: brdf.open(FILE) evaluated as `brdf eval FILE --in 30,0 --out
+# 30,180`; exit 1 with the exception's message on stderr when it refuses.
+PYTHON_EVAL = """
+import sys
+import brdf
+try:
+    brdf.open(sys.argv[1]).eval_deg(30, 0, 30, 180)
+except Exception as e:
+    print(f"{type(e).__name__}: {e}", file=sys.stderr)
+    sys.exit(1)
+"""
+
+
+def python_env(python_path):
+    return dict(os.environ, PYTHONPATH=python_path, OPENBLAS_NUM_THREADS="1",
+                PYTHONDONTWRITEBYTECODE="1")
+
+
+def check_class(tool, vc, work, findings, counts, viewer="", python_path=""):
     out = os.path.join(work, "values-out", vc.name)
     os.makedirs(out)
     results = {}
-    commands = list(vc.expected) + (["convert-auto"] if vc.auto_defaults else [])
+    expected = dict(vc.expected)
+    if python_path and "eval" in expected:
+        expected["python-open"] = expected["eval"]
+    commands = [c for c in expected if c != "brdf-view" or viewer]
+    commands += ["convert-auto"] if vc.auto_defaults else []
     for command in commands:
-        code, stdout, stderr, cpu, rss = run_measured(tool, command_line(command, vc, out), work)
+        if command == "python-open":
+            code, stdout, stderr, cpu, rss = run_measured(
+                "/usr/bin/python3", ["-c", PYTHON_EVAL, vc.path], work, python_env(python_path))
+        else:
+            program = viewer if command == "brdf-view" else tool
+            code, stdout, stderr, cpu, rss = run_measured(
+                program, command_line(command, vc, out), work)
         results[command] = (code, stdout, stderr, cpu, rss)
         counts[command] = counts.get(command, 0) + 1
         where = f"value class {vc.name} {command}"
@@ -261,7 +275,7 @@ def check_class(tool, vc, work, findings, counts):
                             f"{PEAK_RSS_BYTES / 2**20:.0f} MiB")
         hi.check_run(hi.Variant(hi.Seed(os.path.basename(vc.path), vc.path, "values", []),
                                 vc.name, vc.path), command, code, stdout, stderr, findings)
-        want = vc.expected.get(command, 0)
+        want = expected.get(command, 0)
         if code != want:
             findings.append(f"{where}: exit code {code}, the verdict is {want}: "
                             f"{stderr.strip()[:300]}")
@@ -325,12 +339,197 @@ def check_class(tool, vc, work, findings, counts):
     return results
 
 
-def run(tool, seeds_dir, work, table=False):
-    """(findings, runs, counts) of every value class."""
+# ---------------------------------------------------------------------------------------------
+# Bad map texels.
+
+MAP_WIDTH, MAP_HEIGHT = 64, 32
+# The kinds in the order and words of the warning; a texel counts as the first channel's kind.
+MAP_KINDS = ("NaN", "+Inf", "-Inf", "negative")
+
+
+def map_classes():
+    """[(name, pixel format, edit(px))]: px is a float32 (32, 64, 3) array of 0.5."""
+    import numpy as np
+
+    def nan(px):
+        px[1, 2, 0] = np.nan
+        px[3, 4, 1] = np.nan
+        px[30, 60, 2] = np.nan
+
+    def inf(px):
+        px[5, 6, :] = np.inf
+        px[0, 0, 1] = np.inf
+        px[7, 8, 2] = -np.inf
+        px[31, 63, 0] = -np.inf
+
+    def negative(px):
+        px[9, 10, 1] = -0.25
+        px[9, 11, 0] = -3
+        px[9, 12, 2] = -1e-3
+        px[20, 40, :] = -1
+
+    def sun(px):
+        px[4:6, 10:12, :] = 1e6  # beyond float16's 65504: +Inf in the file
+
+    def mixed(px):
+        nan(px)
+        inf(px)
+        negative(px)
+        px[1, 2, 1] = -np.inf  # a NaN first: counted as NaN
+
+    def all_inf(px):
+        px[:] = np.inf
+
+    return [("map-nan", "float", nan), ("map-inf", "float", inf),
+            ("map-negative", "float", negative), ("map-half-sun", "half", sun),
+            ("map-mixed", "float", mixed), ("map-all-inf", "half", all_inf)]
+
+
+def write_map(path, fmt, edit):
+    """Writes the map; returns (bad texels, {kind: count}) of what the file holds."""
+    import numpy as np
+    import OpenImageIO as oiio
+    px = np.full((MAP_HEIGHT, MAP_WIDTH, 3), 0.5, np.float32)
+    edit(px)
+    out = oiio.ImageOutput.create(path)
+    if not out or not out.open(path, oiio.ImageSpec(MAP_WIDTH, MAP_HEIGHT, 3, fmt)):
+        raise SystemExit(f"hostile_values: cannot write {path} with OpenImageIO")
+    out.write_image(px)
+    out.close()
+    with np.errstate(over="ignore"):  # the overflow to +Inf is the point
+        stored = px.astype(np.float16).astype(np.float32) if fmt == "half" else px
+    kinds = dict.fromkeys(MAP_KINDS, 0)
+    bad = 0
+    for texel in stored.reshape(-1, 3):
+        for v in texel:
+            v = float(v)
+            kind = ("NaN" if math.isnan(v) else "+Inf" if v == math.inf else
+                    "-Inf" if v == -math.inf else "negative" if v < 0 else None)
+            if kind:
+                kinds[kind] += 1
+                bad += 1
+                break
+    return bad, kinds
+
+
+PYTHON_PREVIEW = """
+import json, sys, warnings
+import brdf
+with warnings.catch_warnings(record=True) as caught:
+    warnings.simplefilter("always")
+    try:
+        brdf.preview("gold", env=sys.argv[1], size=16, spp=1, jobs=1)
+        error = None
+    except Exception as e:
+        error = f"{type(e).__name__}: {e}"
+print(json.dumps({"warnings": [str(w.message) for w in caught], "error": error}))
+sys.exit(1 if error else 0)
+"""
+
+
+def check_maps(tool, work, python_path, findings, counts):
+    """Every bad-texel map through every command that reads a map. Returns the results per
+    class for the table."""
+    mdir = os.path.join(work, "maps")
+    os.makedirs(mdir)
+    python = "/usr/bin/python3"
+    table = {}
+    for name, fmt, edit in map_classes():
+        path = os.path.join(mdir, name + ".exr")
+        bad, kinds = write_map(path, fmt, edit)
+        texels = MAP_WIDTH * MAP_HEIGHT
+        refused = bad == texels
+        out_png = os.path.join(mdir, name + ".png")
+        runs = {"preview-env": [tool, ["preview", "gold", "--env", path, "--size", "16", "--spp",
+                                        "1", "--jobs", "1", "--quiet", "--out", out_png]]}
+        if python_path:
+            runs["python-preview"] = [python, ["-c", PYTHON_PREVIEW, path]]
+        results = {}
+        for command, (program, args) in runs.items():
+            env = python_env(python_path) if command == "python-preview" else None
+            code, stdout, stderr, cpu, rss = run_measured(program, args, mdir, env)
+            results[command] = (code, stdout, stderr, cpu, rss)
+            counts[command] = counts.get(command, 0) + 1
+            where = f"map class {name} {command}"
+            if code == "timeout":
+                findings.append(f"{where}: timed out after {hi.TIMEOUT_S} s")
+                continue
+            if cpu > CPU_LIMIT_S:
+                findings.append(f"{where}: {cpu:.1f} s of CPU > {CPU_LIMIT_S} s")
+            if rss > PEAK_RSS_BYTES:
+                findings.append(f"{where}: peak RSS {rss / 2**20:.0f} MiB > "
+                                f"{PEAK_RSS_BYTES / 2**20:.0f} MiB")
+            want = 1 if refused else 0
+            if code != want:
+                findings.append(f"{where}: exit code {code}, the verdict is {want}: "
+                                f"{(stderr or stdout).strip()[:300]}")
+            if command == "preview-env":
+                # The pass's checks of every run (one line, the file named, no library words),
+                # without its position rule for damaged bytes: these maps are intact files whose
+                # values are wrong as a whole, which the line counts instead.
+                hi.check_run(hi.Variant(hi.Seed(name + ".exr", path, "values", []), name, path,
+                                        special=True),
+                             command, code, stdout, stderr, findings)
+                lines = [line for line in stderr.split("\n") if line.strip()]
+                if len(lines) != 1:
+                    findings.append(f"{where}: {len(lines)} stderr lines, want the one line of "
+                                    f"the count: {stderr.strip()[:300]!r}")
+                message = lines[0] if lines else ""
+                if refused and os.path.exists(out_png):
+                    findings.append(f"{where}: refused the map but wrote {out_png}")
+            else:
+                try:
+                    doc = json.loads(stdout)
+                except ValueError:
+                    findings.append(f"{where}: no result: {stderr.strip()[:300]}")
+                    continue
+                texel_lines = [w for w in doc["warnings"] if "texels" in w]
+                if refused:
+                    message = doc["error"] or ""
+                else:
+                    if len(texel_lines) != 1:
+                        findings.append(f"{where}: {len(texel_lines)} texel warnings, want one: "
+                                        f"{doc['warnings']}")
+                    message = texel_lines[0] if texel_lines else ""
+            # The count and the kinds, in the file's terms, whoever reads it.
+            said = {k: re.search(r"\b(\d+) " + re.escape(k) + r"(?:\W|$)", message)
+                    for k in MAP_KINDS}
+            if path not in message and os.path.basename(path) not in message:
+                findings.append(f"{where}: the line does not name the map: {message[:300]}")
+            if refused:
+                if (f"all {texels} hold" not in message or
+                        "expected texels with a finite radiance >= 0" not in message):
+                    findings.append(f"{where}: a map with no usable texel not refused in the "
+                                    f"file's terms: {message[:300]}")
+            elif f"{bad} of {texels} texels" not in message:
+                findings.append(f"{where}: want '{bad} of {texels} texels' counted, got: "
+                                f"{message[:300]}")
+            for k in MAP_KINDS:
+                got = int(said[k].group(1)) if said[k] else 0
+                if got != kinds[k]:
+                    findings.append(f"{where}: {kinds[k]} {k} texels in the file, the line says "
+                                    f"{got}: {message[:300]}")
+            if kinds["+Inf"] and fmt == "half" and "half-float value beyond 65504" not in message:
+                findings.append(f"{where}: a half-float map whose values overflowed to +Inf "
+                                f"without saying so: {message[:300]}")
+        table[name] = results
+    return table
+
+
+def run(tool, seeds_dir, work, table=False, python_path="", viewer=""):
+    """(findings, runs, counts) of every value class and map class."""
     findings, counts = [], {}
     runs = 0
+    for name, results in check_maps(tool, work, python_path, findings, counts).items():
+        runs += len(results)
+        if table:
+            codes = " ".join(f"{c}={r[0]}" for c, r in results.items())
+            cpu = max(r[3] for r in results.values())
+            rss = max(r[4] for r in results.values())
+            print(f"map class {name} {codes} (slowest {cpu:.2f} s CPU, peak RSS "
+                  f"{rss / 2**20:.0f} MiB)")
     for vc in make_classes(tool, seeds_dir, work):
-        results = check_class(tool, vc, work, findings, counts)
+        results = check_class(tool, vc, work, findings, counts, viewer, python_path)
         runs += len(results)
         if table:
             codes = " ".join(f"{c}={r[0]}" for c, r in results.items())

@@ -3,8 +3,8 @@
 #include <signal.h>
 
 #include <algorithm>
-#include <atomic>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <filesystem>
 #include <memory>
@@ -15,6 +15,7 @@
 #include "brdf/core/bpc.h"
 #include "brdf/core/brdf_source.h"
 #include "brdf/core/error.h"
+#include "brdf/device/cancel.h"
 #include "brdf/device/capture_session.h"
 #include "brdf/device/driver.h"
 #include "brdf/device/instrument_link.h"
@@ -115,15 +116,20 @@ std::string Eta(double seconds) {
 }
 
 // Ctrl-C, SIGTERM and SIGHUP (the terminal or SSH session closed) ask the session to abort the
-// scan; a second signal is not special (the abort itself is bounded by the reply timeout).
-// SIGPIPE is ignored meanwhile: once the session's stderr pipe is gone, progress lines fail
-// quietly instead of killing the tool with the scan still running.
-std::atomic<bool> g_cancel{false};
-extern "C" void OnSignal(int) { g_cancel.store(true); }
+// scan (brdf/device/cancel.h: raising it is async-signal-safe and wakes a waiting read); a second
+// signal is not special (the abort itself is bounded by the reply timeout). SIGPIPE is ignored
+// meanwhile: once the session's stderr pipe is gone, progress lines fail quietly instead of
+// killing the tool with the scan still running.
+device::CancelSignal* g_cancel = nullptr;
+extern "C" void OnSignal(int) {
+  if (g_cancel != nullptr) g_cancel->Raise();
+}
 
 class SignalScope {
  public:
-  SignalScope() {
+  explicit SignalScope(device::CancelSignal& cancel) {
+    cancel.Reset();
+    g_cancel = &cancel;
     struct sigaction sa {};
     sa.sa_handler = OnSignal;
     sigemptyset(&sa.sa_mask);
@@ -140,6 +146,7 @@ class SignalScope {
     sigaction(SIGTERM, &old_term_, nullptr);
     sigaction(SIGHUP, &old_hup_, nullptr);
     sigaction(SIGPIPE, &old_pipe_, nullptr);
+    g_cancel = nullptr;
   }
   SignalScope(const SignalScope&) = delete;
   SignalScope& operator=(const SignalScope&) = delete;
@@ -237,6 +244,19 @@ int RunCapture(const CaptureOptions& o) {
   config.faults = faults;
   config.model.SetGeometry(o.geometry);
   config.pace_ms_per_row = o.sim_pace_ms;
+  // --sim-fault hold:N, for tests that interrupt the capture at a chosen frame: the lines say
+  // when the hold begins (the moment to send the signal) and that the ABORT reached the
+  // instrument. Always printed (also with --quiet): they are what such a test waits for.
+  config.on_hold = [](std::uint64_t frame) {
+    std::fprintf(stderr,
+                 "brdf: simulated instrument: holding before frame %llu until the capture is "
+                 "cancelled\n",
+                 static_cast<unsigned long long>(frame));
+    std::fflush(stderr);
+  };
+  config.on_hold_released = [] {
+    std::fprintf(stderr, "brdf: simulated instrument: ABORT received, hold released\n");
+  };
   const std::unique_ptr<device::InstrumentLink> link =
       device::OpenInstrumentLink(spec, config, sim_link, kEmulatedLinks);
 
@@ -295,9 +315,9 @@ int RunCapture(const CaptureOptions& o) {
 
   device::CaptureSessionResult r;
   {
-    g_cancel.store(false);
-    SignalScope signals;
-    r = device::RunCaptureSession(request, link->transport(), events, &g_cancel);
+    device::CancelSignal cancel;
+    SignalScope signals(cancel);
+    r = device::RunCaptureSession(request, link->transport(), events, &cancel);
   }
   switch (r.outcome) {
     case device::CaptureOutcome::kFinished:

@@ -363,7 +363,8 @@ int main(int argc, char** argv) {
                    "applied (N = the instrument's Nth frame): disconnect, stall (stops "
                    "answering), timeout (silent until ABORT), corrupt (bad CRC), duplicate, "
                    "reorder (N and N+1 swapped), lamp, contact, overtemp (firmware error "
-                   "codes); halt (the Nth USB/HID IN transfer stalls)")
+                   "codes); halt (the Nth USB/HID IN transfer stalls); hold (silent from frame "
+                   "N until the capture is cancelled, announced on stderr)")
       ->group("Testing");
   capture_cmd
       ->add_option("--sim-pace-ms", capture.sim_pace_ms,

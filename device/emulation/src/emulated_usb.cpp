@@ -460,6 +460,11 @@ std::uint64_t EmulatedUsbInstrument::halts_cleared() const { return impl_->halts
 std::uint64_t EmulatedUsbInstrument::in_transfers() const { return impl_->in_transfers; }
 std::uint64_t EmulatedUsbInstrument::frames_sent() const { return impl_->frames_sent; }
 
+bool EmulatedUsbInstrument::firmware_silent() const {
+  std::lock_guard lock(impl_->mutex);
+  return impl_->firmware.silent();
+}
+
 void EmulatedUsbInstrument::Unplug() { impl_->unplugged = true; }
 
 void EmulatedUsbInstrument::SetNodeMode(unsigned mode) {

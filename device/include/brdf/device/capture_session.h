@@ -18,7 +18,6 @@
 // file (CaptureRequest::calibrate measures fresh ones instead).
 #pragma once
 
-#include <atomic>
 #include <cstddef>
 #include <functional>
 #include <map>
@@ -26,6 +25,7 @@
 #include <vector>
 
 #include "brdf/core/measurement.h"
+#include "brdf/device/cancel.h"
 #include "brdf/device/driver.h"
 #include "brdf/device/transport.h"
 
@@ -125,9 +125,16 @@ struct CaptureSessionResult {
   std::size_t retries = 0;
 };
 
-// Runs the capture of `request` on the instrument behind `link`. `cancel` (may be null) is
-// polled while measuring: once it is true the scan is aborted on the instrument and the result
-// is kInterrupted with the completed slices saved. Throws InvalidArgument for a request no
+// Runs the capture of `request` on the instrument behind `link`. `cancel` (may be null) stops
+// the capture: once it is raised the scan is aborted on the instrument (ABORT, acknowledged)
+// and the result is kInterrupted with the completed slices saved. How soon: the driver looks
+// at the cancel before each slice, before each frame of a slice, and whenever a read returns
+// with nothing while a reply is awaited; a read waiting for a silent instrument ends within
+// kCancelStepMs (50 ms, usb_transport.h) on USB and HID and at once on the loopback
+// (Transport::SetCancel). So a cancel is acted on within one read timeout
+// (DriverOptions::timeout_ms) at most, however the instrument behaves; then the acknowledgement
+// of ABORT is awaited for up to one more timeout (an instrument that never acknowledges gives
+// kFailed). Throws InvalidArgument for a request no
 // capture can run with (a name not ending in .bpc, no θin, a θin listed twice or not offered
 // by the instrument), IoError when the file cannot be written. An existing file follows the
 // overwrite rule of every writing command (brdf::CheckWritableOutput in brdf/core/file_util.h):
@@ -135,7 +142,7 @@ struct CaptureSessionResult {
 // they say; both before anything is measured.
 CaptureSessionResult RunCaptureSession(const CaptureRequest& request, Transport& link,
                                        const SessionEvents& events = {},
-                                       const std::atomic<bool>* cancel = nullptr);
+                                       const CancelSignal* cancel = nullptr);
 
 // The one-line geometry description a capture records ("extra" key "instrument_geometry") and
 // a resume compares: "theta_in 0,20,40,60; theta_out 0-75 step 1; phi_out step 1; 76x360".

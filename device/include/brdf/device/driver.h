@@ -32,7 +32,6 @@
 #pragma once
 
 #include <array>
-#include <atomic>
 #include <functional>
 #include <string>
 #include <vector>
@@ -44,6 +43,8 @@
 #include "brdf/device/white_reference.h"
 
 namespace brdf::device {
+
+class CancelSignal;
 
 // Largest slice the driver accepts from an instrument (a slice is held in memory while it
 // streams): 2^22 samples, room for 0.1° steps over the whole hemisphere.
@@ -120,6 +121,9 @@ class Driver {
  public:
   // `transport` must outlive the driver.
   explicit Driver(Transport& transport, DriverOptions options = {});
+  ~Driver();  // takes its cancel back from the transport
+  Driver(const Driver&) = delete;
+  Driver& operator=(const Driver&) = delete;
 
   // IDENTIFY and GET_GEOMETRY. Throws DeviceError for an instrument speaking another major
   // protocol version.
@@ -149,10 +153,13 @@ class Driver {
   const DarkCalibration* dark() const { return have_dark_ ? &dark_ : nullptr; }
   const std::vector<WhiteCalibration>& whites() const { return whites_; }
 
-  // Polled while a slice streams: once *flag is true the scan is aborted on the instrument and
-  // MeasureSlice throws DriverFault kCancelled. Null disables.
-  void SetCancelFlag(const std::atomic<bool>* flag) { cancel_ = flag; }
-  bool cancelled() const { return cancel_ != nullptr && cancel_->load(); }
+  // The cancel (cancel.h), also handed to the transport (Transport::SetCancel) so that a read
+  // waiting for the instrument ends early. Looked at before every frame of a slice and whenever
+  // a read returns with nothing: once it is raised the scan is aborted on the instrument (ABORT,
+  // and its acknowledgement awaited) and the step throws DriverFault kCancelled. Null disables.
+  // `cancel` must outlive the driver's use of it.
+  void SetCancelFlag(const CancelSignal* cancel);
+  bool cancelled() const;
   // Frames dropped as exact duplicates of the previous one.
   std::size_t duplicates_dropped() const { return duplicates_dropped_; }
 
@@ -168,6 +175,7 @@ class Driver {
   Frame Expect(MessageType request, MessageType reply);
   [[noreturn]] void ThrowInstrumentError(const Frame& frame, MessageType request) const;
   const WhiteCalibration* FindWhite(double theta_in_deg) const;
+  class AbortScope;  // while ABORT's acknowledgement is awaited (driver.cpp)
 
   Transport& transport_;
   DriverOptions options_;
@@ -179,7 +187,8 @@ class Driver {
   std::uint32_t last_frame_crc_ = 0;
   std::size_t last_frame_size_ = 0;
   std::size_t duplicates_dropped_ = 0;
-  const std::atomic<bool>* cancel_ = nullptr;
+  const CancelSignal* cancel_ = nullptr;
+  bool aborting_ = false;    // in Abort or Recover: a cancel is not acted on twice
   std::string last_damage_;  // first damaged frame since the last good one, to explain a loss
   bool connected_ = false;
   InstrumentInfo info_;

@@ -36,8 +36,10 @@
 
 #include <array>
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
+#include <optional>
 #include <random>
 #include <span>
 #include <string>
@@ -101,11 +103,22 @@ enum class FaultType {
   kSampleContact,    // instead of frame N: ERROR sample not in contact, and the scan stops
   kOverTemperature,  // instead of frame N: ERROR over-temperature, and the scan stops
   kEndpointHalt,     // transport level: the Nth bulk/interrupt IN transfer stalls (USB, HID)
+  // Frame N is not sent and the firmware is silent until it receives ABORT, as kTimeout, but
+  // announced (SimulatorConfig::on_hold) and, on the loopback, read as "still waiting" for as
+  // long as the session is not cancelled (transport.h): the deterministic way for a test to
+  // interrupt a capture at a chosen frame, with no race against real time.
+  kHold,
 };
 
 struct Fault {
   FaultType type = FaultType::kCorrupt;
   std::uint64_t at = 0;  // frame number N (kEndpointHalt: IN transfer number N), ≥ 1
+  // When set (a firmware fault only): N counts the frames of the first slice stream at this θin
+  // instead (its SLICE_BEGIN is frame 1), so the fault lands at the same place in the capture
+  // however often earlier steps were measured again (a retry after a frame the host lost sends
+  // frames of its own, which shift every later frame number). The instrument errors (lamp,
+  // contact, over-temperature) then apply to every stream at that θin: the state persists.
+  std::optional<float> in_slice_theta_in_deg;
 };
 
 struct FaultPlan {
@@ -117,7 +130,7 @@ struct FaultPlan {
 };
 
 // "disconnect:50,corrupt:30" → the plan. Names: disconnect, stall, timeout, corrupt, duplicate,
-// reorder, lamp, contact, overtemp, halt. Throws InvalidArgument naming the item and what was
+// reorder, lamp, contact, overtemp, halt, hold. Throws InvalidArgument naming the item and what was
 // expected.
 FaultPlan ParseFaultPlan(std::string_view spec);
 
@@ -134,6 +147,12 @@ struct SimulatorConfig {
   // Real time the firmware spends per θout row (sleeping), for demos and for tests that must
   // interrupt a capture while it runs; 0 = as fast as the host reads (virtual time).
   double pace_ms_per_row = 0;
+  // Testing: called when a FaultType::kHold begins (with the frame number held back) and when
+  // the ABORT that ends it arrives, on the thread that runs the firmware (the caller's over
+  // the loopback, umockdev's behind emulated USB). A test raises the session's cancel from
+  // on_hold, or tells the process it will signal that the hold point is reached.
+  std::function<void(std::uint64_t frame)> on_hold;
+  std::function<void()> on_hold_released;
 };
 
 // One raw reading that clipped, for tests only: real firmware reports clipping through the
@@ -159,6 +178,10 @@ class SimulatedFirmware {
   std::size_t Transmit(std::span<std::uint8_t> out);
 
   bool link_up() const { return link_up_; }
+  // A FaultType::kHold is in force: nothing is sent until ABORT.
+  bool held() const { return held_; }
+  // Nothing more will be sent before ABORT (kTimeout, kHold) or ever (kStall).
+  bool silent() const { return hung_ || stalled_; }
   std::uint64_t frames_sent() const { return frames_sent_; }
   const GeometryInfo& geometry() const { return geometry_; }
   const SimulatorConfig& config() const { return config_; }
@@ -197,7 +220,10 @@ class SimulatedFirmware {
   std::uint8_t sequence_ = 0;
   bool link_up_ = true;
   bool stalled_ = false;
-  bool hung_ = false;                     // kTimeout: silent until ABORT
+  bool hung_ = false;                     // kTimeout, kHold: silent until ABORT
+  bool held_ = false;                     // kHold
+  std::uint64_t stream_frame_ = 0;        // frames of the slice stream, SLICE_BEGIN = 1
+  std::vector<bool> slice_fault_fired_;   // per fault: a slice-relative fault fires once
   std::vector<std::uint8_t> held_frame_;  // kReorder: frame N, sent after frame N+1
   ExposureSetting exposure_;
   std::mt19937_64 rng_;

@@ -15,6 +15,7 @@
 
 namespace brdf::device {
 
+class CancelSignal;
 class SimulatedFirmware;
 
 class Transport {
@@ -31,6 +32,13 @@ class Transport {
 
   // Says what the transport is connected to, for messages: "loopback to SIM-000001".
   virtual std::string Description() const = 0;
+
+  // The session's cancel (cancel.h), or null: once it is raised, a Read waiting for the
+  // instrument returns 0 early (USB and HID within kCancelStepMs of usb_transport.h, the
+  // loopback at once) instead of waiting out its timeout. The default ignores it: such a Read
+  // returns by its timeout, and the driver honours the cancel then. `cancel` must outlive the
+  // transport's use of it (the driver sets it for a session and clears it after).
+  virtual void SetCancel(const CancelSignal* cancel) { (void)cancel; }
 };
 
 // Connects the host to a SimulatedFirmware in the same process and thread: Write hands the
@@ -38,7 +46,10 @@ class Transport {
 // frames on demand, so a slice is never buffered whole). Runs on virtual time: when the
 // firmware has nothing to send, Read returns 0 at once, exactly what a real transport returns
 // after waiting `timeout_ms`. A fault injected into the firmware (FaultPlan) shows here as a
-// DeviceError (disconnect) or as Read returning 0 (stall).
+// DeviceError (disconnect) or as Read returning 0 (stall). The one exception to virtual time is
+// a held firmware (FaultType::kHold): with a cancel set, Read then waits for the cancel, in real
+// time and without a limit, so that a test can interrupt a capture at a chosen frame whatever
+// the machine's load; without a cancel a hold reads as a timeout.
 class LoopbackTransport final : public Transport {
  public:
   // `firmware` must outlive the transport.
@@ -47,9 +58,11 @@ class LoopbackTransport final : public Transport {
   void Write(std::span<const std::uint8_t> bytes) override;
   std::size_t Read(std::span<std::uint8_t> buffer, int timeout_ms) override;
   std::string Description() const override;
+  void SetCancel(const CancelSignal* cancel) override { cancel_ = cancel; }
 
  private:
   SimulatedFirmware& firmware_;
+  const CancelSignal* cancel_ = nullptr;
 };
 
 // Forwards to another transport and keeps every chunk of bytes the instrument sent, in order
@@ -68,6 +81,7 @@ class RecordingTransport final : public Transport {
     return n;
   }
   std::string Description() const override { return link_.Description(); }
+  void SetCancel(const CancelSignal* cancel) override { link_.SetCancel(cancel); }
 
   const std::vector<std::vector<std::uint8_t>>& received() const { return received_; }
 

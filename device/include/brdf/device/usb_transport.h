@@ -6,6 +6,12 @@
 //   - unplugged (LIBUSB_ERROR_NO_DEVICE, hidapi read/write failure): Write/Read throw
 //     DeviceError "… disconnected …";
 //   - read timeout: Read returns 0 after timeout_ms;
+//   - cancel (Transport::SetCancel): neither libusb's synchronous transfers nor hidapi's
+//     hid_read_timeout can be woken, so with a cancel set a Read waits in steps of at most
+//     kCancelStepMs and returns 0 at the first step that ends with the cancel raised: a cancel
+//     ends a waiting read within kCancelStepMs (plus the scheduling of the thread), never later
+//     than the read's own timeout. Bytes that arrive meanwhile are returned as usual (a step
+//     that times out keeps what its transfer received).
 //   - stalled bulk endpoint (LIBUSB_ERROR_PIPE): the USB transport clears the halt
 //     (libusb_clear_halt) and repeats the transfer, up to kMaxHaltRetries times, then throws.
 //     hidapi does not expose clear-halt; its reader thread resubmits a stalled interrupt
@@ -23,6 +29,7 @@
 namespace brdf::device {
 
 inline constexpr int kMaxHaltRetries = 3;
+inline constexpr int kCancelStepMs = 50;
 
 enum class AccessProblem {
   kNone,

@@ -55,6 +55,8 @@ class EmulatedUsbInstrument {
   std::uint64_t halts_cleared() const;  // CLEAR_HALT requests received
   std::uint64_t in_transfers() const;   // IN URBs completed with data
   std::uint64_t frames_sent() const;    // firmware frames
+  // The firmware will send nothing more before ABORT, or ever (SimulatedFirmware::silent).
+  bool firmware_silent() const;
   // Simulates pulling the cable: the device vanishes from the bus.
   void Unplug();
   // Sets the permission bits of the emulated device node (/dev/bus/usb/001/002 inside the
