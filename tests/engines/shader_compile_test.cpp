@@ -82,6 +82,13 @@ class ShaderCompile : public ::testing::Test {
     engines::ExportLutWithEngines(out.string(), lut, meta, options, engines::ParseEngines("all"));
     return out;
   }
+  // The file name of the .hlsl include in the export's unity folder ("" when there is none).
+  static std::string UnityInclude(const fs::path& out) {
+    std::string include;
+    for (const auto& e : fs::directory_iterator(out / "unity"))
+      if (e.path().extension() == ".hlsl") include = e.path().filename().string();
+    return include;
+  }
   fs::path dir_;
 };
 
@@ -201,9 +208,7 @@ TEST_F(ShaderCompile, UnityIblFunctionsCompileForUrpAndHdrp) {
     for (const bool bc6h : {false, true}) {  // RGB9E5 and the BC6H form (364 x 184)
       SCOPED_TRACE(bc6h ? "BC6H" : "RGB9E5");
       const fs::path out = ExportAll(thetas, bc6h);
-      std::string include;
-      for (const auto& e : fs::directory_iterator(out / "unity"))
-        if (e.path().extension() == ".hlsl") include = e.path().filename().string();
+      const std::string include = UnityInclude(out);
       ASSERT_FALSE(include.empty());
       for (const auto& [pipeline, stand_ins, function] :
            {std::tuple{"urp", kUrpStandIns, "MeasuredBrdfIbl_float"},
@@ -231,9 +236,7 @@ TEST_F(ShaderCompile, UnityIncludeCompilesForShaderGraphAndBuiltInPipeline) {
     for (const bool bc6h : {false, true}) {  // RGB9E5 and the BC6H form (364 x 184)
       SCOPED_TRACE(bc6h ? "BC6H" : "RGB9E5");
       const fs::path out = ExportAll(thetas, bc6h);
-      std::string include;
-      for (const auto& e : fs::directory_iterator(out / "unity"))
-        if (e.path().extension() == ".hlsl") include = e.path().filename().string();
+      const std::string include = UnityInclude(out);
       ASSERT_FALSE(include.empty());
       const std::string harness = std::string(kUnityStandIns) +
                                   "#define MEASURED_BRDF_BUILTIN_LIGHTING\n#include \"" + include +

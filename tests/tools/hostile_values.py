@@ -75,6 +75,20 @@ def run_measured(tool, args, cwd, env=None):
 RECORD = struct.Struct("<7fB3x")  # θin, φin, θout, φout, r, g, b, flags (docs/formats/bpc.md)
 
 
+def within_bounds(where, code, cpu, rss, findings):
+    """Adds a finding for a run that timed out or exceeded the CPU or peak-memory bound; False
+    when it timed out (its output says nothing more)."""
+    if code == "timeout":
+        findings.append(f"{where}: timed out after {hi.TIMEOUT_S} s")
+        return False
+    if cpu > CPU_LIMIT_S:
+        findings.append(f"{where}: {cpu:.1f} s of CPU > {CPU_LIMIT_S} s")
+    if rss > PEAK_RSS_BYTES:
+        findings.append(f"{where}: peak RSS {rss / 2**20:.0f} MiB > "
+                        f"{PEAK_RSS_BYTES / 2**20:.0f} MiB")
+    return True
+
+
 def edit_capture(data, edit):
     """`data` (a .bpc) with every slice's samples passed through edit(slice, records) ->
     records, each record [θin, φin, θout, φout, r, g, b, flags, σ (bytes)], CRCs and the end
@@ -265,14 +279,8 @@ def check_class(tool, vc, work, findings, counts, viewer="", python_path=""):
         results[command] = (code, stdout, stderr, cpu, rss)
         counts[command] = counts.get(command, 0) + 1
         where = f"value class {vc.name} {command}"
-        if code == "timeout":
-            findings.append(f"{where}: timed out after {hi.TIMEOUT_S} s")
+        if not within_bounds(where, code, cpu, rss, findings):
             continue
-        if cpu > CPU_LIMIT_S:
-            findings.append(f"{where}: {cpu:.1f} s of CPU > {CPU_LIMIT_S} s")
-        if rss > PEAK_RSS_BYTES:
-            findings.append(f"{where}: peak RSS {rss / 2**20:.0f} MiB > "
-                            f"{PEAK_RSS_BYTES / 2**20:.0f} MiB")
         hi.check_run(hi.Variant(hi.Seed(os.path.basename(vc.path), vc.path, "values", []),
                                 vc.name, vc.path), command, code, stdout, stderr, findings)
         want = expected.get(command, 0)
@@ -451,14 +459,8 @@ def check_maps(tool, work, python_path, findings, counts):
             results[command] = (code, stdout, stderr, cpu, rss)
             counts[command] = counts.get(command, 0) + 1
             where = f"map class {name} {command}"
-            if code == "timeout":
-                findings.append(f"{where}: timed out after {hi.TIMEOUT_S} s")
+            if not within_bounds(where, code, cpu, rss, findings):
                 continue
-            if cpu > CPU_LIMIT_S:
-                findings.append(f"{where}: {cpu:.1f} s of CPU > {CPU_LIMIT_S} s")
-            if rss > PEAK_RSS_BYTES:
-                findings.append(f"{where}: peak RSS {rss / 2**20:.0f} MiB > "
-                                f"{PEAK_RSS_BYTES / 2**20:.0f} MiB")
             want = 1 if refused else 0
             if code != want:
                 findings.append(f"{where}: exit code {code}, the verdict is {want}: "

@@ -257,6 +257,27 @@ ordered_json ProbeJson(const Handoff& h) {
   return probes;
 }
 
+// What both forms of the kit (RGB9E5 and BC6H) say alike of an engine's folder.
+constexpr const char* kUnityVersions =
+    "Unity 2021.3 LTS to Unity 6 (URP, HDRP Shader Graph; built-in pipeline)";
+constexpr const char* kUnrealVersions = "Unreal Engine 5.1 to 5.5";
+
+ordered_json WebImportJson() {
+  return {{"min_filter", "LinearFilter"},
+          {"mag_filter", "LinearFilter"},
+          {"wrap", "ClampToEdgeWrapping"},
+          {"color_space", "NoColorSpace"}};
+}
+
+// One member of "engines" in the manifest, in the order every form writes it.
+ordered_json SectionJson(Engine e, const std::string& versions, const ordered_json& files,
+                         const ordered_json& format, const ordered_json& orientation,
+                         const ordered_json& import) {
+  return ordered_json{
+      {"folder", FolderOf(e)},    {"engine_versions", versions}, {"files", files},
+      {"texture_format", format}, {"orientation", orientation},  {"import", import}};
+}
+
 // The "engines" member of the BC6H form: every texture BC6H_UF16, created at the padded size.
 ordered_json Bc6hEngineSectionJson(Engine e, const Handoff& h, const MaterialFiles& f) {
   const int pw = h.layout.texture_width, ph = h.layout.texture_height, k = h.layout.slices;
@@ -278,7 +299,7 @@ ordered_json Bc6hEngineSectionJson(Engine e, const Handoff& h, const MaterialFil
                                    {"rows", h.composite.rows}};
   switch (e) {
     case Engine::kUnity:
-      versions = "Unity 2021.3 LTS to Unity 6 (URP, HDRP Shader Graph; built-in pipeline)";
+      versions = kUnityVersions;
       files["importer"] = "Editor/MeasuredBrdfImporter.cs";
       files["flipbook"] = f.tiles;
       format = "GraphicsFormat.RGB_BC6H_UFloat from the KTX2 (vkFormat 131), " + padded;
@@ -305,7 +326,7 @@ ordered_json Bc6hEngineSectionJson(Engine e, const Handoff& h, const MaterialFil
                 false } } }};
       break;
     case Engine::kUnreal:
-      versions = "Unreal Engine 5.1 to 5.5";
+      versions = kUnrealVersions;
       files["import_script"] = "import_measured_brdf.py";
       files["tiles"] = f.tiles;
       format = "DDS DXGI_FORMAT_BC6H_UF16 (95), volume, one mip, " + padded;
@@ -354,16 +375,10 @@ ordered_json Bc6hEngineSectionJson(Engine e, const Handoff& h, const MaterialFil
           "KTX2 blocks uploaded as stored (compressedTexImage3D, "
           "COMPRESSED_RGB_BPTC_UNSIGNED_FLOAT); "
           "row 0 (theta_d = 0) at v = 0";
-      import = {{"min_filter", "LinearFilter"},
-                {"mag_filter", "LinearFilter"},
-                {"wrap", "ClampToEdgeWrapping"},
-                { "color_space",
-                  "NoColorSpace" }};
+      import = WebImportJson();
       break;
   }
-  return ordered_json{
-      {"folder", FolderOf(e)},    {"engine_versions", versions}, {"files", files},
-      {"texture_format", format}, {"orientation", orientation},  {"import", import}};
+  return SectionJson(e, versions, files, format, orientation, import);
 }
 
 // What one engine's folder holds and how it imports (a member of "engines" in the manifest).
@@ -381,7 +396,7 @@ ordered_json EngineSectionJson(Engine e, const Handoff& h) {
                   h.composite.columns, h.composite.rows, vol.width, vol.height);
   switch (e) {
     case Engine::kUnity:
-      versions = "Unity 2021.3 LTS to Unity 6 (URP, HDRP Shader Graph; built-in pipeline)";
+      versions = kUnityVersions;
       files["importer"] = "Editor/MeasuredBrdfImporter.cs";
       texture["format"] = "GraphicsFormat.E5B9G9R9_UFloatPack32 (fallback R16G16B16A16_SFloat)";
       orientation["scripted_importer"] =
@@ -403,7 +418,7 @@ ordered_json EngineSectionJson(Engine e, const Handoff& h) {
                 false } } }};
       break;
     case Engine::kUnreal:
-      versions = "Unreal Engine 5.1 to 5.5";
+      versions = kUnrealVersions;
       files["import_script"] = "import_measured_brdf.py";
       files["tiles"] = f.tiles;
       texture["format"] = "DDS DXGI_FORMAT_R16G16B16A16_FLOAT (10), volume, one mip; alpha 1";
@@ -447,19 +462,10 @@ ordered_json EngineSectionJson(Engine e, const Handoff& h) {
       orientation["ktx2loader"] =
           "KTX2 texel (x, y, z) = Data3DTexture texel (x, y, z) (KTXorientation rdi; three.js "
           "does not flip 3D textures); row 0 (theta_d = 0) at v = 0";
-      import = {{"min_filter", "LinearFilter"},
-                {"mag_filter", "LinearFilter"},
-                {"wrap", "ClampToEdgeWrapping"},
-                { "color_space",
-                  "NoColorSpace" }};
+      import = WebImportJson();
       break;
   }
-  return ordered_json{{"folder", FolderOf(e)},
-                      {"engine_versions", versions},
-                      {"files", files},
-                      {"texture_format", texture["format"]},
-                      {"orientation", orientation},
-                      {"import", import}};
+  return SectionJson(e, versions, files, texture["format"], orientation, import);
 }
 
 // The manifest's "ibl": for a LUT its pack (IblPackJson) with "texture"; for an atlas "texture"
