@@ -190,6 +190,14 @@ CaptureSessionResult RunCaptureSession(const CaptureRequest& request, Transport&
     }
     const Metadata& old = existing->measurement.metadata;
     result.slices_saved = existing->measurement.slices.size();
+    if (request.saved_values_refusal) {
+      if (std::optional<std::string> why = request.saved_values_refusal(path)) {
+        result.outcome = CaptureOutcome::kRefused;
+        result.next = NextStep::kRepairSlices;
+        result.message = std::move(*why);
+        return result;
+      }
+    }
     if (existing->finished) {
       result.outcome = CaptureOutcome::kNothingToResume;
       result.resumed = true;

@@ -25,7 +25,8 @@ std::string PythonRemedyText(const Remedy& remedy) {
              " intact bytes";
     case RemedyKind::kRepairCapture:
       return "run 'brdf repair " + f +
-             " --out FIXED.bpc' to keep every intact slice, then call brdf.capture(...) with "
+             " --out FIXED.bpc' to keep every slice a LUT can use, then call brdf.capture(...) "
+             "with "
              "out='FIXED.bpc' and resume=True" +
              missing;
     case RemedyKind::kRecapture:

@@ -48,6 +48,7 @@
 #include "brdf/preview/preview.h"
 #include "brdf/processing/beyond.h"
 #include "brdf/processing/extrapolation.h"
+#include "brdf/sources/capture.h"
 #include "brdf/sources/detect.h"
 #include "brdf/sources/material_library.h"
 #include "brdf/sources/open.h"
@@ -321,6 +322,7 @@ py::dict Capture(const CaptureArguments& a) {
       device::SimulatedCaptureSettings("sim", source->Name(), config, a.geometry, a.exposure);
   request.notes["material_file"] = sources::RecordedSourceName(material_path);
   request.resume = a.resume;
+  request.saved_values_refusal = sources::SavedValuesRefusal;
   request.force = a.overwrite;
   request.calibrate = a.calibrate;
 
@@ -375,6 +377,11 @@ py::dict Capture(const CaptureArguments& a) {
         break;
       case NextStep::kUseOriginalSettings:
         message += "; call it again with the original settings";
+        break;
+      case NextStep::kRepairSlices:
+        message += "; run 'brdf repair " + a.out +
+                   " --out FIXED.bpc' to drop the refused slices, then call brdf.capture(...) "
+                   "with out='FIXED.bpc' and resume=True to measure them again";
         break;
       case NextStep::kRetry:
         message += "; nothing was saved; call it again";

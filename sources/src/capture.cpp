@@ -82,13 +82,38 @@ void CheckStructure(CaptureAssessment& a) {
   }
 }
 
-// The values, by the rule BuildLut applies (any distinct θin: eval accepts those too).
-void CheckValues(CaptureAssessment& a) {
-  if (a.read.measurement.slices.empty()) return;  // reported as missing slices
+// Problems of one slice's values that a LUT cannot be built from and that dropping the slice
+// removes (a resume then measures it again): bad samples, no valid sample, θin out of range.
+// A duplicate θin is dropped as a second slice at the same θin; a degenerate measured range is
+// a property of the whole capture.
+bool DroppableForValues(const processing::LutInputProblem& p) {
+  using Kind = processing::LutInputProblem::Kind;
+  return p.slice >= 0 && (p.kind == Kind::kBadSamples || p.kind == Kind::kNoValidSample ||
+                          p.kind == Kind::kThetaInOutOfRange);
+}
+
+std::vector<processing::LutInputProblem> ValueProblems(const Measurement& m) {
   processing::ResampleOptions options;
-  options.require_uniform_theta_in = false;
-  for (const processing::LutInputProblem& p :
-       processing::FindLutInputProblems(a.read.measurement, options)) {
+  options.require_uniform_theta_in = false;  // any distinct θin: eval accepts those too
+  return processing::FindLutInputProblems(m, options);
+}
+
+// The values, by the rule BuildLut applies. A slice whose values are refused is dropped by
+// RepairCapture, so the remedy is a repair and a resume measuring the dropped slices (and any
+// planned slice not captured yet) again; a whole-capture problem can only be recaptured.
+void CheckValues(CaptureAssessment& a) {
+  const Measurement& m = a.read.measurement;
+  if (m.slices.empty()) return;  // reported as missing slices
+  const std::vector<processing::LutInputProblem> problems = ValueProblems(m);
+  std::vector<double> to_measure = a.missing_theta_in_deg;
+  for (const processing::LutInputProblem& p : problems)
+    if (DroppableForValues(p) && ContainsAngle(a.planned_theta_in_deg, p.theta_in_deg) &&
+        !ContainsAngle(to_measure, p.theta_in_deg))
+      to_measure.push_back(p.theta_in_deg);
+  std::vector<double> in_plan_order;
+  for (double t : a.planned_theta_in_deg)
+    if (ContainsAngle(to_measure, t)) in_plan_order.push_back(t);
+  for (const processing::LutInputProblem& p : problems) {
     std::string where = "values";
     if (p.slice >= 0 && static_cast<std::size_t>(p.slice) < a.read.slice_offsets.size())
       where = BytePosition(a.read.slice_offsets[static_cast<std::size_t>(p.slice)]) + " (slice " +
@@ -97,7 +122,9 @@ void CheckValues(CaptureAssessment& a) {
                           "values a LUT can be built from",
                           p.message,
                           {},
-                          Remedy{RemedyKind::kRecapture, a.path},
+                          DroppableForValues(p) ? Remedy{RemedyKind::kRepairCapture, a.path,
+                                                         a.read.valid_bytes, in_plan_order}
+                                                : Remedy{RemedyKind::kRecapture, a.path},
                           CaptureRefusal::Cause::kValues});
   }
 }
@@ -230,10 +257,26 @@ CaptureAssessment AssessCapture(const std::string& path, BpcReadResult read) {
   return a;
 }
 
-Measurement LoadCaptureForLut(const std::string& path, std::vector<std::string>* warnings) {
+std::optional<std::string> SavedValuesRefusal(const std::string& path) {
+  CaptureAssessment a;
+  try {
+    a = AssessCapture(path);
+  } catch (const FormatError&) {
+    return std::nullopt;  // not even a header: the session's own read says so
+  }
+  for (const CaptureRefusal& refusal : a.refusals)
+    if (refusal.cause == CaptureRefusal::Cause::kValues) return refusal.ToError(path).what();
+  return std::nullopt;
+}
+
+Measurement LoadCaptureForLut(const std::string& path, std::vector<std::string>* warnings,
+                              std::vector<CaptureRefusal>* export_refusals) {
   CaptureAssessment a = AssessCapture(path);
   if (a.refusal) throw a.refusal->ToError(path);
   if (warnings) warnings->insert(warnings->end(), a.warnings.begin(), a.warnings.end());
+  if (export_refusals)
+    export_refusals->insert(export_refusals->end(), a.export_refusals.begin(),
+                            a.export_refusals.end());
   return std::move(a.read.measurement);
 }
 
@@ -279,8 +322,18 @@ RepairReport RepairCapture(const std::string& input, const std::string& output, 
   const BpcReadResult& r = a.read;
   // Damage, an incomplete slice, or CRC-valid chunks that contradict each other (slice
   // indices, the end chunk's counts): what the assessment tells the user to repair.
+  // Slices whose values every reader refuses (by file order), dropped so a resume measures
+  // them again.
+  std::vector<std::string> value_reasons(r.measurement.slices.size());
+  for (const processing::LutInputProblem& p : ValueProblems(r.measurement))
+    if (DroppableForValues(p) && static_cast<std::size_t>(p.slice) < value_reasons.size() &&
+        value_reasons[static_cast<std::size_t>(p.slice)].empty())
+      value_reasons[static_cast<std::size_t>(p.slice)] =
+          "values no LUT can be built from: " + p.message;
+  const bool refused_values = std::any_of(value_reasons.begin(), value_reasons.end(),
+                                          [](const std::string& why) { return !why.empty(); });
   const bool damaged =
-      !r.problems.empty() ||
+      refused_values || !r.problems.empty() ||
       std::any_of(r.measurement.slices.begin(), r.measurement.slices.end(),
                   [](const Slice& s) { return !s.complete; }) ||
       std::any_of(a.refusals.begin(), a.refusals.end(), [](const CaptureRefusal& refusal) {
@@ -335,6 +388,11 @@ RepairReport RepairCapture(const std::string& input, const std::string& output, 
                                   s.theta_in_deg,
                                   "slice incomplete: the instrument stopped after " +
                                       std::to_string(s.samples.size()) + " samples"});
+        continue;
+      }
+      if (!value_reasons[i].empty()) {
+        report.dropped.push_back({r.slice_offsets[i], ChunkBytes(r, i), r.slice_indices[i],
+                                  s.theta_in_deg, value_reasons[i]});
         continue;
       }
       if (ContainsAngle(report.kept_theta_in_deg, s.theta_in_deg)) {

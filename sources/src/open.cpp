@@ -113,7 +113,7 @@ PreparedMeasurement Prepare(const std::string& path, FileKind kind,
   std::shared_ptr<const BrdfSource> source;
   switch (kind) {
     case FileKind::kCapture:
-      out.measurement = LoadCaptureForLut(path, &out.warnings);
+      out.measurement = LoadCaptureForLut(path, &out.warnings, &out.export_refusals);
       break;
     case FileKind::kMaterial: {
       auto material = std::make_shared<AnalyticBrdf>(LoadMaterialInput(path));
@@ -494,6 +494,9 @@ InputLut LutFromInput(const std::string& path, FileKind kind,
     return out;
   }
   PreparedMeasurement p = PrepareMeasurement(path, kind, command_line);
+  // The one rule's sentence (capture.h), naming the file and its slices, for every command that
+  // makes LUT textures (convert, atlas, brdf.convert), rather than BuildLut's own.
+  if (!p.export_refusals.empty()) throw p.export_refusals.front().ToError(path);
   out.warnings = std::move(p.warnings);
   out.saturated_samples = CountSaturated(p.measurement);
   processing::ResampleOptions resample = resample_options;

@@ -23,9 +23,11 @@ give it, written down here from the rule of docs/design.md §4 and §9 and docs/
 
 `export-csv` copies every sample (a CSV can hold any finite number): it accepts the value classes
 and says, in a warning naming slice and sample, what the other commands refuse. The readers are
-info, eval, convert, atlas, preview, fit, export-csv (captures), import (the CSV), when the pass
+info, eval, convert, atlas, preview, fit, export-csv, repair and capture --resume (captures; the
+last two by the rule at REFUSED_BY_ALL), import (the CSV), when the pass
 is given the viewer (--viewer) brdf-view drawing the lobe off screen, and when it is given the
-Python module (--python-path) brdf.open(FILE).eval_deg (the verdict of eval).
+Python module (--python-path) brdf.open(FILE).eval_deg, brdf.info, brdf.fit and brdf.convert
+(the verdicts of eval, info, fit and convert).
 
 Bad map texels (issue 20, finding 7) are classes of environment maps, read by every command
 that reads a map: `brdf preview --env` and, when the pass is given the Python module's folder
@@ -150,10 +152,20 @@ def keep_one_per_slice(_, records):
     return [next(r for r in records if abs(r[2] - 30) < 1e-3 and abs(r[3]) < 1e-3)]
 
 
+# `repair` and `capture --resume` read captures too. A slice whose values every reader refuses
+# is dropped by repair (exit 0), so that a resume of the repaired file measures it again; the
+# resume of the file itself is refused before anything is measured (exit 1, the file unchanged),
+# naming slice and sample and the repair. An intact capture has nothing to repair (exit 1) and a
+# finished one nothing to resume (exit 0).
 REFUSED_BY_ALL = {"info": 1, "eval": 1, "convert": 1, "atlas": 1, "preview": 1, "fit": 1,
-                  "export-csv": 0, "brdf-view": 1}
+                  "export-csv": 0, "brdf-view": 1, "repair": 0, "resume": 1}
 ACCEPTED_BY_ALL = {"info": 0, "eval": 0, "convert": 0, "atlas": 0, "preview": 0, "fit": 0,
-                   "export-csv": 0, "brdf-view": 0}
+                   "export-csv": 0, "brdf-view": 0, "repair": 1, "resume": 0}
+# The capture command of the seed cap.bpc (hostile_inputs.make_seeds), resuming --out.
+RESUME_SEED_CAPTURE = ["capture", "--device", "sim", "--material", "gold", "--sample", "hostile",
+                       "--theta-in", "0,30,60", "--theta-out-step", "5", "--phi-out-step", "10",
+                       "--noise", "1", "--seed", "7", "--sim-pace-ms", "0", "--quiet",
+                       "--resume", "--out"]
 CONVERT_ONLY = {"info": 1, "eval": 0, "convert": 1, "atlas": 1, "preview": 0, "fit": 0,
                 "export-csv": 0, "brdf-view": 0}
 
@@ -236,6 +248,9 @@ def command_line(command, vc, out):
                 "--out", os.path.join(out, "f.json")],
         "export-csv": ["export-csv", p, "--out", os.path.join(out, "e.csv")],
         "import": ["import", p, "--out", os.path.join(out, "i.bpc")],
+        "repair": ["repair", p, "--out", os.path.join(out, "r.bpc")],
+        # A copy of the file: capture --resume appends to its --out (check_class makes it).
+        "resume": RESUME_SEED_CAPTURE + [os.path.join(out, "resume.bpc")],
         # brdf-view's lobe, drawn off screen (it starts its own Xvfb when there is no display).
         "brdf-view": [p, "--screenshot", os.path.join(out, "v.png"), "--size", "64x64"],
     }[command]
@@ -254,6 +269,48 @@ except Exception as e:
 """
 
 
+# The module's other readers of the same files, each held to the verdict of its command:
+# brdf.info (the verdict is its "usable", printed as the exit code info gives), brdf.fit (the
+# warning of an under-determined fit as a UserWarning or in the report's warnings) and
+# brdf.convert.
+PYTHON_READERS = {
+    "python-info": ("info", """
+import sys
+import brdf
+try:
+    doc = brdf.info(sys.argv[1])
+except Exception as e:
+    print(f"{type(e).__name__}: {e}", file=sys.stderr)
+    sys.exit(1)
+if doc.get("usable") is False:
+    print("; ".join(doc.get("refusals", [])), file=sys.stderr)
+    sys.exit(1)
+"""),
+    "python-fit": ("fit", """
+import json, sys, warnings
+import brdf
+with warnings.catch_warnings(record=True) as caught:
+    warnings.simplefilter("always")
+    try:
+        report = brdf.fit(sys.argv[1], model=sys.argv[2], starts=1, jobs=1)["fit"]
+    except Exception as e:
+        print(f"{type(e).__name__}: {e}", file=sys.stderr)
+        sys.exit(1)
+print(json.dumps({"warnings": [str(w.message) for w in caught] + report.get("warnings", []),
+                  "representable": report.get("representable")}))
+"""),
+    "python-convert": ("convert", """
+import sys
+import brdf
+try:
+    brdf.convert(sys.argv[1], sys.argv[2], formats="json,ktx2")
+except Exception as e:
+    print(f"{type(e).__name__}: {e}", file=sys.stderr)
+    sys.exit(1)
+"""),
+}
+
+
 def python_env(python_path):
     return dict(os.environ, PYTHONPATH=python_path, OPENBLAS_NUM_THREADS="1",
                 PYTHONDONTWRITEBYTECODE="1")
@@ -266,12 +323,24 @@ def check_class(tool, vc, work, findings, counts, viewer="", python_path=""):
     expected = dict(vc.expected)
     if python_path and "eval" in expected:
         expected["python-open"] = expected["eval"]
+    if python_path:
+        for reader, (command, _) in PYTHON_READERS.items():
+            if command in expected:
+                expected[reader] = expected[command]
     commands = [c for c in expected if c != "brdf-view" or viewer]
     commands += ["convert-auto"] if vc.auto_defaults else []
+    if "resume" in expected:
+        shutil.copy(vc.path, os.path.join(out, "resume.bpc"))
     for command in commands:
         if command == "python-open":
             code, stdout, stderr, cpu, rss = run_measured(
                 "/usr/bin/python3", ["-c", PYTHON_EVAL, vc.path], work, python_env(python_path))
+        elif command in PYTHON_READERS:
+            extra = {"python-fit": [vc.fit_model],
+                     "python-convert": [os.path.join(out, "pyconv")]}.get(command, [])
+            code, stdout, stderr, cpu, rss = run_measured(
+                "/usr/bin/python3", ["-c", PYTHON_READERS[command][1], vc.path] + extra, work,
+                python_env(python_path))
         else:
             program = viewer if command == "brdf-view" else tool
             code, stdout, stderr, cpu, rss = run_measured(
@@ -314,6 +383,19 @@ def check_class(tool, vc, work, findings, counts, viewer="", python_path=""):
             if doc.get("evaluable") is not True or doc.get("convertible") is not False:
                 findings.append(f"value class {vc.name} info: want evaluable true, convertible "
                                 f"false, got {doc.get('evaluable')}, {doc.get('convertible')}")
+    pyfit = results.get("python-fit")
+    if pyfit and pyfit[0] == 0 and vc.fit_warns:
+        try:
+            doc = json.loads(pyfit[1])
+            if not any("usable sample" in w for w in doc["warnings"]):
+                findings.append(f"value class {vc.name} python-fit: an under-determined fit "
+                                f"without the 'N usable samples' warning: {pyfit[1][:300]}")
+            if doc["representable"] is not False:
+                findings.append(f"value class {vc.name} python-fit: an under-determined fit "
+                                f"recorded representable {doc['representable']}")
+        except (ValueError, KeyError) as e:
+            findings.append(f"value class {vc.name} python-fit: no report ({e}): "
+                            f"{pyfit[1][:300]}")
     fit = results.get("fit")
     if fit and fit[0] == 0 and vc.fit_warns:
         if "usable sample" not in fit[1] + fit[2]:
@@ -339,12 +421,46 @@ def check_class(tool, vc, work, findings, counts, viewer="", python_path=""):
                                 f"{extrapolation}): {stderr.strip()[:300]}")
         except (OSError, ValueError) as e:
             findings.append(f"value class {vc.name} convert --extrapolate auto: no sidecar: {e}")
+    check_repair_and_resume(tool, vc, work, out, results, findings)
     if vc.capture is not None:
         code, _, stderr, _, _ = vc.capture
         if code != 0 or "warning" not in stderr or "convert" not in stderr:
             findings.append(f"value class {vc.name}: capture wrote a file convert refuses "
                             f"without a warning (exit {code}): {stderr.strip()[:300]}")
     return results
+
+
+def check_repair_and_resume(tool, vc, work, out, results, findings):
+    """What the exit codes of repair and resume do not show: a refused resume measured nothing
+    and names the repair; the repair named the slices it dropped for their values, and the
+    repaired file, resumed with the seed's command, is a capture every reader accepts."""
+    where = f"value class {vc.name}"
+    resume, repair = results.get("resume"), results.get("repair")
+    if resume and resume[0] == 1 and vc.expected.get("resume") == 1:
+        if open(os.path.join(out, "resume.bpc"), "rb").read() != open(vc.path, "rb").read():
+            findings.append(f"{where} resume: refused, but the file changed")
+        if "brdf repair" not in resume[2]:
+            findings.append(f"{where} resume: the refusal does not say how to go on (brdf "
+                            f"repair): {resume[2].strip()[:300]}")
+    if repair and repair[0] == 1 and vc.expected.get("repair") == 1:
+        if "nothing to repair" not in repair[2]:
+            findings.append(f"{where} repair: an intact capture refused for another reason: "
+                            f"{repair[2].strip()[:300]}")
+    if not (repair and repair[0] == 0 and vc.expected.get("repair") == 0):
+        return
+    dropped = [line for line in repair[1].split("\n") if "dropped slice" in line]
+    if not dropped or not all("values" in line for line in dropped):
+        findings.append(f"{where} repair: no slice dropped for its values: "
+                        f"{repair[1].strip()[:300]}")
+    fixed = os.path.join(out, "r.bpc")
+    code, _, stderr, cpu, rss = run_measured(tool, RESUME_SEED_CAPTURE + [fixed], work)
+    if within_bounds(f"{where} resume of the repair", code, cpu, rss, findings) and code != 0:
+        findings.append(f"{where}: the repaired capture cannot be resumed (exit {code}): "
+                        f"{stderr.strip()[:300]}")
+    code, _, stderr, cpu, rss = run_measured(tool, ["info", fixed, "--json"], work)
+    if within_bounds(f"{where} info of the resumed repair", code, cpu, rss, findings) and code:
+        findings.append(f"{where}: the repaired and resumed capture is refused (exit {code}): "
+                        f"{stderr.strip()[:300]}")
 
 
 # ---------------------------------------------------------------------------------------------

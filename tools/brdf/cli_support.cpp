@@ -29,7 +29,7 @@ std::string RemedyText(const Remedy& remedy, const std::string& command) {
              std::to_string(remedy.valid_bytes) + " intact bytes";
     case RemedyKind::kRepairCapture:
       return "run 'brdf repair " + f +
-             " --out FIXED.bpc' to keep every intact slice, then rerun the 'brdf capture' "
+             " --out FIXED.bpc' to keep every slice a LUT can use, then rerun the 'brdf capture' "
              "command with --out FIXED.bpc --resume" +
              missing;
     case RemedyKind::kRecapture:

@@ -22,6 +22,7 @@
 #include "brdf/device/simulator.h"
 #include "brdf/device/transport.h"
 #include "brdf/device/usb_models.h"
+#include "brdf/sources/capture.h"
 #include "brdf/sources/open.h"
 #include "cli_support.h"
 #include "commands.h"
@@ -175,6 +176,10 @@ std::string Advice(const device::CaptureSessionResult& r, const std::string& out
       return "connect the original instrument, or add --force to resume on this one";
     case NextStep::kUseOriginalSettings:
       return "rerun with the original settings";
+    case NextStep::kRepairSlices:
+      return "run 'brdf repair " + out +
+             " --out FIXED.bpc' to drop the refused slices, then rerun this command with "
+             "--out FIXED.bpc --resume to measure them again";
   }
   return {};
 }
@@ -274,6 +279,7 @@ int RunCapture(const CaptureOptions& o) {
     request.settings["device"] = o.device;
   }
   request.resume = o.resume;
+  request.saved_values_refusal = sources::SavedValuesRefusal;
   request.force = o.force;
   request.calibrate = o.calibrate;
 

@@ -607,8 +607,9 @@ int main(int argc, char** argv) {
   auto* repair_cmd = app.add_subcommand(
       "repair",
       "Write every intact slice of a damaged or unfinished capture to a new .bpc that "
-      "'brdf capture --resume' completes; names every part it drops (slice, theta_in, byte "
-      "offset, reason)");
+      "'brdf capture --resume' completes, dropping slices whose values every command refuses "
+      "(NaN, negative or absurd f_r, no valid sample); names every part it drops (slice, "
+      "theta_in, byte offset, reason)");
   repair_cmd->add_option("file", repair.file, "Damaged or unfinished capture (.bpc)")->required();
   repair_cmd->add_option("--out", repair.out, "New capture (.bpc, written atomically)")->required();
   repair_cmd->add_flag("--force", repair.force, "Overwrite --out if it already exists");

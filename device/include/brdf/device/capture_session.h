@@ -21,6 +21,7 @@
 #include <cstddef>
 #include <functional>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -56,6 +57,14 @@ struct CaptureRequest {
   // capture always measures them.
   bool calibrate = false;
   DriverOptions driver;
+  // With resume: the rule every reading command applies to a capture's values (NaN, negative
+  // or absurd f_r, a slice without a valid sample: brdf::sources::AssessCapture, a layer above
+  // this library). Called with out_path before anything is measured, it returns the sentence
+  // saying why a reader refuses the slices on disk, or nothing. Such a file is not resumed
+  // (kRefused, NextStep::kRepairSlices) whether finished or not: measuring the missing slices
+  // would still leave a capture no command reads; `brdf repair` drops the refused slices, and a
+  // resume of the repaired file measures them again. Unset: not checked.
+  std::function<std::optional<std::string>(const std::string& path)> saved_values_refusal;
 };
 
 enum class CaptureOutcome {
@@ -69,11 +78,13 @@ enum class CaptureOutcome {
 // What the user should do next, for the tool to put in its own words.
 enum class NextStep {
   kNone,
-  kResume,              // completed slices are saved: run the same capture again, resuming
-  kRetry,               // nothing was saved: check the instrument, run the capture again
-  kOverwrite,           // the file cannot be resumed: start over, overwriting it deliberately
-  kAcceptInstrument,    // a different instrument: connect the original or accept this one
-  kUseOriginalSettings  // resume with other settings than the file records
+  kResume,               // completed slices are saved: run the same capture again, resuming
+  kRetry,                // nothing was saved: check the instrument, run the capture again
+  kOverwrite,            // the file cannot be resumed: start over, overwriting it deliberately
+  kAcceptInstrument,     // a different instrument: connect the original or accept this one
+  kUseOriginalSettings,  // resume with other settings than the file records
+  kRepairSlices          // saved slices hold values no reader accepts: repair drops them, then
+                         // a resume of the repaired file measures them again
 };
 
 // Instrument states the firmware reports with an error code; each has its own remedy.

@@ -83,8 +83,18 @@ CaptureAssessment AssessCapture(const std::string& path);
 // The same rule over a read already done.
 CaptureAssessment AssessCapture(const std::string& path, BpcReadResult read);
 
-// AssessCapture(path).UsableMeasurement(), moved out, warnings appended to `warnings`.
-Measurement LoadCaptureForLut(const std::string& path, std::vector<std::string>* warnings);
+// Why every reading command refuses the values of the slices saved in the capture `path`
+// (the first refusal of AssessCapture caused by values, as its FormatError's sentence), or
+// nothing: the check a resume makes before measuring (device::CaptureRequest::
+// saved_values_refusal). Nothing also when the file has no readable header (the resume's own
+// read reports that).
+std::optional<std::string> SavedValuesRefusal(const std::string& path);
+
+// AssessCapture(path).UsableMeasurement(), moved out, warnings appended to `warnings` and, when
+// `export_refusals` is not null, the assessment's export_refusals there (why the LUT textures
+// cannot be made of a capture every other command accepts).
+Measurement LoadCaptureForLut(const std::string& path, std::vector<std::string>* warnings,
+                              std::vector<CaptureRefusal>* export_refusals = nullptr);
 
 // The same assessment for a command that copies every sample instead of building a LUT
 // (`brdf export-csv`): refused for damage and inconsistent structure exactly as AssessCapture
@@ -113,7 +123,9 @@ struct RepairReport {
   std::uint64_t output_bytes = 0;
 };
 
-// Writes every intact, complete slice of the capture `input` to a new capture `output` as an
+// Writes every intact, complete slice of the capture `input` whose values a LUT can be built
+// from (a slice with NaN, negative or absurd values, no valid sample, or θin out of range is
+// dropped and named, like an incomplete one) to a new capture `output` as an
 // unfinished but valid capture (header with the original metadata and planned θin list, the
 // slices renumbered 0…n−1, no end chunk), so that resuming `output` captures exactly the
 // missing slices. The file appears atomically (written beside `output` under a temporary name

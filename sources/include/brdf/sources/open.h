@@ -47,6 +47,7 @@
 #include "brdf/exporter/texture_file.h"
 #include "brdf/processing/extrapolation.h"
 #include "brdf/processing/resample.h"
+#include "brdf/sources/capture.h"
 #include "brdf/sources/detect.h"
 #include "brdf/sources/material_library.h"
 
@@ -82,6 +83,9 @@ struct PreparedMeasurement {
   // (docs/design.md §4); false for a virtual capture of an evaluable file, whose values are the
   // model's (ResampleOptions::check_measured_values).
   bool measured = true;
+  // A capture's reasons the LUT textures cannot be made of it, though every other command
+  // accepts it (CaptureAssessment::export_refusals: a θin list not k·Δin from 0°).
+  std::vector<CaptureRefusal> export_refusals;
 };
 // Captures follow the damaged-capture rule (capture.h); material files are captured noise-free
 // on the reference geometry (brdf/core/virtual_capture.h); third-party tables (Zemax,
