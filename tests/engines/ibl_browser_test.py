@@ -48,6 +48,7 @@ Reported, not asserted: browser against the truth per material (the split sum's 
 largest at the rim of glossy materials), next to the CPU split sum against the truth.
 Usage: ibl_browser_test.py BRDF_TOOL SOURCE_DIR CHROMIUM DATA_DIR [--keep]  (Debian python3)
 """
+import glob
 import json
 import os
 import shutil
@@ -55,17 +56,20 @@ import subprocess
 import sys
 import tempfile
 import time
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import OpenImageIO as oiio
 
 from check_support import FAILURES, expect, run
 
-SIZE = 128
-LIBRARY = ["gold", "plastic_glossy_red", "paper_white", "wood_walnut"]
-RGL = ["chm_mint_rgb", "vch_silk_blue_rgb"]
+SIZE = 96
 CAPTURE = "gold_capture"  # data-samples/captures/gold.bpc, --beyond auto
 GGX_REFERENCE = "gold"
+# The mutations are rendered for glossy materials only (a 10 % change of a rough lobe's α_eq
+# moves the image by less than the split-sum bound; docs/benchmarks/ibl.md).
+MUTATE = ["gold", "copper", "vch_silk_blue_rgb", CAPTURE]
+JOBS = 2  # the CPU references and the RGL imports, two processes at a time
 ATLAS_CELL = "paper_white"  # cell 1 of the atlas "pair" (gold, paper_white)
 ATLAS_RMSE = 0.001
 SPLIT_SUM_RMSE, SPLIT_SUM_P95 = 0.02, 0.06
@@ -184,6 +188,12 @@ def check_viewer(png, manifest):
           f"({centre_x:.1f}, {centre_y:.1f}), centre {np.round(got, 1)} vs sRGB(E(1)) {np.round(srgb, 1)}")
 
 
+def run_all(commands, jobs=JOBS):
+    """Runs the commands `jobs` at a time (each must succeed, as run())."""
+    with ThreadPoolExecutor(jobs) as pool:
+        list(pool.map(run, commands))
+
+
 def main():
     tool, source, chromium, data_dir = sys.argv[1:5]
     keep = "--keep" in sys.argv
@@ -193,17 +203,17 @@ def main():
     env = os.path.join(work, "env.exr")
     write_environment(env)
     out = os.path.join(work, "out")
-    rgl = [os.path.join(data_dir, "rgl", n + ".bsdf") for n in RGL]
-    for p in rgl:
-        if not os.path.isfile(p):
-            print(f"FAILED: {p}: missing (set BRDF_DATA_DIR to the brdf-data folder)")
-            return 1
+    # Every material of the library (`brdf materials`) and every RGL file of the data folder.
+    library = [m["name"] for m in json.loads(run([tool, "materials", "--json"]))]
+    rgl = sorted(glob.glob(os.path.join(data_dir, "rgl", "*.bsdf")))
+    if not rgl:
+        print(f"FAILED: {os.path.join(data_dir, 'rgl')}: no .bsdf files (set BRDF_DATA_DIR to the brdf-data folder)")
+        return 1
+    rgl_names = [os.path.basename(p)[:-len(".bsdf")] for p in rgl]
     # RGL files become noise-free virtual captures at the instrument's geometry (brdf import).
-    captures = []
-    for n, p in zip(RGL, rgl):
-        captures.append(os.path.join(work, n + ".bpc"))
-        run([tool, "import", p, "--out", captures[-1]])
-    run([tool, "convert", *LIBRARY, *captures, "--out", out, "--engine", "web", "--quiet", "--jobs", "2",
+    captures = [os.path.join(work, n + ".bpc") for n in rgl_names]
+    run_all([[tool, "import", p, "--out", c] for p, c in zip(rgl, captures)])
+    run([tool, "convert", *library, *captures, "--out", out, "--engine", "web", "--quiet", "--jobs", str(JOBS),
          "--formats", "ktx2"])
     capture = os.path.join(work, CAPTURE + ".bpc")
     shutil.copyfile(os.path.join(source, "data-samples", "captures", "gold.bpc"), capture)
@@ -212,12 +222,15 @@ def main():
     # An atlas of two library materials: its second cell (paper) must render as paper does.
     run([tool, "atlas", "gold", ATLAS_CELL, "--out", os.path.join(out, "pair"), "--engine", "web",
          "--quiet"])
-    names = LIBRARY + RGL + [CAPTURE]
+    names = library + rgl_names + [CAPTURE]
+    kind = {n: "library" for n in library} | {n: "RGL" for n in rgl_names} | {CAPTURE: "capture"}
     manifests = {n: json.load(open(os.path.join(out, "web", n + ".manifest.json"))) for n in names}
     slices = len(manifests[CAPTURE]["theta_in_deg"])
     expect(slices != 4, f"{CAPTURE}: --beyond auto gave {slices} slices; the test wants a non-4-slice LUT")
+    prep_s = time.time() - started
 
-    # The browser: every material, its mutations and the furnace; MeshStandardMaterial on gold.
+    # The browser: every material and the furnace in one page; the mutations for MUTATE;
+    # MeshStandardMaterial on gold.
     gold = json.load(open(os.path.join(source, "data-samples", "materials", "gold.json")))
     standard = list(gold["f0"]) + [1.0, float(np.sqrt(gold["alpha"]))]
     renders = os.path.join(work, "browser")
@@ -227,23 +240,26 @@ def main():
     node = subprocess.Popen(
         ["node", os.path.join(source, "tests", "node", "render_ibl.mjs"), "--web",
          os.path.join(out, "web"), "--materials", ",".join(names + ["pair:" + ATLAS_CELL]), "--env", env, "--out", renders,
-         "--size", str(SIZE), "--chromium", chromium,
+         "--size", str(SIZE), "--chromium", chromium, "--mutate", ",".join(MUTATE), "--timeout-s", "300",
          "--standard", ",".join(f"{v:.9g}" for v in standard), "--viewer", GGX_REFERENCE],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     refs = os.path.join(work, "refs")
     os.makedirs(refs)
     preview = [tool, "preview", "--env", env, "--size", str(SIZE), "--no-background", "--quiet",
-               "--jobs", "2"]
+               "--jobs", "1"]
+    commands = []
     for n in names:
         ktx2 = os.path.join(out, n + ".ktx2")
-        run(preview + [ktx2, "--out", os.path.join(refs, n + ".truth.exr")])
-        run(preview + [ktx2, "--ibl", "engine", "--out", os.path.join(refs, n + ".engine.exr")])
-    run(preview + [GGX_REFERENCE, "--out", os.path.join(refs, "ggx.truth.exr")])
+        commands.append(preview + [ktx2, "--out", os.path.join(refs, n + ".truth.exr")])
+        commands.append(preview + [ktx2, "--ibl", "engine", "--out", os.path.join(refs, n + ".engine.exr")])
+    commands.append(preview + [GGX_REFERENCE, "--out", os.path.join(refs, "ggx.truth.exr")])
     furnace_cpu = os.path.join(refs, CAPTURE + ".furnace.exr")
-    run([tool, "preview", os.path.join(out, CAPTURE + ".ktx2"), "--env", "furnace", "--ibl",
-         "engine", "--size", str(SIZE), "--no-background", "--quiet", "--out", furnace_cpu])
+    commands.append([tool, "preview", os.path.join(out, CAPTURE + ".ktx2"), "--env", "furnace", "--ibl",
+                     "engine", "--size", str(SIZE), "--no-background", "--quiet", "--jobs", "1",
+                     "--out", furnace_cpu])
+    run_all(commands)
     cpu_s = time.time() - t0
-    log, err = node.communicate(timeout=240)
+    log, err = node.communicate(timeout=400)
     browser_s = time.time() - t0
     if node.returncode != 0:
         print(f"FAILED: render_ibl.mjs exited with {node.returncode}\n{log}\n{err[-4000:]}")
@@ -251,7 +267,7 @@ def main():
     print("browser:", log.strip().splitlines()[-1][:400])
 
     rows = []
-    pooled = []  # every material's pixel errors against the truth
+    pooled = {"library": [], "RGL": [], "capture": []}  # every material's pixel errors against the truth
     mutation_caught = {"alpha110": [], "noE": []}
     for n in names:
         truth = read_exr(os.path.join(refs, n + ".truth.exr"))
@@ -260,31 +276,40 @@ def main():
         vs_engine = metrics(ibl, engine)
         vs_truth = metrics(ibl, truth)
         cpu_truth = metrics(engine, truth)
+        # Mean brightness of the browser's sphere over the truth's, less 1.
+        bias = float(ibl[MASK].sum() / truth[MASK].sum() - 1)
         furnace_image = read_browser(os.path.join(renders, n + ".furnace.f32"))
         furnace = furnace_error(furnace_image, manifests[n], MU_UNCERTAINTY)
         furnace_raw = furnace_error(furnace_image, manifests[n])
-        rows.append((n, vs_engine, vs_truth, cpu_truth, furnace, furnace_raw))
-        pooled.append(pixel_errors(ibl, truth))
+        rows.append((n, vs_engine, vs_truth, cpu_truth, furnace, furnace_raw, bias))
+        pooled[kind[n]].append(pixel_errors(ibl, truth))
         expect(vs_engine[0] <= SPLIT_SUM_RMSE and vs_engine[1] <= SPLIT_SUM_P95,
                f"{n}: browser vs CPU split sum: relative RMSE {vs_engine[0]:.4f} (bound "
                f"{SPLIT_SUM_RMSE}), p95 {vs_engine[1]:.4f} (bound {SPLIT_SUM_P95})")
         expect(furnace <= FURNACE_TOLERANCE, f"{n}: white furnace: max relative error {furnace:.5f} against E(mu)")
-        for m in mutation_caught:
+        for m in mutation_caught if n in MUTATE else ():
             mm = metrics(read_browser(os.path.join(renders, f"{n}.{m}.f32")), engine)
             if mm[0] > SPLIT_SUM_RMSE or mm[1] > SPLIT_SUM_P95:
                 mutation_caught[m].append((n, mm))
-    print(f"{'material':22s} {'browser vs CPU split sum':>26s} {'browser vs truth':>20s} "
-          f"{'CPU split sum vs truth':>24s} {'furnace (raw)':>16s}")
-    for n, ve, vt, ct, fu, fr in rows:
-        print(f"{n:22s} {ve[0]:12.4f} {ve[1]:12.4f}  {vt[0]:9.4f} {vt[1]:9.4f}  {ct[0]:11.4f} {ct[1]:11.4f}  {fu:8.5f} ({fr:.5f})")
+    print(f"{'material':32s} {'browser vs CPU split sum':>26s} {'browser vs truth':>20s} "
+          f"{'CPU split sum vs truth':>24s} {'bias':>7s} {'furnace (raw)':>16s}")
+    for n, ve, vt, ct, fu, fr, bias in rows:
+        print(f"{n:32s} {ve[0]:12.4f} {ve[1]:12.4f}  {vt[0]:9.4f} {vt[1]:9.4f}  {ct[0]:11.4f} {ct[1]:11.4f}  "
+              f"{bias:+7.3f}  {fu:8.5f} ({fr:.5f})")
     median_rmse = float(np.median([r[2][0] for r in rows]))
     median_p95 = float(np.median([r[2][1] for r in rows]))
-    pooled_p95 = float(np.percentile(np.concatenate(pooled), 95))
-    print(f"browser vs truth over {len(rows)} materials: median relative RMSE {median_rmse:.4f} "
-          f"(bound {TRUTH_MEDIAN_RMSE}), median of the per-material 95th-percentile pixel "
-          f"{median_p95:.4f} (bound {TRUTH_P95}); 95th percentile of all materials' pixels together "
-          f"{pooled_p95:.4f} (not asserted); browser vs CPU split sum: median relative RMSE "
-          f"{np.median([r[1][0] for r in rows]):.4f}")
+    pooled_all = float(np.percentile(np.concatenate(sum(pooled.values(), [])), 95))
+    pooled_kind = {k: float(np.percentile(np.concatenate(v), 95)) for k, v in pooled.items()}
+    over = [(r[0], r[2][1]) for r in rows if r[2][1] > TRUTH_P95]
+    print(f"browser vs truth over {len(rows)} materials ({len(library)} library, {len(rgl_names)} RGL, "
+          f"the capture): median relative RMSE {median_rmse:.4f} (bound {TRUTH_MEDIAN_RMSE}, asserted); "
+          f"median of the per-material 95th-percentile pixel {median_p95:.4f} (bound {TRUTH_P95}, "
+          f"asserted); 95th percentile of all materials' pixels pooled {pooled_all:.4f} (library "
+          f"{pooled_kind['library']:.4f}, RGL {pooled_kind['RGL']:.4f}; bound {TRUTH_P95}, NOT asserted: "
+          f"the split sum's own error, docs/benchmarks/ibl.md); browser vs CPU split sum: median "
+          f"relative RMSE {np.median([r[1][0] for r in rows]):.4f}")
+    print(f"materials whose own 95th-percentile pixel exceeds {TRUTH_P95}: {len(over)} of {len(rows)}: "
+          + ", ".join(f"{n} {v:.3f}" for n, v in sorted(over, key=lambda x: -x[1])))
     expect(median_rmse <= TRUTH_MEDIAN_RMSE, f"browser vs truth: median relative RMSE {median_rmse:.4f}")
     expect(median_p95 <= TRUTH_P95, f"browser vs truth: median 95th-percentile pixel {median_p95:.4f}")
 
@@ -311,10 +336,11 @@ def main():
     expect(atlas_err[0] <= ATLAS_RMSE, f"atlas cell {ATLAS_CELL}: relative RMSE {atlas_err[0]:.6f} against its own LUT")
 
     for m, caught in mutation_caught.items():
-        print(f"mutation {m}: fails the split-sum bound for {len(caught)} of {len(names)} materials: "
+        print(f"mutation {m}: fails the split-sum bound for {len(caught)} of the {len(MUTATE)} mutated: "
               + ", ".join(f"{n} {v[0]:.4f}/{v[1]:.4f}" for n, v in caught))
         expect(any(n == GGX_REFERENCE for n, _ in caught), f"mutation {m} would pass the test for {GGX_REFERENCE}")
-    print(f"times: CPU references {cpu_s:.1f} s and the browser {browser_s:.1f} s (concurrently), "
+    print(f"times: imports and conversions {prep_s:.1f} s, CPU references {cpu_s:.1f} s and the browser "
+          f"{browser_s:.1f} s (concurrently), "
           f"total {time.time() - started:.1f} s")
     if FAILURES or keep:
         print(f"{len(FAILURES)} check(s) failed; kept {work}")
