@@ -1,16 +1,17 @@
 """Measured materials under three.js's own reflection probes, in a real browser, against the
 CPU (ctest: ibl_browser, labels browser, integration).
 
-Materials (a subset, to keep the test near a minute): library materials (gold, a GGX metal,
-also the MeshStandardMaterial reference; glossy red plastic; white paper; walnut, a Ward
-lobe), two RGL measurements (a green paint, a blue silk) read
-through the configurable data path (BRDF_DATA_DIR, default ../shared/brdf-data) and the
-real capture data-samples/captures/gold.bpc converted with `--beyond auto` (a 9-slice LUT,
-θin 0–80° every 10°), all by `brdf convert --engine web`. An equirectangular EXR written here
-(a sky, a ground and three soft lights) is the environment.
+Materials: every material of the library (`brdf materials --json`, 18 today), every RGL file of
+the data path (BRDF_DATA_DIR, default ../shared/brdf-data: rgl/*.bsdf, 18 today, each through
+`brdf import`), and the real capture data-samples/captures/gold.bpc converted with `--beyond
+auto` (a 9-slice LUT, θin 0–80° every 10°), all by `brdf convert --engine web`. An
+equirectangular EXR written here (a sky, a ground and three soft lights) is the environment.
+Runtime (aim ≤ 150 s on 2 loaded cores): a 96² sphere, one browser page rendering every
+material, the `brdf preview` references two at a time while the browser renders, the
+mutations only for the glossy materials of MUTATE, one CPU furnace run.
 
 The browser (tests/node/render_ibl.mjs: headless Chromium on SwiftShader, three.js from npm)
-prefilters that EXR with three's PMREMGenerator and shades a 128² sphere with the shipped
+prefilters that EXR with three's PMREMGenerator and shades a 96² sphere with the shipped
 module's probe term; the references are `brdf preview` of the same exported KTX2 with the same
 map and camera: the true environment-lit image (the rendering integral, the default) and
 `--ibl engine` (the CPU split sum: order-2 SH irradiance and its own GGX-prefiltered pyramid,
@@ -25,9 +26,11 @@ Asserted:
     (the two implementations of the same split sum agree; both bounds leave room for the two
     prefilters' different kernels and resolutions);
   - browser against the truth (the issue's targets): median over the materials of the relative
-    RMSE ≤ 3 % and of the per-material 95th-percentile pixel ≤ 10 % (the 95th percentile of
-    all materials' pixels pooled is printed, not asserted: the rims of the glossy materials,
-    where every split sum is poor, push it above 10 %);
+    RMSE ≤ 3 %, and the MEDIAN OVER THE MATERIALS OF EACH MATERIAL'S OWN 95th-percentile pixel
+    ≤ 10 % (that is the p95 reading asserted). The 95th percentile of all materials' pixels
+    pooled, and the materials whose own p95 exceeds 10 %, are printed, not asserted: they fail
+    with today's split sum, and the CPU split sum fails the same way (docs/benchmarks/ibl.md
+    names them and why);
   - browser against the truth: no worse than 1.25 × the relative RMSE three's
     MeshStandardMaterial makes on the GGX material (gold) against that material's own truth
     (`brdf preview gold`) in the same scene;
@@ -35,10 +38,11 @@ Asserted:
     --ibl engine`, equal the manifest's E(μ) at every pixel's μ = n·v within 0.5 % (for the
     browser beyond the change of E over μ ± 0.002, the uncertainty of a rasterised pixel's μ,
     which matters only where E steps between two rows of the pack; the raw maximum is printed);
-  - mutations: the pack with every α_eq 10 % larger, and the pack with E dropped (the weights
-    divided by E = D + S), each rendered by the same page, must break the bound against the CPU
-    split sum for gold (the test fails if they would pass; for rough and diffuse materials a
-    10 % change of α_eq moves the image by less than the bound, which is printed).
+  - mutations (rendered for the glossy materials of MUTATE): the pack with every α_eq 10 %
+    larger, and the pack with E dropped (the weights divided by E = D + S), each rendered by the
+    same page, must break the bound against the CPU split sum for gold (the test fails if they
+    would pass; for rough and diffuse materials a 10 % change of α_eq moves the image by less
+    than the bound, so they are not mutated).
   - an atlas (gold, paper_white) from `brdf atlas --engine web`: its paper cell, read at the
     cell's origin and the pack's row 1, renders as the single paper LUT within 0.1 % RMSE;
   - the shipped viewer (index.html?material=gold&env=furnace&ibl=1&lights=0&tonemap=linear
