@@ -27,10 +27,11 @@ Asserted:
     prefilters' different kernels and resolutions);
   - browser against the truth (the issue's targets): median over the materials of the relative
     RMSE ≤ 3 %, and the MEDIAN OVER THE MATERIALS OF EACH MATERIAL'S OWN 95th-percentile pixel
-    ≤ 10 % (that is the p95 reading asserted). The 95th percentile of all materials' pixels
-    pooled, and the materials whose own p95 exceeds 10 %, are printed, not asserted: they fail
-    with today's split sum, and the CPU split sum fails the same way (docs/benchmarks/ibl.md
-    names them and why);
+    ≤ 10 % (that is the p95 reading asserted), and the 95th percentile of the library
+    materials' pixels pooled ≤ 10 %. The 95th percentile of all materials' pixels pooled (and
+    of the RGL files'), and the materials whose own p95 exceeds 10 %, are printed, not
+    asserted: they fail with today's split sum, and the CPU split sum fails the same way
+    (docs/benchmarks/ibl.md names them and why);
   - browser against the truth: no worse than 1.25 × the relative RMSE three's
     MeshStandardMaterial makes on the GGX material (gold) against that material's own truth
     (`brdf preview gold`) in the same scene;
@@ -308,14 +309,17 @@ def main():
     print(f"browser vs truth over {len(rows)} materials ({len(library)} library, {len(rgl_names)} RGL, "
           f"the capture): median relative RMSE {median_rmse:.4f} (bound {TRUTH_MEDIAN_RMSE}, asserted); "
           f"median of the per-material 95th-percentile pixel {median_p95:.4f} (bound {TRUTH_P95}, "
-          f"asserted); 95th percentile of all materials' pixels pooled {pooled_all:.4f} (library "
-          f"{pooled_kind['library']:.4f}, RGL {pooled_kind['RGL']:.4f}; bound {TRUTH_P95}, NOT asserted: "
-          f"the split sum's own error, docs/benchmarks/ibl.md); browser vs CPU split sum: median "
+          f"asserted); 95th percentile of all materials' pixels pooled {pooled_all:.4f} (bound {TRUTH_P95}, "
+          f"NOT asserted: the split sum's own error, docs/benchmarks/ibl.md), of the library's "
+          f"{pooled_kind['library']:.4f} (asserted), of the RGL files' {pooled_kind['RGL']:.4f} (not "
+          f"asserted); browser vs CPU split sum: median "
           f"relative RMSE {np.median([r[1][0] for r in rows]):.4f}")
     print(f"materials whose own 95th-percentile pixel exceeds {TRUTH_P95}: {len(over)} of {len(rows)}: "
           + ", ".join(f"{n} {v:.3f}" for n, v in sorted(over, key=lambda x: -x[1])))
     expect(median_rmse <= TRUTH_MEDIAN_RMSE, f"browser vs truth: median relative RMSE {median_rmse:.4f}")
     expect(median_p95 <= TRUTH_P95, f"browser vs truth: median 95th-percentile pixel {median_p95:.4f}")
+    expect(pooled_kind["library"] <= TRUTH_P95,
+           f"browser vs truth: 95th percentile of the library materials' pixels pooled {pooled_kind['library']:.4f}")
 
     standard_err = metrics(read_browser(os.path.join(renders, "standard.f32")),
                            read_exr(os.path.join(refs, "ggx.truth.exr")))
