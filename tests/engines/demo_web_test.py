@@ -26,7 +26,6 @@ Usage: demo_web_test.py BRDF_TOOL SOURCE_DIR CHROMIUM [--keep]  (Debian python3)
 import os
 import re
 import shlex
-import shutil
 import socket
 import subprocess
 import sys
@@ -37,7 +36,7 @@ import urllib.request
 import numpy as np
 import OpenImageIO as oiio
 
-from check_support import FAILURES, expect, run
+from check_support import expect, finish, run
 
 MATERIALS = ["gold", "paper_white"]
 WINDOW = 512
@@ -143,11 +142,7 @@ def main():
     expect(spread >= 8, f"{address}: the sphere is uniform: luminance std {spread:.1f} (at least 8 expected)")
     expect(red_blue >= 1.5, f"{address}: the sphere is not gold: median linear red/blue {red_blue:.2f} (at least 1.5 expected)")
     print(f"times: demo output {made_s:.1f} s, total {time.time() - started:.1f} s")
-    if FAILURES or keep:
-        print(f"{len(FAILURES)} check(s) failed; kept {work}")
-        return 1 if FAILURES else 0
-    shutil.rmtree(work, ignore_errors=True)
-    return 0
+    return finish(work, keep)
 
 
 if __name__ == "__main__":

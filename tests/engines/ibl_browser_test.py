@@ -66,7 +66,7 @@ from concurrent.futures import ThreadPoolExecutor
 import numpy as np
 import OpenImageIO as oiio
 
-from check_support import FAILURES, expect, run
+from check_support import expect, finish, run
 
 SIZE = 96
 CAPTURE = "gold_capture"  # data-samples/captures/gold.bpc, --beyond auto
@@ -350,11 +350,7 @@ def main():
     print(f"times: imports and conversions {prep_s:.1f} s, CPU references {cpu_s:.1f} s and the browser "
           f"{browser_s:.1f} s (concurrently), "
           f"total {time.time() - started:.1f} s")
-    if FAILURES or keep:
-        print(f"{len(FAILURES)} check(s) failed; kept {work}")
-        return 1 if FAILURES else 0
-    shutil.rmtree(work, ignore_errors=True)
-    return 0
+    return finish(work, keep)
 
 
 if __name__ == "__main__":
