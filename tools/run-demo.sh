@@ -43,15 +43,11 @@ echo "== converting captures to RGB9E5 lookup textures and engine kits -> $out/l
 # (tools/install-npm-deps.sh, from the local npm cache), so the page works from a local file
 # server with no network.
 if [ -z "${BRDF_DEMO_TOOLS:-}" ]; then "$root/tools/install-npm-deps.sh"; fi
-three="$root/tests/node/node_modules/three"
-if [ -f "$three/build/three.module.js" ]; then
-  mkdir -p "$out/luts/web/node_modules/three/examples"
-  cp -r "$three/build" "$three/package.json" "$out/luts/web/node_modules/three/"
-  cp -r "$three/examples/jsm" "$out/luts/web/node_modules/three/examples/"
+if "$root/tools/copy-web-three.sh" "$out/luts/web"; then
   echo "environment-lit viewer: python3 -m http.server -d $out/luts/web 8000, then open"
   echo "  http://localhost:8000/index.html?material=gold&env=studio&ibl=1&lights=0&tonemap=linear"
 else
-  echo "environment-lit viewer: three.js not found ($three); run tools/install-npm-deps.sh, or npm install in $out/luts/web"
+  echo "environment-lit viewer: without three.js; run tools/install-npm-deps.sh, or npm install in $out/luts/web"
 fi
 echo "== packing the library into one atlas -> $out/atlas"
 mkdir -p "$out/atlas"

@@ -1,16 +1,18 @@
 """Measured materials under three.js's own reflection probes, in a real browser, against the
 CPU (ctest: ibl_browser, labels browser, integration).
 
-Materials (a subset, to keep the test near a minute): library materials (gold, a GGX metal,
-also the MeshStandardMaterial reference; glossy red plastic; white paper; walnut, a Ward
-lobe), two RGL measurements (a green paint, a blue silk) read
-through the configurable data path (BRDF_DATA_DIR, default ../shared/brdf-data) and the
-real capture data-samples/captures/gold.bpc converted with `--beyond auto` (a 9-slice LUT,
-θin 0–80° every 10°), all by `brdf convert --engine web`. An equirectangular EXR written here
-(a sky, a ground and three soft lights) is the environment.
+Materials: every material of the library (`brdf materials --json`, 18 today), every RGL file of
+the data path (BRDF_DATA_DIR, default ../shared/brdf-data: rgl/*.bsdf, 18 today, each through
+`brdf import`), and the real capture data-samples/captures/gold.bpc converted with `--beyond
+auto` (a 9-slice LUT, θin 0–80° every 10°), all by `brdf convert --engine web`. An
+equirectangular EXR written here (a sky, a ground and three soft lights) is the environment.
+Runtime (aim ≤ 150 s on 2 loaded cores): a 96² sphere, one browser page rendering every
+material, the `brdf preview` references two at a time while the browser renders, the
+mutations only for the glossy materials of MUTATE, three CPU furnace runs (the capture, gold
+and the first RGL file).
 
 The browser (tests/node/render_ibl.mjs: headless Chromium on SwiftShader, three.js from npm)
-prefilters that EXR with three's PMREMGenerator and shades a 128² sphere with the shipped
+prefilters that EXR with three's PMREMGenerator and shades a 96² sphere with the shipped
 module's probe term; the references are `brdf preview` of the same exported KTX2 with the same
 map and camera: the true environment-lit image (the rendering integral, the default) and
 `--ibl engine` (the CPU split sum: order-2 SH irradiance and its own GGX-prefiltered pyramid,
@@ -25,9 +27,12 @@ Asserted:
     (the two implementations of the same split sum agree; both bounds leave room for the two
     prefilters' different kernels and resolutions);
   - browser against the truth (the issue's targets): median over the materials of the relative
-    RMSE ≤ 3 % and of the per-material 95th-percentile pixel ≤ 10 % (the 95th percentile of
-    all materials' pixels pooled is printed, not asserted: the rims of the glossy materials,
-    where every split sum is poor, push it above 10 %);
+    RMSE ≤ 3 %, and the MEDIAN OVER THE MATERIALS OF EACH MATERIAL'S OWN 95th-percentile pixel
+    ≤ 10 % (that is the p95 reading asserted), and the 95th percentile of the library
+    materials' pixels pooled ≤ 10 %. The 95th percentile of all materials' pixels pooled (and
+    of the RGL files'), and the materials whose own p95 exceeds 10 %, are printed, not
+    asserted: they fail with today's split sum, and the CPU split sum fails the same way
+    (docs/benchmarks/ibl.md names them and why);
   - browser against the truth: no worse than 1.25 × the relative RMSE three's
     MeshStandardMaterial makes on the GGX material (gold) against that material's own truth
     (`brdf preview gold`) in the same scene;
@@ -35,10 +40,11 @@ Asserted:
     --ibl engine`, equal the manifest's E(μ) at every pixel's μ = n·v within 0.5 % (for the
     browser beyond the change of E over μ ± 0.002, the uncertainty of a rasterised pixel's μ,
     which matters only where E steps between two rows of the pack; the raw maximum is printed);
-  - mutations: the pack with every α_eq 10 % larger, and the pack with E dropped (the weights
-    divided by E = D + S), each rendered by the same page, must break the bound against the CPU
-    split sum for gold (the test fails if they would pass; for rough and diffuse materials a
-    10 % change of α_eq moves the image by less than the bound, which is printed).
+  - mutations (rendered for the glossy materials of MUTATE): the pack with every α_eq 10 %
+    larger, and the pack with E dropped (the weights divided by E = D + S), each rendered by the
+    same page, must break the bound against the CPU split sum for gold (the test fails if they
+    would pass; for rough and diffuse materials a 10 % change of α_eq moves the image by less
+    than the bound, so they are not mutated).
   - an atlas (gold, paper_white) from `brdf atlas --engine web`: its paper cell, read at the
     cell's origin and the pack's row 1, renders as the single paper LUT within 0.1 % RMSE;
   - the shipped viewer (index.html?material=gold&env=furnace&ibl=1&lights=0&tonemap=linear
@@ -48,6 +54,7 @@ Reported, not asserted: browser against the truth per material (the split sum's 
 largest at the rim of glossy materials), next to the CPU split sum against the truth.
 Usage: ibl_browser_test.py BRDF_TOOL SOURCE_DIR CHROMIUM DATA_DIR [--keep]  (Debian python3)
 """
+import glob
 import json
 import os
 import shutil
@@ -55,17 +62,20 @@ import subprocess
 import sys
 import tempfile
 import time
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import OpenImageIO as oiio
 
-from check_support import FAILURES, expect, run
+from check_support import expect, finish, run
 
-SIZE = 128
-LIBRARY = ["gold", "plastic_glossy_red", "paper_white", "wood_walnut"]
-RGL = ["chm_mint_rgb", "vch_silk_blue_rgb"]
+SIZE = 96
 CAPTURE = "gold_capture"  # data-samples/captures/gold.bpc, --beyond auto
 GGX_REFERENCE = "gold"
+# The mutations are rendered for glossy materials only (a 10 % change of a rough lobe's α_eq
+# moves the image by less than the split-sum bound; docs/benchmarks/ibl.md).
+MUTATE = ["gold", "copper", "vch_silk_blue_rgb", CAPTURE]
+JOBS = 2  # the CPU references and the RGL imports, two processes at a time
 ATLAS_CELL = "paper_white"  # cell 1 of the atlas "pair" (gold, paper_white)
 ATLAS_RMSE = 0.001
 SPLIT_SUM_RMSE, SPLIT_SUM_P95 = 0.02, 0.06
@@ -184,6 +194,12 @@ def check_viewer(png, manifest):
           f"({centre_x:.1f}, {centre_y:.1f}), centre {np.round(got, 1)} vs sRGB(E(1)) {np.round(srgb, 1)}")
 
 
+def run_all(commands, jobs=JOBS):
+    """Runs the commands `jobs` at a time (each must succeed, as run())."""
+    with ThreadPoolExecutor(jobs) as pool:
+        list(pool.map(run, commands))
+
+
 def main():
     tool, source, chromium, data_dir = sys.argv[1:5]
     keep = "--keep" in sys.argv
@@ -193,17 +209,17 @@ def main():
     env = os.path.join(work, "env.exr")
     write_environment(env)
     out = os.path.join(work, "out")
-    rgl = [os.path.join(data_dir, "rgl", n + ".bsdf") for n in RGL]
-    for p in rgl:
-        if not os.path.isfile(p):
-            print(f"FAILED: {p}: missing (set BRDF_DATA_DIR to the brdf-data folder)")
-            return 1
+    # Every material of the library (`brdf materials`) and every RGL file of the data folder.
+    library = [m["name"] for m in json.loads(run([tool, "materials", "--json"]))]
+    rgl = sorted(glob.glob(os.path.join(data_dir, "rgl", "*.bsdf")))
+    if not rgl:
+        print(f"FAILED: {os.path.join(data_dir, 'rgl')}: no .bsdf files (set BRDF_DATA_DIR to the brdf-data folder)")
+        return 1
+    rgl_names = [os.path.basename(p)[:-len(".bsdf")] for p in rgl]
     # RGL files become noise-free virtual captures at the instrument's geometry (brdf import).
-    captures = []
-    for n, p in zip(RGL, rgl):
-        captures.append(os.path.join(work, n + ".bpc"))
-        run([tool, "import", p, "--out", captures[-1]])
-    run([tool, "convert", *LIBRARY, *captures, "--out", out, "--engine", "web", "--quiet", "--jobs", "2",
+    captures = [os.path.join(work, n + ".bpc") for n in rgl_names]
+    run_all([[tool, "import", p, "--out", c] for p, c in zip(rgl, captures)])
+    run([tool, "convert", *library, *captures, "--out", out, "--engine", "web", "--quiet", "--jobs", str(JOBS),
          "--formats", "ktx2"])
     capture = os.path.join(work, CAPTURE + ".bpc")
     shutil.copyfile(os.path.join(source, "data-samples", "captures", "gold.bpc"), capture)
@@ -212,12 +228,15 @@ def main():
     # An atlas of two library materials: its second cell (paper) must render as paper does.
     run([tool, "atlas", "gold", ATLAS_CELL, "--out", os.path.join(out, "pair"), "--engine", "web",
          "--quiet"])
-    names = LIBRARY + RGL + [CAPTURE]
+    names = library + rgl_names + [CAPTURE]
+    kind = {n: "library" for n in library} | {n: "RGL" for n in rgl_names} | {CAPTURE: "capture"}
     manifests = {n: json.load(open(os.path.join(out, "web", n + ".manifest.json"))) for n in names}
     slices = len(manifests[CAPTURE]["theta_in_deg"])
     expect(slices != 4, f"{CAPTURE}: --beyond auto gave {slices} slices; the test wants a non-4-slice LUT")
+    prep_s = time.time() - started
 
-    # The browser: every material, its mutations and the furnace; MeshStandardMaterial on gold.
+    # The browser: every material and the furnace in one page; the mutations for MUTATE;
+    # MeshStandardMaterial on gold.
     gold = json.load(open(os.path.join(source, "data-samples", "materials", "gold.json")))
     standard = list(gold["f0"]) + [1.0, float(np.sqrt(gold["alpha"]))]
     renders = os.path.join(work, "browser")
@@ -227,23 +246,28 @@ def main():
     node = subprocess.Popen(
         ["node", os.path.join(source, "tests", "node", "render_ibl.mjs"), "--web",
          os.path.join(out, "web"), "--materials", ",".join(names + ["pair:" + ATLAS_CELL]), "--env", env, "--out", renders,
-         "--size", str(SIZE), "--chromium", chromium,
+         "--size", str(SIZE), "--chromium", chromium, "--mutate", ",".join(MUTATE), "--timeout-s", "300",
          "--standard", ",".join(f"{v:.9g}" for v in standard), "--viewer", GGX_REFERENCE],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
     refs = os.path.join(work, "refs")
     os.makedirs(refs)
     preview = [tool, "preview", "--env", env, "--size", str(SIZE), "--no-background", "--quiet",
-               "--jobs", "2"]
+               "--jobs", "1"]
+    commands = []
     for n in names:
         ktx2 = os.path.join(out, n + ".ktx2")
-        run(preview + [ktx2, "--out", os.path.join(refs, n + ".truth.exr")])
-        run(preview + [ktx2, "--ibl", "engine", "--out", os.path.join(refs, n + ".engine.exr")])
-    run(preview + [GGX_REFERENCE, "--out", os.path.join(refs, "ggx.truth.exr")])
-    furnace_cpu = os.path.join(refs, CAPTURE + ".furnace.exr")
-    run([tool, "preview", os.path.join(out, CAPTURE + ".ktx2"), "--env", "furnace", "--ibl",
-         "engine", "--size", str(SIZE), "--no-background", "--quiet", "--out", furnace_cpu])
+        commands.append(preview + [ktx2, "--out", os.path.join(refs, n + ".truth.exr")])
+        commands.append(preview + [ktx2, "--ibl", "engine", "--out", os.path.join(refs, n + ".engine.exr")])
+    commands.append(preview + [GGX_REFERENCE, "--out", os.path.join(refs, "ggx.truth.exr")])
+    # `--ibl engine` under the white furnace: one material of each kind (0.3 s each).
+    furnace_cpu = [CAPTURE, GGX_REFERENCE, rgl_names[0]]
+    for n in furnace_cpu:
+        commands.append([tool, "preview", os.path.join(out, n + ".ktx2"), "--env", "furnace", "--ibl",
+                         "engine", "--size", str(SIZE), "--no-background", "--quiet", "--jobs", "1",
+                         "--out", os.path.join(refs, n + ".furnace.exr")])
+    run_all(commands)
     cpu_s = time.time() - t0
-    log, err = node.communicate(timeout=240)
+    log, err = node.communicate(timeout=400)
     browser_s = time.time() - t0
     if node.returncode != 0:
         print(f"FAILED: render_ibl.mjs exited with {node.returncode}\n{log}\n{err[-4000:]}")
@@ -251,7 +275,7 @@ def main():
     print("browser:", log.strip().splitlines()[-1][:400])
 
     rows = []
-    pooled = []  # every material's pixel errors against the truth
+    pooled = {"library": [], "RGL": [], "capture": []}  # every material's pixel errors against the truth
     mutation_caught = {"alpha110": [], "noE": []}
     for n in names:
         truth = read_exr(os.path.join(refs, n + ".truth.exr"))
@@ -260,33 +284,45 @@ def main():
         vs_engine = metrics(ibl, engine)
         vs_truth = metrics(ibl, truth)
         cpu_truth = metrics(engine, truth)
+        # Mean brightness of the browser's sphere over the truth's, less 1.
+        bias = float(ibl[MASK].sum() / truth[MASK].sum() - 1)
         furnace_image = read_browser(os.path.join(renders, n + ".furnace.f32"))
         furnace = furnace_error(furnace_image, manifests[n], MU_UNCERTAINTY)
         furnace_raw = furnace_error(furnace_image, manifests[n])
-        rows.append((n, vs_engine, vs_truth, cpu_truth, furnace, furnace_raw))
-        pooled.append(pixel_errors(ibl, truth))
+        rows.append((n, vs_engine, vs_truth, cpu_truth, furnace, furnace_raw, bias))
+        pooled[kind[n]].append(pixel_errors(ibl, truth))
         expect(vs_engine[0] <= SPLIT_SUM_RMSE and vs_engine[1] <= SPLIT_SUM_P95,
                f"{n}: browser vs CPU split sum: relative RMSE {vs_engine[0]:.4f} (bound "
                f"{SPLIT_SUM_RMSE}), p95 {vs_engine[1]:.4f} (bound {SPLIT_SUM_P95})")
         expect(furnace <= FURNACE_TOLERANCE, f"{n}: white furnace: max relative error {furnace:.5f} against E(mu)")
-        for m in mutation_caught:
+        for m in mutation_caught if n in MUTATE else ():
             mm = metrics(read_browser(os.path.join(renders, f"{n}.{m}.f32")), engine)
             if mm[0] > SPLIT_SUM_RMSE or mm[1] > SPLIT_SUM_P95:
                 mutation_caught[m].append((n, mm))
-    print(f"{'material':22s} {'browser vs CPU split sum':>26s} {'browser vs truth':>20s} "
-          f"{'CPU split sum vs truth':>24s} {'furnace (raw)':>16s}")
-    for n, ve, vt, ct, fu, fr in rows:
-        print(f"{n:22s} {ve[0]:12.4f} {ve[1]:12.4f}  {vt[0]:9.4f} {vt[1]:9.4f}  {ct[0]:11.4f} {ct[1]:11.4f}  {fu:8.5f} ({fr:.5f})")
+    print(f"{'material':32s} {'browser vs CPU split sum':>26s} {'browser vs truth':>20s} "
+          f"{'CPU split sum vs truth':>24s} {'bias':>7s} {'furnace (raw)':>16s}")
+    for n, ve, vt, ct, fu, fr, bias in rows:
+        print(f"{n:32s} {ve[0]:12.4f} {ve[1]:12.4f}  {vt[0]:9.4f} {vt[1]:9.4f}  {ct[0]:11.4f} {ct[1]:11.4f}  "
+              f"{bias:+7.3f}  {fu:8.5f} ({fr:.5f})")
     median_rmse = float(np.median([r[2][0] for r in rows]))
     median_p95 = float(np.median([r[2][1] for r in rows]))
-    pooled_p95 = float(np.percentile(np.concatenate(pooled), 95))
-    print(f"browser vs truth over {len(rows)} materials: median relative RMSE {median_rmse:.4f} "
-          f"(bound {TRUTH_MEDIAN_RMSE}), median of the per-material 95th-percentile pixel "
-          f"{median_p95:.4f} (bound {TRUTH_P95}); 95th percentile of all materials' pixels together "
-          f"{pooled_p95:.4f} (not asserted); browser vs CPU split sum: median relative RMSE "
-          f"{np.median([r[1][0] for r in rows]):.4f}")
+    pooled_all = float(np.percentile(np.concatenate(sum(pooled.values(), [])), 95))
+    pooled_kind = {k: float(np.percentile(np.concatenate(v), 95)) for k, v in pooled.items()}
+    over = [(r[0], r[2][1]) for r in rows if r[2][1] > TRUTH_P95]
+    print(f"browser vs truth over {len(rows)} materials ({len(library)} library, {len(rgl_names)} RGL, "
+          f"the capture): median relative RMSE {median_rmse:.4f} (bound {TRUTH_MEDIAN_RMSE}, asserted); "
+          f"median of the per-material 95th-percentile pixel {median_p95:.4f} (bound {TRUTH_P95}, "
+          f"asserted); 95th percentile of all materials' pixels pooled {pooled_all:.4f} (bound {TRUTH_P95}, "
+          f"NOT asserted: the split sum's own error, docs/benchmarks/ibl.md), of the library's "
+          f"{pooled_kind['library']:.4f} (asserted), of the RGL files' {pooled_kind['RGL']:.4f} (not "
+          f"asserted); browser vs CPU split sum: median "
+          f"relative RMSE {np.median([r[1][0] for r in rows]):.4f}")
+    print(f"materials whose own 95th-percentile pixel exceeds {TRUTH_P95}: {len(over)} of {len(rows)}: "
+          + ", ".join(f"{n} {v:.3f}" for n, v in sorted(over, key=lambda x: -x[1])))
     expect(median_rmse <= TRUTH_MEDIAN_RMSE, f"browser vs truth: median relative RMSE {median_rmse:.4f}")
     expect(median_p95 <= TRUTH_P95, f"browser vs truth: median 95th-percentile pixel {median_p95:.4f}")
+    expect(pooled_kind["library"] <= TRUTH_P95,
+           f"browser vs truth: 95th percentile of the library materials' pixels pooled {pooled_kind['library']:.4f}")
 
     standard_err = metrics(read_browser(os.path.join(renders, "standard.f32")),
                            read_exr(os.path.join(refs, "ggx.truth.exr")))
@@ -297,9 +333,11 @@ def main():
     expect(ours[0] <= STANDARD_RATIO * standard_err[0],
            f"{GGX_REFERENCE}: relative RMSE {ours[0]:.4f} > {STANDARD_RATIO} x MeshStandardMaterial's {standard_err[0]:.4f}")
 
-    cpu_furnace = furnace_error(read_exr(furnace_cpu), manifests[CAPTURE])
-    print(f"{CAPTURE} ({slices} slices): --ibl engine under the white furnace: max relative error {cpu_furnace:.5f}")
-    expect(cpu_furnace <= FURNACE_TOLERANCE, f"--ibl engine furnace: max relative error {cpu_furnace:.5f}")
+    for n in furnace_cpu:
+        cpu_furnace = furnace_error(read_exr(os.path.join(refs, n + ".furnace.exr")), manifests[n])
+        label = f"{n} ({slices} slices)" if n == CAPTURE else n
+        print(f"{label}: --ibl engine under the white furnace: max relative error {cpu_furnace:.5f}")
+        expect(cpu_furnace <= FURNACE_TOLERANCE, f"{n}: --ibl engine furnace: max relative error {cpu_furnace:.5f}")
 
     check_viewer(os.path.join(renders, "viewer.png"), manifests[GGX_REFERENCE])
 
@@ -311,16 +349,13 @@ def main():
     expect(atlas_err[0] <= ATLAS_RMSE, f"atlas cell {ATLAS_CELL}: relative RMSE {atlas_err[0]:.6f} against its own LUT")
 
     for m, caught in mutation_caught.items():
-        print(f"mutation {m}: fails the split-sum bound for {len(caught)} of {len(names)} materials: "
+        print(f"mutation {m}: fails the split-sum bound for {len(caught)} of the {len(MUTATE)} mutated: "
               + ", ".join(f"{n} {v[0]:.4f}/{v[1]:.4f}" for n, v in caught))
         expect(any(n == GGX_REFERENCE for n, _ in caught), f"mutation {m} would pass the test for {GGX_REFERENCE}")
-    print(f"times: CPU references {cpu_s:.1f} s and the browser {browser_s:.1f} s (concurrently), "
+    print(f"times: imports and conversions {prep_s:.1f} s, CPU references {cpu_s:.1f} s and the browser "
+          f"{browser_s:.1f} s (concurrently), "
           f"total {time.time() - started:.1f} s")
-    if FAILURES or keep:
-        print(f"{len(FAILURES)} check(s) failed; kept {work}")
-        return 1 if FAILURES else 0
-    shutil.rmtree(work, ignore_errors=True)
-    return 0
+    return finish(work, keep)
 
 
 if __name__ == "__main__":

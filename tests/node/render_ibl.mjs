@@ -17,6 +17,7 @@
 //   NAME.ibl.f32       the probe term alone (no direct light)
 //   NAME.alpha110.f32  the same with every alpha_eq of the pack 10 % larger (mutation)
 //   NAME.noE.f32       the same with the weights divided by E = D + S (mutation: E dropped)
+//                      (the two mutations only for the materials of --mutate, default all)
 //   NAME.furnace.f32   under a uniform radiance 1 (three's PMREM of a constant map)
 // and with --standard R,G,B,METALNESS,ROUGHNESS: standard.f32, three's MeshStandardMaterial
 // lit by the same PMREM (scene.environment), plus info.json (renderer, timings, PMREM size).
@@ -24,9 +25,10 @@
 // (?material=NAME&env=furnace&ibl=1&lights=0&tonemap=linear&background=0) once its title is
 // "ready". With --bench: bench.json, frame times of the measured material and MeshStandardMaterial
 // under the same environment at --bench-size, alternating.
+// All materials are rendered by one page in one browser (one PMREM of the map and of the furnace).
 // Usage: node render_ibl.mjs --web DIR --materials A,B,ATLAS:CELL,... --env FILE.exr --out DIR
-//        [--size N] [--standard r,g,b,m,ro] [--viewer NAME] [--bench] [--bench-size N]
-//        [--chromium PATH]
+//        [--size N] [--mutate A,B,...] [--standard r,g,b,m,ro] [--viewer NAME] [--bench]
+//        [--bench-size N] [--chromium PATH] [--timeout-s S (default 180)]
 import { writeFileSync, existsSync } from 'node:fs';
 import { join, resolve, dirname, basename } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -44,7 +46,8 @@ if (!existsSync(join(threeDir, 'build/three.module.js'))) {
 }
 const size = parseInt(args.size || '128', 10);
 const materials = args.materials.split(',').filter((m) => m);
-const deadline = Date.now() + 180000;
+const mutate = args.mutate ? new Set(args.mutate.split(',').filter((m) => m)) : null;
+const deadline = Date.now() + 1000 * parseFloat(args['timeout-s'] || '180');
 
 const page = `<!DOCTYPE html><html><head><meta charset="utf-8">
 <script type="importmap">{"imports": {"three": "/three/build/three.module.js", "three/addons/": "/three/examples/jsm/"}}</script>
@@ -167,8 +170,11 @@ try {
         const e = [0, 1, 2].map((c) => v[c] + o[c]);
         return [0, 1, 2].map((c) => (e[c] > 0 ? v[c] / e[c] : 0)).concat([v[3]]);
       });
-      return { ibl: render(material(env, pack)), alpha110: render(material(env, alpha110)),
-               noE: render(material(env, noE)), furnace: render(material(furnace, pack)) };
+      const out = { ibl: render(material(env, pack)), furnace: render(material(furnace, pack)) };
+      if (${mutate === null || mutate.has(entry)})
+        Object.assign(out, { alpha110: render(material(env, alpha110)), noE: render(material(env, noE)) });
+      for (const t of [lut, pack, alpha110, noE]) t.dispose();  // 37 materials in one page
+      return out;
     })()`);
     const stem = entry.replace(':', '.');
     for (const [k, v] of Object.entries(renders)) writeFileSync(join(outDir, `${stem}.${k}.f32`), Buffer.from(fromBase64(v).buffer));
