@@ -59,7 +59,7 @@ def sidecar_json(theta_in, payload_bytes, crc):
         "extrapolation": {"p": 2.0, "l": 0.5, "theta_b_deg": 80.0},
         "tool": {"version": "seed"},
         "payload": {"bytes": payload_bytes, "format": "compact_log_grid",
-                    "checksum": {"algorithm": "crc32", "value": f"{crc:08x}"}},
+                    "checksum": {"algorithm": "crc32", "value": f"0x{crc:08x}"}},
     }
     return json.dumps(doc, separators=(",", ":")).encode("utf-8")
 
