@@ -130,16 +130,16 @@ LutCompression ChooseAtlasCompression(Atlas& atlas, const std::vector<AtlasMater
     throw InvalidArgument(
         fmt::format("atlas: --max-error must be a fraction in (0, 1), got {}", max_error));
   CompressAtlasBc6h(atlas, materials, jobs);
-  const bool bc6h_meets = std::all_of(
-      atlas.certified_error.begin(), atlas.certified_error.end(),
-      [&](const CertifiedError& e) { return e.measured.max <= max_error; });
+  const bool bc6h_meets =
+      std::all_of(atlas.certified_error.begin(), atlas.certified_error.end(),
+                  [&](const CertifiedError& e) { return e.measured.max <= max_error; });
   if (!bc6h_meets) {
     // RGB9E5: each material's cell of the packed words, decoded, against its float LUT.
     atlas.bc6h.reset();
     atlas.certified_error.clear();
     for (std::size_t m = 0; m < materials.size(); ++m) {
-      const Lut cell = ExtractAtlasCell(atlas.volume, atlas.layout, static_cast<int>(m),
-                                        atlas.theta_in_deg);
+      const Lut cell =
+          ExtractAtlasCell(atlas.volume, atlas.layout, static_cast<int>(m), atlas.theta_in_deg);
       const std::optional<ExtrapolationInfo>& x = materials[m].extrapolation;
       CertifiedError e =
           MeasureCompressionError(*materials[m].lut, cell.texels, x ? x->theta_b_deg : 90.0);

@@ -75,9 +75,9 @@ TEST(BrdfcFuzzCorpus, MinimalSeedDecodesByTheFormatsRule) {
   };
   // Corners, the middle of each edge, the centre and (45°, 90°), a quarter along both axes:
   // top -0.25, bottom -2.25, g = -0.25 + (-2)·0.25 = -0.75.
-  for (const Case& t : {Case{0, 0, 0.0}, Case{0, 360, -1.0}, Case{180, 0, -2.0},
-                        Case{180, 360, -3.0}, Case{0, 180, -0.5}, Case{90, 0, -1.0},
-                        Case{90, 180, -1.5}, Case{45, 90, -0.75}}) {
+  for (const Case& t :
+       {Case{0, 0, 0.0}, Case{0, 360, -1.0}, Case{180, 0, -2.0}, Case{180, 360, -3.0},
+        Case{0, 180, -0.5}, Case{90, 0, -1.0}, Case{90, 180, -1.5}, Case{45, 90, -0.75}}) {
     SCOPED_TRACE(testing::Message() << t.theta_d << ", " << t.phi_d);
     const std::array<float, 3> v = lut.SampleSlice(0, t.theta_d, t.phi_d);
     EXPECT_NEAR(v[0], f(t.g_r), 1e-6 * f(t.g_r) + 1e-7);

@@ -11,7 +11,7 @@ computed over the measured range θout <= θb and the filled range, then:
   loose bound, same deterministic encoder) is at most E, else RGB9E5;
 - the manifest's per-material "compression" figures (max, p99, median, texel counts, format, the
   bound and whether it is met) equal the numpy ones; stdout names the format and each material
-  with its max, and warns for the materials above E;
+  with its max, and warns for the materials above E; `brdf info` names the format per material;
 - the unused cell decodes to zero and is not a material of the manifest.
 
 Bounds: a loose one BC6H meets, 0.5 % (BC6H's max on these materials is above it, RGB9E5's below:
@@ -139,6 +139,10 @@ def check_bound(args, refs, bound, bc6h_max):
     word = "BC6H" if fmt == "bc6h" else "RGB9E5"
     if f"{word} for the atlas" not in text:
         fail(f"--max-error {bound:g}: stdout does not say '{word} for the atlas': {text!r}")
+    info = run([args.brdf, "info", prefix + ".json"]).stdout
+    if info.count(f"certified {word} error") != len(MATERIALS):
+        fail(f"--max-error {bound:g}: `brdf info` does not name {word} for every material: "
+             f"{info!r}")
     print(f"--max-error {100 * bound:g} %: {word}; measured max per material "
           + ", ".join(f"{n} {100 * v:.3f} %" for n, v in errors.items())
           + " (numpy, as the manifest records)")
