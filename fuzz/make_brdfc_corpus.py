@@ -16,6 +16,9 @@ import struct
 import sys
 import zlib
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from make_bpc_corpus import write_seeds  # noqa: E402
+
 MAGIC = b"BRDFCLUT"
 HEADER = 36  # magic, version, K, flags, S, epsilon, CRC, L
 
@@ -114,10 +117,7 @@ def main():
         "bad_at56_truncated.brdfc": minimal[:60],
         "bad_at80_trailing_bytes.brdfc": minimal + b"\0junk",
     }
-    for name, data in files.items():
-        with open(os.path.join(out, name), "wb") as f:
-            f.write(data)
-    print(f"wrote {len(files)} seeds to {out}")
+    write_seeds(out, files)
 
 
 if __name__ == "__main__":
