@@ -64,6 +64,14 @@ def end_chunk(slices, samples, metadata=METADATA):
     return chunk(b"END ", NO_SLICE, payload)
 
 
+def write_seeds(out, files):
+    """Writes {file name: bytes} into OUT (also used by make_brdfc_corpus.py)."""
+    for name, data in files.items():
+        with open(os.path.join(out, name), "wb") as f:
+            f.write(data)
+    print(f"wrote {len(files)} seeds to {out}")
+
+
 def main():
     out = sys.argv[1] if len(sys.argv) > 1 else os.path.join(
         os.path.dirname(os.path.abspath(__file__)), "corpus", "bpc")
@@ -89,10 +97,7 @@ def main():
             preamble_and_head(minor=1) + chunk(b"NOTE", NO_SLICE, b"later minor version") +
             slice_chunk(0, 60.0, plain, flags=0x100, record_size=40) + end_chunk(1, 3),
     }
-    for name, data in files.items():
-        with open(os.path.join(out, name), "wb") as f:
-            f.write(data)
-    print(f"wrote {len(files)} seeds to {out}")
+    write_seeds(out, files)
 
 
 if __name__ == "__main__":

@@ -8,12 +8,12 @@
 # The mutation seed is fixed (BRDF_FUZZ_SEED, default 1) so that test runs repeat: with one seed a
 # slower machine mostly explores a prefix of what a faster one does in the same time. Explore with
 # other seeds by hand (BRDF_FUZZ_SEED=0 lets libFuzzer pick one) and longer runs.
-# The run fails unless it built and ran exactly the ten targets below (one per reader and the
+# The run fails unless it built and ran exactly the eleven targets below (one per reader and the
 # device link) and each executed at least BRDF_FUZZ_MIN_UNITS inputs (default 200; libFuzzer's
 # stat::number_of_executed_units, seeds included): a target that silently dropped out of the
 # build, or one that stopped after its seeds, is a failure, not a pass.
 set -euo pipefail
-expected_targets="bpc_fuzzer csv_fuzzer dds_fuzzer gonio_fuzzer ktx2_fuzzer lighttools_fuzzer merl_fuzzer protocol_fuzzer rgl_fuzzer zemax_fuzzer"
+expected_targets="bpc_fuzzer brdfc_fuzzer csv_fuzzer dds_fuzzer gonio_fuzzer ktx2_fuzzer lighttools_fuzzer merl_fuzzer protocol_fuzzer rgl_fuzzer zemax_fuzzer"
 min_units="${BRDF_FUZZ_MIN_UNITS:-200}"
 src="$(cd "${1:-$(dirname "$0")/..}" && pwd)"
 work="${2:-$src/build/fuzz-run}"
@@ -30,7 +30,7 @@ cmake --build "$work/build" --target fuzzers -j "${BRDF_FUZZ_JOBS:-2}"
 mkdir -p "$work/artifacts"
 listed="$(cut -d'|' -f1 "$work/build/fuzzers.txt" | grep -v '^$' | LC_ALL=C sort | tr '\n' ' ' | sed 's/ $//')"
 if [ "$listed" != "$expected_targets" ]; then
-  echo "!! fuzz targets: expected the ten '$expected_targets', the build lists '$listed'"
+  echo "!! fuzz targets: expected the eleven '$expected_targets', the build lists '$listed'"
   exit 1
 fi
 failed=0
@@ -58,8 +58,8 @@ while IFS='|' read -r name exe corpus dict; do
     failed=1
   fi
 done < "$work/build/fuzzers.txt"
-if [ "$ran" -ne 10 ]; then
-  echo "!! $ran of the ten fuzz targets ran to the end"
+if [ "$ran" -ne 11 ]; then
+  echo "!! $ran of the eleven fuzz targets ran to the end"
   failed=1
 fi
 exit "$failed"

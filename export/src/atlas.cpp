@@ -1,5 +1,6 @@
 #include "brdf/exporter/atlas.h"
 
+#include <algorithm>
 #include <array>
 #include <filesystem>
 #include <set>
@@ -123,6 +124,37 @@ void CompressAtlasBc6h(Atlas& atlas, const std::vector<AtlasMaterial>& materials
   }
 }
 
+LutCompression ChooseAtlasCompression(Atlas& atlas, const std::vector<AtlasMaterial>& materials,
+                                      double max_error, int jobs) {
+  if (!(max_error > 0 && max_error < 1))
+    throw InvalidArgument(
+        fmt::format("atlas: --max-error must be a fraction in (0, 1), got {}", max_error));
+  CompressAtlasBc6h(atlas, materials, jobs);
+  const bool bc6h_meets =
+      std::all_of(atlas.certified_error.begin(), atlas.certified_error.end(),
+                  [&](const CertifiedError& e) { return e.measured.max <= max_error; });
+  if (!bc6h_meets) {
+    // RGB9E5: each material's cell of the packed words, decoded, against its float LUT.
+    atlas.bc6h.reset();
+    atlas.certified_error.clear();
+    for (std::size_t m = 0; m < materials.size(); ++m) {
+      const Lut cell =
+          ExtractAtlasCell(atlas.volume, atlas.layout, static_cast<int>(m), atlas.theta_in_deg);
+      const std::optional<ExtrapolationInfo>& x = materials[m].extrapolation;
+      CertifiedError e =
+          MeasureCompressionError(*materials[m].lut, cell.texels, x ? x->theta_b_deg : 90.0);
+      e.format = "rgb9e5";
+      e.bytes = e.rgb9e5_bytes = atlas.volume.ByteSize();
+      atlas.certified_error.push_back(e);
+    }
+  }
+  for (CertifiedError& e : atlas.certified_error) {
+    e.max_error_bound = max_error;
+    e.max_error_met = e.measured.max <= max_error;
+  }
+  return bc6h_meets ? LutCompression::kBc6h : LutCompression::kNone;
+}
+
 FloatImage AtlasImage(const std::vector<AtlasMaterial>& materials) {
   const std::vector<double> theta = CheckMaterials(materials);
   const AtlasLayout layout =
@@ -198,7 +230,7 @@ std::string AtlasManifestJson(const Atlas& atlas, const std::vector<std::string>
     const auto i = static_cast<std::size_t>(m);
     if (i < atlas.extrapolation.size() && atlas.extrapolation[i])
       materials.back()["extrapolation"] = detail::ExtrapolationJson(*atlas.extrapolation[i]);
-    if (atlas.bc6h && i < atlas.certified_error.size())
+    if (i < atlas.certified_error.size())
       materials.back()["compression"] = detail::CertifiedErrorJson(atlas.certified_error[i]);
     if (i < atlas.fitted_models_json.size() && !atlas.fitted_models_json[i].empty()) {
       ordered_json fitted = ordered_json::array();
@@ -251,9 +283,12 @@ std::vector<std::string> AtlasOutputPaths(const std::string& prefix) {
 std::vector<std::string> WriteAtlas(const std::string& prefix,
                                     const std::vector<AtlasMaterial>& materials,
                                     const ExrOptions& exr_options, LutCompression compression,
-                                    int jobs) {
+                                    int jobs, double max_error) {
   Atlas atlas = BuildAtlas(materials);
-  if (compression == LutCompression::kBc6h) CompressAtlasBc6h(atlas, materials, jobs);
+  if (max_error > 0)
+    ChooseAtlasCompression(atlas, materials, max_error, jobs);
+  else if (compression == LutCompression::kBc6h)
+    CompressAtlasBc6h(atlas, materials, jobs);
   const std::string stem = std::filesystem::path(prefix).filename().string();
   const std::vector<std::string> files = {stem + ".ktx2", stem + ".dds", stem + ".exr",
                                           stem + ".json"};

@@ -374,8 +374,10 @@ std::array<float, 3> CompactLut::SampleAngles(double theta_in, double theta_out_
   const Vec3 w_out = SphericalDirectionDeg(theta_out_deg, phi_out_deg);
   const Vec3 w_d = SpecularFrame::FromThetaInDeg(theta_in).ToSpecular(w_out);
   const double theta_d = RadToDeg(ThetaOf(w_d)), phi_d = RadToDeg(PhiOf(w_d));
-  // Slice taps as a GPU takes them along w (clamp-to-edge).
-  const double x = shell.SliceCoordinate(theta_in);
+  // Slice taps as a GPU takes them along w (clamp-to-edge). Clamped before the integer
+  // conversion: a file's θin step may be tiny (any ascending k·Δ list parses), and a huge
+  // coordinate must still read the last slice.
+  const double x = std::clamp(shell.SliceCoordinate(theta_in), -1.0, static_cast<double>(slices()));
   const double fl = std::floor(x);
   const int k0 = std::clamp(static_cast<int>(fl), 0, slices() - 1);
   const int k1 = std::clamp(static_cast<int>(fl) + 1, 0, slices() - 1);

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 
 #include <nlohmann/json.hpp>
@@ -130,6 +131,57 @@ TEST(Atlas, Bc6hAtlasRecordsEachCellsError) {
     EXPECT_FLOAT_EQ(got.measured.p99, want.measured.p99) << n;
     EXPECT_FLOAT_EQ(got.measured.median, want.measured.median) << n;
   }
+}
+
+// --max-error for an atlas: one texel format for the whole texture. Three materials in 2 × 2
+// cells (one unused). A bound BC6H meets on every cell keeps BC6H; a bound below BC6H's error
+// falls back to RGB9E5, and each cell's recorded error is then that of its RGB9E5 words, the same
+// as the material's LUT packed on its own (PackLut), whatever the unused cell holds.
+TEST(Atlas, MaxErrorPicksBc6hOnlyWhenEveryCellMeetsIt) {
+  const Five five;
+  const std::vector<AtlasMaterial> three(five.materials.begin(), five.materials.begin() + 3);
+  Atlas bc6h = BuildAtlas(three);
+  CompressAtlasBc6h(bc6h, three, 2);
+  double worst = 0;
+  for (const CertifiedError& e : bc6h.certified_error) worst = std::max(worst, e.measured.max);
+  ASSERT_GT(worst, 1e-4);  // BC6H is lossy on these LUTs
+
+  Atlas loose = BuildAtlas(three);
+  EXPECT_EQ(ChooseAtlasCompression(loose, three, std::min(0.99, 2 * worst), 2),
+            LutCompression::kBc6h);
+  ASSERT_TRUE(loose.bc6h);
+  ASSERT_EQ(loose.certified_error.size(), 3u);
+  for (const CertifiedError& e : loose.certified_error) {
+    EXPECT_EQ(e.format, "bc6h_ufloat");
+    EXPECT_TRUE(e.max_error_met);
+  }
+
+  Atlas tight = BuildAtlas(three);
+  EXPECT_EQ(ChooseAtlasCompression(tight, three, worst / 2, 2), LutCompression::kNone);
+  EXPECT_FALSE(tight.bc6h);
+  ASSERT_EQ(tight.certified_error.size(), 3u);
+  for (int m = 0; m < 3; ++m) {
+    const Lut& lut = five.luts[m];
+    const CertifiedError want =
+        MeasureCompressionError(lut, UnpackLut(PackLut(lut), lut.theta_in_deg).texels, 90.0);
+    const CertifiedError& got = tight.certified_error[m];
+    EXPECT_EQ(got.format, "rgb9e5");
+    EXPECT_EQ(got.measured.max, want.measured.max) << m;
+    EXPECT_EQ(got.filled.p99, want.filled.p99) << m;
+    EXPECT_EQ(got.max_error_bound, worst / 2);
+    EXPECT_EQ(got.max_error_met, want.measured.max <= worst / 2) << m;
+  }
+  // The manifest records the RGB9E5 figures for every material.
+  const AtlasManifest parsed = ParseAtlasManifest(AtlasManifestJson(tight, {}));
+  EXPECT_EQ(parsed.payload_format, "rgb9e5");
+  for (const AtlasManifestEntry& e : parsed.materials) {
+    ASSERT_TRUE(e.certified_error) << e.name;
+    EXPECT_EQ(e.certified_error->format, "rgb9e5");
+    EXPECT_EQ(e.certified_error->max_error_bound, worst / 2);
+  }
+  Atlas bad = BuildAtlas(three);
+  EXPECT_THROW(ChooseAtlasCompression(bad, three, 0.0), InvalidArgument);
+  EXPECT_THROW(ChooseAtlasCompression(bad, three, 1.0), InvalidArgument);
 }
 
 TEST(Atlas, UnusedCellsAreZero) {

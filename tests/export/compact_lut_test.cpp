@@ -4,7 +4,9 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -100,6 +102,21 @@ TEST(CompactLut, ContainerRoundTripsAndRefusesDamage) {
   std::vector<std::uint8_t> longer = file;
   longer.push_back(0);
   EXPECT_THROW(ParseCompactLut(longer, "x.brdfc"), FormatError);
+}
+
+// A file's θin list only has to be ascending k·Δ, so Δ may be tiny (10^-300 here): any θin then
+// lies far beyond the last slice and reads it, as clamp-to-edge does, instead of converting a
+// coordinate of 10^301 to an integer.
+TEST(CompactLut, TinyThetaInStepReadsTheLastSlice) {
+  CompactLut c;
+  c.theta_in_deg = {0.0, 1e-300};
+  c.scale = 1.0f;
+  c.rows = {{0, 180}, {0, 180}};
+  c.cols = {{0, 360}, {0, 360}};
+  c.values = {std::vector<std::uint16_t>(12, 0xBC00),   // g = -1
+              std::vector<std::uint16_t>(12, 0x0000)};  // g = 0
+  const std::array<float, 3> f = c.SampleAngles(45.0, 30.0, 0.0);
+  for (const float v : f) EXPECT_FLOAT_EQ(v, 1.0f - kCompactEpsilon);
 }
 
 }  // namespace

@@ -27,6 +27,29 @@ namespace brdf::cli {
 
 namespace fs = std::filesystem;
 
+namespace {
+
+// --max-error's report, from the manifest just written: the texel format chosen for the whole
+// atlas, then one line per material with its error (a warning line when it is above the bound).
+void PrintAtlasChoice(const std::string& manifest_path, double bound) {
+  const exporter::AtlasManifest m =
+      exporter::ParseAtlasManifest(ReadFileText(manifest_path, 64u << 20), manifest_path);
+  const bool bc6h = m.payload_format == "bc6h_ufloat";
+  std::printf("--max-error %g %%: %s for the atlas (%llu bytes%s)\n", 100 * bound,
+              bc6h ? "BC6H" : "RGB9E5", static_cast<unsigned long long>(m.payload_bytes),
+              bc6h ? ", every material meets the bound with BC6H"
+                   : ", BC6H does not meet the bound for every material");
+  for (const exporter::AtlasManifestEntry& e : m.materials) {
+    if (!e.certified_error) continue;
+    const exporter::CertifiedError& c = *e.certified_error;
+    std::printf("  %s: measured max %.2f %% (p99 %.2f %%, median %.3f %%)%s\n", e.name.c_str(),
+                100 * c.measured.max, 100 * c.measured.p99, 100 * c.measured.median,
+                c.max_error_met ? "" : " - WARNING: above the bound");
+  }
+}
+
+}  // namespace
+
 int RunAtlas(const AtlasOptions& options) {
   if (options.out.empty()) throw InvalidArgument("--out: an output prefix is required");
   std::optional<processing::ExtrapolationParams> extrapolate;
@@ -43,6 +66,10 @@ int RunAtlas(const AtlasOptions& options) {
     throw InvalidArgument(
         "--compress bc6h: the engine hand-offs (--engine) are written as RGB9E5 only so far; "
         "write them in a separate run without --compress");
+  if (options.max_error > 0 && engine_set.Any())
+    throw InvalidArgument(
+        "--max-error: the engine hand-offs (--engine) are written as RGB9E5 only so far; "
+        "write them in a separate run without --max-error");
 
   DiscoveredInputs found = DiscoverInputs(options.inputs, InputKinds{.exported_luts = true});
   if (found.inputs.empty() && found.failures.empty()) {
@@ -144,7 +171,7 @@ int RunAtlas(const AtlasOptions& options) {
   try {
     // BuildAtlas inside WriteAtlas refuses different θin sets, naming both materials.
     written = engines::WriteAtlasWithEngines(options.out, materials, exr_options, engine_set,
-                                             compression, options.jobs);
+                                             compression, options.jobs, options.max_error);
   } catch (...) {
     guard.RemoveNew();
     throw;
@@ -156,6 +183,7 @@ int RunAtlas(const AtlasOptions& options) {
               layout.cells.rows, layout.TextureWidth(), layout.TextureHeight(), layout.slices,
               exporter::FormatThetaList(luts.front().theta_in_deg).c_str());
   for (const std::string& w : written) std::printf("  %s\n", w.c_str());
+  if (options.max_error > 0) PrintAtlasChoice(options.out + ".json", options.max_error);
   return 0;
 }
 

@@ -353,12 +353,21 @@ void PrintTextureText(const Json& j) {
                   m["column"].get<int>(), m["row"].get<int>(), m["x0"].get<int>(),
                   m["y0"].get<int>(), m["source"].get<std::string>().c_str());
       if (m.contains("certified_error")) {
-        const Json& e = m["certified_error"]["measured"];
+        const Json& c = m["certified_error"];
+        const Json& e = c["measured"];
+        const std::string format = c["format"].get<std::string>();
+        // An atlas is BC6H, or RGB9E5 when --max-error found BC6H above its bound.
         std::printf(
-            "      certified BC6H error, measured range: max %.3g %%, p99 %.3g %%, median "
-            "%.3g %%\n",
+            "      certified %s error, measured range: max %.3g %%, p99 %.3g %%, median "
+            "%.3g %%%s\n",
+            format == "rgb9e5"        ? "RGB9E5"
+            : format == "bc6h_ufloat" ? "BC6H"
+                                      : format.c_str(),
             100.0 * e["max"].get<double>(), 100.0 * e["p99"].get<double>(),
-            100.0 * e["median"].get<double>());
+            100.0 * e["median"].get<double>(),
+            !c.contains("max_error_bound")   ? ""
+            : c["max_error_met"].get<bool>() ? " (within --max-error)"
+                                             : " (above --max-error)");
       }
     }
   }

@@ -77,6 +77,9 @@ struct AtlasOptions {
   std::string exr_type = "float";
   std::string exr_compression = "none";  // as convert's: one default for every EXR written
   std::string compress = "none";         // as convert's
+  // --max-error E (a fraction; 0: not given): BC6H for the whole atlas when every material's
+  // cell meets E with it, else RGB9E5 (exporter::ChooseAtlasCompression); overrides --compress.
+  double max_error = 0;
   int jobs = DefaultJobs();
   bool quiet = false;
   bool force = false;   // overwrite existing PREFIX.* files

@@ -535,6 +535,14 @@ int main(int argc, char** argv) {
                    "the manifest records each material's error against its float LUT)")
       ->capture_default_str()
       ->check(CLI::IsMember({"none", "bc6h"}));
+  atlas_cmd
+      ->add_option("--max-error", atlas.max_error,
+                   "Largest relative error allowed on each material's measured range (a "
+                   "fraction, e.g. 0.01): the atlas is one texture, so it is BC6H when every "
+                   "material meets the bound with BC6H, else RGB9E5 (a warning for materials "
+                   "still above it); prints which, and each material's error, also recorded in "
+                   "the manifest; overrides --compress")
+      ->check(CLI::Range(1e-6, 0.999999));
   atlas_cmd->add_option("--jobs", atlas.jobs, "Inputs resampled in parallel")
       ->capture_default_str()
       ->check(WholeNumberAtLeast(1));

@@ -924,9 +924,9 @@ EngineExportResult ExportLutWithEngines(const std::string& out_dir, const Lut& l
 std::vector<std::string> WriteAtlasWithEngines(
     const std::string& prefix, const std::vector<exporter::AtlasMaterial>& materials,
     const exporter::ExrOptions& exr_options, const EngineSet& engines,
-    exporter::LutCompression compression, int jobs) {
+    exporter::LutCompression compression, int jobs, double max_error) {
   std::vector<std::string> written =
-      exporter::WriteAtlas(prefix, materials, exr_options, compression, jobs);
+      exporter::WriteAtlas(prefix, materials, exr_options, compression, jobs, max_error);
   if (!engines.Any()) return written;
   const exporter::Atlas atlas = exporter::BuildAtlas(materials);
   const fs::path prefix_path(prefix);

@@ -84,6 +84,16 @@ Atlas BuildAtlas(const std::vector<AtlasMaterial>& materials);
 // materials; each cell's certified error includes that. Fills atlas.bc6h and certified_error.
 void CompressAtlasBc6h(Atlas& atlas, const std::vector<AtlasMaterial>& materials, int jobs = 1);
 
+// `--max-error E` for an atlas (a fraction, on each material's measured range θout ≤ θb). The
+// atlas is one texture in one texel format, so BC6H is chosen when every material's cell meets
+// E with BC6H (CompressAtlasBc6h), else RGB9E5 (atlas.bc6h reset; the compact form is per
+// material and never chosen). Either way atlas.certified_error then holds each material's
+// error for the chosen format, with E as its bound and whether it is met; unused cells hold no
+// material and are not measured. Returns kBc6h or kNone. Throws InvalidArgument for E outside
+// (0, 1).
+LutCompression ChooseAtlasCompression(Atlas& atlas, const std::vector<AtlasMaterial>& materials,
+                                      double max_error, int jobs = 1);
+
 // The flat float image of the atlas (EXR layout above), from the unquantised LUTs.
 FloatImage AtlasImage(const std::vector<AtlasMaterial>& materials);
 
@@ -98,12 +108,15 @@ std::vector<std::string> AtlasOutputPaths(const std::string& prefix);
 // and returns the paths written. The manifest is also embedded in the KTX2 ("brdf.atlas") and
 // the EXR ("brdf:atlas"). Throws InvalidArgument / IoError.
 // With compression kBc6h the KTX2 and DDS hold the BC6H form (CompressAtlasBc6h) and the
-// manifest records it ("payload" of the blocks, a "compression" member per material).
+// manifest records it ("payload" of the blocks, a "compression" member per material). With
+// max_error > 0, `compression` is ignored and ChooseAtlasCompression picks BC6H or RGB9E5; the
+// manifest's "compression" members record the chosen format's error per material, the bound and
+// whether it is met.
 std::vector<std::string> WriteAtlas(const std::string& prefix,
                                     const std::vector<AtlasMaterial>& materials,
                                     const ExrOptions& exr_options = {},
                                     LutCompression compression = LutCompression::kNone,
-                                    int jobs = 1);
+                                    int jobs = 1, double max_error = 0);
 
 // Material m's cell of an atlas volume, decoded into a LUT with the given θin list.
 Lut ExtractAtlasCell(const PackedVolume& atlas_volume, const AtlasLayout& layout, int m,

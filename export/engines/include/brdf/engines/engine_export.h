@@ -146,11 +146,12 @@ std::vector<std::string> EngineOutputsToCheck(const std::string& out_dir,
 // beside the prefix (<dir of prefix>/<engine>/<stem of prefix>.*), with shaders addressing
 // cells (MeasuredBrdfCell with the cell origin the manifest lists per material).
 // Returns every path written. Throws InvalidArgument / IoError.
-// `compression` and `jobs` go to WriteAtlas (the engine folders stay RGB9E5).
+// `compression`, `jobs` and `max_error` go to WriteAtlas (the engine folders stay RGB9E5).
 std::vector<std::string> WriteAtlasWithEngines(
     const std::string& prefix, const std::vector<exporter::AtlasMaterial>& materials,
     const exporter::ExrOptions& exr_options, const EngineSet& engines,
-    exporter::LutCompression compression = exporter::LutCompression::kNone, int jobs = 1);
+    exporter::LutCompression compression = exporter::LutCompression::kNone, int jobs = 1,
+    double max_error = 0);
 
 // The RGBA16F payload of the Unreal DDS: every RGB9E5 channel converted to IEEE half
 // directly from its mantissa and exponent (Rgb9e5ChannelToHalf: exact, no rounding), alpha =
