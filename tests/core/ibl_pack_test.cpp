@@ -6,6 +6,7 @@
 // sum.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "brdf/core/brdf_source.h"
@@ -31,9 +32,52 @@ TEST(IblPack, LambertianAlbedoIsRhoAndAllDiffuseAtEveryView) {
     for (int c = 0; c < 3; ++c) {
       EXPECT_NEAR(pack.albedo[i][c], rho[c], 1e-3 * rho[c]) << "row " << i;
       // The lobe is the irradiance kernel itself: nothing for the prefiltered radiance.
-      EXPECT_LT(pack.specular[i][c], 1e-2 * rho[c]) << "row " << i;
+      EXPECT_LT(std::abs(pack.specular[i][c]), 1e-2 * rho[c]) << "row " << i;
     }
     EXPECT_LT(pack.residual[i], 1e-3) << "row " << i;
+  }
+  // D(μ) = ρ is its own quadratic: c0 = ρ, c1 = c2 = 0.
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(pack.diffuse_quadratic[0][c], rho[c], 2e-3 * rho[c]) << "channel " << c;
+    EXPECT_NEAR(pack.diffuse_quadratic[1][c], 0.0, 1e-2 * rho[c]) << "channel " << c;
+    EXPECT_NEAR(pack.diffuse_quadratic[2][c], 0.0, 1e-2 * rho[c]) << "channel " << c;
+  }
+}
+
+// The engines' diffuse weight D_fit(μ) = c0 + c1·t + c2·t² (t = 1 − μ) is the least-squares
+// quadratic of the split's D rows: its residual is orthogonal to 1, t and t² (the normal
+// equations, the definition of the fit); and S_i = E_i − D_fit(μ_i), so the pack as an engine
+// reads it (At) gives D + S = E at every texel centre and at both clamped ends.
+TEST(IblPack, DiffuseQuadraticIsTheLeastSquaresFitAndKeepsTheAlbedoAtTexelCentres) {
+  for (const double kd : {0.0, 0.3}) {
+    const IblPack pack = ComputeIblPack(Ggx(kd, 0.04, 0.3));
+    for (int c = 0; c < 3; ++c) {
+      double orthogonality[3] = {}, scale = 0.0;
+      for (int i = 0; i < IblPack::kRows; ++i) {
+        const double t = 1.0 - pack.mu[i];
+        const double q = pack.diffuse_quadratic[0][c] + pack.diffuse_quadratic[1][c] * t +
+                         pack.diffuse_quadratic[2][c] * t * t;
+        const double r = pack.diffuse[i][c] - q;
+        orthogonality[0] += r;
+        orthogonality[1] += r * t;
+        orthogonality[2] += r * t * t;
+        scale += std::abs(pack.diffuse[i][c]);
+      }
+      for (int k = 0; k < 3; ++k)
+        EXPECT_NEAR(orthogonality[k], 0.0, 1e-9 * std::max(scale, 1e-3))
+            << "kd " << kd << " channel " << c << " power " << k;
+    }
+    for (int i = 0; i < IblPack::kRows; ++i) {
+      const IblPack::Row row = pack.At(pack.mu[i]);
+      for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(row.diffuse[c] + row.specular[c], pack.albedo[i][c], 1e-12)
+            << "kd " << kd << " row " << i;
+    }
+    for (const double mu : {0.0, 1.0}) {
+      const IblPack::Row row = pack.At(mu);
+      const Rgb& e = mu == 0.0 ? pack.albedo.front() : pack.albedo.back();
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(row.diffuse[c] + row.specular[c], e[c], 1e-12);
+    }
   }
 }
 

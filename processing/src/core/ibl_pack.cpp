@@ -136,6 +136,14 @@ Bands GgxPrefilterLegendre(double alpha) {
   return k;
 }
 
+Rgb IblPack::DiffuseFit(double m) const {
+  const double t = 1.0 - m;
+  const auto& q = diffuse_quadratic;
+  Rgb d;
+  for (int c = 0; c < 3; ++c) d[c] = q[0][c] + t * (q[1][c] + t * q[2][c]);
+  return d;
+}
+
 IblPack::Row IblPack::At(double m) const {
   Row row;
   if (mu.empty()) return row;
@@ -146,9 +154,9 @@ IblPack::Row IblPack::At(double m) const {
   const double f = std::clamp(x - i, 0.0, 1.0);
   for (int c = 0; c < 3; ++c) {
     row.albedo[c] = (1.0 - f) * albedo[i][c] + f * albedo[j][c];
-    row.diffuse[c] = (1.0 - f) * diffuse[i][c] + f * diffuse[j][c];
     row.specular[c] = (1.0 - f) * specular[i][c] + f * specular[j][c];
   }
+  row.diffuse = DiffuseFit(std::clamp(m, 0.5 / kRows, 1.0 - 0.5 / kRows));
   row.alpha = (1.0 - f) * alpha[i] + f * alpha[j];
   return row;
 }
@@ -180,6 +188,40 @@ void ConcentratedNodes(double lo, double hi, double c, double sigma, double peak
     const double t = lo + (k + (target - cdf[k]) / (cdf[k + 1] - cdf[k])) * h;
     (*x)[i] = t;
     (*w)[i] = cdf[kTable] / (n * density(t));
+  }
+}
+
+// D_fit(μ) = c0 + c1·t + c2·t², t = 1 − μ, by least squares over the rows per channel (the
+// 3 × 3 normal equations, solved by Cramer's rule: t ∈ [0, 1] keeps them well conditioned),
+// then S_i = E_i − D_fit(μ_i) (brdf/core/ibl_pack.h: the furnace exact at texel centres).
+void FitDiffuseQuadratic(IblPack* pack) {
+  double m[3][3] = {};
+  double rhs[3][3] = {};  // [power][channel]
+  for (std::size_t i = 0; i < pack->mu.size(); ++i) {
+    const double t = 1.0 - pack->mu[i];
+    const double pw[5] = {1.0, t, t * t, t * t * t, t * t * t * t};
+    for (int a = 0; a < 3; ++a) {
+      for (int b = 0; b < 3; ++b) m[a][b] += pw[a + b];
+      for (int c = 0; c < 3; ++c) rhs[a][c] += pw[a] * pack->diffuse[i][c];
+    }
+  }
+  auto det3 = [](const double (&x)[3][3]) {
+    return x[0][0] * (x[1][1] * x[2][2] - x[1][2] * x[2][1]) -
+           x[0][1] * (x[1][0] * x[2][2] - x[1][2] * x[2][0]) +
+           x[0][2] * (x[1][0] * x[2][1] - x[1][1] * x[2][0]);
+  };
+  const double det = det3(m);
+  for (int c = 0; c < 3; ++c) {
+    for (int k = 0; k < 3; ++k) {
+      double mk[3][3];
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) mk[a][b] = b == k ? rhs[a][c] : m[a][b];
+      pack->diffuse_quadratic[k][c] = det != 0.0 ? det3(mk) / det : 0.0;
+    }
+  }
+  for (std::size_t i = 0; i < pack->mu.size(); ++i) {
+    const Rgb d = pack->DiffuseFit(pack->mu[i]);
+    for (int c = 0; c < 3; ++c) pack->specular[i][c] = pack->albedo[i][c] - d[c];
   }
 }
 
@@ -352,15 +394,17 @@ IblPack ComputeIblPack(const BrdfSource& source) {
     pack.alpha[row] = alpha;
     pack.residual[row] = residual;
   }
+  FitDiffuseQuadratic(&pack);
   return pack;
 }
 
 std::string IblPackJson(const IblPack& pack) {
   std::string out =
       "{\"convention\": \"docs/engines.md, IBL pack: mu = cos(theta_view) at texel "
-      "centres (i + 0.5)/rows; radiance = diffuse_rgb * irradiance/pi + "
-      "specular_rgb * prefiltered(alpha_eq, reflect(-v, n)); albedo_rgb = "
-      "diffuse_rgb + specular_rgb\", \"rows\": ";
+      "centres (i + 0.5)/rows; radiance = D_fit(mu) * irradiance/pi + "
+      "specular_rgb * prefiltered(alpha_eq, reflect(-v, n)), D_fit(mu) = c0 + c1 t + c2 t^2, "
+      "t = 1 - mu, [c0, c1, c2] = diffuse_quadratic_rgb (least squares to diffuse_rgb, the "
+      "split's diffuse part); albedo_rgb = D_fit(mu) + specular_rgb at every mu\", \"rows\": ";
   out += std::to_string(pack.mu.size());
   char buf[96];
   auto list = [&](const char* key, auto&& value) {
@@ -385,6 +429,12 @@ std::string IblPackJson(const IblPack& pack) {
   list("albedo_rgb", [&](std::size_t i) { return rgb(pack.albedo[i]); });
   list("diffuse_rgb", [&](std::size_t i) { return rgb(pack.diffuse[i]); });
   list("specular_rgb", [&](std::size_t i) { return rgb(pack.specular[i]); });
+  out += ", \"diffuse_quadratic_rgb\": [";
+  for (int k = 0; k < 3; ++k) {
+    if (k) out += ", ";
+    out += rgb(pack.diffuse_quadratic[k]);
+  }
+  out += "]";
   list("alpha_eq", [&](std::size_t i) { return number(pack.alpha[i]); });
   list("fit_residual", [&](std::size_t i) { return number(pack.residual[i]); });
   out += "}";

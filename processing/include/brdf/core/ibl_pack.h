@@ -50,6 +50,16 @@
 //    kernel plus Lambert fits (off-specular, retro-reflective) says so there.
 // Rows with E = 0 (a black material, or a view where the source is zero) get S = D = 0 and
 // α_eq = 1.
+//
+// What an engine reads (one pack fetch per pixel): the diffuse part as a quadratic in
+// t = 1 − μ, D_fit(μ) = c0 + c1·t + c2·t², three RGB constants per material fitted by least
+// squares, per channel, to the split's D rows (`diffuse`); and per row S_i = E_i − D_fit(μ_i)
+// (`specular`, stored with α_eq in one texel), so that D_fit + S = E exactly at every texel
+// centre and the white furnace holds whatever the quadratic's error. S_i may then be slightly
+// negative where D_fit lies above E (a Lambertian's S is D_i − D_fit(μ_i), rounding-small);
+// clamping it would trade the furnace's exactness for a sign. Between texel centres S is
+// linear and D_fit quadratic: D_fit + S departs from the linear E by at most |c2|·Δt²/4,
+// Δt = 1/kRows (|c2|/16384).
 #pragma once
 
 #include <array>
@@ -70,13 +80,19 @@ struct IblPack {
 
   std::vector<double> mu;        // μ_i = (i + 0.5)/kRows
   std::vector<Rgb> albedo;       // E(μ), 1 (no unit: reflected over incident)
-  std::vector<Rgb> diffuse;      // D(μ), weight of Ē(n)
-  std::vector<Rgb> specular;     // S(μ) = E − D, weight of P(α_eq, R)
+  std::vector<Rgb> diffuse;      // D(μ_i) of the split (what the quadratic is fitted to)
+  std::vector<Rgb> specular;     // S_i = E_i − D_fit(μ_i), weight of P(α_eq, R)
+  std::array<Rgb, 3> diffuse_quadratic{};  // c0, c1, c2 of D_fit(μ) = c0 + c1·t + c2·t², t = 1 − μ
   std::vector<double> alpha;     // α_eq(μ)
   std::vector<double> residual;  // relative residual of the fit per row (see above)
 
-  // One row interpolated at `mu` as a linearly filtered texture of kRows texels with clamp to
-  // edge would return it (linear between μ_i, constant beyond μ_0 and μ_{kRows−1}).
+  // D_fit at `mu` (the quadratic of diffuse_quadratic; `mu` as given, no clamping).
+  Rgb DiffuseFit(double mu) const;
+
+  // One row at `mu` as an engine reads it: albedo, specular and alpha as a linearly filtered
+  // texture of kRows texels with clamp to edge returns them (linear between μ_i, constant
+  // beyond μ_0 and μ_{kRows−1}), diffuse = D_fit at `mu` clamped to [μ_0, μ_{kRows−1}] (the
+  // texture coordinate the shader computes), so diffuse + specular = albedo at texel centres.
   struct Row {
     Rgb albedo, diffuse, specular;
     double alpha = 1.0;
@@ -94,7 +110,8 @@ std::array<double, IblPack::kMaxBand + 1> GgxPrefilterLegendre(double alpha);
 
 // The pack as the JSON object documented in docs/engines.md ("ibl"): {"mu": [...],
 // "albedo_rgb": [[r, g, b], ...], "diffuse_rgb": ..., "specular_rgb": ..., "alpha_eq": [...],
-// "fit_residual": [...], "convention": ...}.
+// "diffuse_quadratic_rgb": [c0, c1, c2] (each [r, g, b]), "fit_residual": [...],
+// "convention": ...}.
 std::string IblPackJson(const IblPack& pack);
 
 }  // namespace brdf
