@@ -478,9 +478,10 @@ ordered_json IblJson(const Handoff& h) {
       {"width", kRows},
       {"height", h.ibl.size()},
       {"row_of_material", "row m = cell m (0 for a single LUT), row 0 first in the file, at v = 0"},
-      {"texels", "texel i: (specular_rgb, alpha_eq) at mu_i; the diffuse part is not in the "
-                 "texture: D_fit(mu) = c0 + c1 t + c2 t^2 (t = 1 - mu) from "
-                 "diffuse_quadratic_rgb, material constants"},
+      {"texels",
+       "texel i: (specular_rgb, alpha_eq) at mu_i; the diffuse part is not in the "
+       "texture: D_fit(mu) = c0 + c1 t + c2 t^2 (t = 1 - mu) from "
+       "diffuse_quadratic_rgb, material constants"},
       {"sampling",
        fmt::format("linear, clamp-to-edge, no mipmaps, no sRGB decode; u = clamp(mu * {0}, 0.5, "
                    "{1}) / {0}, v = (row + 0.5) / height; D_fit at the same clamped mu = u",

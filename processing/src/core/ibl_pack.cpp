@@ -205,7 +205,7 @@ void FitDiffuseQuadratic(IblPack* pack) {
       for (int c = 0; c < 3; ++c) rhs[a][c] += pw[a] * pack->diffuse[i][c];
     }
   }
-  auto det3 = [](const double (&x)[3][3]) {
+  auto det3 = [](const double(&x)[3][3]) {
     return x[0][0] * (x[1][1] * x[2][2] - x[1][2] * x[2][1]) -
            x[0][1] * (x[1][0] * x[2][2] - x[1][2] * x[2][0]) +
            x[0][2] * (x[1][0] * x[2][1] - x[1][1] * x[2][0]);

@@ -78,13 +78,13 @@ struct IblPack {
   static constexpr int kMaxBand = 48;     // Legendre degrees ℓ = 0…kMaxBand of the fit
   static constexpr double kMinAlpha = 0.005;
 
-  std::vector<double> mu;        // μ_i = (i + 0.5)/kRows
-  std::vector<Rgb> albedo;       // E(μ), 1 (no unit: reflected over incident)
-  std::vector<Rgb> diffuse;      // D(μ_i) of the split (what the quadratic is fitted to)
-  std::vector<Rgb> specular;     // S_i = E_i − D_fit(μ_i), weight of P(α_eq, R)
+  std::vector<double> mu;                  // μ_i = (i + 0.5)/kRows
+  std::vector<Rgb> albedo;                 // E(μ), 1 (no unit: reflected over incident)
+  std::vector<Rgb> diffuse;                // D(μ_i) of the split (what the quadratic is fitted to)
+  std::vector<Rgb> specular;               // S_i = E_i − D_fit(μ_i), weight of P(α_eq, R)
   std::array<Rgb, 3> diffuse_quadratic{};  // c0, c1, c2 of D_fit(μ) = c0 + c1·t + c2·t², t = 1 − μ
-  std::vector<double> alpha;     // α_eq(μ)
-  std::vector<double> residual;  // relative residual of the fit per row (see above)
+  std::vector<double> alpha;               // α_eq(μ)
+  std::vector<double> residual;            // relative residual of the fit per row (see above)
 
   // D_fit at `mu` (the quadratic of diffuse_quadratic; `mu` as given, no clamping).
   Rgb DiffuseFit(double mu) const;
