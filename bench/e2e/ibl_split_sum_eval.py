@@ -9,7 +9,7 @@ files chm_mint_rgb and vch_silk_blue_rgb through `brdf import`, and data-samples
 gold.bpc with `--beyond auto`. Prints one line per material (relative RMSE, p95 pixel error),
 the medians and the pooled 95th percentile over every material's pixels.
 
-Usage: bench/e2e/ibl_split_sum_eval.py BRDF_TOOL [DATA_DIR] [--work DIR] [--size N]
+Usage: bench/e2e/ibl_split_sum_eval.py BRDF_TOOL [DATA_DIR] [--work DIR] [--env MAP]
 (Debian python3 with numpy and OpenImageIO; DATA_DIR default ../shared/brdf-data.)
 Environment variables are passed on to `brdf`, so one script run can compare builds or forms.
 """
@@ -32,14 +32,16 @@ def main():
     ap.add_argument("data_dir", nargs="?", default=os.path.join(HERE, "..", "..", "..", "shared",
                                                                 "brdf-data"))
     ap.add_argument("--work", default="")
+    ap.add_argument("--env", default="", help="a map for brdf preview --env instead of the test's")
     args = ap.parse_args()
     work = args.work or tempfile.mkdtemp(prefix="brdf_ibl_eval_")
     os.makedirs(work, exist_ok=True)
-    env = os.path.join(work, "env.exr")
+    env = args.env or os.path.join(work, "env.exr")
     out = os.path.join(work, "luts")
     names = ibt.LIBRARY + ibt.RGL + [ibt.CAPTURE]
     if not os.path.isfile(os.path.join(out, ibt.CAPTURE + ".ktx2")):
-        ibt.write_environment(env)
+        if not args.env:
+            ibt.write_environment(env)
         captures = []
         for n in ibt.RGL:
             captures.append(os.path.join(work, n + ".bpc"))
@@ -62,7 +64,7 @@ def main():
         if not os.path.isfile(truth):  # the truth does not depend on the split sum
             subprocess.run(preview + [ktx2, "--out", truth], check=True)
         engine = os.path.join(work, n + ".engine.exr")
-        subprocess.run(preview + [ktx2, "--ibl", "engine", "--out", engine], check=True)
+        subprocess.run(preview + [ktx2, "--ibl", "engine", "--force", "--out", engine], check=True)
         t, e = ibt.read_exr(truth), ibt.read_exr(engine)
         r, p = ibt.metrics(e, t)
         rmse.append(r)
