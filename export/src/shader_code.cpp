@@ -140,7 +140,7 @@ FLOAT3 MeasuredBrdf(@LUT_PARAM@FLOAT3 n, FLOAT3 l, FLOAT3 v) {
 
 // Image-based lighting (docs/engines.md, "ibl"): the split sum of the material's IBL pack,
 //   radiance = diffuse(mu) * irradiance(n)/pi + specular(mu) * prefiltered(alpha_eq(mu), R),
-// mu = dot(n, v), R = reflect(-v, n); irradiance/pi is the probe's cosine-convolved radiance
+// mu = dot(n, v), R = reflect(-v, n) moved toward n (MeasuredBrdfIblDirection); irradiance/pi is the probe's cosine-convolved radiance
 // (1 under a uniform radiance 1) and prefiltered the GGX-prefiltered probe about R at
 // alpha_eq (GGX alpha = perceptual roughness squared). Under a white furnace the material
 // reflects exactly its directional albedo diffuse + specular.
@@ -164,9 +164,14 @@ float MeasuredBrdfIblPack(@PACK_PARAM@float pack_v, float mu, FLOAT3 diffuse0, F
   return max(s.a, 0.0);
 }
 
-// The direction the specular probe is read in: R = reflect(-v, n) = 2 (n.v) n - v.
-FLOAT3 MeasuredBrdfIblReflect(FLOAT3 n, FLOAT3 v) {
-  return n * (2.0 * dot(n, v)) - v;
+// The direction the specular probe is read in: R = reflect(-v, n) = 2 (n.v) n - v moved
+// toward n by s = alpha_eq * (1 - mu) (the dominant-direction shift: 0 near the normal), then
+// normalised: normalize(mix(R, n, s)).
+FLOAT3 MeasuredBrdfIblDirection(FLOAT3 n, FLOAT3 v, float alpha_eq) {
+  float mu = dot(n, v);
+  FLOAT3 r = n * (2.0 * mu) - v;
+  float s = clamp(alpha_eq, 0.0, 1.0) * (1.0 - clamp(mu, 0.0, 1.0));
+  return normalize(r + (n - r) * s);
 }
 
 // The probe term from the pack's weights and the engine's two probe values.

@@ -141,5 +141,26 @@ TEST(IblPack, RowsInterpolateLikeALinearTexture) {
   EXPECT_NEAR(pack.At(mid).specular[1], 0.5 * (pack.specular[10][1] + pack.specular[11][1]), 1e-12);
 }
 
+// The dominant direction R' = normalize(mix(R, n, α·(1 − μ))): R itself at the normal and for
+// a mirror (α → 0); for n = z and v at θ in the xz plane, R = (−sinθ, 0, cosθ) and R' lies in
+// that plane at the angle atan2((1 − s)·sinθ, (1 − s)·cosθ + s) from n, s = α·(1 − cosθ).
+TEST(IblPack, SpecularDirectionMovesTheMirrorDirectionTowardTheNormal) {
+  const Vec3 n = {0.0, 0.0, 1.0};
+  for (const double alpha : {0.0, 0.1, 0.5, 1.0}) {
+    const Vec3 at_normal = IblSpecularDirection(n, n, alpha);
+    EXPECT_NEAR(at_normal.z, 1.0, 1e-15) << alpha;
+    for (const double theta_deg : {20.0, 60.0, 85.0}) {
+      const double t = theta_deg * kPi / 180.0;
+      const Vec3 v = {std::sin(t), 0.0, std::cos(t)};
+      const Vec3 r = IblSpecularDirection(n, v, alpha);
+      const double s = alpha * (1.0 - std::cos(t));
+      const double want = std::atan2((1.0 - s) * std::sin(t), (1.0 - s) * std::cos(t) + s);
+      EXPECT_NEAR(std::atan2(-r.x, r.z), want, 1e-12) << alpha << " " << theta_deg;
+      EXPECT_NEAR(r.y, 0.0, 1e-15);
+      EXPECT_NEAR(r.x * r.x + r.y * r.y + r.z * r.z, 1.0, 1e-12);
+    }
+  }
+}
+
 }  // namespace
 }  // namespace brdf

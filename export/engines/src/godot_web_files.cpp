@@ -56,7 +56,8 @@ void fragment() {
                                          measured_brdf_ibl_diffuse0, measured_brdf_ibl_diffuse1,
                                          measured_brdf_ibl_diffuse2, ibl_diffuse, ibl_specular);
     vec3 irradiance = textureLod(measured_brdf_radiance, n, measured_brdf_radiance_max_lod).rgb;
-    vec3 prefiltered = textureLod(measured_brdf_radiance, MeasuredBrdfIblReflect(n, v),
+    vec3 prefiltered = textureLod(measured_brdf_radiance,
+                                  MeasuredBrdfIblDirection(n, v, alpha_eq),
                                   sqrt(alpha_eq) * measured_brdf_radiance_max_lod).rgb;
     EMISSION = MeasuredBrdfIblRadiance(ibl_diffuse, ibl_specular, irradiance, prefiltered);
   }
@@ -285,7 +286,7 @@ void main() {{
   vec3 ibl_diffuse, ibl_specular;
   float alpha_eq = MeasuredBrdfIblPack(iblPack, iblPackRow, max(dot(n, v), 0.0), iblDiffuse[0],
                                        iblDiffuse[1], iblDiffuse[2], ibl_diffuse, ibl_specular);
-  vec3 r = MeasuredBrdfIblReflect(n, v);
+  vec3 r = MeasuredBrdfIblDirection(n, v, alpha_eq);
   vec3 irradiance = textureLod(envMap, envMapRotation * n, ENVMAP_MAX_LOD).rgb;
   vec3 prefiltered = textureLod(envMap, envMapRotation * r, roughnessToMip(sqrt(alpha_eq))).rgb;
   radiance += MeasuredBrdfIblRadiance(ibl_diffuse, ibl_specular, irradiance, prefiltered) *

@@ -262,7 +262,7 @@ void MeasuredBrdfIbl_float(UnityTexture2D IblPack, float IblRow, float3 IblDiffu
     float alpha_eq = MeasuredBrdfIblPack(IblPack.tex, IblPack.samplerstate, IblRow,
                                          saturate(dot(n, v)), IblDiffuse0, IblDiffuse1,
                                          IblDiffuse2, d, s);
-    float3 r = MeasuredBrdfIblReflect(n, v);
+    float3 r = MeasuredBrdfIblDirection(n, v, alpha_eq);
     Out = MeasuredBrdfIblRadiance(d, s, MEASURED_BRDF_IRRADIANCE(n),
                                   MEASURED_BRDF_PREFILTERED(r, sqrt(alpha_eq)));
 }
@@ -336,7 +336,8 @@ float3 MeasuredBrdfIblUnreal(Texture2D IblPack, SamplerState IblPackSampler, flo
                                          IblDiffuse0, IblDiffuse1, IblDiffuse2, diffuse,
                                          specular);
     float sky_brightness;
-    float3 prefiltered = GetSkyLightReflection(MeasuredBrdfIblReflect(N, V), sqrt(alpha_eq),
+    float3 prefiltered = GetSkyLightReflection(MeasuredBrdfIblDirection(N, V, alpha_eq),
+                                               sqrt(alpha_eq),
                                                sky_brightness);
     return MeasuredBrdfIblRadiance(diffuse, specular, GetSkySHDiffuse(N) * View.SkyLightColor.rgb,
                                    prefiltered);

@@ -144,6 +144,17 @@ Rgb IblPack::DiffuseFit(double m) const {
   return d;
 }
 
+double IblSpecularShift(double alpha_eq, double mu) {
+  return std::clamp(alpha_eq, 0.0, 1.0) * (1.0 - std::clamp(mu, 0.0, 1.0));
+}
+
+Vec3 IblSpecularDirection(const Vec3& n, const Vec3& v, double alpha_eq) {
+  const double mu = Dot(n, v);
+  const Vec3 r = n * (2.0 * mu) - v;
+  const double s = IblSpecularShift(alpha_eq, mu);
+  return Normalize(r + (n - r) * s);
+}
+
 IblPack::Row IblPack::At(double m) const {
   Row row;
   if (mu.empty()) return row;

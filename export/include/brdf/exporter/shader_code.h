@@ -48,7 +48,8 @@
 //       the material's row of the RGBA16F pack texture (IblPack::kRows texels (S, α_eq)) at
 //       μ = n·v, one linear fetch; pack_v the row's v; diffuse = c0 + c1·t + c2·t², t = 1 − μ
 //       (μ clamped to the texel centres), from the material's constants diffuse0…2
-//   MeasuredBrdfIblReflect(n, v) → R = 2(n·v)n − v
+//   MeasuredBrdfIblDirection(n, v, α_eq) → normalize(mix(R, n, α_eq·(1 − n·v))), R = 2(n·v)n − v
+//       (IblSpecularDirection, brdf/core/ibl_pack.h)
 //   MeasuredBrdfIblRadiance(diffuse, specular, irradiance_over_pi, prefiltered) → radiance
 //       = diffuse·irradiance_over_pi + specular·prefiltered (the probe filtered with GGX α_eq)
 // [pack,] is `highp sampler2D pack` in GLSL, `Texture2D pack, SamplerState pack_sampler` in

@@ -100,6 +100,15 @@ struct IblPack {
   Row At(double mu) const;
 };
 
+// The dominant-direction shift of the specular lookup: engines read the prefiltered probe at
+// R' = normalize(mix(R, n, s)), s = IblSpecularShift(α_eq(μ), μ) = α_eq·(1 − μ) (0 near the
+// normal, where the split sum's n = v = R holds; toward n for rough lobes at oblique views,
+// where the horizon clips the lobe and its centre moves off R). Chosen against the true
+// environment-lit preview (docs/benchmarks/ibl.md, "Dominant direction").
+double IblSpecularShift(double alpha_eq, double mu);
+// R' for the unit normal n and unit view v (pointing away from the surface).
+Vec3 IblSpecularDirection(const Vec3& n, const Vec3& v, double alpha_eq);
+
 // Computes the pack of `source`: 64 × 64 × 72 = 294,912 evaluations of the source and the fit,
 // on the calling thread (docs/benchmarks/ibl.md).
 IblPack ComputeIblPack(const BrdfSource& source);
