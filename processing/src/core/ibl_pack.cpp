@@ -268,7 +268,7 @@ IblPack ComputeIblPack(const BrdfSource& source) {
   // light at φ = 0 and the view at the relative azimuth, exactly what LutBrdf::Eval computes
   // from the vectors), which saves the vectors' trigonometry: most of the pack's cost.
   const auto* lut = dynamic_cast<const LutBrdf*>(&source);
-  std::vector<double> phi_out_deg(kPhi);
+  std::vector<double> phi_out_deg(kPhi), cos_phi_out(kPhi), sin_phi_out(kPhi);
 
   for (int row = 0; row < kRows; ++row) {
     const double mu = (row + 0.5) / kRows;
@@ -289,6 +289,16 @@ IblPack ComputeIblPack(const BrdfSource& source) {
       phi_out_deg[k] = WrapDeg360(-RadToDeg(phi_x[k]));
     }
     const double theta_v_deg = RadToDeg(theta_v);
+    // The trigonometry Lut::SampleAngles would do per sample, once per row, per θ node or per
+    // φ node (Lut::SampleTextureFrame; the same values, so the same bits): the view's and each
+    // light's specular frame and slice coordinate, ω_out's azimuth terms.
+    const SpecularFrame frame_v = SpecularFrame::FromThetaInDeg(theta_v_deg);
+    const double sin_v = std::sin(DegToRad(theta_v_deg)), cos_v = std::cos(DegToRad(theta_v_deg));
+    const double slice_v = lut != nullptr ? lut->lut().SliceCoordinate(theta_v_deg) : 0.0;
+    for (int k = 0; k < kPhi; ++k) {
+      cos_phi_out[k] = std::cos(DegToRad(phi_out_deg[k]));
+      sin_phi_out[k] = std::sin(DegToRad(phi_out_deg[k]));
+    }
     std::fill(hist.begin(), hist.end(), Rgb{0, 0, 0});
     std::array<Moments, 3> m{};
     Rgb e = {0, 0, 0};
@@ -296,13 +306,26 @@ IblPack ComputeIblPack(const BrdfSource& source) {
       const double st = std::sin(theta_x[j]), ct = std::cos(theta_x[j]);
       const double row_weight = st * ct * theta_w[j];
       const double theta_l_deg = RadToDeg(theta_x[j]);
+      // Lut::SampleAngles(θl, θv, φout): the texture at (θl; θv, φout), or with light and view
+      // exchanged at (θv; θl, −φout) (sin(−φ) = −sin φ).
+      const bool exchange =
+          lut != nullptr && lut->lut().ExchangesLightAndView(theta_l_deg, theta_v_deg);
+      const SpecularFrame frame_l = SpecularFrame::FromThetaInDeg(theta_l_deg);
+      const double slice_l =
+          lut != nullptr && !exchange ? lut->lut().SliceCoordinate(theta_l_deg) : 0.0;
+      const double sin_l = std::sin(DegToRad(theta_l_deg)), cos_l = std::cos(DegToRad(theta_l_deg));
       Rgb ring = {0, 0, 0};
       for (int k = 0; k < kPhi; ++k) {
         const Vec3 l = {st * cos_phi[k], st * sin_phi[k], ct};
         Rgb f;
         if (lut != nullptr) {
           const std::array<float, 3> t =
-              lut->lut().SampleAngles(theta_l_deg, theta_v_deg, phi_out_deg[k]);
+              exchange ? lut->lut().SampleTextureFrame(frame_v.cos_m, frame_v.sin_m, slice_v,
+                                                       sin_l * cos_phi_out[k],
+                                                       sin_l * -sin_phi_out[k], cos_l)
+                       : lut->lut().SampleTextureFrame(frame_l.cos_m, frame_l.sin_m, slice_l,
+                                                       sin_v * cos_phi_out[k],
+                                                       sin_v * sin_phi_out[k], cos_v);
           f = {t[0], t[1], t[2]};
         } else {
           f = source.Eval(l, v);
