@@ -264,9 +264,9 @@ IblPack ComputeIblPack(const BrdfSource& source) {
   Bands p{};
   const KappaTable& table = Kappa();
   std::vector<double> theta_x, theta_w, phi_x, phi_w, cos_phi(kPhi), sin_phi(kPhi);
-  // A LUT is sampled by its own rule directly from the grid's angles (Lut::SampleAngles with the
-  // light at φ = 0 and the view at the relative azimuth, exactly what LutBrdf::Eval computes
-  // from the vectors), which saves the vectors' trigonometry: most of the pack's cost.
+  // A LUT is sampled by its own rule directly from the grid's angles (Lut::SampleAngles's rule
+  // with the light at φ = 0 and the view at the relative azimuth, exactly what LutBrdf::Eval
+  // computes from the vectors), which saves the vectors' trigonometry: most of the pack's cost.
   const auto* lut = dynamic_cast<const LutBrdf*>(&source);
   std::vector<double> phi_out_deg(kPhi), cos_phi_out(kPhi), sin_phi_out(kPhi);
 

@@ -26,8 +26,9 @@
 //    in φl ∈ [0°, 360°), each axis a midpoint rule mapped through a smooth density that puts
 //    30 % of its nodes in a Gaussian of σ ≈ 6° around the mirror direction R = (θv, 180°)
 //    (σ/sinθv in φ), where lobes are narrow; weight sinθl·cosθl·dθ·dφ over the density.
-//    Integrand f_r from BrdfSource::Eval (for a LutBrdf, Lut::SampleAngles called with the
-//    grid's angles directly: the same rule without the vectors' trigonometry). Against NumPy's
+//    Integrand f_r from BrdfSource::Eval (for a LutBrdf, Lut::SampleAngles's rule applied to
+//    the grid's angles directly, its trigonometry shared between the samples of a row through
+//    Lut::SampleTextureFrame: the same values without the vectors' trigonometry). Against NumPy's
 //    midpoint rule of `brdf eval` of the same file on a uniform 0.5° × 1° grid
 //    (tests/python/ibl_albedo_check.py, a 4-slice and a 6-slice capture) every channel agrees
 //    within 0.2 % (test bound 0.5 %; part of the difference is NumPy's own, which moves by
