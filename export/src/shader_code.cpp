@@ -140,33 +140,38 @@ FLOAT3 MeasuredBrdf(@LUT_PARAM@FLOAT3 n, FLOAT3 l, FLOAT3 v) {
 
 // Image-based lighting (docs/engines.md, "ibl"): the split sum of the material's IBL pack,
 //   radiance = diffuse(mu) * irradiance(n)/pi + specular(mu) * prefiltered(alpha_eq(mu), R),
-// mu = dot(n, v), R = reflect(-v, n); irradiance/pi is the probe's cosine-convolved radiance
+// mu = dot(n, v), R = reflect(-v, n) moved toward n (MeasuredBrdfIblDirection); irradiance/pi is the probe's cosine-convolved radiance
 // (1 under a uniform radiance 1) and prefiltered the GGX-prefiltered probe about R at
 // alpha_eq (GGX alpha = perceptual roughness squared). Under a white furnace the material
 // reflects exactly its directional albedo diffuse + specular.
 CONST MEASURED_BRDF_IBL_ROWS = @IBL_ROWS@;
 
-// The material's row of the RGBA16F pack texture (NAME_ibl.dds: 2 * ROWS texels wide, texel i
-// = (diffuse_rgb, alpha_eq) at mu_i = (i + 0.5)/ROWS, texel ROWS + i = (specular_rgb, fit
-// residual)) read at mu; pack_v = (row + 0.5)/rows (0.5 for a single LUT). Sampler: linear,
-// clamp-to-edge, no mipmaps, no sRGB decode. Returns alpha_eq; diffuse and specular are the
-// weights of the two probe values.
-float MeasuredBrdfIblPack(@PACK_PARAM@float pack_v, float mu, out FLOAT3 diffuse,
-                          out FLOAT3 specular) {
-  float tex_u = clamp(mu * MEASURED_BRDF_IBL_ROWS, 0.5, MEASURED_BRDF_IBL_ROWS - 0.5) /
-                (2.0 * MEASURED_BRDF_IBL_ROWS);
-  FLOAT2 uv_d = FLOAT2(tex_u, pack_v);
-  FLOAT2 uv_s = FLOAT2(tex_u + 0.5, pack_v);
-  FLOAT4 d = @PACK_FETCH_D@;
-  FLOAT4 s = @PACK_FETCH_S@;
-  diffuse = d.rgb;
+// The material's row of the RGBA16F pack texture (NAME_ibl.dds: ROWS texels wide, texel i =
+// (specular_rgb, alpha_eq) at mu_i = (i + 0.5)/ROWS) read at mu, one fetch; pack_v = (row +
+// 0.5)/rows (0.5 for a single LUT). Sampler: linear, clamp-to-edge, no mipmaps, no sRGB
+// decode. The diffuse weight is the material's quadratic in t = 1 - mu (manifest
+// "diffuse_quadratic_rgb": diffuse0, diffuse1, diffuse2), at mu clamped to the texel centres
+// as the fetch is, so diffuse + specular is the albedo at every mu_i. Returns alpha_eq.
+float MeasuredBrdfIblPack(@PACK_PARAM@float pack_v, float mu, FLOAT3 diffuse0, FLOAT3 diffuse1,
+                          FLOAT3 diffuse2, out FLOAT3 diffuse, out FLOAT3 specular) {
+  float mu_texel = clamp(mu * MEASURED_BRDF_IBL_ROWS, 0.5, MEASURED_BRDF_IBL_ROWS - 0.5) /
+                   MEASURED_BRDF_IBL_ROWS;
+  FLOAT2 uv = FLOAT2(mu_texel, pack_v);
+  FLOAT4 s = @PACK_FETCH@;
+  float t = 1.0 - mu_texel;
+  diffuse = diffuse0 + t * (diffuse1 + t * diffuse2);
   specular = s.rgb;
-  return max(d.a, 0.0);
+  return max(s.a, 0.0);
 }
 
-// The direction the specular probe is read in: R = reflect(-v, n) = 2 (n.v) n - v.
-FLOAT3 MeasuredBrdfIblReflect(FLOAT3 n, FLOAT3 v) {
-  return n * (2.0 * dot(n, v)) - v;
+// The direction the specular probe is read in: R = reflect(-v, n) = 2 (n.v) n - v moved
+// toward n by s = alpha_eq * (1 - mu) (the dominant-direction shift: 0 near the normal), then
+// normalised: normalize(mix(R, n, s)).
+FLOAT3 MeasuredBrdfIblDirection(FLOAT3 n, FLOAT3 v, float alpha_eq) {
+  float mu = dot(n, v);
+  FLOAT3 r = n * (2.0 * mu) - v;
+  float s = clamp(alpha_eq, 0.0, 1.0) * (1.0 - clamp(mu, 0.0, 1.0));
+  return normalize(r + (n - r) * s);
 }
 
 // The probe term from the pack's weights and the engine's two probe values.
@@ -277,8 +282,7 @@ std::string MeasuredBrdfShaderCode(ShaderLanguage language, const ShaderLutLayou
       ReplaceAll(code, "FLOAT2", "vec2");
       ReplaceAll(code, "ATAN2(", "atan(");
       ReplaceAll(code, "@PACK_PARAM@", "highp sampler2D pack, ");
-      ReplaceAll(code, "@PACK_FETCH_D@", "textureLod(pack, uv_d, 0.0)");
-      ReplaceAll(code, "@PACK_FETCH_S@", "textureLod(pack, uv_s, 0.0)");
+      ReplaceAll(code, "@PACK_FETCH@", "textureLod(pack, uv, 0.0)");
       ReplaceAll(code, "@LUT_PARAM@", "highp sampler3D lut, ");
       ReplaceAll(code, "@LUT_ARG@", "lut, ");
       ReplaceAll(code, "@FETCH@", "textureLod(lut, uvw, 0.0).rgb");
@@ -289,8 +293,7 @@ std::string MeasuredBrdfShaderCode(ShaderLanguage language, const ShaderLutLayou
       ReplaceAll(code, "FLOAT3", "float3");
       ReplaceAll(code, "FLOAT2", "float2");
       ReplaceAll(code, "@PACK_PARAM@", "Texture2D pack, SamplerState pack_sampler, ");
-      ReplaceAll(code, "@PACK_FETCH_D@", "pack.SampleLevel(pack_sampler, uv_d, 0.0)");
-      ReplaceAll(code, "@PACK_FETCH_S@", "pack.SampleLevel(pack_sampler, uv_s, 0.0)");
+      ReplaceAll(code, "@PACK_FETCH@", "pack.SampleLevel(pack_sampler, uv, 0.0)");
       ReplaceAll(code, "ATAN2(", "atan2(");
       ReplaceAll(code, "@LUT_PARAM@", "Texture3D lut, SamplerState lut_sampler, ");
       ReplaceAll(code, "@LUT_ARG@", "lut, lut_sampler, ");
@@ -304,8 +307,7 @@ std::string MeasuredBrdfShaderCode(ShaderLanguage language, const ShaderLutLayou
       ReplaceAll(code, "ATAN2(", "atan(");
       ReplaceAll(code, "@LUT_PARAM@", "");
       ReplaceAll(code, "@PACK_PARAM@", "");
-      ReplaceAll(code, "@PACK_FETCH_D@", "textureLod(measured_brdf_ibl_pack, uv_d, 0.0)");
-      ReplaceAll(code, "@PACK_FETCH_S@", "textureLod(measured_brdf_ibl_pack, uv_s, 0.0)");
+      ReplaceAll(code, "@PACK_FETCH@", "textureLod(measured_brdf_ibl_pack, uv, 0.0)");
       ReplaceAll(code, "@LUT_ARG@", "");
       ReplaceAll(code, "@FETCH@", "textureLod(measured_brdf_lut, uvw, 0.0).rgb");
       break;

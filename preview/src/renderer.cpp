@@ -421,8 +421,8 @@ struct PreviewRenderer::Impl {
             const double mu = std::clamp(s.wo.z, 0.0, 1.0);
             const Vec3 n = s.frame.n;
             const Vec3 wo = s.frame.ToWorld(s.wo);
-            const Vec3 r = Normalize(n * (2.0 * mu) - wo);
             const IblPack::Row row = pack.At(mu);
+            const Vec3 r = IblSpecularDirection(n, wo, row.alpha);
             const Rgb irradiance = lighting.Irradiance(ToMap(n));
             const Rgb prefiltered = lighting.Prefiltered(row.alpha, ToMap(r));
             for (int ch = 0; ch < 3; ++ch)

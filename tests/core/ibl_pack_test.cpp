@@ -6,6 +6,7 @@
 // sum.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "brdf/core/brdf_source.h"
@@ -31,9 +32,52 @@ TEST(IblPack, LambertianAlbedoIsRhoAndAllDiffuseAtEveryView) {
     for (int c = 0; c < 3; ++c) {
       EXPECT_NEAR(pack.albedo[i][c], rho[c], 1e-3 * rho[c]) << "row " << i;
       // The lobe is the irradiance kernel itself: nothing for the prefiltered radiance.
-      EXPECT_LT(pack.specular[i][c], 1e-2 * rho[c]) << "row " << i;
+      EXPECT_LT(std::abs(pack.specular[i][c]), 1e-2 * rho[c]) << "row " << i;
     }
     EXPECT_LT(pack.residual[i], 1e-3) << "row " << i;
+  }
+  // D(μ) = ρ is its own quadratic: c0 = ρ, c1 = c2 = 0.
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(pack.diffuse_quadratic[0][c], rho[c], 2e-3 * rho[c]) << "channel " << c;
+    EXPECT_NEAR(pack.diffuse_quadratic[1][c], 0.0, 1e-2 * rho[c]) << "channel " << c;
+    EXPECT_NEAR(pack.diffuse_quadratic[2][c], 0.0, 1e-2 * rho[c]) << "channel " << c;
+  }
+}
+
+// The engines' diffuse weight D_fit(μ) = c0 + c1·t + c2·t² (t = 1 − μ) is the least-squares
+// quadratic of the split's D rows: its residual is orthogonal to 1, t and t² (the normal
+// equations, the definition of the fit); and S_i = E_i − D_fit(μ_i), so the pack as an engine
+// reads it (At) gives D + S = E at every texel centre and at both clamped ends.
+TEST(IblPack, DiffuseQuadraticIsTheLeastSquaresFitAndKeepsTheAlbedoAtTexelCentres) {
+  for (const double kd : {0.0, 0.3}) {
+    const IblPack pack = ComputeIblPack(Ggx(kd, 0.04, 0.3));
+    for (int c = 0; c < 3; ++c) {
+      double orthogonality[3] = {}, scale = 0.0;
+      for (int i = 0; i < IblPack::kRows; ++i) {
+        const double t = 1.0 - pack.mu[i];
+        const double q = pack.diffuse_quadratic[0][c] + pack.diffuse_quadratic[1][c] * t +
+                         pack.diffuse_quadratic[2][c] * t * t;
+        const double r = pack.diffuse[i][c] - q;
+        orthogonality[0] += r;
+        orthogonality[1] += r * t;
+        orthogonality[2] += r * t * t;
+        scale += std::abs(pack.diffuse[i][c]);
+      }
+      for (int k = 0; k < 3; ++k)
+        EXPECT_NEAR(orthogonality[k], 0.0, 1e-9 * std::max(scale, 1e-3))
+            << "kd " << kd << " channel " << c << " power " << k;
+    }
+    for (int i = 0; i < IblPack::kRows; ++i) {
+      const IblPack::Row row = pack.At(pack.mu[i]);
+      for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(row.diffuse[c] + row.specular[c], pack.albedo[i][c], 1e-12)
+            << "kd " << kd << " row " << i;
+    }
+    for (const double mu : {0.0, 1.0}) {
+      const IblPack::Row row = pack.At(mu);
+      const Rgb& e = mu == 0.0 ? pack.albedo.front() : pack.albedo.back();
+      for (int c = 0; c < 3; ++c) EXPECT_NEAR(row.diffuse[c] + row.specular[c], e[c], 1e-12);
+    }
   }
 }
 
@@ -95,6 +139,27 @@ TEST(IblPack, RowsInterpolateLikeALinearTexture) {
   EXPECT_DOUBLE_EQ(pack.At(1.0).alpha, pack.alpha.back());
   const double mid = 0.5 * (pack.mu[10] + pack.mu[11]);
   EXPECT_NEAR(pack.At(mid).specular[1], 0.5 * (pack.specular[10][1] + pack.specular[11][1]), 1e-12);
+}
+
+// The dominant direction R' = normalize(mix(R, n, α·(1 − μ))): R itself at the normal and for
+// a mirror (α → 0); for n = z and v at θ in the xz plane, R = (−sinθ, 0, cosθ) and R' lies in
+// that plane at the angle atan2((1 − s)·sinθ, (1 − s)·cosθ + s) from n, s = α·(1 − cosθ).
+TEST(IblPack, SpecularDirectionMovesTheMirrorDirectionTowardTheNormal) {
+  const Vec3 n = {0.0, 0.0, 1.0};
+  for (const double alpha : {0.0, 0.1, 0.5, 1.0}) {
+    const Vec3 at_normal = IblSpecularDirection(n, n, alpha);
+    EXPECT_NEAR(at_normal.z, 1.0, 1e-15) << alpha;
+    for (const double theta_deg : {20.0, 60.0, 85.0}) {
+      const double t = theta_deg * kPi / 180.0;
+      const Vec3 v = {std::sin(t), 0.0, std::cos(t)};
+      const Vec3 r = IblSpecularDirection(n, v, alpha);
+      const double s = alpha * (1.0 - std::cos(t));
+      const double want = std::atan2((1.0 - s) * std::sin(t), (1.0 - s) * std::cos(t) + s);
+      EXPECT_NEAR(std::atan2(-r.x, r.z), want, 1e-12) << alpha << " " << theta_deg;
+      EXPECT_NEAR(r.y, 0.0, 1e-15);
+      EXPECT_NEAR(r.x * r.x + r.y * r.y + r.z * r.z, 1.0, 1e-12);
+    }
+  }
 }
 
 }  // namespace

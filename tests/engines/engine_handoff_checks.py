@@ -11,9 +11,10 @@
     module: both import routes ask for sRGB off, TC_HDR, no mips, clamp, tiles 361 × 181.
   - The Godot .import file: importer 3d_texture, 2 × 2 slices, no mipmaps.
   - The IBL pack texture NAME_ibl.dds (of a LUT and of a two-material atlas): DXGI 10, 2D, one
-    mip, 128 × cells; every half is numpy's float16 of the manifest's "ibl" numbers (texel i:
-    diffuse_rgb, alpha_eq at mu_i; texel 64 + i: specular_rgb, fit_residual), identical in
-    every engine folder.
+    mip, 64 × cells; every half is numpy's float16 of the manifest's "ibl" numbers (texel i:
+    specular_rgb, alpha_eq at mu_i), identical in every engine folder; the diffuse constants
+    diffuse_quadratic_rgb are numpy's least-squares quadratic in 1 - mu of diffuse_rgb, and
+    with them D_fit(mu_i) + specular_rgb = albedo_rgb.
   - `brdf fit` output passed with --engine-fits is the manifest's fallback material, as written.
   - The BC6H hand-off (`--engine all --compress bc6h`): the Unreal and Godot DDS are DXGI 95
     volumes of 364 × 184 × K (the padded size) holding the KTX2's blocks; Unity's importer
@@ -108,28 +109,40 @@ def check_ibl_pack(folder, name, engines):
            f"{name}_ibl.dds header {d['fourcc']} dxgi {d['dxgi']} mips {d['mips']}")
     expect(d["dimension"] == 3 and not (d["caps2"] & 0x200000) and not (d["flags"] & 0x800000),
            f"{name}_ibl.dds is not a 2D texture (dimension {d['dimension']})")
-    expect((d["width"], d["height"], d["pitch"]) == (128, len(cells), 128 * 8),
+    expect((d["width"], d["height"], d["pitch"]) == (64, len(cells), 64 * 8),
            f"{name}_ibl.dds size {d['width']}x{d['height']} pitch {d['pitch']}")
-    texels = np.frombuffer(d["data"], dtype="<f2").reshape(len(cells), 128, 4)
+    texels = np.frombuffer(d["data"], dtype="<f2").reshape(len(cells), 64, 4)
     for m, c in enumerate(cells):
         expect(c.get("row", m) == m, f"{name}: cell {m} row {c.get('row')}")
-        want = np.zeros((128, 4))
-        want[:64, :3] = c["diffuse_rgb"]
-        want[:64, 3] = c["alpha_eq"]
-        want[64:, :3] = c["specular_rgb"]
-        want[64:, 3] = c["fit_residual"]
+        want = np.zeros((64, 4))
+        want[:, :3] = c["specular_rgb"]
+        want[:, 3] = c["alpha_eq"]
         got = texels[m]
         same = np.array_equal(got, want.astype(np.float16))
         expect(same, f"{name}_ibl.dds row {m} differs from float16 of the manifest by "
                      f"{np.abs(got.astype(float) - want).max()}")
+        # The diffuse constants: numpy's own least-squares quadratic in t = 1 - mu of the
+        # manifest's diffuse_rgb, and with them D_fit(mu_i) + S_i = E_i at every texel centre.
+        mu = np.asarray(c["mu"])
+        t = 1.0 - mu
+        diffuse = np.asarray(c["diffuse_rgb"])
+        coeffs = np.asarray(c["diffuse_quadratic_rgb"])
+        expect(coeffs.shape == (3, 3), f"{name}: diffuse_quadratic_rgb shape {coeffs.shape}")
+        basis = np.stack([np.ones_like(t), t, t * t], axis=1)
+        lstsq = np.linalg.lstsq(basis, diffuse, rcond=None)[0]
+        fit_err = np.abs(lstsq - coeffs).max()
+        expect(fit_err <= 1e-5 * max(1.0, np.abs(lstsq).max()),
+               f"{name}: diffuse_quadratic_rgb differs from numpy's least squares by {fit_err}")
         albedo = np.asarray(c["albedo_rgb"])
-        split = np.abs(np.asarray(c["diffuse_rgb"]) + np.asarray(c["specular_rgb"]) - albedo)
-        expect(split.max() <= 1e-6 * max(1.0, albedo.max()), f"{name}: D + S differs from E by {split.max()}")
+        split = np.abs(basis @ coeffs + np.asarray(c["specular_rgb"]) - albedo)
+        expect(split.max() <= 1e-5 * max(1.0, albedo.max()),
+               f"{name}: D_fit + S differs from E by {split.max()}")
     data = open(os.path.join(folder, engines[0], name + "_ibl.dds"), "rb").read()
     for e in engines[1:]:
         expect(open(os.path.join(folder, e, name + "_ibl.dds"), "rb").read() == data,
                f"{e}/{name}_ibl.dds differs from {engines[0]}'s")
-    print(f"{name}_ibl.dds: DXGI 10 2D 128x{len(cells)}, 1 mip; every half is float16 of the manifest's pack")
+    print(f"{name}_ibl.dds: DXGI 10 2D 64x{len(cells)}, 1 mip; every half is float16 of the manifest's pack; "
+          "diffuse_quadratic_rgb is numpy's least-squares fit, D_fit + S = E")
 
 
 def check_unity(out, name, mcs, mono, work, words, want):

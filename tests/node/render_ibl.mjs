@@ -141,35 +141,34 @@ try {
       const mod = await import('/web/' + manifest.engines.web.files.shader);
       const lut = await mod.loadMeasuredBrdfTexture('/web/${name}.ktx2', window.ibl.renderer);
       const pack = await mod.loadMeasuredBrdfIblPack('/web/' + manifest.ibl.texture.file);
-      let cell = [0, 0], row = manifest.ibl.row;
+      let cell = [0, 0], ibl = manifest.ibl;
       if (manifest.atlas) {
         const m = manifest.cells.findIndex((c) => c.material === ${JSON.stringify(cellName ?? '')});
         if (m < 0) throw new Error('${entry}: no such cell');
         cell = [manifest.cells[m].x0, manifest.cells[m].y0];
-        row = manifest.ibl.cells[m].row;
+        ibl = manifest.ibl.cells[m];
       }
+      const row = ibl.row, q = ibl.diffuse_quadratic_rgb;
       const material = (environment, iblPack) => mod.createMeasuredBrdfMaterial(lut, {
           lightColor: new THREE.Vector3(0, 0, 0), encodeSrgb: false, environment, iblPack,
-          iblPackRow: row, cell });
-      // A copy of the pack with its halves changed by f(texel, channel, value, row of halves).
+          iblPackRow: row, iblDiffuse: q, cell });
+      // A copy of the pack (texels (specular_rgb, alpha_eq) at mu_i) changed by f(values, D_fit(mu_i)).
       const mutated = (f) => {
         const w = pack.image.width, src = pack.image.data, data = new Uint16Array(src.length);
         for (let t = 0; t < src.length / 4; t++) {
-          const x = t % w, k = x < w / 2 ? x : x - w / 2, row = t - x;
+          const s = 1 - ((t % w) + 0.5) / w;
+          const d = [0, 1, 2].map((c) => q[0][c] + s * (q[1][c] + s * q[2][c]));
           const vals = [0, 1, 2, 3].map((c) => THREE.DataUtils.fromHalfFloat(src[4 * t + c]));
-          const other = [0, 1, 2, 3].map((c) => THREE.DataUtils.fromHalfFloat(src[4 * (row + (x < w / 2 ? k + w / 2 : k)) + c]));
-          const out = f(x < w / 2, vals, other);
+          const out = f(vals, d);
           for (let c = 0; c < 4; c++) data[4 * t + c] = THREE.DataUtils.toHalfFloat(out[c]);
         }
         const t = new THREE.DataTexture(data, w, pack.image.height, THREE.RGBAFormat, THREE.HalfFloatType);
         t.minFilter = t.magFilter = THREE.LinearFilter; t.generateMipmaps = false; t.needsUpdate = true;
         return t;
       };
-      const alpha110 = mutated((diffuseHalf, v) => diffuseHalf ? [v[0], v[1], v[2], v[3] * 1.1] : v);
-      const noE = mutated((diffuseHalf, v, o) => {
-        const e = [0, 1, 2].map((c) => v[c] + o[c]);
-        return [0, 1, 2].map((c) => (e[c] > 0 ? v[c] / e[c] : 0)).concat([v[3]]);
-      });
+      const alpha110 = mutated((v) => [v[0], v[1], v[2], v[3] * 1.1]);
+      // E dropped: the specular weight made 1 - D_fit, so D_fit + S = 1 at every mu_i.
+      const noE = mutated((v, d) => [1 - d[0], 1 - d[1], 1 - d[2], v[3]]);
       const out = { ibl: render(material(env, pack)), furnace: render(material(furnace, pack)) };
       if (${mutate === null || mutate.has(entry)})
         Object.assign(out, { alpha110: render(material(env, alpha110)), noE: render(material(env, noE)) });
@@ -203,6 +202,7 @@ try {
       const lut = await mod.loadMeasuredBrdfTexture('/web/' + name + '.ktx2', renderer);
       const pack = await mod.loadMeasuredBrdfIblPack('/web/' + manifest.ibl.texture.file);
       const measured = mod.createMeasuredBrdfMaterial(lut, { encodeSrgb: false, environment: env, iblPack: pack,
+          iblDiffuse: manifest.ibl.diffuse_quadratic_rgb,
           lightDirection: new THREE.Vector3(-0.5, 0.7, 0.5) });
       const standard = new THREE.MeshStandardMaterial({ metalness: 1, roughness: 0.39 });
       const sun = new THREE.DirectionalLight(0xffffff, 3);

@@ -475,17 +475,17 @@ ordered_json IblJson(const Handoff& h) {
   ordered_json texture = {
       {"file", h.name + "_ibl.dds"},
       {"format", "DDS DXGI_FORMAT_R16G16B16A16_FLOAT (10), 2D, one mip; halves of the values here"},
-      {"width", 2 * kRows},
+      {"width", kRows},
       {"height", h.ibl.size()},
       {"row_of_material", "row m = cell m (0 for a single LUT), row 0 first in the file, at v = 0"},
       {"texels",
-       fmt::format("texel i < {0}: (diffuse_rgb, alpha_eq) at mu_i; texel {0} + i: (specular_rgb, "
-                   "fit_residual) at mu_i",
-                   kRows)},
+       "texel i: (specular_rgb, alpha_eq) at mu_i; the diffuse part is not in the "
+       "texture: D_fit(mu) = c0 + c1 t + c2 t^2 (t = 1 - mu) from "
+       "diffuse_quadratic_rgb, material constants"},
       {"sampling",
        fmt::format("linear, clamp-to-edge, no mipmaps, no sRGB decode; u = clamp(mu * {0}, 0.5, "
-                   "{1}) / {2} (+ 0.5 for the specular half), v = (row + 0.5) / height",
-                   kRows, kRows - 0.5, 2 * kRows)}};
+                   "{1}) / {0}, v = (row + 0.5) / height; D_fit at the same clamped mu = u",
+                   kRows, kRows - 0.5)}};
   if (!h.atlas) {
     ordered_json j = ordered_json::parse(IblPackJson(h.ibl.at(0)));
     j["texture"] = texture;

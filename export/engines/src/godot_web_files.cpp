@@ -21,7 +21,8 @@ std::string GodotShader(const exporter::ShaderLutLayout& layout) {
 // Image-based lighting (docs/engines.md, "ibl"): Godot's own ambient and reflection terms are
 // disabled (they would light a white Lambertian); instead fragment() adds the material's probe
 // term as EMISSION from the IBL pack (measured_brdf_ibl_pack: <name>_ibl.dds, or its row of an
-// atlas's pack with measured_brdf_ibl_row = (row + 0.5) / rows) and a GGX-prefiltered radiance
+// atlas's pack with measured_brdf_ibl_row = (row + 0.5) / rows; measured_brdf_ibl_diffuse0..2
+// = the manifest's "diffuse_quadratic_rgb" of the material or its cell) and a GGX-prefiltered radiance
 // cube map in the layout of Godot's own radiance maps (mip level = perceptual roughness x
 // max level, e.g. a baked ReflectionProbe's or the sky's exported radiance; Godot 4 spatial
 // shaders cannot read the scene's radiance map themselves). measured_brdf_radiance_max_lod = 0
@@ -33,6 +34,9 @@ uniform sampler3D measured_brdf_lut : filter_linear, repeat_disable, hint_defaul
 uniform sampler2D measured_brdf_ibl_pack : filter_linear, repeat_disable, hint_default_black;
 uniform samplerCube measured_brdf_radiance : filter_linear_mipmap, hint_default_black;
 uniform float measured_brdf_ibl_row = 0.5;
+uniform vec3 measured_brdf_ibl_diffuse0 = vec3(0.0);
+uniform vec3 measured_brdf_ibl_diffuse1 = vec3(0.0);
+uniform vec3 measured_brdf_ibl_diffuse2 = vec3(0.0);
 uniform float measured_brdf_radiance_max_lod = 0.0;
 
 )~~" + exporter::MeasuredBrdfShaderCode(exporter::ShaderLanguage::kGodot, layout) +
@@ -43,15 +47,17 @@ void fragment() {
   SPECULAR = 0.0;
   ROUGHNESS = 1.0;
   if (measured_brdf_radiance_max_lod > 0.0) {
-    // World space, where the cube map is indexed; two probe fetches and the pack row.
+    // World space, where the cube map is indexed; two probe fetches and one pack fetch.
     vec3 n = normalize((INV_VIEW_MATRIX * vec4(NORMAL, 0.0)).xyz);
     vec3 v = normalize((INV_VIEW_MATRIX * vec4(VIEW, 0.0)).xyz);
     vec3 ibl_diffuse;
     vec3 ibl_specular;
-    float alpha_eq = MeasuredBrdfIblPack(measured_brdf_ibl_row, max(dot(n, v), 0.0), ibl_diffuse,
-                                         ibl_specular);
+    float alpha_eq = MeasuredBrdfIblPack(measured_brdf_ibl_row, max(dot(n, v), 0.0),
+                                         measured_brdf_ibl_diffuse0, measured_brdf_ibl_diffuse1,
+                                         measured_brdf_ibl_diffuse2, ibl_diffuse, ibl_specular);
     vec3 irradiance = textureLod(measured_brdf_radiance, n, measured_brdf_radiance_max_lod).rgb;
-    vec3 prefiltered = textureLod(measured_brdf_radiance, MeasuredBrdfIblReflect(n, v),
+    vec3 prefiltered = textureLod(measured_brdf_radiance,
+                                  MeasuredBrdfIblDirection(n, v, alpha_eq),
                                   sqrt(alpha_eq) * measured_brdf_radiance_max_lod).rgb;
     EMISSION = MeasuredBrdfIblRadiance(ibl_diffuse, ibl_specular, irradiance, prefiltered);
   }
@@ -253,6 +259,7 @@ uniform bool toneMapReinhard; // with encodeSrgb: x / (1 + x) per channel before
 #include <envmap_common_pars_fragment>
 uniform highp sampler2D iblPack;  // NAME_ibl.dds (loadMeasuredBrdfIblPack)
 uniform float iblPackRow;         // (row + 0.5) / rows of the material's pack row
+uniform vec3 iblDiffuse[3];       // the material's "diffuse_quadratic_rgb" (c0, c1, c2)
 #endif
 in vec3 v_normal_world;
 in vec3 v_position_world;
@@ -274,12 +281,12 @@ void main() {{
     radiance = f * lightColor * max(dot(n, l), 0.0);
   }}
 #ifdef MEASURED_BRDF_IBL
-  // One pack row (two texels at mu) and two probe fetches: the PMREM's last level (GGX alpha 1
+  // One pack fetch (one texel at mu) and two probe fetches: the PMREM's last level (GGX alpha 1
   // = the cosine lobe: irradiance / pi) about n, and the level of alpha_eq about R.
   vec3 ibl_diffuse, ibl_specular;
-  float alpha_eq = MeasuredBrdfIblPack(iblPack, iblPackRow, max(dot(n, v), 0.0), ibl_diffuse,
-                                       ibl_specular);
-  vec3 r = MeasuredBrdfIblReflect(n, v);
+  float alpha_eq = MeasuredBrdfIblPack(iblPack, iblPackRow, max(dot(n, v), 0.0), iblDiffuse[0],
+                                       iblDiffuse[1], iblDiffuse[2], ibl_diffuse, ibl_specular);
+  vec3 r = MeasuredBrdfIblDirection(n, v, alpha_eq);
   vec3 irradiance = textureLod(envMap, envMapRotation * n, ENVMAP_MAX_LOD).rgb;
   vec3 prefiltered = textureLod(envMap, envMapRotation * r, roughnessToMip(sqrt(alpha_eq))).rgb;
   radiance += MeasuredBrdfIblRadiance(ibl_diffuse, ibl_specular, irradiance, prefiltered) *
@@ -327,7 +334,8 @@ export async function loadMeasuredBrdfIblPack(url) {{
 // an atlas material's cell origin in texels, from the manifest), environment (the texture of
 // PMREMGenerator.fromEquirectangular/fromScene: its GGX-prefiltered cube map), iblPack (the
 // texture of loadMeasuredBrdfIblPack), iblPackRow (the material's row, 0 for a single LUT; the
-// manifest's "ibl" "row"), environmentIntensity.
+// manifest's "ibl" "row"), iblDiffuse (its "diffuse_quadratic_rgb": [[r, g, b] x 3], the
+// cell's for an atlas material), environmentIntensity.
 export function createMeasuredBrdfMaterial(texture, options = {{}}) {{
   const color = options.lightColor ?? new THREE.Vector3(1, 1, 1);
   const uniforms = {{
@@ -344,6 +352,9 @@ export function createMeasuredBrdfMaterial(texture, options = {{}}) {{
   if (environment) {{
     if (!environment.isPMREMTexture || !options.iblPack)
       throw new Error('measured BRDF: options.environment must be a PMREMGenerator texture, with options.iblPack');
+    const q = options.iblDiffuse;
+    if (!Array.isArray(q) || q.length !== 3 || !q.every((c) => Array.isArray(c) && c.length === 3))
+      throw new Error(`measured BRDF: options.iblDiffuse: expected the manifest's diffuse_quadratic_rgb ([[r, g, b] x 3]), got ${{JSON.stringify(q)}}`);
     const rows = options.iblPack.image.height;
     defines.MEASURED_BRDF_IBL = '';
     defines.ENVMAP_MAX_LOD = `${{environment.mipmaps.length - 1}}.0`;
@@ -352,6 +363,7 @@ export function createMeasuredBrdfMaterial(texture, options = {{}}) {{
     uniforms.envMapRotation = {{ value: new THREE.Matrix3() }};  // a PMREM needs no flip
     uniforms.iblPack = {{ value: options.iblPack }};
     uniforms.iblPackRow = {{ value: ((options.iblPackRow ?? 0) + 0.5) / rows }};
+    uniforms.iblDiffuse = {{ value: q.map((c) => new THREE.Vector3(...c)) }};
   }}
   return new THREE.ShaderMaterial({{
     glslVersion: THREE.GLSL3,
@@ -578,7 +590,9 @@ window.measuredBrdf.ready = (async () => {{
       pmrem.dispose();
       const ibl = manifest.ibl;
       options.iblPack = await module.loadMeasuredBrdfIblPack(`./${{ibl.texture.file}}`);
-      options.iblPackRow = manifest.atlas ? ibl.cells[cellIndex].row : ibl.row;
+      const pack = manifest.atlas ? ibl.cells[cellIndex] : ibl;
+      options.iblPackRow = pack.row;
+      options.iblDiffuse = pack.diffuse_quadratic_rgb;
     }}
   }}
   const shader = module.createMeasuredBrdfMaterial(texture, options);

@@ -108,7 +108,7 @@ std::string EncodeRgba16fDds(const exporter::PackedVolume& volume) {
 std::string EncodeIblPackDds(const std::vector<const IblPack*>& packs) {
   constexpr int kRows = IblPack::kRows;
   if (packs.empty()) throw InvalidArgument("IBL pack texture: no material");
-  std::string out = exporter::DdsTexture2dHeader(2 * kRows, static_cast<int>(packs.size()),
+  std::string out = exporter::DdsTexture2dHeader(kRows, static_cast<int>(packs.size()),
                                                  kDxgiFormatR16g16b16a16Float, 8);
   const auto put = [&](double v) {
     const std::uint16_t h = exporter::FloatToHalf(static_cast<float>(v));
@@ -116,17 +116,12 @@ std::string EncodeIblPackDds(const std::vector<const IblPack*>& packs) {
     out.push_back(static_cast<char>(h >> 8));
   };
   for (const IblPack* pack : packs) {
-    if (pack == nullptr || pack->mu.size() != kRows || pack->diffuse.size() != kRows ||
-        pack->specular.size() != kRows || pack->alpha.size() != kRows ||
-        pack->residual.size() != kRows)
+    if (pack == nullptr || pack->mu.size() != kRows || pack->specular.size() != kRows ||
+        pack->alpha.size() != kRows)
       throw InvalidArgument(fmt::format("IBL pack texture: a pack without {} rows", kRows));
     for (int i = 0; i < kRows; ++i) {
-      for (int c = 0; c < 3; ++c) put(pack->diffuse[i][c]);
-      put(pack->alpha[i]);
-    }
-    for (int i = 0; i < kRows; ++i) {
       for (int c = 0; c < 3; ++c) put(pack->specular[i][c]);
-      put(pack->residual[i]);
+      put(pack->alpha[i]);
     }
   }
   return out;

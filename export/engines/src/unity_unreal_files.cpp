@@ -236,8 +236,10 @@ void MeasuredBrdfRadiance_half(UnityTexture3D Lut, half3 N, half3 L, half3 V,
 // Image-based lighting with the pipeline's own probes (docs/engines.md, "ibl"): the probe
 // term of the measured material, added to MeasuredBrdfRadiance's direct lighting (Custom
 // Function Name MeasuredBrdfIbl; inputs IblPack (Texture 2D: the <name>_ibl.dds pack, linear,
-// clamp, no mips, sRGB off), IblRow (Float: (row + 0.5) / rows, 0.5 for one LUT), N, V (world
-// space); output Out = radiance). One pack row (two texels at mu = N.V) and two probe fetches:
+// clamp, no mips, sRGB off), IblRow (Float: (row + 0.5) / rows, 0.5 for one LUT), IblDiffuse0,
+// IblDiffuse1, IblDiffuse2 (Vector3: the manifest's "diffuse_quadratic_rgb", the material's or
+// its atlas cell's), N, V (world space); output Out = radiance). One pack fetch (one texel at
+// mu = N.V) and two probe fetches:
 //   URP (its Lighting.hlsl included, as in Lit and Unlit graphs): SampleSH(N) (irradiance / pi)
 //     and GlossyEnvironmentReflection(R, perceptual roughness sqrt(alpha_eq), 1) (the
 //     reflection probe, or the sky, at URP's mip for that roughness);
@@ -252,13 +254,15 @@ void MeasuredBrdfRadiance_half(UnityTexture3D Lut, half3 N, half3 L, half3 V,
     SampleSkyTexture(r, PerceptualRoughnessToMipmapLevel(roughness), 0).rgb
 #endif
 #ifdef MEASURED_BRDF_IRRADIANCE
-void MeasuredBrdfIbl_float(UnityTexture2D IblPack, float IblRow, float3 N, float3 V,
+void MeasuredBrdfIbl_float(UnityTexture2D IblPack, float IblRow, float3 IblDiffuse0,
+                           float3 IblDiffuse1, float3 IblDiffuse2, float3 N, float3 V,
                            out float3 Out)
 {
     float3 n = normalize(N), v = normalize(V), d, s;
     float alpha_eq = MeasuredBrdfIblPack(IblPack.tex, IblPack.samplerstate, IblRow,
-                                         saturate(dot(n, v)), d, s);
-    float3 r = MeasuredBrdfIblReflect(n, v);
+                                         saturate(dot(n, v)), IblDiffuse0, IblDiffuse1,
+                                         IblDiffuse2, d, s);
+    float3 r = MeasuredBrdfIblDirection(n, v, alpha_eq);
     Out = MeasuredBrdfIblRadiance(d, s, MEASURED_BRDF_IRRADIANCE(n),
                                   MEASURED_BRDF_PREFILTERED(r, sqrt(alpha_eq)));
 }
@@ -311,25 +315,29 @@ std::string UnrealUsh(const exporter::ShaderLutLayout& layout) {
 // Image-based lighting (docs/engines.md, "ibl"): a second Custom node, same include, Additional
 // Defines MEASURED_BRDF_UNREAL_SKY = 1, inputs IblPack (TextureObject of <name>_ibl.dds: sRGB
 // off, TC_HDR, no mips, clamp; Unreal passes IblPack and IblPackSampler), IblRow ((row + 0.5) /
-// rows, 0.5 for one LUT), N, V, Output Type CMOT Float 3, added to the direct term (Emissive
-// of an Unlit material, or the lit sum):
-// Code:   return MeasuredBrdfIblUnreal(IblPack, IblPackSampler, IblRow, normalize(N), normalize(V));
+// rows, 0.5 for one LUT), IblDiffuse0, IblDiffuse1, IblDiffuse2 (float3 constants: the
+// manifest's "diffuse_quadratic_rgb", the material's or its atlas cell's), N, V, Output Type
+// CMOT Float 3, added to the direct term (Emissive of an Unlit material, or the lit sum):
+// Code:   return MeasuredBrdfIblUnreal(IblPack, IblPackSampler, IblRow, IblDiffuse0, IblDiffuse1, IblDiffuse2, normalize(N), normalize(V));
 // It reads the Sky Light, Unreal's own probe: GetSkySHDiffuse (irradiance / pi) and
 // GetSkyLightReflection at roughness sqrt(alpha_eq) (the captured sky cube map at Unreal's mip
-// for that roughness), each times the light's colour; one pack row, two probe fetches.
+// for that roughness), each times the light's colour; one pack fetch, two probe fetches.
 #pragma once
 
 )~~" + exporter::MeasuredBrdfShaderCode(exporter::ShaderLanguage::kHlsl, layout) +
          R"~~(
 #if MEASURED_BRDF_UNREAL_SKY
 float3 MeasuredBrdfIblUnreal(Texture2D IblPack, SamplerState IblPackSampler, float IblRow,
+                             float3 IblDiffuse0, float3 IblDiffuse1, float3 IblDiffuse2,
                              float3 N, float3 V)
 {
     float3 diffuse, specular;
     float alpha_eq = MeasuredBrdfIblPack(IblPack, IblPackSampler, IblRow, saturate(dot(N, V)),
-                                         diffuse, specular);
+                                         IblDiffuse0, IblDiffuse1, IblDiffuse2, diffuse,
+                                         specular);
     float sky_brightness;
-    float3 prefiltered = GetSkyLightReflection(MeasuredBrdfIblReflect(N, V), sqrt(alpha_eq),
+    float3 prefiltered = GetSkyLightReflection(MeasuredBrdfIblDirection(N, V, alpha_eq),
+                                               sqrt(alpha_eq),
                                                sky_brightness);
     return MeasuredBrdfIblRadiance(diffuse, specular, GetSkySHDiffuse(N) * View.SkyLightColor.rgb,
                                    prefiltered);

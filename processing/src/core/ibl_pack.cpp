@@ -136,6 +136,25 @@ Bands GgxPrefilterLegendre(double alpha) {
   return k;
 }
 
+Rgb IblPack::DiffuseFit(double m) const {
+  const double t = 1.0 - m;
+  const auto& q = diffuse_quadratic;
+  Rgb d;
+  for (int c = 0; c < 3; ++c) d[c] = q[0][c] + t * (q[1][c] + t * q[2][c]);
+  return d;
+}
+
+double IblSpecularShift(double alpha_eq, double mu) {
+  return std::clamp(alpha_eq, 0.0, 1.0) * (1.0 - std::clamp(mu, 0.0, 1.0));
+}
+
+Vec3 IblSpecularDirection(const Vec3& n, const Vec3& v, double alpha_eq) {
+  const double mu = Dot(n, v);
+  const Vec3 r = n * (2.0 * mu) - v;
+  const double s = IblSpecularShift(alpha_eq, mu);
+  return Normalize(r + (n - r) * s);
+}
+
 IblPack::Row IblPack::At(double m) const {
   Row row;
   if (mu.empty()) return row;
@@ -146,9 +165,9 @@ IblPack::Row IblPack::At(double m) const {
   const double f = std::clamp(x - i, 0.0, 1.0);
   for (int c = 0; c < 3; ++c) {
     row.albedo[c] = (1.0 - f) * albedo[i][c] + f * albedo[j][c];
-    row.diffuse[c] = (1.0 - f) * diffuse[i][c] + f * diffuse[j][c];
     row.specular[c] = (1.0 - f) * specular[i][c] + f * specular[j][c];
   }
+  row.diffuse = DiffuseFit(std::clamp(m, 0.5 / kRows, 1.0 - 0.5 / kRows));
   row.alpha = (1.0 - f) * alpha[i] + f * alpha[j];
   return row;
 }
@@ -183,6 +202,40 @@ void ConcentratedNodes(double lo, double hi, double c, double sigma, double peak
   }
 }
 
+// D_fit(μ) = c0 + c1·t + c2·t², t = 1 − μ, by least squares over the rows per channel (the
+// 3 × 3 normal equations, solved by Cramer's rule: t ∈ [0, 1] keeps them well conditioned),
+// then S_i = E_i − D_fit(μ_i) (brdf/core/ibl_pack.h: the furnace exact at texel centres).
+void FitDiffuseQuadratic(IblPack* pack) {
+  double m[3][3] = {};
+  double rhs[3][3] = {};  // [power][channel]
+  for (std::size_t i = 0; i < pack->mu.size(); ++i) {
+    const double t = 1.0 - pack->mu[i];
+    const double pw[5] = {1.0, t, t * t, t * t * t, t * t * t * t};
+    for (int a = 0; a < 3; ++a) {
+      for (int b = 0; b < 3; ++b) m[a][b] += pw[a + b];
+      for (int c = 0; c < 3; ++c) rhs[a][c] += pw[a] * pack->diffuse[i][c];
+    }
+  }
+  auto det3 = [](const double(&x)[3][3]) {
+    return x[0][0] * (x[1][1] * x[2][2] - x[1][2] * x[2][1]) -
+           x[0][1] * (x[1][0] * x[2][2] - x[1][2] * x[2][0]) +
+           x[0][2] * (x[1][0] * x[2][1] - x[1][1] * x[2][0]);
+  };
+  const double det = det3(m);
+  for (int c = 0; c < 3; ++c) {
+    for (int k = 0; k < 3; ++k) {
+      double mk[3][3];
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) mk[a][b] = b == k ? rhs[a][c] : m[a][b];
+      pack->diffuse_quadratic[k][c] = det != 0.0 ? det3(mk) / det : 0.0;
+    }
+  }
+  for (std::size_t i = 0; i < pack->mu.size(); ++i) {
+    const Rgb d = pack->DiffuseFit(pack->mu[i]);
+    for (int c = 0; c < 3; ++c) pack->specular[i][c] = pack->albedo[i][c] - d[c];
+  }
+}
+
 }  // namespace
 
 IblPack ComputeIblPack(const BrdfSource& source) {
@@ -211,11 +264,11 @@ IblPack ComputeIblPack(const BrdfSource& source) {
   Bands p{};
   const KappaTable& table = Kappa();
   std::vector<double> theta_x, theta_w, phi_x, phi_w, cos_phi(kPhi), sin_phi(kPhi);
-  // A LUT is sampled by its own rule directly from the grid's angles (Lut::SampleAngles with the
-  // light at φ = 0 and the view at the relative azimuth, exactly what LutBrdf::Eval computes
-  // from the vectors), which saves the vectors' trigonometry: most of the pack's cost.
+  // A LUT is sampled by its own rule directly from the grid's angles (Lut::SampleAngles's rule
+  // with the light at φ = 0 and the view at the relative azimuth, exactly what LutBrdf::Eval
+  // computes from the vectors), which saves the vectors' trigonometry: most of the pack's cost.
   const auto* lut = dynamic_cast<const LutBrdf*>(&source);
-  std::vector<double> phi_out_deg(kPhi);
+  std::vector<double> phi_out_deg(kPhi), cos_phi_out(kPhi), sin_phi_out(kPhi);
 
   for (int row = 0; row < kRows; ++row) {
     const double mu = (row + 0.5) / kRows;
@@ -236,6 +289,16 @@ IblPack ComputeIblPack(const BrdfSource& source) {
       phi_out_deg[k] = WrapDeg360(-RadToDeg(phi_x[k]));
     }
     const double theta_v_deg = RadToDeg(theta_v);
+    // The trigonometry Lut::SampleAngles would do per sample, once per row, per θ node or per
+    // φ node (Lut::SampleTextureFrame; the same values, so the same bits): the view's and each
+    // light's specular frame and slice coordinate, ω_out's azimuth terms.
+    const SpecularFrame frame_v = SpecularFrame::FromThetaInDeg(theta_v_deg);
+    const double sin_v = std::sin(DegToRad(theta_v_deg)), cos_v = std::cos(DegToRad(theta_v_deg));
+    const double slice_v = lut != nullptr ? lut->lut().SliceCoordinate(theta_v_deg) : 0.0;
+    for (int k = 0; k < kPhi; ++k) {
+      cos_phi_out[k] = std::cos(DegToRad(phi_out_deg[k]));
+      sin_phi_out[k] = std::sin(DegToRad(phi_out_deg[k]));
+    }
     std::fill(hist.begin(), hist.end(), Rgb{0, 0, 0});
     std::array<Moments, 3> m{};
     Rgb e = {0, 0, 0};
@@ -243,13 +306,26 @@ IblPack ComputeIblPack(const BrdfSource& source) {
       const double st = std::sin(theta_x[j]), ct = std::cos(theta_x[j]);
       const double row_weight = st * ct * theta_w[j];
       const double theta_l_deg = RadToDeg(theta_x[j]);
+      // Lut::SampleAngles(θl, θv, φout): the texture at (θl; θv, φout), or with light and view
+      // exchanged at (θv; θl, −φout) (sin(−φ) = −sin φ).
+      const bool exchange =
+          lut != nullptr && lut->lut().ExchangesLightAndView(theta_l_deg, theta_v_deg);
+      const SpecularFrame frame_l = SpecularFrame::FromThetaInDeg(theta_l_deg);
+      const double slice_l =
+          lut != nullptr && !exchange ? lut->lut().SliceCoordinate(theta_l_deg) : 0.0;
+      const double sin_l = std::sin(DegToRad(theta_l_deg)), cos_l = std::cos(DegToRad(theta_l_deg));
       Rgb ring = {0, 0, 0};
       for (int k = 0; k < kPhi; ++k) {
         const Vec3 l = {st * cos_phi[k], st * sin_phi[k], ct};
         Rgb f;
         if (lut != nullptr) {
           const std::array<float, 3> t =
-              lut->lut().SampleAngles(theta_l_deg, theta_v_deg, phi_out_deg[k]);
+              exchange ? lut->lut().SampleTextureFrame(frame_v.cos_m, frame_v.sin_m, slice_v,
+                                                       sin_l * cos_phi_out[k],
+                                                       sin_l * -sin_phi_out[k], cos_l)
+                       : lut->lut().SampleTextureFrame(frame_l.cos_m, frame_l.sin_m, slice_l,
+                                                       sin_v * cos_phi_out[k],
+                                                       sin_v * sin_phi_out[k], cos_v);
           f = {t[0], t[1], t[2]};
         } else {
           f = source.Eval(l, v);
@@ -352,15 +428,17 @@ IblPack ComputeIblPack(const BrdfSource& source) {
     pack.alpha[row] = alpha;
     pack.residual[row] = residual;
   }
+  FitDiffuseQuadratic(&pack);
   return pack;
 }
 
 std::string IblPackJson(const IblPack& pack) {
   std::string out =
       "{\"convention\": \"docs/engines.md, IBL pack: mu = cos(theta_view) at texel "
-      "centres (i + 0.5)/rows; radiance = diffuse_rgb * irradiance/pi + "
-      "specular_rgb * prefiltered(alpha_eq, reflect(-v, n)); albedo_rgb = "
-      "diffuse_rgb + specular_rgb\", \"rows\": ";
+      "centres (i + 0.5)/rows; radiance = D_fit(mu) * irradiance/pi + "
+      "specular_rgb * prefiltered(alpha_eq, reflect(-v, n)), D_fit(mu) = c0 + c1 t + c2 t^2, "
+      "t = 1 - mu, [c0, c1, c2] = diffuse_quadratic_rgb (least squares to diffuse_rgb, the "
+      "split's diffuse part); albedo_rgb = D_fit(mu) + specular_rgb at every mu\", \"rows\": ";
   out += std::to_string(pack.mu.size());
   char buf[96];
   auto list = [&](const char* key, auto&& value) {
@@ -385,6 +463,12 @@ std::string IblPackJson(const IblPack& pack) {
   list("albedo_rgb", [&](std::size_t i) { return rgb(pack.albedo[i]); });
   list("diffuse_rgb", [&](std::size_t i) { return rgb(pack.diffuse[i]); });
   list("specular_rgb", [&](std::size_t i) { return rgb(pack.specular[i]); });
+  out += ", \"diffuse_quadratic_rgb\": [";
+  for (int k = 0; k < 3; ++k) {
+    if (k) out += ", ";
+    out += rgb(pack.diffuse_quadratic[k]);
+  }
+  out += "]";
   list("alpha_eq", [&](std::size_t i) { return number(pack.alpha[i]); });
   list("fit_residual", [&](std::size_t i) { return number(pack.residual[i]); });
   out += "}";

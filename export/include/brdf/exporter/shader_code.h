@@ -43,10 +43,13 @@
 //
 // Image-based lighting (docs/engines.md, "ibl": the split sum of the material's IBL pack,
 // brdf/core/ibl_pack.h), the same in every language; the engine supplies its two probe values:
-//   MeasuredBrdfIblPack([pack,] pack_v, mu, out diffuse, out specular) → α_eq
-//       the material's row of the RGBA16F pack texture (2·IblPack::kRows texels: (D, α_eq),
-//       then (S, residual)) at μ = n·v, two linear fetches at the same μ; pack_v the row's v
-//   MeasuredBrdfIblReflect(n, v) → R = 2(n·v)n − v
+//   MeasuredBrdfIblPack([pack,] pack_v, mu, diffuse0, diffuse1, diffuse2, out diffuse,
+//                       out specular) → α_eq
+//       the material's row of the RGBA16F pack texture (IblPack::kRows texels (S, α_eq)) at
+//       μ = n·v, one linear fetch; pack_v the row's v; diffuse = c0 + c1·t + c2·t², t = 1 − μ
+//       (μ clamped to the texel centres), from the material's constants diffuse0…2
+//   MeasuredBrdfIblDirection(n, v, α_eq) → normalize(mix(R, n, α_eq·(1 − n·v))), R = 2(n·v)n − v
+//       (IblSpecularDirection, brdf/core/ibl_pack.h)
 //   MeasuredBrdfIblRadiance(diffuse, specular, irradiance_over_pi, prefiltered) → radiance
 //       = diffuse·irradiance_over_pi + specular·prefiltered (the probe filtered with GGX α_eq)
 // [pack,] is `highp sampler2D pack` in GLSL, `Texture2D pack, SamplerState pack_sampler` in

@@ -26,8 +26,9 @@
 //    in φl ∈ [0°, 360°), each axis a midpoint rule mapped through a smooth density that puts
 //    30 % of its nodes in a Gaussian of σ ≈ 6° around the mirror direction R = (θv, 180°)
 //    (σ/sinθv in φ), where lobes are narrow; weight sinθl·cosθl·dθ·dφ over the density.
-//    Integrand f_r from BrdfSource::Eval (for a LutBrdf, Lut::SampleAngles called with the
-//    grid's angles directly: the same rule without the vectors' trigonometry). Against NumPy's
+//    Integrand f_r from BrdfSource::Eval (for a LutBrdf, Lut::SampleAngles's rule applied to
+//    the grid's angles directly, its trigonometry shared between the samples of a row through
+//    Lut::SampleTextureFrame: the same values without the vectors' trigonometry). Against NumPy's
 //    midpoint rule of `brdf eval` of the same file on a uniform 0.5° × 1° grid
 //    (tests/python/ibl_albedo_check.py, a 4-slice and a 6-slice capture) every channel agrees
 //    within 0.2 % (test bound 0.5 %; part of the difference is NumPy's own, which moves by
@@ -50,6 +51,16 @@
 //    kernel plus Lambert fits (off-specular, retro-reflective) says so there.
 // Rows with E = 0 (a black material, or a view where the source is zero) get S = D = 0 and
 // α_eq = 1.
+//
+// What an engine reads (one pack fetch per pixel): the diffuse part as a quadratic in
+// t = 1 − μ, D_fit(μ) = c0 + c1·t + c2·t², three RGB constants per material fitted by least
+// squares, per channel, to the split's D rows (`diffuse`); and per row S_i = E_i − D_fit(μ_i)
+// (`specular`, stored with α_eq in one texel), so that D_fit + S = E exactly at every texel
+// centre and the white furnace holds whatever the quadratic's error. S_i may then be slightly
+// negative where D_fit lies above E (a Lambertian's S is D_i − D_fit(μ_i), rounding-small);
+// clamping it would trade the furnace's exactness for a sign. Between texel centres S is
+// linear and D_fit quadratic: D_fit + S departs from the linear E by at most |c2|·Δt²/4,
+// Δt = 1/kRows (|c2|/16384).
 #pragma once
 
 #include <array>
@@ -68,21 +79,36 @@ struct IblPack {
   static constexpr int kMaxBand = 48;     // Legendre degrees ℓ = 0…kMaxBand of the fit
   static constexpr double kMinAlpha = 0.005;
 
-  std::vector<double> mu;        // μ_i = (i + 0.5)/kRows
-  std::vector<Rgb> albedo;       // E(μ), 1 (no unit: reflected over incident)
-  std::vector<Rgb> diffuse;      // D(μ), weight of Ē(n)
-  std::vector<Rgb> specular;     // S(μ) = E − D, weight of P(α_eq, R)
-  std::vector<double> alpha;     // α_eq(μ)
-  std::vector<double> residual;  // relative residual of the fit per row (see above)
+  std::vector<double> mu;                  // μ_i = (i + 0.5)/kRows
+  std::vector<Rgb> albedo;                 // E(μ), 1 (no unit: reflected over incident)
+  std::vector<Rgb> diffuse;                // D(μ_i) of the split (what the quadratic is fitted to)
+  std::vector<Rgb> specular;               // S_i = E_i − D_fit(μ_i), weight of P(α_eq, R)
+  std::array<Rgb, 3> diffuse_quadratic{};  // c0, c1, c2 of D_fit(μ) = c0 + c1·t + c2·t², t = 1 − μ
+  std::vector<double> alpha;               // α_eq(μ)
+  std::vector<double> residual;            // relative residual of the fit per row (see above)
 
-  // One row interpolated at `mu` as a linearly filtered texture of kRows texels with clamp to
-  // edge would return it (linear between μ_i, constant beyond μ_0 and μ_{kRows−1}).
+  // D_fit at `mu` (the quadratic of diffuse_quadratic; `mu` as given, no clamping).
+  Rgb DiffuseFit(double mu) const;
+
+  // One row at `mu` as an engine reads it: albedo, specular and alpha as a linearly filtered
+  // texture of kRows texels with clamp to edge returns them (linear between μ_i, constant
+  // beyond μ_0 and μ_{kRows−1}), diffuse = D_fit at `mu` clamped to [μ_0, μ_{kRows−1}] (the
+  // texture coordinate the shader computes), so diffuse + specular = albedo at texel centres.
   struct Row {
     Rgb albedo, diffuse, specular;
     double alpha = 1.0;
   };
   Row At(double mu) const;
 };
+
+// The dominant-direction shift of the specular lookup: engines read the prefiltered probe at
+// R' = normalize(mix(R, n, s)), s = IblSpecularShift(α_eq(μ), μ) = α_eq·(1 − μ) (0 near the
+// normal, where the split sum's n = v = R holds; toward n for rough lobes at oblique views,
+// where the horizon clips the lobe and its centre moves off R). Chosen against the true
+// environment-lit preview (docs/benchmarks/ibl.md, "Dominant direction").
+double IblSpecularShift(double alpha_eq, double mu);
+// R' for the unit normal n and unit view v (pointing away from the surface).
+Vec3 IblSpecularDirection(const Vec3& n, const Vec3& v, double alpha_eq);
 
 // Computes the pack of `source`: 64 × 64 × 72 = 294,912 evaluations of the source and the fit,
 // on the calling thread (docs/benchmarks/ibl.md).
@@ -94,7 +120,8 @@ std::array<double, IblPack::kMaxBand + 1> GgxPrefilterLegendre(double alpha);
 
 // The pack as the JSON object documented in docs/engines.md ("ibl"): {"mu": [...],
 // "albedo_rgb": [[r, g, b], ...], "diffuse_rgb": ..., "specular_rgb": ..., "alpha_eq": [...],
-// "fit_residual": [...], "convention": ...}.
+// "diffuse_quadratic_rgb": [c0, c1, c2] (each [r, g, b]), "fit_residual": [...],
+// "convention": ...}.
 std::string IblPackJson(const IblPack& pack);
 
 }  // namespace brdf

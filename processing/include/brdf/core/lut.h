@@ -64,6 +64,12 @@ struct Lut {
   // Step 2 alone: the texture lookup at (θin, θout, φout), no exchange.
   std::array<float, 3> SampleTexture(double theta_in_deg, double theta_out_deg,
                                      double phi_out_deg) const;
+  // SampleTexture with the caller's trigonometry, for loops that share it between samples
+  // (the IBL pack's grid): the light's cos θin and sin θin, its SliceCoordinate, and ω_out =
+  // (x, y, z) as SphericalDirectionDeg(θout, φout) gives it. The same arithmetic as
+  // SampleTexture from there on, so equal inputs give the same bits.
+  std::array<float, 3> SampleTextureFrame(double cos_in, double sin_in, double slice, double x,
+                                          double y, double z) const;
   // The fractional slice coordinate of `theta_in_deg` (k + t), before clamping: θin/Δin for a
   // k·Δin list, piecewise linear between entries otherwise.
   double SliceCoordinate(double theta_in_deg) const;

@@ -161,11 +161,11 @@ std::string Rgba16fBytes(const exporter::PackedVolume& volume);
 // The whole RGBA16F volume DDS (exporter::DdsVolumeHeader with DXGI format 10).
 std::string EncodeRgba16fDds(const exporter::PackedVolume& volume);
 // The IBL packs (brdf/core/ibl_pack.h) of a LUT (one) or of an atlas's cells (in cell order) as
-// a DDS RGBA16F 2D texture (DXGI 10, one mip) of 2·IblPack::kRows texels × packs.size() rows,
-// row m for pack m, row 0 first in the file (at v = 0 without a flip); texel i < kRows of a row
-// holds (D_r, D_g, D_b, α_eq) at μ_i and texel kRows + i holds (S_r, S_g, S_b, fit residual),
-// each float rounded to the nearest half. A linearly filtered, clamp-to-edge fetch at
-// u = clamp(μ·kRows, 0.5, kRows − 0.5)/(2·kRows) (+ 0.5 for S) returns IblPack::At(μ).
+// a DDS RGBA16F 2D texture (DXGI 10, one mip) of IblPack::kRows texels × packs.size() rows,
+// row m for pack m, row 0 first in the file (at v = 0 without a flip); texel i of a row holds
+// (S_r, S_g, S_b, α_eq) at μ_i, each float rounded to the nearest half (the diffuse part is the
+// pack's diffuse_quadratic, passed as material constants). A linearly filtered, clamp-to-edge
+// fetch at u = clamp(μ·kRows, 0.5, kRows − 0.5)/kRows returns IblPack::At(μ)'s specular and α.
 // Throws InvalidArgument for no packs or a pack without kRows rows.
 std::string EncodeIblPackDds(const std::vector<const IblPack*>& packs);
 
