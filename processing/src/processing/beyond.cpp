@@ -644,7 +644,10 @@ FillModel FitFillModel(const Lut& lut, double theta_b, Model family) {
   std::array<double, 3> eps{};
   const double all = (mean[0] + mean[1] + mean[2]) / (3.0 * std::max<std::size_t>(pts.size(), 1));
   for (int c = 0; c < 3; ++c) eps[c] = 0.02 * all + 1e-6;
-  const auto fit_at = [&](double shape, Candidate* out) {
+  // The grid's shapes and the golden section's first two (set by the best grid shape alone) are
+  // shared; the later ones depend on the values fitted and are computed here.
+  const auto fit_at = [&](double shape, Candidate* out, bool shared = true) {
+    if (!shared) return FitAtShape(pts, PartsAtShape(family, pts, shape), eps, shape, out);
     return FitAtShape(pts, *SharedPartsAtShape(family, lut.theta_in_deg, theta_b, pts, shape), eps,
                       shape, out);
   };
@@ -670,11 +673,11 @@ FillModel FitFillModel(const Lut& lut, double theta_b, Model family) {
     if (f1 < f2) {
       b = x2, x2 = x1, f2 = f1, m2 = m1;
       x1 = b - g * (b - a);
-      f1 = fit_at(std::exp(x1), &m1);
+      f1 = fit_at(std::exp(x1), &m1, false);
     } else {
       a = x1, x1 = x2, f1 = f2, m1 = m2;
       x2 = a + g * (b - a);
-      f2 = fit_at(std::exp(x2), &m2);
+      f2 = fit_at(std::exp(x2), &m2, false);
     }
   }
   if (f1 < best_cost) best = m1, best_cost = f1;
