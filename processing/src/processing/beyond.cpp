@@ -13,6 +13,7 @@
 #include "brdf/core/error.h"
 #include "brdf/core/geometry.h"
 #include "brdf/core/models.h"
+#include "fill_model_eval.h"
 
 #include <tbb/parallel_for.h>
 #include <nlohmann/json.hpp>
@@ -311,9 +312,7 @@ struct Ratio {
         for (int i = 0; i < Lut::kWidth; ++i) {
           const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
           // FillModel::Eval at the cached geometry (the same numbers).
-          const Rgb f =
-              models::EvaluateRgb(model->material.model, at[n], model->material.values.data());
-          g.m[n] = {f[0], f[1], f[2]};
+          g.m[n] = detail::EvaluateFillModel(model->material, at[n]);
         }
       });
     }
@@ -439,8 +438,7 @@ Lut Fill(const Lut& measured_in, double theta_b, double max_theta_in, double ste
         const View v = g.view()[n];
         if (v.theta_deg <= theta_b) continue;
         // FillModel::Eval(t, θb, φout) at the shared geometry (the same numbers).
-        const Rgb at_b = models::EvaluateRgb(model.model, (*band)[n], model.values.data());
-        const auto r = RatioOf(g.m[n], {at_b[0], at_b[1], at_b[2]});
+        const auto r = RatioOf(g.m[n], detail::EvaluateFillModel(model, (*band)[n]));
         float* f = out.Texel(k, j, i);
         for (int c = 0; c < 3; ++c) f[c] = static_cast<float>(f[c] * r[c]);
       }
