@@ -261,15 +261,15 @@ class SharedTables {
 
 // The fit points of FitFillModel are chosen by their views alone (θout ≤ θb), so a LUT's θin
 // list and θb name them; the model's parts at a shape are then the same for every capture of
-// the batch. The shape grid is fixed and the golden section's shapes repeat for materials
-// alike, so the parts are shared like the tables above (about 160 KB per shape for a capture).
+// the batch. The shape grid is fixed, so its parts are shared like the tables above (about
+// 200 KB per shape for a capture; 18 shapes per family and point set).
 using PointsKey = std::tuple<int, std::vector<std::uint64_t>, std::uint64_t, std::uint64_t>;
 std::shared_ptr<const std::vector<Parts>> SharedPartsAtShape(Model family,
                                                              const std::vector<double>& theta_in,
                                                              double theta_b,
                                                              const std::vector<FitPoint>& pts,
                                                              double shape) {
-  static SharedMap<PointsKey, std::vector<Parts>> parts(512);
+  static SharedMap<PointsKey, std::vector<Parts>> parts(128);
   std::vector<std::uint64_t> slices(theta_in.size());
   std::transform(theta_in.begin(), theta_in.end(), slices.begin(), Bits);
   return parts.Get({static_cast<int>(family), std::move(slices), Bits(theta_b), Bits(shape)}, [&] {
