@@ -1,14 +1,19 @@
 #include "brdf/processing/beyond.h"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <string>
+#include <tuple>
 
 #include "brdf/core/error.h"
 #include "brdf/core/geometry.h"
 #include "brdf/core/models.h"
+#include "fill_model_eval.h"
 
 #include <tbb/parallel_for.h>
 #include <nlohmann/json.hpp>
@@ -109,11 +114,20 @@ struct Candidate {
   double shape = 0;
 };
 
-double FitAtShape(Model family, const std::vector<FitPoint>& pts, const std::array<double, 3>& eps,
-                  double shape, Candidate* out) {
+// PartsOf(family, p.g, shape) of every point: what a fit at one shape needs from the model,
+// independent of the values fitted.
+std::vector<Parts> PartsAtShape(Model family, const std::vector<FitPoint>& pts, double shape) {
+  std::vector<Parts> parts(pts.size());
+  for (std::size_t k = 0; k < pts.size(); ++k) parts[k] = PartsOf(family, pts[k].g, shape);
+  return parts;
+}
+
+double FitAtShape(const std::vector<FitPoint>& pts, const std::vector<Parts>& parts,
+                  const std::array<double, 3>& eps, double shape, Candidate* out) {
   std::array<Normal, 3> n{};
-  for (const FitPoint& p : pts) {
-    const Parts q = PartsOf(family, p.g, shape);
+  for (std::size_t k = 0; k < pts.size(); ++k) {
+    const FitPoint& p = pts[k];
+    const Parts& q = parts[k];
     const double x = kInvPi;
     for (int c = 0; c < 3; ++c) {
       const double w = 1.0 / ((p.f[c] + eps[c]) * (p.f[c] + eps[c]));
@@ -136,20 +150,148 @@ std::array<double, 3> RatioOf(const std::array<double, 3>& a, const std::array<d
   return r;
 }
 
-// Every texel's view and shading geometry in the slice at one θin: the same for every fill
-// model, so one ExtendBeyondMeasured call computes them once per θin for all its fills (the
-// validations and the final one); the trigonometry of these was most of the fill's time.
+// The per-texel tables of a slice that depend on its θin alone, not on the measurement: every
+// texel's view (TexelView) and shading geometry (GeometryAt at that view), and for the θout band
+// GeometryAt(θin, θb, φout of the view). A batch of captures on one instrument's θin grid asks
+// for the same few dozen tables once per capture and fill, and their trigonometry was about a
+// third of a fill's instructions (docs/benchmarks/batch.md), so they are computed once per
+// process and shared, read-only, by every fill on every thread. The tables are keyed by the
+// exact bits of their inputs (and the view table they were computed from), so a table holds
+// exactly the numbers the fill computed for itself before they were shared.
+using Views = std::vector<View>;                  // index j·361 + i
+using Geometries = std::vector<ShadingGeometry>;  // index j·361 + i
+using ViewsPtr = std::shared_ptr<const Views>;
+using GeometriesPtr = std::shared_ptr<const Geometries>;
+
+// A process-wide map of read-only tables, thread-safe. Tables are computed outside the lock
+// (they run on TBB's workers): when two threads compute the same table both get the same
+// numbers, and the first one inserted is kept. Past `max_entries` the map starts over (tables
+// in use stay alive through their shared pointers).
+template <class Key, class Table>
+class SharedMap {
+ public:
+  explicit SharedMap(std::size_t max_entries) : max_entries_(max_entries) {}
+  template <class Make>
+  std::shared_ptr<const Table> Get(const Key& key, const Make& make) {
+    {
+      const std::lock_guard<std::mutex> lock(mutex_);
+      if (const auto it = map_.find(key); it != map_.end()) return it->second;
+    }
+    std::shared_ptr<const Table> made = make();
+    const std::lock_guard<std::mutex> lock(mutex_);
+    if (const auto it = map_.find(key); it != map_.end()) return it->second;
+    if (map_.size() >= max_entries_) map_.clear();
+    return map_.emplace(key, std::move(made)).first->second;
+  }
+
+ private:
+  std::size_t max_entries_;
+  std::mutex mutex_;
+  std::map<Key, std::shared_ptr<const Table>> map_;
+};
+
+std::uint64_t Bits(double x) { return std::bit_cast<std::uint64_t>(x); }
+
+class SharedTables {
+ public:
+  // TexelView(θin, j, i) of every texel.
+  static ViewsPtr ViewsAt(double theta_in_deg) {
+    static SharedMap<std::uint64_t, Views> views(kMaxSlices);
+    return views.Get(Bits(theta_in_deg), [&] {
+      auto v = std::make_shared<Views>(static_cast<std::size_t>(Lut::kHeight) * Lut::kWidth);
+      ForRows([&](int j) {
+        for (int i = 0; i < Lut::kWidth; ++i)
+          (*v)[static_cast<std::size_t>(j) * Lut::kWidth + i] = TexelView(theta_in_deg, j, i);
+      });
+      return v;
+    });
+  }
+  // GeometryAt(θin, view) of every texel of `views`.
+  static GeometriesPtr GeometryAtViews(double theta_in_deg, const ViewsPtr& views) {
+    static SharedMap<GeometryKey, Held> geometry(kMaxSlices);
+    return geometry
+        .Get({Bits(theta_in_deg), 0, views.get()},
+             [&] {
+               auto g = std::make_shared<Held>(views, Geometries(views->size()));
+               ForRows([&](int j) {
+                 for (int i = 0; i < Lut::kWidth; ++i) {
+                   const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
+                   g->table[n] =
+                       GeometryAt(theta_in_deg, (*views)[n].theta_deg, (*views)[n].phi_deg);
+                 }
+               });
+               return g;
+             })
+        ->Table();
+  }
+  // GeometryAt(θin, θb, φout) at every texel of `views` whose θout is beyond θb (the others
+  // are left default).
+  static GeometriesPtr BandAtViews(double theta_in_deg, double theta_b_deg, const ViewsPtr& views) {
+    static SharedMap<GeometryKey, Held> band(kMaxSlices);
+    return band
+        .Get({Bits(theta_in_deg), Bits(theta_b_deg), views.get()},
+             [&] {
+               auto g = std::make_shared<Held>(views, Geometries(views->size()));
+               ForRows([&](int j) {
+                 for (int i = 0; i < Lut::kWidth; ++i) {
+                   const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
+                   if ((*views)[n].theta_deg > theta_b_deg)
+                     g->table[n] = GeometryAt(theta_in_deg, theta_b_deg, (*views)[n].phi_deg);
+                 }
+               });
+               return g;
+             })
+        ->Table();
+  }
+
+ private:
+  // 1 MB of views and 3 MB of geometry per θin: a capture's fill uses 9 θin, an RGL file's
+  // a few dozen.
+  static constexpr std::size_t kMaxSlices = 64;
+  using GeometryKey = std::tuple<std::uint64_t, std::uint64_t, const Views*>;
+  // A geometry table keeps the view table it was computed from alive, so the address in its
+  // key cannot be taken by another view table while the entry exists.
+  struct Held : std::enable_shared_from_this<Held> {
+    Held(ViewsPtr v, Geometries t) : views(std::move(v)), table(std::move(t)) {}
+    ViewsPtr views;
+    Geometries table;
+    GeometriesPtr Table() const { return GeometriesPtr(shared_from_this(), &table); }
+  };
+};
+
+// The fit points of FitFillModel are chosen by their views alone (θout ≤ θb), so a LUT's θin
+// list and θb name them; the model's parts at a shape are then the same for every capture of
+// the batch. The shape grid is fixed, so its parts are shared like the tables above (about
+// 200 KB per shape for a capture; 18 shapes per family and point set).
+using PointsKey = std::tuple<int, std::vector<std::uint64_t>, std::uint64_t, std::uint64_t>;
+std::shared_ptr<const std::vector<Parts>> SharedPartsAtShape(Model family,
+                                                             const std::vector<double>& theta_in,
+                                                             double theta_b,
+                                                             const std::vector<FitPoint>& pts,
+                                                             double shape) {
+  static SharedMap<PointsKey, std::vector<Parts>> parts(128);
+  std::vector<std::uint64_t> slices(theta_in.size());
+  std::transform(theta_in.begin(), theta_in.end(), slices.begin(), Bits);
+  return parts.Get({static_cast<int>(family), std::move(slices), Bits(theta_b), Bits(shape)}, [&] {
+    return std::make_shared<const std::vector<Parts>>(PartsAtShape(family, pts, shape));
+  });
+}
+
+// The tables of the slices one ExtendBeyondMeasured call has asked for, by θin rounded to
+// 10⁻⁶ degree (the first θin asked for within rounding gives the views; the geometry is of the
+// θin that first needs it): shared by all its fills (the validations and the final one).
 struct SliceGeometry {
-  std::vector<View> view;          // index j·361 + i
-  std::vector<ShadingGeometry> g;  // GeometryAt(θin, view); computed when a model needs it
+  ViewsPtr view;
+  GeometriesPtr g;  // GeometryAt(θin, view); looked up when a model needs it
 };
 using GeometryCache = std::map<long, SliceGeometry>;
 
 // Every texel's view in the slice at one θin (the shared SliceGeometry's), and the model there
 // (computed once per θin and model).
 struct SliceGrid {
-  const std::vector<View>& view;         // index j·361 + i
+  ViewsPtr views;
   std::vector<std::array<double, 3>> m;  // empty for M ≡ 1
+  const Views& view() const { return *views; }
 };
 
 // M(new)/M(old) at texels; kHold's model is null (M ≡ 1).
@@ -163,23 +305,14 @@ struct Ratio {
     SliceGeometry& s = GeometryOf(theta_in_deg, key);
     SliceGrid g{s.view, {}};
     if (model) {
-      if (s.g.empty()) {
-        s.g.resize(s.view.size());
-        ForRows([&](int j) {
-          for (int i = 0; i < Lut::kWidth; ++i) {
-            const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
-            s.g[n] = GeometryAt(theta_in_deg, s.view[n].theta_deg, s.view[n].phi_deg);
-          }
-        });
-      }
-      g.m.resize(s.view.size());
+      if (!s.g) s.g = SharedTables::GeometryAtViews(theta_in_deg, s.view);
+      const Geometries& at = *s.g;
+      g.m.resize(at.size());
       ForRows([&](int j) {
         for (int i = 0; i < Lut::kWidth; ++i) {
           const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
           // FillModel::Eval at the cached geometry (the same numbers).
-          const Rgb f =
-              models::EvaluateRgb(model->material.model, s.g[n], model->material.values.data());
-          g.m[n] = {f[0], f[1], f[2]};
+          g.m[n] = detail::EvaluateFillModel(model->material, at[n]);
         }
       });
     }
@@ -187,19 +320,13 @@ struct Ratio {
   }
   SliceGeometry& GeometryOf(double theta_in_deg, long key) const {
     if (auto it = geometry->find(key); it != geometry->end()) return it->second;
-    SliceGeometry s;
-    s.view.resize(static_cast<std::size_t>(Lut::kHeight) * Lut::kWidth);
-    ForRows([&](int j) {
-      for (int i = 0; i < Lut::kWidth; ++i)
-        s.view[static_cast<std::size_t>(j) * Lut::kWidth + i] = TexelView(theta_in_deg, j, i);
-    });
-    return geometry->emplace(key, std::move(s)).first->second;
+    return geometry->emplace(key, SliceGeometry{SharedTables::ViewsAt(theta_in_deg), nullptr})
+        .first->second;
   }
   std::array<double, 3> Between(const SliceGrid& now, const SliceGrid& old, std::size_t n) const {
     if (model == nullptr) return {1.0, 1.0, 1.0};
     return RatioOf(now.m[n], old.m[n]);
   }
-  // Declared first so that it outlives the grids, which refer to its views.
   std::shared_ptr<GeometryCache> geometry = std::make_shared<GeometryCache>();
   std::shared_ptr<std::map<long, SliceGrid>> grids = std::make_shared<std::map<long, SliceGrid>>();
 };
@@ -259,7 +386,7 @@ void Albedo(const Lut& lut, int k, const SliceGrid& g, Filled filled, std::array
                        std::cos(DegToRad(std::min(j + 0.5, 180.0)))) *
                       DegToRad(Lut::kTexelDeg);
     for (int i = 0; i < Lut::kWidth - 1; ++i) {
-      const View v = g.view[static_cast<std::size_t>(j) * Lut::kWidth + i];
+      const View v = g.view()[static_cast<std::size_t>(j) * Lut::kWidth + i];
       if (v.theta_deg >= 90.0) continue;
       const double w = dw * std::cos(DegToRad(v.theta_deg));
       const float* f = lut.Texel(k, j, i);
@@ -283,7 +410,7 @@ void LimitAlbedo(Lut* lut, int k, const SliceGrid& g, Filled filled, BeyondRepor
       const double s = std::max(0.0, (1.0 - (total[c] - fill[c])) / fill[c]);
       for (int j = 0; j < Lut::kHeight; ++j)
         for (int i = 0; i < Lut::kWidth; ++i)
-          if (filled(j, i, g.view[static_cast<std::size_t>(j) * Lut::kWidth + i]))
+          if (filled(j, i, g.view()[static_cast<std::size_t>(j) * Lut::kWidth + i]))
             lut->Texel(k, j, i)[c] *= s;
       albedo = total[c] - fill[c] + fill[c] * s;
       ++report->albedo_scaled_channels;
@@ -303,12 +430,15 @@ Lut Fill(const Lut& measured_in, double theta_b, double max_theta_in, double ste
     const double t = measured_in.theta_in_deg[k];
     if (ratio.model == nullptr) break;  // M ≡ 1: the band stays as it is
     const SliceGrid& g = ratio.Prepare(t);
+    const GeometriesPtr band = SharedTables::BandAtViews(t, theta_b, g.views);
+    const Material& model = ratio.model->material;
     ForRows([&](int j) {
       for (int i = 0; i < Lut::kWidth; ++i) {
         const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
-        const View v = g.view[n];
+        const View v = g.view()[n];
         if (v.theta_deg <= theta_b) continue;
-        const auto r = RatioOf(g.m[n], ratio.model->Eval(t, theta_b, v.phi_deg));
+        // FillModel::Eval(t, θb, φout) at the shared geometry (the same numbers).
+        const auto r = RatioOf(g.m[n], detail::EvaluateFillModel(model, (*band)[n]));
         float* f = out.Texel(k, j, i);
         for (int c = 0; c < 3; ++c) f[c] = static_cast<float>(f[c] * r[c]);
       }
@@ -329,6 +459,9 @@ Lut Fill(const Lut& measured_in, double theta_b, double max_theta_in, double ste
   const Lut banded = out;  // measured slices with their band: what reciprocity reads
   // 3. New slices beyond the last measured one.
   const int k_total = static_cast<int>(std::floor(max_theta_in / delta + 1e-9)) + 1;
+  // One allocation for the new slices (growing slice by slice copied the LUT each time).
+  out.texels.reserve(static_cast<std::size_t>(std::max(k_total, k_meas_step)) * Lut::kHeight *
+                     Lut::kWidth * 3);
   for (int k = k_meas_step; k < k_total; ++k) {
     const double t = k * delta;
     out.theta_in_deg.push_back(t);
@@ -338,7 +471,7 @@ Lut Fill(const Lut& measured_in, double theta_b, double max_theta_in, double ste
     ForRows([&](int j) {
       for (int i = 0; i < Lut::kWidth; ++i) {
         const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
-        const View v = g.view[n];
+        const View v = g.view()[n];
         const double to = std::min(v.theta_deg, 90.0);
         const double w = std::clamp((to - (last - kBlendDeg)) / (2 * kBlendDeg), 0.0, 1.0);
         std::array<double, 3> value{};
@@ -374,9 +507,10 @@ LeaveLastSliceOut Validate(const Lut& measured, double theta_b, const Lut& fille
                    [&](double t) { return std::fabs(t - v.theta_in_deg) < 1e-6; }) -
       filled.theta_in_deg.begin());
   std::vector<double> got, want;
+  const ViewsPtr views = SharedTables::ViewsAt(v.theta_in_deg);
   for (int j = 0; j < Lut::kHeight; ++j)
     for (int i = 0; i < Lut::kWidth - 1; ++i) {
-      if (TexelView(v.theta_in_deg, j, i).theta_deg > theta_b) continue;
+      if ((*views)[static_cast<std::size_t>(j) * Lut::kWidth + i].theta_deg > theta_b) continue;
       const float* a = filled.Texel(kf, j, i);
       const float* b = measured.Texel(k, j, i);
       got.push_back(double(a[0]) + a[1] + a[2]);
@@ -487,16 +621,18 @@ FillModel FitFillModel(const Lut& lut, double theta_b, Model family) {
   std::array<double, 3> mean{};
   for (int k = 0; k < lut.slices(); ++k) {
     const double t = lut.theta_in_deg[k];
+    const ViewsPtr views = SharedTables::ViewsAt(t);
+    const GeometriesPtr geometry = SharedTables::GeometryAtViews(t, views);
     for (int j = 0; j < Lut::kHeight; ++j) {
       // Every texel row near the peak (every third column), every fourth row and column
       // elsewhere.
       const bool near = j <= 20;
       if (!near && j % 4 != 0) continue;
       for (int i = 0; i < Lut::kWidth - 1; i += near ? 3 : 4) {
-        const View v = TexelView(t, j, i);
-        if (v.theta_deg > theta_b) continue;
+        const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
+        if ((*views)[n].theta_deg > theta_b) continue;
         FitPoint p;
-        p.g = GeometryAt(t, v.theta_deg, v.phi_deg);
+        p.g = (*geometry)[n];
         const float* f = lut.Texel(k, j, i);
         for (int c = 0; c < 3; ++c) p.f[c] = f[c], mean[c] += f[c];
         pts.push_back(p);
@@ -506,6 +642,13 @@ FillModel FitFillModel(const Lut& lut, double theta_b, Model family) {
   std::array<double, 3> eps{};
   const double all = (mean[0] + mean[1] + mean[2]) / (3.0 * std::max<std::size_t>(pts.size(), 1));
   for (int c = 0; c < 3; ++c) eps[c] = 0.02 * all + 1e-6;
+  // The grid's shapes and the golden section's first two (set by the best grid shape alone) are
+  // shared; the later ones depend on the values fitted and are computed here.
+  const auto fit_at = [&](double shape, Candidate* out, bool shared = true) {
+    if (!shared) return FitAtShape(pts, PartsAtShape(family, pts, shape), eps, shape, out);
+    return FitAtShape(pts, *SharedPartsAtShape(family, lut.theta_in_deg, theta_b, pts, shape), eps,
+                      shape, out);
+  };
   const bool lafortune = family == Model::kLafortune;
   const double lo = std::log(lafortune ? 1.0 : 0.005), hi = std::log(lafortune ? 20000.0 : 1.5);
   Candidate best, trial;
@@ -513,8 +656,7 @@ FillModel FitFillModel(const Lut& lut, double theta_b, Model family) {
   const int n_grid = 16;
   int best_n = 0;
   for (int n = 0; n < n_grid; ++n) {
-    const double c =
-        FitAtShape(family, pts, eps, std::exp(lo + (hi - lo) * n / (n_grid - 1)), &trial);
+    const double c = fit_at(std::exp(lo + (hi - lo) * n / (n_grid - 1)), &trial);
     if (c < best_cost) best_cost = c, best = trial, best_n = n;
   }
   // Golden section in log(shape) between the grid neighbours.
@@ -523,17 +665,17 @@ FillModel FitFillModel(const Lut& lut, double theta_b, Model family) {
   const double g = 0.5 * (std::sqrt(5.0) - 1.0);
   double x1 = b - g * (b - a), x2 = a + g * (b - a);
   Candidate m1, m2;
-  double f1 = FitAtShape(family, pts, eps, std::exp(x1), &m1);
-  double f2 = FitAtShape(family, pts, eps, std::exp(x2), &m2);
+  double f1 = fit_at(std::exp(x1), &m1);
+  double f2 = fit_at(std::exp(x2), &m2);
   for (int it = 0; it < 12; ++it) {
     if (f1 < f2) {
       b = x2, x2 = x1, f2 = f1, m2 = m1;
       x1 = b - g * (b - a);
-      f1 = FitAtShape(family, pts, eps, std::exp(x1), &m1);
+      f1 = fit_at(std::exp(x1), &m1, false);
     } else {
       a = x1, x1 = x2, f1 = f2, m1 = m2;
       x2 = a + g * (b - a);
-      f2 = FitAtShape(family, pts, eps, std::exp(x2), &m2);
+      f2 = fit_at(std::exp(x2), &m2, false);
     }
   }
   if (f1 < best_cost) best = m1, best_cost = f1;
@@ -585,7 +727,7 @@ Lut ExtendBeyondMeasured(const Lut& measured, double theta_b, const BeyondOption
         measured.texels.begin() +
             static_cast<std::ptrdiff_t>(head.theta_in_deg.size() * Lut::kHeight * Lut::kWidth * 3));
   }
-  // One geometry cache for every fill below (the ratios differ only in their model).
+  // One table of slices for every fill below (the ratios differ only in their model).
   const auto geometry = std::make_shared<GeometryCache>();
   const auto ratio_of = [&](const FillModel* model) {
     Ratio ratio;

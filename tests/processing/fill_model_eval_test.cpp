@@ -1,0 +1,75 @@
+// The blind-spot fill's model evaluation (processing/src/processing/fill_model_eval.h) against the
+// models' one definition, models::EvaluateRgb (brdf/core/models.h): the same doubles, bit for bit,
+// at geometries over the whole hemisphere pair and shapes over the ranges FitFillModel searches.
+#include "fill_model_eval.h"
+
+#include <gtest/gtest.h>
+
+#include <bit>
+#include <cstdint>
+#include <random>
+
+#include "brdf/core/geometry.h"
+
+namespace brdf::processing::detail {
+namespace {
+
+ShadingGeometry RandomGeometry(std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> theta(0.0, 89.5), phi(0.0, 360.0);
+  return ShadingGeometry::Of(SphericalDirectionDeg(theta(rng), 0.0),
+                             SphericalDirectionDeg(theta(rng), phi(rng)));
+}
+
+void ExpectSameBits(Model family, double shape_lo, double shape_hi) {
+  std::mt19937_64 rng(20261202);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::uniform_real_distribution<double> log_shape(std::log(shape_lo), std::log(shape_hi));
+  int compared = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const double shape = std::exp(log_shape(rng));
+    const Material m =
+        Material::Make(family,
+                       {Rgb{unit(rng), unit(rng), unit(rng)}, Rgb{unit(rng), unit(rng), unit(rng)},
+                        Rgb{shape, shape, shape}},
+                       "fill");
+    const ShadingGeometry g = RandomGeometry(rng);
+    const Rgb want = models::EvaluateRgb(family, g, m.values.data());
+    const std::array<double, 3> got = EvaluateFillModel(m, g);
+    for (int c = 0; c < 3; ++c) {
+      ASSERT_EQ(std::bit_cast<std::uint64_t>(got[c]), std::bit_cast<std::uint64_t>(want[c]))
+          << ModelName(family) << " shape " << shape << " channel " << c << ": " << got[c]
+          << " against " << want[c];
+      compared += want[c] > 0;
+    }
+  }
+  EXPECT_GT(compared, 50000);  // the values compared are mostly non-zero
+}
+
+TEST(FillModelEval, GgxIsModelsEvaluateRgbBitForBit) { ExpectSameBits(Model::kGgx, 0.005, 1.5); }
+TEST(FillModelEval, WardIsModelsEvaluateRgbBitForBit) { ExpectSameBits(Model::kWard, 0.005, 1.5); }
+TEST(FillModelEval, LafortuneIsModelsEvaluateRgbBitForBit) {
+  ExpectSameBits(Model::kLafortune, 1.0, 20000.0);
+}
+
+TEST(FillModelEval, ChannelsWithTheirOwnShapesGoToEvaluateRgb) {
+  const Material m = Material::Make(
+      Model::kGgx, {Rgb{0.1, 0.2, 0.3}, Rgb{0.9, 0.5, 0.04}, Rgb{0.1, 0.3, 0.6}}, "three shapes");
+  const ShadingGeometry g =
+      ShadingGeometry::Of(SphericalDirectionDeg(30.0, 0.0), SphericalDirectionDeg(35.0, 170.0));
+  const Rgb want = models::EvaluateRgb(Model::kGgx, g, m.values.data());
+  const std::array<double, 3> got = EvaluateFillModel(m, g);
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(got[c], want[c]) << "channel " << c;
+  EXPECT_NE(got[0], got[2]);
+}
+
+TEST(FillModelEval, BelowTheHorizonIsZero) {
+  const Material m = Material::Make(
+      Model::kWard, {Rgb{0.5, 0.5, 0.5}, Rgb{0.2, 0.2, 0.2}, Rgb{0.3, 0.3, 0.3}}, "ward");
+  const ShadingGeometry g =
+      ShadingGeometry::Of(SphericalDirectionDeg(30.0, 0.0), SphericalDirectionDeg(95.0, 10.0));
+  const std::array<double, 3> got = EvaluateFillModel(m, g);
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(got[c], 0.0);
+}
+
+}  // namespace
+}  // namespace brdf::processing::detail
