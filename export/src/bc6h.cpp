@@ -233,9 +233,17 @@ bool IsAnchor(int texel, int subsets, int partition) {
 // One block's input in the two domains the encoder works in: h, the value as a continuous
 // half-float bit pattern (what the decoded half should equal), and t = (h + 0.5)·64/31, the
 // interpolated value c whose (c·31) >> 6 is h.
+//
+// w weighs a channel's squared error in half steps by what it costs in the certified metric
+// (brdf/exporter/metadata.h: e = max_c |d_c − r_c| / S, S = max(max_c r_c, 10^−4·R, 2^−14)).
+// One half step of a normal half x is x·ln2/1024 (of a denormal, 2^−24, the same as a normal
+// x of 2^−14/ln2), so an error of Δ steps in channel c costs Δ·max(x_c, 2^−14/ln2)·ln2/1024/S:
+// w_c = (max(x_c, 2^−14/ln2) / S)². The colour's largest channel has weight 1; a minor
+// channel, or a texel far below the LUT's dark floor 10^−4·R, counts for what it costs.
 struct BlockInput {
   float h[16][3];
   float t[16][3];
+  float w[16][3];
 };
 
 float ContinuousHalf(float x) {
@@ -272,8 +280,9 @@ int QuantizeEndpoint(float value, int epb) {
 
 // The best candidate so far, kept as its fields: the block is packed once, at the end.
 struct Encoded {
-  float error = std::numeric_limits<float>::infinity();  // Σ (decoded − h)² in half steps
-  float worst = 0.0f;  // max |decoded − h| over the texels and channels, in half steps
+  float error = std::numeric_limits<float>::infinity();  // Σ w·(decoded − h)², candidates' order
+  float plain_error = 0.0f;  // Σ (decoded − h)² in half steps, unweighted (the two-subset gate)
+  float worst = 0.0f;        // max |decoded − h| over the texels and channels, in half steps
   const Mode* mode = nullptr;
   int partition = 0;
   int fields[4][3] = {};
@@ -351,7 +360,7 @@ void TryMode(const Mode& mode, int partition, Endpoints ends, const BlockInput& 
           palette[s][k][c] = FinishUnquantize(Interpolate(a, b, weights[k]));
       }
     std::array<int, 16> indices{};
-    float error = 0.0f;
+    float error = 0.0f, plain_error = 0.0f;
     // Each texel's index: its projection on the subset's decoded segment gives a weight, the
     // nearest weights' entries are compared exactly (the palette is monotonic per channel).
     const std::uint8_t* nearest = subsets == 2 ? kNearest3.data() : kNearest4.data();
@@ -372,19 +381,20 @@ void TryMode(const Mode& mode, int partition, Endpoints ends, const BlockInput& 
         p += (in.h[t][c] - static_cast<float>(palette[s][0][c])) * dir[s][c];
       const int w = std::clamp(static_cast<int>(p * inv_len2[s] + 0.5f), 0, 64);
       const int centre = std::min<int>(nearest[w], allowed - 1);
-      float best_e = std::numeric_limits<float>::infinity();
+      float best_e = std::numeric_limits<float>::infinity(), best_plain = 0.0f;
       for (int k = std::max(0, centre - 1); k <= std::min(allowed - 1, centre + 1); ++k) {
-        float e2 = 0.0f;
+        float e2 = 0.0f, plain = 0.0f;
         for (int c = 0; c < 3; ++c) {
           const float d = static_cast<float>(palette[s][k][c]) - in.h[t][c];
-          e2 += d * d;
+          e2 += in.w[t][c] * d * d, plain += d * d;
         }
-        if (e2 < best_e) best_e = e2, indices[t] = k;
+        if (e2 < best_e) best_e = e2, best_plain = plain, indices[t] = k;
       }
-      error += best_e;
+      error += best_e, plain_error += best_plain;
     }
     if (error < best.error) {
       best.error = error;
+      best.plain_error = plain_error;
       best.mode = &mode;
       best.partition = partition;
       std::memcpy(best.fields, fields, sizeof(fields));
@@ -400,25 +410,29 @@ void TryMode(const Mode& mode, int partition, Endpoints ends, const BlockInput& 
     }
     // No refit can beat an exact candidate.
     if (pass == refinements || error == 0.0f) break;
-    // Least squares per subset and channel: min Σ ((1 − α)a + αb − t)² over the texels.
+    // Weighted least squares per subset and channel: min Σ w·((1 − α)a + αb − t)² over the
+    // texels (the weights differ per channel, so each channel has its own 2 × 2 system).
     for (int s = 0; s < subsets; ++s) {
-      double aa = 0, ab = 0, bb = 0, at[3] = {}, bt[3] = {}, sum[3] = {};
-      int n = 0;
+      double aa[3] = {}, ab[3] = {}, bb[3] = {}, at[3] = {}, bt[3] = {}, wsum[3] = {}, wt[3] = {};
       for (int t = 0; t < 16; ++t) {
         if (((mask >> t) & 1) != s) continue;
         const double alpha = weights[indices[t]] / 64.0, beta = 1.0 - alpha;
-        aa += beta * beta, ab += alpha * beta, bb += alpha * alpha, ++n;
         for (int c = 0; c < 3; ++c) {
-          at[c] += beta * in.t[t][c], bt[c] += alpha * in.t[t][c], sum[c] += in.t[t][c];
+          const double w = in.w[t][c], x = in.t[t][c];
+          aa[c] += w * beta * beta, ab[c] += w * alpha * beta, bb[c] += w * alpha * alpha;
+          at[c] += w * beta * x, bt[c] += w * alpha * x;
+          wsum[c] += w, wt[c] += w * x;
         }
       }
-      const double det = aa * bb - ab * ab;
       for (int c = 0; c < 3; ++c) {
-        if (std::abs(det) < 1e-9) {
-          ends.e[s][0][c] = ends.e[s][1][c] = static_cast<float>(sum[c] / std::max(n, 1));
+        // The determinant relative to (Σw)²: all texels on one index leaves only the mean.
+        const double det = aa[c] * bb[c] - ab[c] * ab[c];
+        if (!(wsum[c] > 0.0) || std::abs(det) < 1e-9 * wsum[c] * wsum[c]) {
+          const double mean = wsum[c] > 0.0 ? wt[c] / wsum[c] : 0.0;
+          ends.e[s][0][c] = ends.e[s][1][c] = static_cast<float>(mean);
         } else {
-          ends.e[s][0][c] = static_cast<float>((bb * at[c] - ab * bt[c]) / det);
-          ends.e[s][1][c] = static_cast<float>((aa * bt[c] - ab * at[c]) / det);
+          ends.e[s][0][c] = static_cast<float>((bb[c] * at[c] - ab[c] * bt[c]) / det);
+          ends.e[s][1][c] = static_cast<float>((aa[c] * bt[c] - ab[c] * at[c]) / det);
         }
       }
     }
@@ -655,13 +669,26 @@ Bc6hHalfTexels DecodeBc6hBlock(const std::uint8_t* block) {
   return out;
 }
 
-Bc6hBlock EncodeBc6hBlock(const float* rgb48) {
+Bc6hBlock EncodeBc6hBlock(const float* rgb48, float reference_max) {
   BlockInput in;
-  for (int t = 0; t < 16; ++t)
+  // The metric's floor: 10^−4·R and 2^−14 (R clamped as the reference is, to [0, 65504]).
+  const float reference = std::clamp(reference_max, 0.0f, kBc6hMaxValue);
+  const float floor = std::max(1e-4f * reference, 6.103515625e-05f);
+  constexpr float kDenormalValue = 6.103515625e-05f / 0.69314718f;  // 2^−14/ln2
+  for (int t = 0; t < 16; ++t) {
+    float x[3], scale = floor;
+    for (int c = 0; c < 3; ++c) {
+      const float v = rgb48[3 * t + c];
+      x[c] = v > 0.0f ? std::min(v, kBc6hMaxValue) : 0.0f;  // NaN and negatives: 0
+      scale = std::max(scale, x[c]);
+    }
     for (int c = 0; c < 3; ++c) {
       in.h[t][c] = ContinuousHalf(rgb48[3 * t + c]);
       in.t[t][c] = (in.h[t][c] + 0.5f) * (64.0f / 31.0f);
+      const float ratio = std::min(std::max(x[c], kDenormalValue) / scale, 1.0f);
+      in.w[t][c] = ratio * ratio;
     }
+  }
   Encoded best;
   {
     Endpoints ends{};
@@ -674,7 +701,8 @@ Bc6hBlock EncodeBc6hBlock(const float* rgb48) {
   // Scatter that no line fits (noise) stays whatever the partition: only a two-line estimate
   // below the one-subset block's error is worth the two-subset modes. The estimate is in
   // the interpolation domain, (64/31)² times the half domain of `best.error`.
-  if (estimate * (31.0 / 64.0) * (31.0 / 64.0) > kTwoSubsetGain * best.error) return PackBest(best);
+  if (estimate * (31.0 / 64.0) * (31.0 / 64.0) > kTwoSubsetGain * best.plain_error)
+    return PackBest(best);
   for (int r = 0; r < kPartitionsTried; ++r) {
     const int part = ranked[r];
     Endpoints ends{};
@@ -696,6 +724,11 @@ Bc6hVolume EncodeBc6hVolume(const float* rgb, int width, int height, int depth, 
   v.width = width, v.height = height, v.depth = depth;
   v.bytes.assign(v.BlockCount() * kBc6hBlockBytes, 0);
   const int bw = v.BlocksWide(), bh = v.BlocksHigh();
+  // R of the error metric: the texture's largest value as the reference holds it.
+  float reference_max = 0.0f;
+  const std::size_t values = static_cast<std::size_t>(width) * height * depth * 3;
+  for (std::size_t i = 0; i < values; ++i)
+    if (rgb[i] > reference_max) reference_max = rgb[i];  // NaN never compares greater
   // Tasks of kRowsPerTask block rows. Each block's bytes depend on its 16 texels only, so the
   // result is the same for any number of threads, and a block whose texels equal those of its
   // left or upper neighbour (flat regions, the clamped padding at the right and bottom edges)
@@ -726,7 +759,7 @@ Bc6hVolume EncodeBc6hVolume(const float* rgb, int width, int height, int depth, 
               std::memcpy(out, v.bytes.data() + v.BlockOffset(4 * bx, 4 * (by - 1), z),
                           kBc6hBlockBytes);
             } else {
-              const Bc6hBlock block = EncodeBc6hBlock(texels);
+              const Bc6hBlock block = EncodeBc6hBlock(texels, reference_max);
               std::memcpy(out, block.data(), kBc6hBlockBytes);
             }
           }

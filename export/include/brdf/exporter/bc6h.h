@@ -39,7 +39,10 @@
 // when the best estimate is below the one-subset error, the best two partitions are tried in the
 // most precise two-subset mode that holds their endpoints. Every candidate gets a least-squares
 // endpoint refinement on its chosen indices, and candidates are compared by their exact decoded
-// error (the palettes the decoder computes). The result depends only on the 16 input texels:
+// error (the palettes the decoder computes), each channel's squared error in half steps
+// weighted by what it costs in the certified metric (a channel's value relative to the texel's
+// largest, bounded below: bc6h.cpp, BlockInput); the early exit and the two-subset gate use the
+// unweighted error. The result depends only on the 16 input texels:
 // the same bytes for any thread count.
 #pragma once
 
@@ -77,7 +80,10 @@ Bc6hHalfTexels DecodeBc6hBlock(const std::uint8_t* block);
 int Bc6hBlockMode(const std::uint8_t* block);
 
 // Encodes 16 texels (x fastest, rows top first), RGB floats each, as described above.
-Bc6hBlock EncodeBc6hBlock(const float* rgb48);
+// `reference_max` is R of the certified error (brdf/exporter/metadata.h), the largest value of
+// the texture the block belongs to: texels below 10^−4·R weigh as that floor (0: no floor
+// beyond 2^−14).
+Bc6hBlock EncodeBc6hBlock(const float* rgb48, float reference_max = 0.0f);
 
 // A 3D texture of BC6H blocks: the payload of a compressed LUT's KTX2 and DDS files.
 //
