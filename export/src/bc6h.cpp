@@ -496,9 +496,20 @@ void FitLine(const BlockInput& in, std::uint16_t mask, int s, int anchor, float 
 // Search effort: least-squares refinements per candidate, partitions tried in the two-subset
 // modes, modes tried per endpoint set, and the factor of the one-subset error a two-line
 // estimate must stay under to try two subsets (benchmarks in docs/benchmarks/bc6h.md).
+// BRDF_BC6H_REFERENCE_SEARCH (a build for bench/bc6h/reference_search.sh only) makes the
+// search near exhaustive: every partition, every mode that holds the endpoints, 4
+// refinements, no early exit and no gate, to show what the format allows.
+#ifdef BRDF_BC6H_REFERENCE_SEARCH
+constexpr bool kReferenceSearch = true;
+constexpr int kRefinements = 4;
+constexpr int kPartitionsTried = 32;
+constexpr int kModesTried = 14;
+#else
+constexpr bool kReferenceSearch = false;
 constexpr int kRefinements = 1;
 constexpr int kPartitionsTried = 2;
 constexpr int kModesTried = 1;
+#endif
 constexpr double kTwoSubsetGain = 1.0;
 
 // Estimated squared error of a two-line fit for every partition: per subset the scatter off
@@ -695,13 +706,15 @@ Bc6hBlock EncodeBc6hBlock(const float* rgb48, float reference_max) {
     FitLine(in, 0, 0, 0, ends.e[0]);
     TryBestModes(1, 0, ends, in, best);
   }
-  if (static_cast<int>(std::ceil(best.worst)) <= kBc6hGoodEnoughHalfSteps) return PackBest(best);
+  if (!kReferenceSearch && static_cast<int>(std::ceil(best.worst)) <= kBc6hGoodEnoughHalfSteps)
+    return PackBest(best);
   double estimate = 0.0;
   const std::array<int, kPartitionsTried> ranked = RankPartitions(in, estimate);
   // Scatter that no line fits (noise) stays whatever the partition: only a two-line estimate
   // below the one-subset block's error is worth the two-subset modes. The estimate is in
   // the interpolation domain, (64/31)² times the half domain of `best.error`.
-  if (estimate * (31.0 / 64.0) * (31.0 / 64.0) > kTwoSubsetGain * best.plain_error)
+  if (!kReferenceSearch &&
+      estimate * (31.0 / 64.0) * (31.0 / 64.0) > kTwoSubsetGain * best.plain_error)
     return PackBest(best);
   for (int r = 0; r < kPartitionsTried; ++r) {
     const int part = ranked[r];
