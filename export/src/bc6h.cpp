@@ -244,6 +244,7 @@ struct BlockInput {
   float h[16][3];
   float t[16][3];
   float w[16][3];
+  float r[16][3];  // √w: a channel's half steps in half steps of the texel's largest channel
 };
 
 float ContinuousHalf(float x) {
@@ -282,7 +283,7 @@ int QuantizeEndpoint(float value, int epb) {
 struct Encoded {
   float error = std::numeric_limits<float>::infinity();  // Σ w·(decoded − h)², candidates' order
   float plain_error = 0.0f;  // Σ (decoded − h)² in half steps, unweighted (the two-subset gate)
-  float worst = 0.0f;        // max |decoded − h| over the texels and channels, in half steps
+  float worst = 0.0f;  // max √w·|decoded − h|: half steps of each texel's largest channel
   const Mode* mode = nullptr;
   int partition = 0;
   int fields[4][3] = {};
@@ -404,7 +405,7 @@ void TryMode(const Mode& mode, int partition, Endpoints ends, const BlockInput& 
       for (int t = 0; t < 16; ++t) {
         const int* entry = palette[(mask >> t) & 1][indices[t]];
         for (int c = 0; c < 3; ++c)
-          worst = std::max(worst, std::abs(static_cast<float>(entry[c]) - in.h[t][c]));
+          worst = std::max(worst, in.r[t][c] * std::abs(static_cast<float>(entry[c]) - in.h[t][c]));
       }
       best.worst = worst;
     }
@@ -698,6 +699,7 @@ Bc6hBlock EncodeBc6hBlock(const float* rgb48, float reference_max) {
       in.t[t][c] = (in.h[t][c] + 0.5f) * (64.0f / 31.0f);
       const float ratio = std::min(std::max(x[c], kDenormalValue) / scale, 1.0f);
       in.w[t][c] = ratio * ratio;
+      in.r[t][c] = ratio;
     }
   }
   Encoded best;
