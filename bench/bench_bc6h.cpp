@@ -4,13 +4,21 @@
 // and the RGL files), beside RGB9E5 packing of the same LUT as the baseline:
 //   BRDF_BC6H_LUTS=DIR build/dev/bench/bench_bc6h --benchmark_repetitions=5
 //       --benchmark_report_aggregates_only=true
+// Each composite's θin list comes from its "brdf:theta_in_deg" header attribute (4 slices for
+// the default fill, 9 for `--beyond auto`).
+//   BRDF_BC6H_LUTS=DIR build/dev/bench/bench_bc6h --checksums
+// prints, instead of timing, one line per composite: its name, the block count and the CRC-32
+// of the BC6H bytes encoded on one thread, so two builds' outputs can be compared byte for byte
+// (docs/benchmarks/bc6h.md: the speed-up keeps every material's bytes).
 #include <benchmark/benchmark.h>
 
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "brdf/core/lut.h"
@@ -58,6 +66,21 @@ void BM_PackRgb9e5(benchmark::State& state, const Lut* lut) {
   }
 }
 
+// "0, 20, 40, 60" (FormatThetaList's form) back to numbers; empty when the attribute is absent.
+std::vector<double> ParseThetaList(const std::string& text) {
+  std::vector<double> out;
+  const char* p = text.c_str();
+  while (*p != '\0') {
+    char* end = nullptr;
+    const double v = std::strtod(p, &end);
+    if (end == p) break;
+    out.push_back(v);
+    p = end;
+    while (*p == ',' || *p == ' ') ++p;
+  }
+  return out;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -74,8 +97,25 @@ int main(int argc, char** argv) {
   std::sort(files.begin(), files.end());
   for (const auto& f : files) {
     const ExrFile exr = ReadExr(f.string());
-    Luts().push_back({f.stem().string(), LutFromComposite(exr.image, {0, 20, 40, 60})});
+    std::vector<double> theta = ParseThetaList(exr.Attribute("brdf:theta_in_deg"));
+    if (theta.empty()) {
+      std::fprintf(stderr,
+                   "bench_bc6h: %s: no \"brdf:theta_in_deg\" attribute (expected a composite "
+                   "`brdf convert --exr-type float` wrote)\n",
+                   f.string().c_str());
+      return 2;
+    }
+    Luts().push_back({f.stem().string(), LutFromComposite(exr.image, std::move(theta))});
   }
+  for (int i = 1; i < argc; ++i)
+    if (std::strcmp(argv[i], "--checksums") == 0) {
+      for (const NamedLut& l : Luts()) {
+        const Bc6hVolume v =
+            EncodeBc6hVolume(l.lut.texels.data(), Lut::kWidth, Lut::kHeight, l.lut.slices(), 1);
+        std::printf("%s %zu %08x\n", l.name.c_str(), v.BlockCount(), v.Crc32());
+      }
+      return 0;
+    }
   for (const NamedLut& l : Luts()) {
     benchmark::RegisterBenchmark(("EncodeBc6h/" + l.name).c_str(), BM_EncodeBc6h, &l.lut)
         ->Unit(benchmark::kMillisecond);

@@ -233,9 +233,18 @@ bool IsAnchor(int texel, int subsets, int partition) {
 // One block's input in the two domains the encoder works in: h, the value as a continuous
 // half-float bit pattern (what the decoded half should equal), and t = (h + 0.5)·64/31, the
 // interpolated value c whose (c·31) >> 6 is h.
+//
+// w weighs a channel's squared error in half steps by what it costs in the certified metric
+// (brdf/exporter/metadata.h: e = max_c |d_c − r_c| / S, S = max(max_c r_c, 10^−4·R, 2^−14)).
+// One half step of a normal half x is x·ln2/1024 (of a denormal, 2^−24, the same as a normal
+// x of 2^−14/ln2), so an error of Δ steps in channel c costs Δ·max(x_c, 2^−14/ln2)·ln2/1024/S:
+// w_c = (max(x_c, 2^−14/ln2) / S)². The colour's largest channel has weight 1; a minor
+// channel, or a texel far below the LUT's dark floor 10^−4·R, counts for what it costs.
 struct BlockInput {
   float h[16][3];
   float t[16][3];
+  float w[16][3];
+  float r[16][3];  // √w: a channel's half steps in half steps of the texel's largest channel
 };
 
 float ContinuousHalf(float x) {
@@ -270,9 +279,15 @@ int QuantizeEndpoint(float value, int epb) {
   return best;
 }
 
+// The best candidate so far, kept as its fields: the block is packed once, at the end.
 struct Encoded {
-  float error = std::numeric_limits<float>::infinity();  // Σ (decoded − h)² in half steps
-  Bc6hBlock block{};
+  float error = std::numeric_limits<float>::infinity();  // Σ w·(decoded − h)², candidates' order
+  float plain_error = 0.0f;  // Σ (decoded − h)² in half steps, unweighted (the two-subset gate)
+  float worst = 0.0f;  // max √w·|decoded − h|: half steps of each texel's largest channel
+  const Mode* mode = nullptr;
+  int partition = 0;
+  int fields[4][3] = {};
+  std::array<int, 16> indices{};
 };
 
 void WriteBits(Bc6hBlock& block, int& pos, std::uint32_t value, int count) {
@@ -300,9 +315,10 @@ Bc6hBlock Pack(const Mode& mode, int partition, const int (&fields)[4][3],
   return block;
 }
 
-// Quantizes the endpoints for `mode`, picks each texel's best index, packs the block and
-// refits the endpoints to the indices by least squares, `refinements` times; the best block
-// seen goes into `best`.
+// Quantizes the endpoints for `mode`, picks each texel's best index and refits the endpoints
+// to the indices by least squares, `refinements` times; the best candidate seen goes into
+// `best`. A refit whose quantized endpoints equal the previous pass's would repeat that pass
+// exactly (same palette, indices and error, so never strictly better): the loop stops there.
 void TryMode(const Mode& mode, int partition, Endpoints ends, const BlockInput& in, int refinements,
              Encoded& best) {
   const ModeInfo& info = mode.info;
@@ -311,6 +327,7 @@ void TryMode(const Mode& mode, int partition, Endpoints ends, const BlockInput& 
   const int levels = subsets == 2 ? 8 : 16;
   const int* weights = subsets == 2 ? kWeights3.data() : kWeights4.data();
   const int wrap = (1 << info.epb) - 1;
+  int previous_q[4][3];
   for (int pass = 0; pass <= refinements; ++pass) {
     int q[4][3], fields[4][3];
     for (int s = 0; s < subsets; ++s)
@@ -333,6 +350,8 @@ void TryMode(const Mode& mode, int partition, Endpoints ends, const BlockInput& 
         fields[e][c] = d & ((1 << info.delta[c]) - 1);
       }
     }
+    if (pass > 0 && std::memcmp(q, previous_q, sizeof(int) * 3 * 2 * subsets) == 0) break;
+    std::memcpy(previous_q, q, sizeof(int) * 3 * 2 * subsets);
     // Decoded palettes, exactly as the decoder computes them.
     int palette[2][16][3];
     for (int s = 0; s < subsets; ++s)
@@ -342,7 +361,7 @@ void TryMode(const Mode& mode, int partition, Endpoints ends, const BlockInput& 
           palette[s][k][c] = FinishUnquantize(Interpolate(a, b, weights[k]));
       }
     std::array<int, 16> indices{};
-    float error = 0.0f;
+    float error = 0.0f, plain_error = 0.0f;
     // Each texel's index: its projection on the subset's decoded segment gives a weight, the
     // nearest weights' entries are compared exactly (the palette is monotonic per channel).
     const std::uint8_t* nearest = subsets == 2 ? kNearest3.data() : kNearest4.data();
@@ -363,41 +382,58 @@ void TryMode(const Mode& mode, int partition, Endpoints ends, const BlockInput& 
         p += (in.h[t][c] - static_cast<float>(palette[s][0][c])) * dir[s][c];
       const int w = std::clamp(static_cast<int>(p * inv_len2[s] + 0.5f), 0, 64);
       const int centre = std::min<int>(nearest[w], allowed - 1);
-      float best_e = std::numeric_limits<float>::infinity();
+      float best_e = std::numeric_limits<float>::infinity(), best_plain = 0.0f;
       for (int k = std::max(0, centre - 1); k <= std::min(allowed - 1, centre + 1); ++k) {
-        float e2 = 0.0f;
+        float e2 = 0.0f, plain = 0.0f;
         for (int c = 0; c < 3; ++c) {
           const float d = static_cast<float>(palette[s][k][c]) - in.h[t][c];
-          e2 += d * d;
+          e2 += in.w[t][c] * d * d, plain += d * d;
         }
-        if (e2 < best_e) best_e = e2, indices[t] = k;
+        if (e2 < best_e) best_e = e2, best_plain = plain, indices[t] = k;
       }
-      error += best_e;
+      error += best_e, plain_error += best_plain;
     }
     if (error < best.error) {
       best.error = error;
-      best.block = Pack(mode, partition, fields, indices);
+      best.plain_error = plain_error;
+      best.mode = &mode;
+      best.partition = partition;
+      std::memcpy(best.fields, fields, sizeof(fields));
+      best.indices = indices;
+      // The decoder's texels are these palette entries, so this is the decoded block's error.
+      float worst = 0.0f;
+      for (int t = 0; t < 16; ++t) {
+        const int* entry = palette[(mask >> t) & 1][indices[t]];
+        for (int c = 0; c < 3; ++c)
+          worst = std::max(worst, in.r[t][c] * std::abs(static_cast<float>(entry[c]) - in.h[t][c]));
+      }
+      best.worst = worst;
     }
-    if (pass == refinements) break;
-    // Least squares per subset and channel: min Σ ((1 − α)a + αb − t)² over the texels.
+    // No refit can beat an exact candidate.
+    if (pass == refinements || error == 0.0f) break;
+    // Weighted least squares per subset and channel: min Σ w·((1 − α)a + αb − t)² over the
+    // texels (the weights differ per channel, so each channel has its own 2 × 2 system).
     for (int s = 0; s < subsets; ++s) {
-      double aa = 0, ab = 0, bb = 0, at[3] = {}, bt[3] = {}, sum[3] = {};
-      int n = 0;
+      double aa[3] = {}, ab[3] = {}, bb[3] = {}, at[3] = {}, bt[3] = {}, wsum[3] = {}, wt[3] = {};
       for (int t = 0; t < 16; ++t) {
         if (((mask >> t) & 1) != s) continue;
         const double alpha = weights[indices[t]] / 64.0, beta = 1.0 - alpha;
-        aa += beta * beta, ab += alpha * beta, bb += alpha * alpha, ++n;
         for (int c = 0; c < 3; ++c) {
-          at[c] += beta * in.t[t][c], bt[c] += alpha * in.t[t][c], sum[c] += in.t[t][c];
+          const double w = in.w[t][c], x = in.t[t][c];
+          aa[c] += w * beta * beta, ab[c] += w * alpha * beta, bb[c] += w * alpha * alpha;
+          at[c] += w * beta * x, bt[c] += w * alpha * x;
+          wsum[c] += w, wt[c] += w * x;
         }
       }
-      const double det = aa * bb - ab * ab;
       for (int c = 0; c < 3; ++c) {
-        if (std::abs(det) < 1e-9) {
-          ends.e[s][0][c] = ends.e[s][1][c] = static_cast<float>(sum[c] / std::max(n, 1));
+        // The determinant relative to (Σw)²: all texels on one index leaves only the mean.
+        const double det = aa[c] * bb[c] - ab[c] * ab[c];
+        if (!(wsum[c] > 0.0) || std::abs(det) < 1e-9 * wsum[c] * wsum[c]) {
+          const double mean = wsum[c] > 0.0 ? wt[c] / wsum[c] : 0.0;
+          ends.e[s][0][c] = ends.e[s][1][c] = static_cast<float>(mean);
         } else {
-          ends.e[s][0][c] = static_cast<float>((bb * at[c] - ab * bt[c]) / det);
-          ends.e[s][1][c] = static_cast<float>((aa * bt[c] - ab * at[c]) / det);
+          ends.e[s][0][c] = static_cast<float>((bb[c] * at[c] - ab[c] * bt[c]) / det);
+          ends.e[s][1][c] = static_cast<float>((aa[c] * bt[c] - ab[c] * at[c]) / det);
         }
       }
     }
@@ -433,11 +469,15 @@ void FitLine(const BlockInput& in, std::uint16_t mask, int s, int anchor, float 
       ++n;
     }
   for (double& m : mean) m /= std::max(n, 1);
-  double cov[3][3] = {};
+  // Symmetric: the six sums above the diagonal, mirrored (the products are the same numbers).
+  double c00 = 0, c01 = 0, c02 = 0, c11 = 0, c12 = 0, c22 = 0;
   for (int t = 0; t < 16; ++t)
-    if (((mask >> t) & 1) == s)
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) cov[r][c] += (in.t[t][r] - mean[r]) * (in.t[t][c] - mean[c]);
+    if (((mask >> t) & 1) == s) {
+      const double d0 = in.t[t][0] - mean[0], d1 = in.t[t][1] - mean[1], d2 = in.t[t][2] - mean[2];
+      c00 += d0 * d0, c01 += d0 * d1, c02 += d0 * d2;
+      c11 += d1 * d1, c12 += d1 * d2, c22 += d2 * d2;
+    }
+  const double cov[3][3] = {{c00, c01, c02}, {c01, c11, c12}, {c02, c12, c22}};
   const std::array<double, 3> axis = PrincipalAxis(cov);
   double lo = 0.0, hi = 0.0, anchor_p = 0.0;
   for (int t = 0; t < 16; ++t) {
@@ -457,9 +497,20 @@ void FitLine(const BlockInput& in, std::uint16_t mask, int s, int anchor, float 
 // Search effort: least-squares refinements per candidate, partitions tried in the two-subset
 // modes, modes tried per endpoint set, and the factor of the one-subset error a two-line
 // estimate must stay under to try two subsets (benchmarks in docs/benchmarks/bc6h.md).
+// BRDF_BC6H_REFERENCE_SEARCH (a build for bench/bc6h/reference_search.sh only) makes the
+// search near exhaustive: every partition, every mode that holds the endpoints, 4
+// refinements, no early exit and no gate, to show what the format allows.
+#ifdef BRDF_BC6H_REFERENCE_SEARCH
+constexpr bool kReferenceSearch = true;
+constexpr int kRefinements = 4;
+constexpr int kPartitionsTried = 32;
+constexpr int kModesTried = 14;
+#else
+constexpr bool kReferenceSearch = false;
 constexpr int kRefinements = 1;
 constexpr int kPartitionsTried = 2;
 constexpr int kModesTried = 1;
+#endif
 constexpr double kTwoSubsetGain = 1.0;
 
 // Estimated squared error of a two-line fit for every partition: per subset the scatter off
@@ -484,43 +535,43 @@ std::array<int, kPartitionsTried> RankPartitions(const BlockInput& in, double& b
       for (int c = 0; c < 3; ++c) cov[r][c] = total[k[r][c]] - total[r] * total[c] / 16.0;
     axis = PrincipalAxis(cov);
   }
+  // One subset's estimate from its running sums m (x, y, z, xx, xy, xz, yy, yz, zz) of n
+  // texels. Written out in scalars so the sums stay in registers; every operation is the one
+  // the matrix form does, in the same order (the ranking, and so the bytes, are unchanged).
+  const auto estimate = [&axis](double n, double m0, double m1, double m2, double m3, double m4,
+                                double m5, double m6, double m7, double m8) {
+    const double mx = m0 / n, my = m1 / n, mz = m2 / n;
+    const double c00 = m3 - n * mx * mx, c01 = m4 - n * mx * my, c02 = m5 - n * mx * mz;
+    const double c11 = m6 - n * my * my, c12 = m7 - n * my * mz, c22 = m8 - n * mz * mz;
+    // λmax ≈ the Rayleigh quotient after one power step from the block's axis.
+    const double v0 = c00 * axis[0] + c01 * axis[1] + c02 * axis[2];
+    const double v1 = c01 * axis[0] + c11 * axis[1] + c12 * axis[2];
+    const double v2 = c02 * axis[0] + c12 * axis[1] + c22 * axis[2];
+    const double len2 = v0 * v0 + v1 * v1 + v2 * v2;
+    double lambda = 0.0;
+    if (len2 > 1e-30) {
+      lambda += v0 * c00 * v0, lambda += v0 * c01 * v1, lambda += v0 * c02 * v2;
+      lambda += v1 * c01 * v0, lambda += v1 * c11 * v1, lambda += v1 * c12 * v2;
+      lambda += v2 * c02 * v0, lambda += v2 * c12 * v1, lambda += v2 * c22 * v2;
+      lambda /= len2;
+    }
+    const double trace = std::max(0.0, c00 + c11 + c22);
+    lambda = std::clamp(lambda, 0.0, trace);
+    return (trace - lambda) + lambda / 49.0;
+  };
   std::array<double, 32> score{};
   for (int part = 0; part < 32; ++part) {
-    double sub[2][9] = {};
+    double s0 = 0, s1 = 0, s2 = 0, s3 = 0, s4 = 0, s5 = 0, s6 = 0, s7 = 0, s8 = 0;
     int n1 = 0;
-    for (int t = 0; t < 16; ++t)
-      if ((kPartitions[part] >> t) & 1) {
-        for (int i = 0; i < 9; ++i) sub[1][i] += texel[t][i];
-        ++n1;
-      }
-    for (int i = 0; i < 9; ++i) sub[0][i] = total[i] - sub[1][i];
-    const int counts[2] = {16 - n1, n1};
-    double est = 0.0;
-    for (int s = 0; s < 2; ++s) {
-      const double n = counts[s];
-      const double* m = sub[s];
-      const double mx = m[0] / n, my = m[1] / n, mz = m[2] / n;
-      double cov[3][3];
-      cov[0][0] = m[3] - n * mx * mx, cov[0][1] = m[4] - n * mx * my,
-      cov[0][2] = m[5] - n * mx * mz;
-      cov[1][1] = m[6] - n * my * my, cov[1][2] = m[7] - n * my * mz,
-      cov[2][2] = m[8] - n * mz * mz;
-      cov[1][0] = cov[0][1], cov[2][0] = cov[0][2], cov[2][1] = cov[1][2];
-      // λmax ≈ the Rayleigh quotient after one power step from the block's axis.
-      double v[3];
-      for (int r = 0; r < 3; ++r)
-        v[r] = cov[r][0] * axis[0] + cov[r][1] * axis[1] + cov[r][2] * axis[2];
-      const double v2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
-      double lambda = 0.0;
-      if (v2 > 1e-30) {
-        for (int r = 0; r < 3; ++r)
-          for (int c = 0; c < 3; ++c) lambda += v[r] * cov[r][c] * v[c];
-        lambda /= v2;
-      }
-      const double trace = std::max(0.0, cov[0][0] + cov[1][1] + cov[2][2]);
-      lambda = std::clamp(lambda, 0.0, trace);
-      est += (trace - lambda) + lambda / 49.0;
+    for (unsigned bits = kPartitions[part]; bits != 0; bits &= bits - 1, ++n1) {
+      const double* p = texel[std::countr_zero(bits)];
+      s0 += p[0], s1 += p[1], s2 += p[2], s3 += p[3], s4 += p[4];
+      s5 += p[5], s6 += p[6], s7 += p[7], s8 += p[8];
     }
+    double est = 0.0;
+    est += estimate(16 - n1, total[0] - s0, total[1] - s1, total[2] - s2, total[3] - s3,
+                    total[4] - s4, total[5] - s5, total[6] - s6, total[7] - s7, total[8] - s8);
+    est += estimate(n1, s0, s1, s2, s3, s4, s5, s6, s7, s8);
     score[part] = est;
   }
   // The kPartitionsTried lowest scores, lower partition numbers first on ties.
@@ -573,12 +624,8 @@ void TryBestModes(int subsets, int partition, const Endpoints& ends, const Block
   }
 }
 
-int MaxHalfError(const Bc6hBlock& block, const BlockInput& in) {
-  const Bc6hHalfTexels decoded = DecodeBc6hBlock(block.data());
-  float worst = 0.0f;
-  for (int t = 0; t < 16; ++t)
-    for (int c = 0; c < 3; ++c) worst = std::max(worst, std::abs(decoded[t][c] - in.h[t][c]));
-  return static_cast<int>(std::ceil(worst));
+Bc6hBlock PackBest(const Encoded& best) {
+  return Pack(*best.mode, best.partition, best.fields, best.indices);
 }
 
 }  // namespace
@@ -634,26 +681,43 @@ Bc6hHalfTexels DecodeBc6hBlock(const std::uint8_t* block) {
   return out;
 }
 
-Bc6hBlock EncodeBc6hBlock(const float* rgb48) {
+Bc6hBlock EncodeBc6hBlock(const float* rgb48, float reference_max) {
   BlockInput in;
-  for (int t = 0; t < 16; ++t)
+  // The metric's floor: 10^−4·R and 2^−14 (R clamped as the reference is, to [0, 65504]).
+  const float reference = std::clamp(reference_max, 0.0f, kBc6hMaxValue);
+  const float floor = std::max(1e-4f * reference, 6.103515625e-05f);
+  constexpr float kDenormalValue = 6.103515625e-05f / 0.69314718f;  // 2^−14/ln2
+  for (int t = 0; t < 16; ++t) {
+    float x[3], scale = floor;
+    for (int c = 0; c < 3; ++c) {
+      const float v = rgb48[3 * t + c];
+      x[c] = v > 0.0f ? std::min(v, kBc6hMaxValue) : 0.0f;  // NaN and negatives: 0
+      scale = std::max(scale, x[c]);
+    }
     for (int c = 0; c < 3; ++c) {
       in.h[t][c] = ContinuousHalf(rgb48[3 * t + c]);
       in.t[t][c] = (in.h[t][c] + 0.5f) * (64.0f / 31.0f);
+      const float ratio = std::min(std::max(x[c], kDenormalValue) / scale, 1.0f);
+      in.w[t][c] = ratio * ratio;
+      in.r[t][c] = ratio;
     }
+  }
   Encoded best;
   {
     Endpoints ends{};
     FitLine(in, 0, 0, 0, ends.e[0]);
     TryBestModes(1, 0, ends, in, best);
   }
-  if (MaxHalfError(best.block, in) <= kBc6hGoodEnoughHalfSteps) return best.block;
+  if (!kReferenceSearch && static_cast<int>(std::ceil(best.worst)) <= kBc6hGoodEnoughHalfSteps)
+    return PackBest(best);
   double estimate = 0.0;
   const std::array<int, kPartitionsTried> ranked = RankPartitions(in, estimate);
   // Scatter that no line fits (noise) stays whatever the partition: only a two-line estimate
   // below the one-subset block's error is worth the two-subset modes. The estimate is in
   // the interpolation domain, (64/31)² times the half domain of `best.error`.
-  if (estimate * (31.0 / 64.0) * (31.0 / 64.0) > kTwoSubsetGain * best.error) return best.block;
+  if (!kReferenceSearch &&
+      estimate * (31.0 / 64.0) * (31.0 / 64.0) > kTwoSubsetGain * best.plain_error)
+    return PackBest(best);
   for (int r = 0; r < kPartitionsTried; ++r) {
     const int part = ranked[r];
     Endpoints ends{};
@@ -661,7 +725,7 @@ Bc6hBlock EncodeBc6hBlock(const float* rgb48) {
     FitLine(in, kPartitions[part], 1, kAnchor2[part], ends.e[1]);
     TryBestModes(2, part, ends, in, best);
   }
-  return best.block;
+  return PackBest(best);
 }
 
 std::uint32_t Bc6hVolume::Crc32() const { return brdf::Crc32(bytes.data(), bytes.size()); }
@@ -675,25 +739,46 @@ Bc6hVolume EncodeBc6hVolume(const float* rgb, int width, int height, int depth, 
   v.width = width, v.height = height, v.depth = depth;
   v.bytes.assign(v.BlockCount() * kBc6hBlockBytes, 0);
   const int bw = v.BlocksWide(), bh = v.BlocksHigh();
-  // One task per block row; each block's bytes depend on its texels only, so the result is the
-  // same for any number of threads.
+  // R of the error metric: the texture's largest value as the reference holds it.
+  float reference_max = 0.0f;
+  const std::size_t values = static_cast<std::size_t>(width) * height * depth * 3;
+  for (std::size_t i = 0; i < values; ++i)
+    if (rgb[i] > reference_max) reference_max = rgb[i];  // NaN never compares greater
+  // Tasks of kRowsPerTask block rows. Each block's bytes depend on its 16 texels only, so the
+  // result is the same for any number of threads, and a block whose texels equal those of its
+  // left or upper neighbour (flat regions, the clamped padding at the right and bottom edges)
+  // takes that neighbour's bytes without encoding again.
+  constexpr std::size_t kRowsPerTask = 8;
   ParallelChunks(
-      static_cast<std::size_t>(bh) * depth, 1, ResolveJobs(jobs), nullptr,
+      static_cast<std::size_t>(bh) * depth, kRowsPerTask, ResolveJobs(jobs), nullptr,
       [&](std::size_t begin, std::size_t end) {
-        float texels[48];
+        // The texels of this task's previous block row, block by block (valid for row − 1).
+        std::vector<float> above(static_cast<std::size_t>(bw) * 48), current(above.size());
         for (std::size_t row = begin; row < end; ++row) {
           const int z = static_cast<int>(row / bh), by = static_cast<int>(row % bh);
+          const bool have_above = row > begin && by > 0;
           for (int bx = 0; bx < bw; ++bx) {
+            float* texels = &current[static_cast<std::size_t>(bx) * 48];
             for (int t = 0; t < 16; ++t) {
               const int x = std::min(4 * bx + t % 4, width - 1);
               const int y = std::min(4 * by + t / 4, height - 1);
               const float* src = rgb + ((static_cast<std::size_t>(z) * height + y) * width + x) * 3;
               texels[3 * t] = src[0], texels[3 * t + 1] = src[1], texels[3 * t + 2] = src[2];
             }
-            const Bc6hBlock block = EncodeBc6hBlock(texels);
-            std::memcpy(v.bytes.data() + v.BlockOffset(4 * bx, 4 * by, z), block.data(),
-                        kBc6hBlockBytes);
+            std::uint8_t* out = v.bytes.data() + v.BlockOffset(4 * bx, 4 * by, z);
+            constexpr std::size_t kTexelBytes = 48 * sizeof(float);
+            if (bx > 0 && std::memcmp(texels, texels - 48, kTexelBytes) == 0) {
+              std::memcpy(out, out - kBc6hBlockBytes, kBc6hBlockBytes);
+            } else if (have_above && std::memcmp(texels, &above[static_cast<std::size_t>(bx) * 48],
+                                                 kTexelBytes) == 0) {
+              std::memcpy(out, v.bytes.data() + v.BlockOffset(4 * bx, 4 * (by - 1), z),
+                          kBc6hBlockBytes);
+            } else {
+              const Bc6hBlock block = EncodeBc6hBlock(texels, reference_max);
+              std::memcpy(out, block.data(), kBc6hBlockBytes);
+            }
           }
+          above.swap(current);
         }
       });
   return v;

@@ -122,9 +122,17 @@ TEST(Bc6hEncode, SmoothBlocksWithinTheFormatsBound) {
                                  sy * static_cast<float>(t / 4 - 1.5) * 2.0f);
     }
     const Bc6hHalfTexels texels = DecodeBc6hBlock(EncodeBc6hBlock(rgb).data());
-    for (int t = 0; t < 16; ++t)
+    for (int t = 0; t < 16; ++t) {
+      // The certified metric (brdf/exporter/metadata.h): the channel error relative to the
+      // texel's largest channel, whose own relative error the bound above is for; the encoder
+      // weighs the channels by this metric, so a minor channel's own relative error may exceed
+      // the bound where it costs less than that of the largest.
+      const float scale = std::max({rgb[3 * t], rgb[3 * t + 1], rgb[3 * t + 2]});
+      float e = 0.0f;
       for (int c = 0; c < 3; ++c)
-        errors.push_back(RelativeError(HalfToFloat(texels[t][c]), rgb[3 * t + c]));
+        e = std::max(e, std::abs(HalfToFloat(texels[t][c]) - rgb[3 * t + c]) / scale);
+      errors.push_back(e);
+    }
   }
   std::sort(errors.begin(), errors.end());
   EXPECT_LE(errors.back(), 0.013f);

@@ -39,8 +39,12 @@
 // when the best estimate is below the one-subset error, the best two partitions are tried in the
 // most precise two-subset mode that holds their endpoints. Every candidate gets a least-squares
 // endpoint refinement on its chosen indices, and candidates are compared by their exact decoded
-// error (the palettes the decoder computes). The result depends only on the 16 input texels:
-// the same bytes for any thread count.
+// error (the palettes the decoder computes), each channel's squared error in half steps
+// weighted by what it costs in the certified metric (a channel's value relative to the texel's
+// largest, bounded below: bc6h.cpp, BlockInput). The early exit counts each channel's error in
+// half steps of the texel's largest channel (so a dim minor channel does not force the
+// two-subset search); the two-subset gate compares the unweighted error. The result depends only on
+// the 16 input texels: the same bytes for any thread count.
 #pragma once
 
 #include <array>
@@ -59,7 +63,8 @@ inline constexpr std::uint32_t kDxgiFormatBc6hUf16 = 95;        // DXGI_FORMAT_B
 // The largest value a BC6H_UF16 texel decodes to: half 0x7BFF.
 inline constexpr float kBc6hMaxValue = 65504.0f;
 // The encoder stops looking beyond one-subset modes for a block whose every texel channel is
-// within this many half-float steps (about 0.4–0.8 % relative) of its input.
+// within this many half-float steps of the texel's largest channel (about 0.4–0.8 % of that
+// channel's value) of its input.
 inline constexpr int kBc6hGoodEnoughHalfSteps = 8;
 
 using Bc6hBlock = std::array<std::uint8_t, kBc6hBlockBytes>;
@@ -77,7 +82,10 @@ Bc6hHalfTexels DecodeBc6hBlock(const std::uint8_t* block);
 int Bc6hBlockMode(const std::uint8_t* block);
 
 // Encodes 16 texels (x fastest, rows top first), RGB floats each, as described above.
-Bc6hBlock EncodeBc6hBlock(const float* rgb48);
+// `reference_max` is R of the certified error (brdf/exporter/metadata.h), the largest value of
+// the texture the block belongs to: texels below 10^−4·R weigh as that floor (0: no floor
+// beyond 2^−14).
+Bc6hBlock EncodeBc6hBlock(const float* rgb48, float reference_max = 0.0f);
 
 // A 3D texture of BC6H blocks: the payload of a compressed LUT's KTX2 and DDS files.
 //
