@@ -166,6 +166,7 @@ def es_harnesses(out, work):
                                  (r"uniform (sampler3D|sampler2D|samplerCube) (\w+) : [^;]+;",
                                   r"uniform highp \1 \2;", 3),
                                  (r"uniform float (\w+) = [^;]+;", r"uniform float \1;", 2),
+                                 (r"uniform vec3 (\w+) = [^;]+;", r"uniform vec3 \1;", 3),
                                  (r"void fragment\(\)", "void godot_fragment()", 1),
                                  (r"void light\(\)", "void godot_light()", 1)):
         src, n = re.subn(pattern, repl, src)
