@@ -131,6 +131,8 @@ constexpr std::array<std::uint8_t, 32> kAnchor2 = {15, 15, 15, 15, 15, 15, 15, 1
 constexpr std::array<int, 16> kWeights4 = {0,  4,  9,  13, 17, 21, 26, 30,
                                            34, 38, 43, 47, 51, 55, 60, 64};
 constexpr std::array<int, 8> kWeights3 = {0, 9, 18, 27, 37, 46, 55, 64};
+// Slots of one channel of a palette in TryMode: 16 entries, one slot before, two after.
+constexpr int kPaletteSlots = 19;
 
 // For every weight 0..64, the index whose table weight is nearest (the encoder's first guess).
 template <std::size_t N>
@@ -279,6 +281,24 @@ int QuantizeEndpoint(float value, int epb) {
   return best;
 }
 
+// The endpoints quantized to one precision, each on first use (modes of the same precision
+// share them; a mode whose first delta does not fit needs only a few).
+struct QuantizedEnds {
+  explicit QuantizedEnds(const Endpoints& e) : ends(e) {}
+  const Endpoints& ends;
+  int epb = -1;
+  int q[4][3] = {};
+  int Get(int e, int c) {
+    if (q[e][c] < 0) q[e][c] = QuantizeEndpoint(ends.e[e / 2][e % 2][c], epb);
+    return q[e][c];
+  }
+  void SetPrecision(int bits) {
+    if (bits == epb) return;
+    epb = bits;
+    std::memset(q, -1, sizeof(q));
+  }
+};
+
 // The best candidate so far, kept as its fields: the block is packed once, at the end.
 struct Encoded {
   float error = std::numeric_limits<float>::infinity();  // Σ w·(decoded − h)², candidates' order
@@ -319,8 +339,8 @@ Bc6hBlock Pack(const Mode& mode, int partition, const int (&fields)[4][3],
 // to the indices by least squares, `refinements` times; the best candidate seen goes into
 // `best`. A refit whose quantized endpoints equal the previous pass's would repeat that pass
 // exactly (same palette, indices and error, so never strictly better): the loop stops there.
-void TryMode(const Mode& mode, int partition, Endpoints ends, const BlockInput& in, int refinements,
-             Encoded& best) {
+void TryMode(const Mode& mode, int partition, Endpoints ends, QuantizedEnds& first,
+             const BlockInput& in, int refinements, Encoded& best) {
   const ModeInfo& info = mode.info;
   const int subsets = info.subsets;
   const std::uint16_t mask = subsets == 2 ? kPartitions[partition] : 0;
@@ -330,10 +350,12 @@ void TryMode(const Mode& mode, int partition, Endpoints ends, const BlockInput& 
   int previous_q[4][3];
   for (int pass = 0; pass <= refinements; ++pass) {
     int q[4][3], fields[4][3];
+    if (pass == 0) first.SetPrecision(info.epb);  // `ends` as given: quantized once
     for (int s = 0; s < subsets; ++s)
       for (int end = 0; end < 2; ++end)
         for (int c = 0; c < 3; ++c)
-          q[2 * s + end][c] = QuantizeEndpoint(ends.e[s][end][c], info.epb);
+          q[2 * s + end][c] =
+              pass == 0 ? first.Get(2 * s + end, c) : QuantizeEndpoint(ends.e[s][end][c], info.epb);
     for (int c = 0; c < 3; ++c) {
       fields[0][c] = q[0][c];
       for (int e = 1; e < 2 * subsets; ++e) {
@@ -352,16 +374,23 @@ void TryMode(const Mode& mode, int partition, Endpoints ends, const BlockInput& 
     }
     if (pass > 0 && std::memcmp(q, previous_q, sizeof(int) * 3 * 2 * subsets) == 0) break;
     std::memcpy(previous_q, q, sizeof(int) * 3 * 2 * subsets);
-    // Decoded palettes, exactly as the decoder computes them.
-    int palette[2][16][3];
+    // Decoded palettes, exactly as the decoder computes them, as floats by channel: entry k of
+    // subset s, channel c is pal[s][c][k + 1] (one slot of padding before entry 0 and two
+    // after the last, so a texel's three neighbouring entries are one load of four lanes).
+    float pal[2][3][kPaletteSlots];
     for (int s = 0; s < subsets; ++s)
       for (int c = 0; c < 3; ++c) {
         const int a = Unquantize(q[2 * s][c], info.epb), b = Unquantize(q[2 * s + 1][c], info.epb);
+        pal[s][c][0] = pal[s][c][levels + 1] = pal[s][c][levels + 2] = 0.0f;  // never compared
         for (int k = 0; k < levels; ++k)
-          palette[s][k][c] = FinishUnquantize(Interpolate(a, b, weights[k]));
+          pal[s][c][k + 1] = static_cast<float>(FinishUnquantize(Interpolate(a, b, weights[k])));
       }
     std::array<int, 16> indices{};
     float error = 0.0f, plain_error = 0.0f;
+    // On the last pass no refit follows, so the candidate matters only if its error ends below
+    // best.error; the sum of non-negative terms never decreases, so once it reaches best.error
+    // the remaining texels cannot change the outcome and are skipped.
+    const bool last_pass = pass == refinements;
     // Each texel's index: its projection on the subset's decoded segment gives a weight, the
     // nearest weights' entries are compared exactly (the palette is monotonic per channel).
     const std::uint8_t* nearest = subsets == 2 ? kNearest3.data() : kNearest4.data();
@@ -369,7 +398,7 @@ void TryMode(const Mode& mode, int partition, Endpoints ends, const BlockInput& 
     for (int s = 0; s < subsets; ++s) {
       float len2 = 0.0f;
       for (int c = 0; c < 3; ++c) {
-        dir[s][c] = static_cast<float>(palette[s][levels - 1][c] - palette[s][0][c]);
+        dir[s][c] = pal[s][c][levels] - pal[s][c][1];
         len2 += dir[s][c] * dir[s][c];
       }
       inv_len2[s] = len2 > 0.0f ? 64.0f / len2 : 0.0f;
@@ -377,21 +406,29 @@ void TryMode(const Mode& mode, int partition, Endpoints ends, const BlockInput& 
     for (int t = 0; t < 16; ++t) {
       const int s = (mask >> t) & 1;
       const int allowed = IsAnchor(t, subsets, partition) ? levels / 2 : levels;
+      const float* h = in.h[t];
+      const float* w3 = in.w[t];
       float p = 0.0f;
-      for (int c = 0; c < 3; ++c)
-        p += (in.h[t][c] - static_cast<float>(palette[s][0][c])) * dir[s][c];
+      for (int c = 0; c < 3; ++c) p += (h[c] - pal[s][c][1]) * dir[s][c];
       const int w = std::clamp(static_cast<int>(p * inv_len2[s] + 0.5f), 0, 64);
       const int centre = std::min<int>(nearest[w], allowed - 1);
+      // Lane j holds entry centre − 1 + j (lane 3 and out-of-range lanes are not compared); each
+      // lane's sums are formed in the order of one entry's: channel 0, 1, 2.
+      float e2[4] = {}, plain[4] = {};
+      for (int c = 0; c < 3; ++c) {
+        const float* entry = &pal[s][c][centre];
+        for (int j = 0; j < 4; ++j) {
+          const float d = entry[j] - h[c];
+          e2[j] += w3[c] * d * d, plain[j] += d * d;
+        }
+      }
       float best_e = std::numeric_limits<float>::infinity(), best_plain = 0.0f;
       for (int k = std::max(0, centre - 1); k <= std::min(allowed - 1, centre + 1); ++k) {
-        float e2 = 0.0f, plain = 0.0f;
-        for (int c = 0; c < 3; ++c) {
-          const float d = static_cast<float>(palette[s][k][c]) - in.h[t][c];
-          e2 += in.w[t][c] * d * d, plain += d * d;
-        }
-        if (e2 < best_e) best_e = e2, best_plain = plain, indices[t] = k;
+        const int j = k - centre + 1;
+        if (e2[j] < best_e) best_e = e2[j], best_plain = plain[j], indices[t] = k;
       }
       error += best_e, plain_error += best_plain;
+      if (last_pass && !(error < best.error)) break;
     }
     if (error < best.error) {
       best.error = error;
@@ -403,9 +440,9 @@ void TryMode(const Mode& mode, int partition, Endpoints ends, const BlockInput& 
       // The decoder's texels are these palette entries, so this is the decoded block's error.
       float worst = 0.0f;
       for (int t = 0; t < 16; ++t) {
-        const int* entry = palette[(mask >> t) & 1][indices[t]];
+        const int s = (mask >> t) & 1;
         for (int c = 0; c < 3; ++c)
-          worst = std::max(worst, in.r[t][c] * std::abs(static_cast<float>(entry[c]) - in.h[t][c]));
+          worst = std::max(worst, in.r[t][c] * std::abs(pal[s][c][indices[t] + 1] - in.h[t][c]));
       }
       best.worst = worst;
     }
@@ -413,30 +450,31 @@ void TryMode(const Mode& mode, int partition, Endpoints ends, const BlockInput& 
     if (pass == refinements || error == 0.0f) break;
     // Weighted least squares per subset and channel: min Σ w·((1 − α)a + αb − t)² over the
     // texels (the weights differ per channel, so each channel has its own 2 × 2 system).
-    for (int s = 0; s < subsets; ++s) {
-      double aa[3] = {}, ab[3] = {}, bb[3] = {}, at[3] = {}, bt[3] = {}, wsum[3] = {}, wt[3] = {};
-      for (int t = 0; t < 16; ++t) {
-        if (((mask >> t) & 1) != s) continue;
-        const double alpha = weights[indices[t]] / 64.0, beta = 1.0 - alpha;
-        for (int c = 0; c < 3; ++c) {
-          const double w = in.w[t][c], x = in.t[t][c];
-          aa[c] += w * beta * beta, ab[c] += w * alpha * beta, bb[c] += w * alpha * alpha;
-          at[c] += w * beta * x, bt[c] += w * alpha * x;
-          wsum[c] += w, wt[c] += w * x;
-        }
-      }
+    // One pass over the texels; each subset's sums still take its texels in ascending order.
+    double aa[2][3] = {}, ab[2][3] = {}, bb[2][3] = {}, at[2][3] = {}, bt[2][3] = {},
+           wsum[2][3] = {}, wt[2][3] = {};
+    for (int t = 0; t < 16; ++t) {
+      const int s = (mask >> t) & 1;
+      const double alpha = weights[indices[t]] / 64.0, beta = 1.0 - alpha;
       for (int c = 0; c < 3; ++c) {
-        // The determinant relative to (Σw)²: all texels on one index leaves only the mean.
-        const double det = aa[c] * bb[c] - ab[c] * ab[c];
-        if (!(wsum[c] > 0.0) || std::abs(det) < 1e-9 * wsum[c] * wsum[c]) {
-          const double mean = wsum[c] > 0.0 ? wt[c] / wsum[c] : 0.0;
-          ends.e[s][0][c] = ends.e[s][1][c] = static_cast<float>(mean);
-        } else {
-          ends.e[s][0][c] = static_cast<float>((bb[c] * at[c] - ab[c] * bt[c]) / det);
-          ends.e[s][1][c] = static_cast<float>((aa[c] * bt[c] - ab[c] * at[c]) / det);
-        }
+        const double w = in.w[t][c], x = in.t[t][c];
+        aa[s][c] += w * beta * beta, ab[s][c] += w * alpha * beta, bb[s][c] += w * alpha * alpha;
+        at[s][c] += w * beta * x, bt[s][c] += w * alpha * x;
+        wsum[s][c] += w, wt[s][c] += w * x;
       }
     }
+    for (int s = 0; s < subsets; ++s)
+      for (int c = 0; c < 3; ++c) {
+        // The determinant relative to (Σw)²: all texels on one index leaves only the mean.
+        const double det = aa[s][c] * bb[s][c] - ab[s][c] * ab[s][c];
+        if (!(wsum[s][c] > 0.0) || std::abs(det) < 1e-9 * wsum[s][c] * wsum[s][c]) {
+          const double mean = wsum[s][c] > 0.0 ? wt[s][c] / wsum[s][c] : 0.0;
+          ends.e[s][0][c] = ends.e[s][1][c] = static_cast<float>(mean);
+        } else {
+          ends.e[s][0][c] = static_cast<float>((bb[s][c] * at[s][c] - ab[s][c] * bt[s][c]) / det);
+          ends.e[s][1][c] = static_cast<float>((aa[s][c] * bt[s][c] - ab[s][c] * at[s][c]) / det);
+        }
+      }
   }
 }
 
@@ -461,27 +499,27 @@ std::array<double, 3> PrincipalAxis(const double (&cov)[3][3]) {
 // Endpoints of subset s (texels where ((mask >> t) & 1) == s) along its principal axis, end 0
 // on the side of the subset's anchor texel so that its index fits the shortened field.
 void FitLine(const BlockInput& in, std::uint16_t mask, int s, int anchor, float (&ends)[2][3]) {
+  // The subset's texels as bits, visited in ascending order as a loop over all 16 would.
+  const unsigned members = s == 1 ? mask : ~static_cast<unsigned>(mask) & 0xFFFFu;
   double mean[3] = {};
-  int n = 0;
-  for (int t = 0; t < 16; ++t)
-    if (((mask >> t) & 1) == s) {
-      for (int c = 0; c < 3; ++c) mean[c] += in.t[t][c];
-      ++n;
-    }
-  for (double& m : mean) m /= std::max(n, 1);
+  for (unsigned bits = members; bits != 0; bits &= bits - 1) {
+    const float* x = in.t[std::countr_zero(bits)];
+    for (int c = 0; c < 3; ++c) mean[c] += x[c];
+  }
+  for (double& m : mean) m /= std::max(std::popcount(members), 1);
   // Symmetric: the six sums above the diagonal, mirrored (the products are the same numbers).
   double c00 = 0, c01 = 0, c02 = 0, c11 = 0, c12 = 0, c22 = 0;
-  for (int t = 0; t < 16; ++t)
-    if (((mask >> t) & 1) == s) {
-      const double d0 = in.t[t][0] - mean[0], d1 = in.t[t][1] - mean[1], d2 = in.t[t][2] - mean[2];
-      c00 += d0 * d0, c01 += d0 * d1, c02 += d0 * d2;
-      c11 += d1 * d1, c12 += d1 * d2, c22 += d2 * d2;
-    }
+  for (unsigned bits = members; bits != 0; bits &= bits - 1) {
+    const float* x = in.t[std::countr_zero(bits)];
+    const double d0 = x[0] - mean[0], d1 = x[1] - mean[1], d2 = x[2] - mean[2];
+    c00 += d0 * d0, c01 += d0 * d1, c02 += d0 * d2;
+    c11 += d1 * d1, c12 += d1 * d2, c22 += d2 * d2;
+  }
   const double cov[3][3] = {{c00, c01, c02}, {c01, c11, c12}, {c02, c12, c22}};
   const std::array<double, 3> axis = PrincipalAxis(cov);
   double lo = 0.0, hi = 0.0, anchor_p = 0.0;
-  for (int t = 0; t < 16; ++t) {
-    if (((mask >> t) & 1) != s) continue;
+  for (unsigned bits = members; bits != 0; bits &= bits - 1) {
+    const int t = std::countr_zero(bits);
     double p = 0.0;
     for (int c = 0; c < 3; ++c) p += (in.t[t][c] - mean[c]) * axis[c];
     lo = std::min(lo, p), hi = std::max(hi, p);
@@ -559,7 +597,14 @@ std::array<int, kPartitionsTried> RankPartitions(const BlockInput& in, double& b
     lambda = std::clamp(lambda, 0.0, trace);
     return (trace - lambda) + lambda / 49.0;
   };
-  std::array<double, 32> score{};
+  // The kPartitionsTried lowest scores so far, in order of (score, partition number): the
+  // same list as sorting all 32 with lower partition numbers first on ties. A partition
+  // enters only with a score strictly below the list's last once the list is full, and its
+  // score is the sum of two non-negative subset estimates, so when the first one alone
+  // already reaches the last score the second is not needed.
+  std::array<int, kPartitionsTried> order;
+  std::array<double, kPartitionsTried> kept;
+  int count = 0;
   for (int part = 0; part < 32; ++part) {
     double s0 = 0, s1 = 0, s2 = 0, s3 = 0, s4 = 0, s5 = 0, s6 = 0, s7 = 0, s8 = 0;
     int n1 = 0;
@@ -568,35 +613,31 @@ std::array<int, kPartitionsTried> RankPartitions(const BlockInput& in, double& b
       s0 += p[0], s1 += p[1], s2 += p[2], s3 += p[3], s4 += p[4];
       s5 += p[5], s6 += p[6], s7 += p[7], s8 += p[8];
     }
+    const bool full = count == kPartitionsTried;
     double est = 0.0;
     est += estimate(16 - n1, total[0] - s0, total[1] - s1, total[2] - s2, total[3] - s3,
                     total[4] - s4, total[5] - s5, total[6] - s6, total[7] - s7, total[8] - s8);
+    if (full && !(est < kept[kPartitionsTried - 1])) continue;
     est += estimate(n1, s0, s1, s2, s3, s4, s5, s6, s7, s8);
-    score[part] = est;
+    if (full && !(est < kept[kPartitionsTried - 1])) continue;
+    int at = full ? kPartitionsTried - 1 : count++;
+    for (; at > 0 && est < kept[at - 1]; --at) kept[at] = kept[at - 1], order[at] = order[at - 1];
+    kept[at] = est, order[at] = part;
   }
-  // The kPartitionsTried lowest scores, lower partition numbers first on ties.
-  std::array<int, kPartitionsTried> order;
-  std::array<bool, 32> taken{};
-  for (int r = 0; r < kPartitionsTried; ++r) {
-    int pick = -1;
-    for (int part = 0; part < 32; ++part)
-      if (!taken[part] && (pick < 0 || score[part] < score[pick])) pick = part;
-    order[r] = pick;
-    taken[pick] = true;
-  }
-  best_estimate = score[order[0]];
+  best_estimate = kept[0];
   return order;
 }
 
 // True when the endpoints' quantized deltas fit the mode's fields without clamping.
-bool DeltasFit(const ModeInfo& info, const Endpoints& ends) {
+bool DeltasFit(const ModeInfo& info, QuantizedEnds& quantized) {
   if (!info.transformed) return true;
+  quantized.SetPrecision(info.epb);
   const int wrap = (1 << info.epb) - 1;
   for (int c = 0; c < 3; ++c) {
-    const int base = QuantizeEndpoint(ends.e[0][0][c], info.epb);
+    const int base = quantized.Get(0, c);
     const int limit = 1 << (info.delta[c] - 1);
     for (int e = 1; e < 2 * info.subsets; ++e) {
-      int d = (QuantizeEndpoint(ends.e[e / 2][e % 2][c], info.epb) - base) & wrap;
+      int d = (quantized.Get(e, c) - base) & wrap;
       if (d > wrap / 2) d -= wrap + 1;
       if (d < -limit || d >= limit) return false;
     }
@@ -615,11 +656,13 @@ void TryBestModes(int subsets, int partition, const Endpoints& ends, const Block
                      [](int a, int b) { return kModes[a].epb > kModes[b].epb; });
     return o;
   }();
+  const Tables& tables = GetTables();
+  QuantizedEnds quantized(ends);
   int tried = 0;
   for (int i : order) {
-    const Mode& mode = GetTables().modes[i];
-    if (mode.info.subsets != subsets || !DeltasFit(mode.info, ends)) continue;
-    TryMode(mode, partition, ends, in, kRefinements, best);
+    const Mode& mode = tables.modes[i];
+    if (mode.info.subsets != subsets || !DeltasFit(mode.info, quantized)) continue;
+    TryMode(mode, partition, ends, quantized, in, kRefinements, best);
     if (++tried == kModesTried) break;
   }
 }
