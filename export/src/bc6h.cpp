@@ -422,11 +422,15 @@ void TryMode(const Mode& mode, int partition, Endpoints ends, QuantizedEnds& fir
           e2[j] += w3[c] * d * d, plain[j] += d * d;
         }
       }
-      float best_e = std::numeric_limits<float>::infinity(), best_plain = 0.0f;
-      for (int k = std::max(0, centre - 1); k <= std::min(allowed - 1, centre + 1); ++k) {
-        const int j = k - centre + 1;
-        if (e2[j] < best_e) best_e = e2[j], best_plain = plain[j], indices[t] = k;
-      }
+      // Entries centre − 1, centre, centre + 1 in turn, a later one only when strictly better;
+      // the centre is always in range, so a missing neighbour simply loses.
+      constexpr float kMissing = std::numeric_limits<float>::infinity();
+      if (centre == 0) e2[0] = kMissing;
+      if (centre + 1 > allowed - 1) e2[2] = kMissing;
+      int pick = e2[1] < e2[0] ? 1 : 0;
+      if (e2[2] < e2[pick]) pick = 2;
+      const float best_e = e2[pick], best_plain = plain[pick];
+      indices[t] = centre - 1 + pick;
       error += best_e, plain_error += best_plain;
       if (last_pass && !(error < best.error)) break;
     }
