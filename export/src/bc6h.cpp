@@ -304,6 +304,7 @@ struct Encoded {
   float error = std::numeric_limits<float>::infinity();  // Σ w·(decoded − h)², candidates' order
   float plain_error = 0.0f;  // Σ (decoded − h)² in half steps, unweighted (the two-subset gate)
   float worst = 0.0f;  // max √w·|decoded − h|: half steps of each texel's largest channel
+                       // (one-subset candidates; infinity for two subsets)
   const Mode* mode = nullptr;
   int partition = 0;
   int fields[4][3] = {};
@@ -442,12 +443,12 @@ void TryMode(const Mode& mode, int partition, Endpoints ends, QuantizedEnds& fir
       std::memcpy(best.fields, fields, sizeof(fields));
       best.indices = indices;
       // The decoder's texels are these palette entries, so this is the decoded block's error.
-      float worst = 0.0f;
-      for (int t = 0; t < 16; ++t) {
-        const int s = (mask >> t) & 1;
+      // Only the one-subset search's early exit reads it; two-subset candidates leave it at
+      // infinity (not computed).
+      float worst = subsets == 1 ? 0.0f : std::numeric_limits<float>::infinity();
+      for (int t = 0; subsets == 1 && t < 16; ++t)
         for (int c = 0; c < 3; ++c)
-          worst = std::max(worst, in.r[t][c] * std::abs(pal[s][c][indices[t] + 1] - in.h[t][c]));
-      }
+          worst = std::max(worst, in.r[t][c] * std::abs(pal[0][c][indices[t] + 1] - in.h[t][c]));
       best.worst = worst;
     }
     // No refit can beat an exact candidate.
