@@ -286,8 +286,22 @@ struct SliceGeometry {
 };
 using GeometryCache = std::map<long, SliceGeometry>;
 
+// The texels of a validation fill's slices that its one read slice needs (ValidationNeeds), by
+// slice key (θin·10⁶ rounded); a slice without an entry is computed whole.
+using Mask = std::vector<std::uint8_t>;  // index j·361 + i, 1 = needed
+struct Needs {
+  std::map<long, Mask> texels;  // band and inserted slices: the texels to fill
+  std::map<long, Mask> model;   // the model grid: the texels to evaluate it at
+};
+long SliceKey(double theta_in_deg) { return std::lround(theta_in_deg * 1e6); }
+const Mask* MaskAt(const std::map<long, Mask>* masks, double theta_in_deg) {
+  if (masks == nullptr) return nullptr;
+  const auto it = masks->find(SliceKey(theta_in_deg));
+  return it == masks->end() ? nullptr : &it->second;
+}
+
 // Every texel's view in the slice at one θin (the shared SliceGeometry's), and the model there
-// (computed once per θin and model).
+// (computed once per θin and model; at the needed texels alone when the fill has Needs).
 struct SliceGrid {
   ViewsPtr views;
   std::vector<std::array<double, 3>> m;  // empty for M ≡ 1
@@ -300,17 +314,19 @@ struct Ratio {
   // The grid of the slice at `theta_in_deg`, computed on first use. Not thread-safe: call it
   // outside the parallel loops, which then only read the grids.
   const SliceGrid& Prepare(double theta_in_deg) const {
-    const long key = std::lround(theta_in_deg * 1e6);
+    const long key = SliceKey(theta_in_deg);
     if (auto it = grids->find(key); it != grids->end()) return it->second;
     SliceGeometry& s = GeometryOf(theta_in_deg, key);
     SliceGrid g{s.view, {}};
     if (model) {
       if (!s.g) s.g = SharedTables::GeometryAtViews(theta_in_deg, s.view);
       const Geometries& at = *s.g;
+      const Mask* only = MaskAt(needs ? &needs->model : nullptr, theta_in_deg);
       g.m.resize(at.size());
       ForRows([&](int j) {
         for (int i = 0; i < Lut::kWidth; ++i) {
           const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
+          if (only && !(*only)[n]) continue;  // never read (left 0)
           // FillModel::Eval at the cached geometry (the same numbers).
           g.m[n] = detail::EvaluateFillModel(model->material, at[n]);
         }
@@ -328,6 +344,8 @@ struct Ratio {
     return RatioOf(now.m[n], old.m[n]);
   }
   std::shared_ptr<GeometryCache> geometry = std::make_shared<GeometryCache>();
+  // A validation fill's needed texels (null: every texel of every slice).
+  std::shared_ptr<const Needs> needs;
   std::shared_ptr<std::map<long, SliceGrid>> grids = std::make_shared<std::map<long, SliceGrid>>();
 };
 
@@ -357,9 +375,11 @@ Lut Densify(const Lut& measured, double step, const Ratio& ratio) {
     const SliceGrid& g = ratio.Prepare(theta);
     const SliceGrid& ga = ratio.Prepare(ta);
     const SliceGrid& gb = ratio.Prepare(tb);
+    const Mask* only = MaskAt(ratio.needs ? &ratio.needs->texels : nullptr, theta);
     ForRows([&](int j) {
       for (int i = 0; i < Lut::kWidth; ++i) {
         const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
+        if (only && !(*only)[n]) continue;  // never read (left 0)
         const auto ra = ratio.Between(g, ga, n);
         const auto rb = ratio.Between(g, gb, n);
         const float* fa = measured.Texel(a, j, i);
@@ -432,11 +452,14 @@ Lut Fill(const Lut& measured_in, double theta_b, double max_theta_in, double ste
     const SliceGrid& g = ratio.Prepare(t);
     const GeometriesPtr band = SharedTables::BandAtViews(t, theta_b, g.views);
     const Material& model = ratio.model->material;
+    const Mask* only = MaskAt(ratio.needs ? &ratio.needs->texels : nullptr, t);
     ForRows([&](int j) {
       for (int i = 0; i < Lut::kWidth; ++i) {
         const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
         const View v = g.view()[n];
         if (v.theta_deg <= theta_b) continue;
+        // Neither read nor in the slice's albedo (θout < 90°), which scales the band below.
+        if (only && !(*only)[n] && v.theta_deg >= 90.0) continue;
         // FillModel::Eval(t, θb, φout) at the shared geometry (the same numbers).
         const auto r = RatioOf(g.m[n], detail::EvaluateFillModel(model, (*band)[n]));
         float* f = out.Texel(k, j, i);
@@ -496,6 +519,97 @@ Lut Fill(const Lut& measured_in, double theta_b, double max_theta_in, double ste
     report->extrapolated_theta_in_deg.push_back(t);
   }
   return out;
+}
+
+// The tap indices [lo, hi] along one axis that SampleTrilinear can read at coordinate x (the
+// texel coordinate before its floor), widened by 10⁻⁶ of a texel against rounding.
+std::pair<int, int> TapRange(double x, int n) {
+  const int lo = static_cast<int>(std::floor(x - 1e-6));
+  const int hi = static_cast<int>(std::floor(x + 1e-6)) + 1;
+  return {std::clamp(lo, 0, n - 1), std::clamp(hi, 0, n - 1)};
+}
+
+// What a validation fill (Fill of the slices `head` up to `max_theta_in`, of which Validate reads
+// the last slice alone) needs of its measured and inserted slices. Its new slices are computed
+// whole (each one's albedo limit reads all of it, and the next new slice continues it), and so
+// is the last measured slice (the first new slice continues it texel by texel). The other
+// slices are read only by the new slices' reciprocity, Lut::SampleTexture of the banded LUT
+// where the blend weight is below 1: the trilinear taps of those samples; an inserted slice's
+// taps again in its two measured neighbours (Densify reads them at the same texel); and for the
+// model grid of a measured slice also its band above the horizon, which the band's albedo
+// limit sums. The needs depend on the θin lists, θb and the steps alone, so they are computed
+// once per process and shared like the tables above.
+using NeedsKey =
+    std::tuple<std::vector<std::uint64_t>, std::uint64_t, std::uint64_t, std::uint64_t>;
+std::shared_ptr<const Needs> ValidationNeeds(const std::vector<double>& head, double theta_b,
+                                             double max_theta_in, double step) {
+  static SharedMap<NeedsKey, Needs> shared(16);
+  std::vector<std::uint64_t> bits(head.size());
+  std::transform(head.begin(), head.end(), bits.begin(), Bits);
+  return shared.Get({std::move(bits), Bits(theta_b), Bits(max_theta_in), Bits(step)}, [&] {
+    // The banded LUT's θin as Fill makes them (Densify when the step is finer).
+    const double delta = head[1] - head[0];
+    const int per = step > 0 ? static_cast<int>(std::lround(delta / step)) : 1;
+    Lut banded;                    // θin alone: for SliceCoordinate
+    std::vector<int> measured_of;  // the head slice of each banded slice, −1 when inserted
+    if (per > 1) {
+      for (int k = 0; k <= (static_cast<int>(head.size()) - 1) * per; ++k) {
+        banded.theta_in_deg.push_back(k * step);
+        measured_of.push_back(k % per == 0 ? k / per : -1);
+      }
+    } else {
+      banded.theta_in_deg = head;
+      for (int k = 0; k < static_cast<int>(head.size()); ++k) measured_of.push_back(k);
+    }
+    const int k_meas_step = banded.slices();
+    const double delta_b = banded.DeltaInDeg();
+    const double last = head.back();
+    const int k_total = static_cast<int>(std::floor(max_theta_in / delta_b + 1e-9)) + 1;
+    const std::size_t texels = static_cast<std::size_t>(Lut::kHeight) * Lut::kWidth;
+    std::vector<Mask> taps(static_cast<std::size_t>(k_meas_step), Mask(texels, 0));
+    for (int k = k_meas_step; k < k_total; ++k) {
+      const double t = k * delta_b;
+      const ViewsPtr views = SharedTables::ViewsAt(t);
+      for (std::size_t n = 0; n < texels; ++n) {
+        const View v = (*views)[n];
+        const double to = std::min(v.theta_deg, 90.0);
+        // Fill reads the banded LUT where w < 1, i.e. θout < θL + 5° (with a margin).
+        if (to >= last + kBlendDeg + 1e-6) continue;
+        const double ti = std::min(to, last);
+        const Vec3 w_d = SpecularFrame::FromThetaInDeg(ti).ToSpecular(
+            SphericalDirectionDeg(std::min(t, 90.0), -v.phi_deg));
+        const auto [k0, k1] = TapRange(banded.SliceCoordinate(ti), k_meas_step);
+        const auto [j0, j1] = TapRange(RadToDeg(ThetaOf(w_d)) / Lut::kTexelDeg, Lut::kHeight);
+        const auto [i0, i1] = TapRange(RadToDeg(PhiOf(w_d)) / Lut::kTexelDeg, Lut::kWidth);
+        for (int kk = k0; kk <= k1; ++kk)
+          for (int j = j0; j <= j1; ++j)
+            for (int i = i0; i <= i1; ++i)
+              taps[static_cast<std::size_t>(kk)][static_cast<std::size_t>(j) * Lut::kWidth + i] = 1;
+      }
+    }
+    auto needs = std::make_shared<Needs>();
+    for (int k = 0; k + 1 < k_meas_step; ++k) {
+      Mask m = taps[static_cast<std::size_t>(k)];
+      if (measured_of[k] < 0) {
+        needs->texels.emplace(SliceKey(banded.theta_in_deg[k]), m);
+        needs->model.emplace(SliceKey(banded.theta_in_deg[k]), std::move(m));
+        continue;
+      }
+      // The inserted slices on either side read this one at their own taps.
+      for (int q = std::max(0, k - per + 1); q < std::min(k_meas_step, k + per); ++q)
+        if (measured_of[q] < 0)
+          for (std::size_t n = 0; n < texels; ++n) m[n] |= taps[static_cast<std::size_t>(q)][n];
+      const double theta = head[static_cast<std::size_t>(measured_of[k])];
+      Mask model = m;
+      const ViewsPtr views = SharedTables::ViewsAt(theta);
+      for (std::size_t n = 0; n < texels; ++n)
+        if ((*views)[n].theta_deg > theta_b - 1e-6 && (*views)[n].theta_deg < 90.0 + 1e-6)
+          model[n] = 1;
+      needs->texels.emplace(SliceKey(theta), std::move(m));
+      needs->model.emplace(SliceKey(theta), std::move(model));
+    }
+    return std::shared_ptr<const Needs>(std::move(needs));
+  });
 }
 
 LeaveLastSliceOut Validate(const Lut& measured, double theta_b, const Lut& filled) {
@@ -735,7 +849,11 @@ Lut ExtendBeyondMeasured(const Lut& measured, double theta_b, const BeyondOption
     ratio.geometry = geometry;
     return ratio;
   };
-  const auto validate_with = [&](const Ratio& ratio) {
+  // What the validations' fills need (they are read at the left-out slice alone).
+  const std::shared_ptr<const Needs> needs =
+      validate ? ValidationNeeds(head.theta_in_deg, theta_b, last, fill_step) : nullptr;
+  const auto validate_with = [&](Ratio ratio) {
+    ratio.needs = needs;
     BeyondReport scratch;
     const Lut f = Fill(head, theta_b, last, fill_step, ratio, &scratch);
     return Validate(measured, theta_b, f);
