@@ -491,9 +491,11 @@ Lut Fill(const Lut& measured_in, double theta_b, double max_theta_in, double ste
     out.texels.resize(static_cast<std::size_t>(k + 1) * Lut::kHeight * Lut::kWidth * 3);
     const SliceGrid& g = ratio.Prepare(t);
     const SliceGrid& g_below = ratio.Prepare(t - delta);
+    const Mask* only = MaskAt(ratio.needs ? &ratio.needs->texels : nullptr, t);
     ForRows([&](int j) {
       for (int i = 0; i < Lut::kWidth; ++i) {
         const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
+        if (only && !(*only)[n]) continue;  // never read (left 0)
         const View v = g.view()[n];
         const double to = std::min(v.theta_deg, 90.0);
         const double w = std::clamp((to - (last - kBlendDeg)) / (2 * kBlendDeg), 0.0, 1.0);
@@ -530,15 +532,17 @@ std::pair<int, int> TapRange(double x, int n) {
 }
 
 // What a validation fill (Fill of the slices `head` up to `max_theta_in`, of which Validate reads
-// the last slice alone) needs of its measured and inserted slices. Its new slices are computed
-// whole (each one's albedo limit reads all of it, and the next new slice continues it), and so
-// is the last measured slice (the first new slice continues it texel by texel). The other
-// slices are read only by the new slices' reciprocity, Lut::SampleTexture of the banded LUT
-// where the blend weight is below 1: the trilinear taps of those samples; an inserted slice's
-// taps again in its two measured neighbours (Densify reads them at the same texel); and for the
-// model grid of a measured slice also its band above the horizon, which the band's albedo
-// limit sums. The needs depend on the θin lists, θb and the steps alone, so they are computed
-// once per process and shared like the tables above.
+// the last slice alone) needs of its slices, from the last one back. A new slice needs its
+// albedo's texels (θout < 90°: its albedo limit scales the slice by their sum; the last one's
+// include those Validate reads) and those the next new slice continues (blend weight w > 0),
+// and its model where it continues the slice below and where the next one continues it. The
+// banded LUT (the measured slices with their band and the inserted ones) is read by the new
+// slices' reciprocity (Lut::SampleTexture where w < 1) at that sample's trilinear taps, and its
+// last slice also where the first new slice continues it; an inserted slice is computed from
+// its two measured neighbours at the same texel, so they need its texels too; and a measured
+// slice's band is also computed above the horizon, which its albedo limit sums. The needs
+// depend on the θin lists, θb and the steps alone, so they are computed once per process and
+// shared like the tables above.
 using NeedsKey =
     std::tuple<std::vector<std::uint64_t>, std::uint64_t, std::uint64_t, std::uint64_t>;
 std::shared_ptr<const Needs> ValidationNeeds(const std::vector<double>& head, double theta_b,
@@ -566,16 +570,48 @@ std::shared_ptr<const Needs> ValidationNeeds(const std::vector<double>& head, do
     const double last = head.back();
     const int k_total = static_cast<int>(std::floor(max_theta_in / delta_b + 1e-9)) + 1;
     const std::size_t texels = static_cast<std::size_t>(Lut::kHeight) * Lut::kWidth;
-    std::vector<Mask> taps(static_cast<std::size_t>(k_meas_step), Mask(texels, 0));
-    for (int k = k_meas_step; k < k_total; ++k) {
-      const double t = k * delta_b;
-      const ViewsPtr views = SharedTables::ViewsAt(t);
+    const int n_new = k_total - k_meas_step;
+    auto needs = std::make_shared<Needs>();
+    if (n_new <= 0) return std::shared_ptr<const Needs>(std::move(needs));
+    // Fill's blend weight w of a new slice's texel is above 0 where θout > θL − 5° and below 1
+    // where θout < θL + 5° (both with a margin).
+    const auto continues = [&](const View& v) {
+      return std::min(v.theta_deg, 90.0) > last - kBlendDeg - 1e-6;
+    };
+    const auto reads_banded = [&](const View& v) {
+      return std::min(v.theta_deg, 90.0) < last + kBlendDeg + 1e-6;
+    };
+    // The new slices, last first: each needs its albedo's texels (θout < 90°; the last one's
+    // include those Validate reads) and those the next new slice continues; its model grid is
+    // read where it continues the slice below and where the next one continues it.
+    std::vector<ViewsPtr> views_new(static_cast<std::size_t>(n_new));
+    for (int q = 0; q < n_new; ++q)
+      views_new[static_cast<std::size_t>(q)] = SharedTables::ViewsAt((k_meas_step + q) * delta_b);
+    std::vector<Mask> need(static_cast<std::size_t>(n_new));
+    Mask continued(texels, 0);  // of the slice q: the texels slice q + 1 continues
+    for (int q = n_new - 1; q >= 0; --q) {
+      const Views& views = *views_new[static_cast<std::size_t>(q)];
+      Mask m(texels, 0), model = continued, below(texels, 0);
       for (std::size_t n = 0; n < texels; ++n) {
-        const View v = (*views)[n];
-        const double to = std::min(v.theta_deg, 90.0);
-        // Fill reads the banded LUT where w < 1, i.e. θout < θL + 5° (with a margin).
-        if (to >= last + kBlendDeg + 1e-6) continue;
-        const double ti = std::min(to, last);
+        m[n] = views[n].theta_deg < 90.0 + 1e-6 || continued[n];
+        if (m[n] && continues(views[n])) below[n] = 1, model[n] = 1;
+      }
+      const double t = (k_meas_step + q) * delta_b;
+      needs->texels.emplace(SliceKey(t), m);
+      needs->model.emplace(SliceKey(t), std::move(model));
+      need[static_cast<std::size_t>(q)] = std::move(m);
+      continued = std::move(below);
+    }
+    // Now `continued` is of the last banded slice. The banded LUT's reads: their taps.
+    std::vector<Mask> taps(static_cast<std::size_t>(k_meas_step), Mask(texels, 0));
+    taps.back() = continued;
+    for (int q = 0; q < n_new; ++q) {
+      const double t = (k_meas_step + q) * delta_b;
+      const Views& views = *views_new[static_cast<std::size_t>(q)];
+      for (std::size_t n = 0; n < texels; ++n) {
+        const View v = views[n];
+        if (!need[static_cast<std::size_t>(q)][n] || !reads_banded(v)) continue;
+        const double ti = std::min(std::min(v.theta_deg, 90.0), last);
         const Vec3 w_d = SpecularFrame::FromThetaInDeg(ti).ToSpecular(
             SphericalDirectionDeg(std::min(t, 90.0), -v.phi_deg));
         const auto [k0, k1] = TapRange(banded.SliceCoordinate(ti), k_meas_step);
@@ -587,8 +623,7 @@ std::shared_ptr<const Needs> ValidationNeeds(const std::vector<double>& head, do
               taps[static_cast<std::size_t>(kk)][static_cast<std::size_t>(j) * Lut::kWidth + i] = 1;
       }
     }
-    auto needs = std::make_shared<Needs>();
-    for (int k = 0; k + 1 < k_meas_step; ++k) {
+    for (int k = 0; k < k_meas_step; ++k) {
       Mask m = taps[static_cast<std::size_t>(k)];
       if (measured_of[k] < 0) {
         needs->texels.emplace(SliceKey(banded.theta_in_deg[k]), m);
