@@ -244,6 +244,19 @@ class SharedTables {
         ->Table();
   }
 
+  // cos θout of every texel of `views` (the albedo's weights, std::cos as Albedo computed it).
+  static std::shared_ptr<const std::vector<double>> CosinesAt(const ViewsPtr& views) {
+    using Entry = std::pair<ViewsPtr, std::vector<double>>;  // the views kept alive (the key)
+    static SharedMap<const Views*, Entry> cosines(kMaxSlices);
+    const std::shared_ptr<const Entry> e = cosines.Get(views.get(), [&] {
+      auto c = std::make_shared<Entry>(views, std::vector<double>(views->size()));
+      for (std::size_t n = 0; n < views->size(); ++n)
+        c->second[n] = std::cos(DegToRad((*views)[n].theta_deg));
+      return c;
+    });
+    return {e, &e->second};
+  }
+
  private:
   // 1 MB of views and 3 MB of geometry per θin: a capture's fill uses 9 θin, an RGL file's
   // a few dozen.
@@ -400,15 +413,17 @@ void Albedo(const Lut& lut, int k, const SliceGrid& g, Filled filled, std::array
             std::array<double, 3>* fill) {
   *total = {0, 0, 0};
   *fill = {0, 0, 0};
+  const std::shared_ptr<const std::vector<double>> cosines = SharedTables::CosinesAt(g.views);
   for (int j = 0; j < Lut::kHeight; ++j) {
     // The texel's cell: θd ∈ [j − ½, j + ½]° (clipped at the poles), φd ∈ [i − ½, i + ½]°.
     const double dw = (std::cos(DegToRad(std::max(j - 0.5, 0.0))) -
                        std::cos(DegToRad(std::min(j + 0.5, 180.0)))) *
                       DegToRad(Lut::kTexelDeg);
     for (int i = 0; i < Lut::kWidth - 1; ++i) {
-      const View v = g.view()[static_cast<std::size_t>(j) * Lut::kWidth + i];
+      const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
+      const View v = g.view()[n];
       if (v.theta_deg >= 90.0) continue;
-      const double w = dw * std::cos(DegToRad(v.theta_deg));
+      const double w = dw * (*cosines)[n];
       const float* f = lut.Texel(k, j, i);
       const bool is_fill = filled(j, i, v);
       for (int c = 0; c < 3; ++c) {
