@@ -244,6 +244,19 @@ class SharedTables {
         ->Table();
   }
 
+  // cos θout of every texel of `views` (the albedo's weights, std::cos as Albedo computed it).
+  static std::shared_ptr<const std::vector<double>> CosinesAt(const ViewsPtr& views) {
+    using Entry = std::pair<ViewsPtr, std::vector<double>>;  // the views kept alive (the key)
+    static SharedMap<const Views*, Entry> cosines(kMaxSlices);
+    const std::shared_ptr<const Entry> e = cosines.Get(views.get(), [&] {
+      auto c = std::make_shared<Entry>(views, std::vector<double>(views->size()));
+      for (std::size_t n = 0; n < views->size(); ++n)
+        c->second[n] = std::cos(DegToRad((*views)[n].theta_deg));
+      return c;
+    });
+    return {e, &e->second};
+  }
+
  private:
   // 1 MB of views and 3 MB of geometry per θin: a capture's fill uses 9 θin, an RGL file's
   // a few dozen.
@@ -286,8 +299,22 @@ struct SliceGeometry {
 };
 using GeometryCache = std::map<long, SliceGeometry>;
 
+// The texels of a validation fill's slices that its one read slice needs (ValidationNeeds), by
+// slice key (θin·10⁶ rounded); a slice without an entry is computed whole.
+using Mask = std::vector<std::uint8_t>;  // index j·361 + i, 1 = needed
+struct Needs {
+  std::map<long, Mask> texels;  // band and inserted slices: the texels to fill
+  std::map<long, Mask> model;   // the model grid: the texels to evaluate it at
+};
+long SliceKey(double theta_in_deg) { return std::lround(theta_in_deg * 1e6); }
+const Mask* MaskAt(const std::map<long, Mask>* masks, double theta_in_deg) {
+  if (masks == nullptr) return nullptr;
+  const auto it = masks->find(SliceKey(theta_in_deg));
+  return it == masks->end() ? nullptr : &it->second;
+}
+
 // Every texel's view in the slice at one θin (the shared SliceGeometry's), and the model there
-// (computed once per θin and model).
+// (computed once per θin and model; at the needed texels alone when the fill has Needs).
 struct SliceGrid {
   ViewsPtr views;
   std::vector<std::array<double, 3>> m;  // empty for M ≡ 1
@@ -300,17 +327,19 @@ struct Ratio {
   // The grid of the slice at `theta_in_deg`, computed on first use. Not thread-safe: call it
   // outside the parallel loops, which then only read the grids.
   const SliceGrid& Prepare(double theta_in_deg) const {
-    const long key = std::lround(theta_in_deg * 1e6);
+    const long key = SliceKey(theta_in_deg);
     if (auto it = grids->find(key); it != grids->end()) return it->second;
     SliceGeometry& s = GeometryOf(theta_in_deg, key);
     SliceGrid g{s.view, {}};
     if (model) {
       if (!s.g) s.g = SharedTables::GeometryAtViews(theta_in_deg, s.view);
       const Geometries& at = *s.g;
+      const Mask* only = MaskAt(needs ? &needs->model : nullptr, theta_in_deg);
       g.m.resize(at.size());
       ForRows([&](int j) {
         for (int i = 0; i < Lut::kWidth; ++i) {
           const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
+          if (only && !(*only)[n]) continue;  // never read (left 0)
           // FillModel::Eval at the cached geometry (the same numbers).
           g.m[n] = detail::EvaluateFillModel(model->material, at[n]);
         }
@@ -328,6 +357,8 @@ struct Ratio {
     return RatioOf(now.m[n], old.m[n]);
   }
   std::shared_ptr<GeometryCache> geometry = std::make_shared<GeometryCache>();
+  // A validation fill's needed texels (null: every texel of every slice).
+  std::shared_ptr<const Needs> needs;
   std::shared_ptr<std::map<long, SliceGrid>> grids = std::make_shared<std::map<long, SliceGrid>>();
 };
 
@@ -357,9 +388,11 @@ Lut Densify(const Lut& measured, double step, const Ratio& ratio) {
     const SliceGrid& g = ratio.Prepare(theta);
     const SliceGrid& ga = ratio.Prepare(ta);
     const SliceGrid& gb = ratio.Prepare(tb);
+    const Mask* only = MaskAt(ratio.needs ? &ratio.needs->texels : nullptr, theta);
     ForRows([&](int j) {
       for (int i = 0; i < Lut::kWidth; ++i) {
         const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
+        if (only && !(*only)[n]) continue;  // never read (left 0)
         const auto ra = ratio.Between(g, ga, n);
         const auto rb = ratio.Between(g, gb, n);
         const float* fa = measured.Texel(a, j, i);
@@ -380,15 +413,17 @@ void Albedo(const Lut& lut, int k, const SliceGrid& g, Filled filled, std::array
             std::array<double, 3>* fill) {
   *total = {0, 0, 0};
   *fill = {0, 0, 0};
+  const std::shared_ptr<const std::vector<double>> cosines = SharedTables::CosinesAt(g.views);
   for (int j = 0; j < Lut::kHeight; ++j) {
     // The texel's cell: θd ∈ [j − ½, j + ½]° (clipped at the poles), φd ∈ [i − ½, i + ½]°.
     const double dw = (std::cos(DegToRad(std::max(j - 0.5, 0.0))) -
                        std::cos(DegToRad(std::min(j + 0.5, 180.0)))) *
                       DegToRad(Lut::kTexelDeg);
     for (int i = 0; i < Lut::kWidth - 1; ++i) {
-      const View v = g.view()[static_cast<std::size_t>(j) * Lut::kWidth + i];
+      const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
+      const View v = g.view()[n];
       if (v.theta_deg >= 90.0) continue;
-      const double w = dw * std::cos(DegToRad(v.theta_deg));
+      const double w = dw * (*cosines)[n];
       const float* f = lut.Texel(k, j, i);
       const bool is_fill = filled(j, i, v);
       for (int c = 0; c < 3; ++c) {
@@ -432,11 +467,14 @@ Lut Fill(const Lut& measured_in, double theta_b, double max_theta_in, double ste
     const SliceGrid& g = ratio.Prepare(t);
     const GeometriesPtr band = SharedTables::BandAtViews(t, theta_b, g.views);
     const Material& model = ratio.model->material;
+    const Mask* only = MaskAt(ratio.needs ? &ratio.needs->texels : nullptr, t);
     ForRows([&](int j) {
       for (int i = 0; i < Lut::kWidth; ++i) {
         const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
         const View v = g.view()[n];
         if (v.theta_deg <= theta_b) continue;
+        // Neither read nor in the slice's albedo (θout < 90°), which scales the band below.
+        if (only && !(*only)[n] && v.theta_deg >= 90.0) continue;
         // FillModel::Eval(t, θb, φout) at the shared geometry (the same numbers).
         const auto r = RatioOf(g.m[n], detail::EvaluateFillModel(model, (*band)[n]));
         float* f = out.Texel(k, j, i);
@@ -468,9 +506,11 @@ Lut Fill(const Lut& measured_in, double theta_b, double max_theta_in, double ste
     out.texels.resize(static_cast<std::size_t>(k + 1) * Lut::kHeight * Lut::kWidth * 3);
     const SliceGrid& g = ratio.Prepare(t);
     const SliceGrid& g_below = ratio.Prepare(t - delta);
+    const Mask* only = MaskAt(ratio.needs ? &ratio.needs->texels : nullptr, t);
     ForRows([&](int j) {
       for (int i = 0; i < Lut::kWidth; ++i) {
         const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
+        if (only && !(*only)[n]) continue;  // never read (left 0)
         const View v = g.view()[n];
         const double to = std::min(v.theta_deg, 90.0);
         const double w = std::clamp((to - (last - kBlendDeg)) / (2 * kBlendDeg), 0.0, 1.0);
@@ -496,6 +536,130 @@ Lut Fill(const Lut& measured_in, double theta_b, double max_theta_in, double ste
     report->extrapolated_theta_in_deg.push_back(t);
   }
   return out;
+}
+
+// The tap indices [lo, hi] along one axis that SampleTrilinear can read at coordinate x (the
+// texel coordinate before its floor), widened by 10⁻⁶ of a texel against rounding.
+std::pair<int, int> TapRange(double x, int n) {
+  const int lo = static_cast<int>(std::floor(x - 1e-6));
+  const int hi = static_cast<int>(std::floor(x + 1e-6)) + 1;
+  return {std::clamp(lo, 0, n - 1), std::clamp(hi, 0, n - 1)};
+}
+
+// What a validation fill (Fill of the slices `head` up to `max_theta_in`, of which Validate reads
+// the last slice alone) needs of its slices, from the last one back. A new slice needs its
+// albedo's texels (θout < 90°: its albedo limit scales the slice by their sum; the last one's
+// include those Validate reads) and those the next new slice continues (blend weight w > 0),
+// and its model where it continues the slice below and where the next one continues it. The
+// banded LUT (the measured slices with their band and the inserted ones) is read by the new
+// slices' reciprocity (Lut::SampleTexture where w < 1) at that sample's trilinear taps, and its
+// last slice also where the first new slice continues it; an inserted slice is computed from
+// its two measured neighbours at the same texel, so they need its texels too; and a measured
+// slice's band is also computed above the horizon, which its albedo limit sums. The needs
+// depend on the θin lists, θb and the steps alone, so they are computed once per process and
+// shared like the tables above.
+using NeedsKey =
+    std::tuple<std::vector<std::uint64_t>, std::uint64_t, std::uint64_t, std::uint64_t>;
+std::shared_ptr<const Needs> ValidationNeeds(const std::vector<double>& head, double theta_b,
+                                             double max_theta_in, double step) {
+  static SharedMap<NeedsKey, Needs> shared(16);
+  std::vector<std::uint64_t> bits(head.size());
+  std::transform(head.begin(), head.end(), bits.begin(), Bits);
+  return shared.Get({std::move(bits), Bits(theta_b), Bits(max_theta_in), Bits(step)}, [&] {
+    // The banded LUT's θin as Fill makes them (Densify when the step is finer).
+    const double delta = head[1] - head[0];
+    const int per = step > 0 ? static_cast<int>(std::lround(delta / step)) : 1;
+    Lut banded;                    // θin alone: for SliceCoordinate
+    std::vector<int> measured_of;  // the head slice of each banded slice, −1 when inserted
+    if (per > 1) {
+      for (int k = 0; k <= (static_cast<int>(head.size()) - 1) * per; ++k) {
+        banded.theta_in_deg.push_back(k * step);
+        measured_of.push_back(k % per == 0 ? k / per : -1);
+      }
+    } else {
+      banded.theta_in_deg = head;
+      for (int k = 0; k < static_cast<int>(head.size()); ++k) measured_of.push_back(k);
+    }
+    const int k_meas_step = banded.slices();
+    const double delta_b = banded.DeltaInDeg();
+    const double last = head.back();
+    const int k_total = static_cast<int>(std::floor(max_theta_in / delta_b + 1e-9)) + 1;
+    const std::size_t texels = static_cast<std::size_t>(Lut::kHeight) * Lut::kWidth;
+    const int n_new = k_total - k_meas_step;
+    auto needs = std::make_shared<Needs>();
+    if (n_new <= 0) return std::shared_ptr<const Needs>(std::move(needs));
+    // Fill's blend weight w of a new slice's texel is above 0 where θout > θL − 5° and below 1
+    // where θout < θL + 5° (both with a margin).
+    const auto continues = [&](const View& v) {
+      return std::min(v.theta_deg, 90.0) > last - kBlendDeg - 1e-6;
+    };
+    const auto reads_banded = [&](const View& v) {
+      return std::min(v.theta_deg, 90.0) < last + kBlendDeg + 1e-6;
+    };
+    // The new slices, last first: each needs its albedo's texels (θout < 90°; the last one's
+    // include those Validate reads) and those the next new slice continues; its model grid is
+    // read where it continues the slice below and where the next one continues it.
+    std::vector<ViewsPtr> views_new(static_cast<std::size_t>(n_new));
+    for (int q = 0; q < n_new; ++q)
+      views_new[static_cast<std::size_t>(q)] = SharedTables::ViewsAt((k_meas_step + q) * delta_b);
+    std::vector<Mask> need(static_cast<std::size_t>(n_new));
+    Mask continued(texels, 0);  // of the slice q: the texels slice q + 1 continues
+    for (int q = n_new - 1; q >= 0; --q) {
+      const Views& views = *views_new[static_cast<std::size_t>(q)];
+      Mask m(texels, 0), model = continued, below(texels, 0);
+      for (std::size_t n = 0; n < texels; ++n) {
+        m[n] = views[n].theta_deg < 90.0 + 1e-6 || continued[n];
+        if (m[n] && continues(views[n])) below[n] = 1, model[n] = 1;
+      }
+      const double t = (k_meas_step + q) * delta_b;
+      needs->texels.emplace(SliceKey(t), m);
+      needs->model.emplace(SliceKey(t), std::move(model));
+      need[static_cast<std::size_t>(q)] = std::move(m);
+      continued = std::move(below);
+    }
+    // Now `continued` is of the last banded slice. The banded LUT's reads: their taps.
+    std::vector<Mask> taps(static_cast<std::size_t>(k_meas_step), Mask(texels, 0));
+    taps.back() = continued;
+    for (int q = 0; q < n_new; ++q) {
+      const double t = (k_meas_step + q) * delta_b;
+      const Views& views = *views_new[static_cast<std::size_t>(q)];
+      for (std::size_t n = 0; n < texels; ++n) {
+        const View v = views[n];
+        if (!need[static_cast<std::size_t>(q)][n] || !reads_banded(v)) continue;
+        const double ti = std::min(std::min(v.theta_deg, 90.0), last);
+        const Vec3 w_d = SpecularFrame::FromThetaInDeg(ti).ToSpecular(
+            SphericalDirectionDeg(std::min(t, 90.0), -v.phi_deg));
+        const auto [k0, k1] = TapRange(banded.SliceCoordinate(ti), k_meas_step);
+        const auto [j0, j1] = TapRange(RadToDeg(ThetaOf(w_d)) / Lut::kTexelDeg, Lut::kHeight);
+        const auto [i0, i1] = TapRange(RadToDeg(PhiOf(w_d)) / Lut::kTexelDeg, Lut::kWidth);
+        for (int kk = k0; kk <= k1; ++kk)
+          for (int j = j0; j <= j1; ++j)
+            for (int i = i0; i <= i1; ++i)
+              taps[static_cast<std::size_t>(kk)][static_cast<std::size_t>(j) * Lut::kWidth + i] = 1;
+      }
+    }
+    for (int k = 0; k < k_meas_step; ++k) {
+      Mask m = taps[static_cast<std::size_t>(k)];
+      if (measured_of[k] < 0) {
+        needs->texels.emplace(SliceKey(banded.theta_in_deg[k]), m);
+        needs->model.emplace(SliceKey(banded.theta_in_deg[k]), std::move(m));
+        continue;
+      }
+      // The inserted slices on either side read this one at their own taps.
+      for (int q = std::max(0, k - per + 1); q < std::min(k_meas_step, k + per); ++q)
+        if (measured_of[q] < 0)
+          for (std::size_t n = 0; n < texels; ++n) m[n] |= taps[static_cast<std::size_t>(q)][n];
+      const double theta = head[static_cast<std::size_t>(measured_of[k])];
+      Mask model = m;
+      const ViewsPtr views = SharedTables::ViewsAt(theta);
+      for (std::size_t n = 0; n < texels; ++n)
+        if ((*views)[n].theta_deg > theta_b - 1e-6 && (*views)[n].theta_deg < 90.0 + 1e-6)
+          model[n] = 1;
+      needs->texels.emplace(SliceKey(theta), std::move(m));
+      needs->model.emplace(SliceKey(theta), std::move(model));
+    }
+    return std::shared_ptr<const Needs>(std::move(needs));
+  });
 }
 
 LeaveLastSliceOut Validate(const Lut& measured, double theta_b, const Lut& filled) {
@@ -735,7 +899,11 @@ Lut ExtendBeyondMeasured(const Lut& measured, double theta_b, const BeyondOption
     ratio.geometry = geometry;
     return ratio;
   };
-  const auto validate_with = [&](const Ratio& ratio) {
+  // What the validations' fills need (they are read at the left-out slice alone).
+  const std::shared_ptr<const Needs> needs =
+      validate ? ValidationNeeds(head.theta_in_deg, theta_b, last, fill_step) : nullptr;
+  const auto validate_with = [&](Ratio ratio) {
+    ratio.needs = needs;
     BeyondReport scratch;
     const Lut f = Fill(head, theta_b, last, fill_step, ratio, &scratch);
     return Validate(measured, theta_b, f);
