@@ -141,11 +141,8 @@ LutCompression ChooseAtlasCompression(Atlas& atlas, const std::vector<AtlasMater
       const Lut cell =
           ExtractAtlasCell(atlas.volume, atlas.layout, static_cast<int>(m), atlas.theta_in_deg);
       const std::optional<ExtrapolationInfo>& x = materials[m].extrapolation;
-      CertifiedError e =
-          MeasureCompressionError(*materials[m].lut, cell.texels, x ? x->theta_b_deg : 90.0);
-      e.format = "rgb9e5";
-      e.bytes = e.rgb9e5_bytes = atlas.volume.ByteSize();
-      atlas.certified_error.push_back(e);
+      atlas.certified_error.push_back(MeasureRgb9e5Error(
+          *materials[m].lut, cell.texels, x ? x->theta_b_deg : 90.0, atlas.volume.ByteSize()));
     }
   }
   for (CertifiedError& e : atlas.certified_error) {

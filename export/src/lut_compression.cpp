@@ -88,6 +88,14 @@ CertifiedError MeasureCompressionError(const Lut& reference, const std::vector<f
   return e;
 }
 
+CertifiedError MeasureRgb9e5Error(const Lut& reference, const std::vector<float>& decoded,
+                                  double theta_b_deg, std::uint64_t bytes) {
+  CertifiedError e = MeasureCompressionError(reference, decoded, theta_b_deg);
+  e.format = "rgb9e5";
+  e.bytes = e.rgb9e5_bytes = bytes;
+  return e;
+}
+
 CompressedLut CompressLutBc6h(const Lut& lut, double theta_b_deg, int jobs) {
   ValidateLutForExport(lut);
   CompressedLut out;

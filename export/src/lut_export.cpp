@@ -72,19 +72,6 @@ const char* LutCompressionName(LutCompression compression) {
   return "RGB9E5";
 }
 
-namespace {
-
-// The certified error of the RGB9E5 words themselves (for --max-error's comparison).
-CertifiedError Rgb9e5Error(const Lut& lut, const PackedVolume& packed, double theta_b_deg) {
-  CertifiedError e =
-      MeasureCompressionError(lut, UnpackLut(packed, lut.theta_in_deg).texels, theta_b_deg);
-  e.format = "rgb9e5";
-  e.bytes = e.rgb9e5_bytes = packed.ByteSize();
-  return e;
-}
-
-}  // namespace
-
 LutExportResult ExportLut(const std::string& out_dir, const Lut& lut, TextureMetadata metadata,
                           const LutExportOptions& options) {
   return ExportLut(out_dir, lut, PackLut(lut), std::move(metadata), options);
@@ -124,7 +111,8 @@ LutExportResult ExportLut(const std::string& out_dir, const Lut& lut, const Pack
       } else {
         chosen = LutCompression::kNone;
         compressed.reset(), compact.reset();
-        result.certified_error = Rgb9e5Error(lut, packed, theta_b);
+        result.certified_error = MeasureRgb9e5Error(lut, UnpackLut(packed, lut.theta_in_deg).texels,
+                                                    theta_b, packed.ByteSize());
         result.met_max_error = result.certified_error->measured.max <= bound;
       }
     }

@@ -12,6 +12,7 @@
 // them.
 #pragma once
 
+#include <cstdint>
 #include <string_view>
 #include <vector>
 
@@ -38,6 +39,12 @@ double TexelThetaOutDeg(double theta_in_deg, int j, int i);
 // on a size mismatch.
 CertifiedError MeasureCompressionError(const Lut& reference, const std::vector<float>& decoded,
                                        double theta_b_deg);
+
+// MeasureCompressionError of RGB9E5 words decoded into `decoded`, recorded as the "rgb9e5"
+// format whose texture holds `bytes` (a LUT's packed volume, or a whole atlas for one of its
+// cells): what `--max-error` compares when it keeps RGB9E5.
+CertifiedError MeasureRgb9e5Error(const Lut& reference, const std::vector<float>& decoded,
+                                  double theta_b_deg, std::uint64_t bytes);
 
 struct CompressedLut {
   Bc6hVolume blocks;
