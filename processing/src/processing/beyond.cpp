@@ -208,53 +208,28 @@ class SharedTables {
   }
   // GeometryAt(θin, view) of every texel of `views`.
   static GeometriesPtr GeometryAtViews(double theta_in_deg, const ViewsPtr& views) {
-    static SharedMap<GeometryKey, Held> geometry(kMaxSlices);
-    return geometry
-        .Get({Bits(theta_in_deg), 0, views.get()},
-             [&] {
-               auto g = std::make_shared<Held>(views, Geometries(views->size()));
-               ForRows([&](int j) {
-                 for (int i = 0; i < Lut::kWidth; ++i) {
-                   const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
-                   g->table[n] =
-                       GeometryAt(theta_in_deg, (*views)[n].theta_deg, (*views)[n].phi_deg);
-                 }
-               });
-               return g;
-             })
-        ->Table();
+    static SharedMap<GeometryKey, Derived<ShadingGeometry>> geometry(kMaxSlices);
+    return PerTexel(geometry, {Bits(theta_in_deg), 0, views.get()}, views, true,
+                    [&](const View& v, ShadingGeometry& g) {
+                      g = GeometryAt(theta_in_deg, v.theta_deg, v.phi_deg);
+                    });
   }
   // GeometryAt(θin, θb, φout) at every texel of `views` whose θout is beyond θb (the others
   // are left default).
   static GeometriesPtr BandAtViews(double theta_in_deg, double theta_b_deg, const ViewsPtr& views) {
-    static SharedMap<GeometryKey, Held> band(kMaxSlices);
-    return band
-        .Get({Bits(theta_in_deg), Bits(theta_b_deg), views.get()},
-             [&] {
-               auto g = std::make_shared<Held>(views, Geometries(views->size()));
-               ForRows([&](int j) {
-                 for (int i = 0; i < Lut::kWidth; ++i) {
-                   const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
-                   if ((*views)[n].theta_deg > theta_b_deg)
-                     g->table[n] = GeometryAt(theta_in_deg, theta_b_deg, (*views)[n].phi_deg);
-                 }
-               });
-               return g;
-             })
-        ->Table();
+    static SharedMap<GeometryKey, Derived<ShadingGeometry>> band(kMaxSlices);
+    return PerTexel(band, {Bits(theta_in_deg), Bits(theta_b_deg), views.get()}, views, true,
+                    [&](const View& v, ShadingGeometry& g) {
+                      if (v.theta_deg > theta_b_deg)
+                        g = GeometryAt(theta_in_deg, theta_b_deg, v.phi_deg);
+                    });
   }
 
   // cos θout of every texel of `views` (the albedo's weights, std::cos as Albedo computed it).
   static std::shared_ptr<const std::vector<double>> CosinesAt(const ViewsPtr& views) {
-    using Entry = std::pair<ViewsPtr, std::vector<double>>;  // the views kept alive (the key)
-    static SharedMap<const Views*, Entry> cosines(kMaxSlices);
-    const std::shared_ptr<const Entry> e = cosines.Get(views.get(), [&] {
-      auto c = std::make_shared<Entry>(views, std::vector<double>(views->size()));
-      for (std::size_t n = 0; n < views->size(); ++n)
-        c->second[n] = std::cos(DegToRad((*views)[n].theta_deg));
-      return c;
-    });
-    return {e, &e->second};
+    static SharedMap<const Views*, Derived<double>> cosines(kMaxSlices);
+    return PerTexel(cosines, views.get(), views, false,
+                    [](const View& v, double& c) { c = std::cos(DegToRad(v.theta_deg)); });
   }
 
  private:
@@ -262,14 +237,36 @@ class SharedTables {
   // a few dozen.
   static constexpr std::size_t kMaxSlices = 64;
   using GeometryKey = std::tuple<std::uint64_t, std::uint64_t, const Views*>;
-  // A geometry table keeps the view table it was computed from alive, so the address in its
-  // key cannot be taken by another view table while the entry exists.
-  struct Held : std::enable_shared_from_this<Held> {
-    Held(ViewsPtr v, Geometries t) : views(std::move(v)), table(std::move(t)) {}
+  // A table computed from a view table, one entry per texel. It keeps the view table alive, so
+  // the address in its key cannot be taken by another view table while the entry exists.
+  template <class T>
+  struct Derived {
+    Derived(ViewsPtr v, std::size_t n) : views(std::move(v)), table(n) {}
     ViewsPtr views;
-    Geometries table;
-    GeometriesPtr Table() const { return GeometriesPtr(shared_from_this(), &table); }
+    std::vector<T> table;
   };
+  // The shared table of `key`, made by fill(view, entry) for every texel of `views` (by rows on
+  // TBB's workers when `parallel`).
+  template <class Key, class T, class Fill>
+  static std::shared_ptr<const std::vector<T>> PerTexel(SharedMap<Key, Derived<T>>& map,
+                                                        const Key& key, const ViewsPtr& views,
+                                                        bool parallel, const Fill& fill) {
+    const std::shared_ptr<const Derived<T>> d = map.Get(key, [&] {
+      auto made = std::make_shared<Derived<T>>(views, views->size());
+      const auto row = [&](int j) {
+        for (int i = 0; i < Lut::kWidth; ++i) {
+          const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
+          fill((*views)[n], made->table[n]);
+        }
+      };
+      if (parallel)
+        ForRows(row);
+      else
+        for (int j = 0; j < Lut::kHeight; ++j) row(j);
+      return made;
+    });
+    return {d, &d->table};
+  }
 };
 
 // The fit points of FitFillModel are chosen by their views alone (θout ≤ θb), so a LUT's θin
