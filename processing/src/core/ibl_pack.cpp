@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -96,25 +97,56 @@ struct Moments {
   double e = 0.0;
   Bands at_n{}, at_r{};  // t_{n,ℓ}, t_{R,ℓ}
 };
-double Criterion(const Moments& m, const Bands& kappa, const Bands& p_mu, double* s_out) {
-  const Bands& cosine = CosineCoefficients();
-  // Model response: (E − S)·a + S·b = E·a + S·(b − a).
-  double num = 0.0, den = 0.0;
-  for (int l = 1; l < kBands; ++l) {
-    const double weight = 2.0 * l + 1.0;
-    const double a_n = cosine[l], b_n = p_mu[l] * kappa[l];
-    const double a_r = p_mu[l] * cosine[l], b_r = kappa[l];
-    num += weight * ((m.at_n[l] - m.e * a_n) * (b_n - a_n) + (m.at_r[l] - m.e * a_r) * (b_r - a_r));
-    den += weight * ((b_n - a_n) * (b_n - a_n) + (b_r - a_r) * (b_r - a_r));
+// The model's zonal responses about n and about R of the two lobes for one view: the broad
+// lobe (weight B) and the sharp lobe (weight S) per band ℓ.
+struct Responses {
+  Bands broad_n{}, broad_r{}, sharp_n{}, sharp_r{};
+};
+// The broad lobe's responses: B·κ_ℓ(α_b)·P_ℓ(a·R_b), R_b = normalize(mix(R, n, s_b)); at α_b = 1,
+// s_b = 1 the clamped cosine about n (κ_ℓ(1) = A_ℓ/π).
+void BroadResponses(const Bands& kappa_b, double mu, double shift, Responses* out) {
+  const double sv = std::sqrt(std::max(0.0, 1.0 - mu * mu));
+  // R = (−sv, μ), n = (0, 1) in the plane of incidence.
+  double x = (1.0 - shift) * -sv, z = (1.0 - shift) * mu + shift;
+  const double len = std::sqrt(x * x + z * z);
+  x /= len;
+  z /= len;
+  Bands pn{}, pr{};
+  Legendre(z, &pn);                 // n·R_b
+  Legendre(-sv * x + mu * z, &pr);  // R·R_b
+  for (int l = 0; l < kBands; ++l) {
+    out->broad_n[l] = kappa_b[l] * pn[l];
+    out->broad_r[l] = kappa_b[l] * pr[l];
   }
-  double s = den > 0.0 ? num / den : 0.0;
-  s = std::clamp(s, 0.0, std::max(0.0, m.e));
+}
+void SharpResponses(const Bands& kappa, const Bands& p_mu, Responses* out) {
+  for (int l = 0; l < kBands; ++l) {
+    out->sharp_n[l] = p_mu[l] * kappa[l];
+    out->sharp_r[l] = kappa[l];
+  }
+}
+// The fit criterion of one view (luminance or one channel): S by least squares with B = E − S,
+// clamped to [0, E] (or S given: *s_out ≥ 0 on entry with `fixed_s`); returns the weighted
+// squared residual, *s_out the S used.
+double Criterion(const Moments& m, const Responses& q, double* s_out, bool fixed_s = false) {
+  // Model response: (E − S)·b + S·c = E·b + S·(c − b).
+  double s = *s_out;
+  if (!fixed_s) {
+    double num = 0.0, den = 0.0;
+    for (int l = 1; l < kBands; ++l) {
+      const double weight = 2.0 * l + 1.0;
+      const double dn = q.sharp_n[l] - q.broad_n[l], dr = q.sharp_r[l] - q.broad_r[l];
+      num += weight * ((m.at_n[l] - m.e * q.broad_n[l]) * dn + (m.at_r[l] - m.e * q.broad_r[l]) * dr);
+      den += weight * (dn * dn + dr * dr);
+    }
+    s = den > 0.0 ? num / den : 0.0;
+    s = std::clamp(s, 0.0, std::max(0.0, m.e));
+  }
   double residual = 0.0;
   for (int l = 1; l < kBands; ++l) {
     const double weight = 2.0 * l + 1.0;
-    const double rn = m.at_n[l] - (m.e * cosine[l] + s * (p_mu[l] * kappa[l] - cosine[l]));
-    const double rr =
-        m.at_r[l] - (m.e * p_mu[l] * cosine[l] + s * (kappa[l] - p_mu[l] * cosine[l]));
+    const double rn = m.at_n[l] - (m.e * q.broad_n[l] + s * (q.sharp_n[l] - q.broad_n[l]));
+    const double rr = m.at_r[l] - (m.e * q.broad_r[l] + s * (q.sharp_r[l] - q.broad_r[l]));
     residual += weight * (rn * rn + rr * rr);
   }
   *s_out = s;
@@ -152,6 +184,13 @@ Vec3 IblSpecularDirection(const Vec3& n, const Vec3& v, double alpha_eq) {
   const double mu = Dot(n, v);
   const Vec3 r = n * (2.0 * mu) - v;
   const double s = IblSpecularShift(alpha_eq, mu);
+  return Normalize(r + (n - r) * s);
+}
+
+Vec3 IblBroadDirection(const Vec3& n, const Vec3& v, double broad_shift) {
+  const double mu = Dot(n, v);
+  const Vec3 r = n * (2.0 * mu) - v;
+  const double s = std::clamp(broad_shift, 0.0, 1.0);
   return Normalize(r + (n - r) * s);
 }
 
@@ -236,6 +275,159 @@ void FitDiffuseQuadratic(IblPack* pack) {
   }
 }
 
+// The lobes' moments of one view: per channel and of the luminance, and P_ℓ(μ).
+struct RowMoments {
+  std::array<Moments, 3> channel{};
+  Moments luma;
+  Bands p_mu{};
+};
+
+// Σ (2ℓ+1)(t_{n,ℓ}² + t_{R,ℓ}²) over ℓ ≥ 1: what a row's residual is relative to.
+double ResponseNorm(const Moments& m) {
+  double norm = 0.0;
+  for (int l = 1; l < kBands; ++l)
+    norm += (2.0 * l + 1.0) * (m.at_n[l] * m.at_n[l] + m.at_r[l] * m.at_r[l]);
+  return norm;
+}
+
+// The sharp lobe's α_s of one view given the broad lobe's responses in *q: the κ table's grid
+// up to `max_alpha`, then (with `refine`) golden-section refinement between the best node's
+// neighbours. Fills q's sharp responses at the α returned; *value the criterion there.
+double FitSharpAlpha(const Moments& luma, const Bands& p_mu, double max_alpha, bool refine,
+                     Responses* q, double* value) {
+  const KappaTable& table = Kappa();
+  const double max_la = std::log(std::clamp(max_alpha, IblPack::kMinAlpha, 1.0));
+  double sy = 0.0;
+  int best = 0;
+  double best_value = 0.0;
+  int last = 0;
+  for (int a = 0; a < kAlphaGrid && table.log_alpha[a] <= max_la + 1e-12; ++a) {
+    SharpResponses(table.kappa[a], p_mu, q);
+    const double v = Criterion(luma, *q, &sy);
+    if (a == 0 || v < best_value) {
+      best = a;
+      best_value = v;
+    }
+    last = a;
+  }
+  double la = table.log_alpha[best];
+  if (refine) {
+    double lo = table.log_alpha[std::max(0, best - 1)];
+    double hi = std::min(max_la, table.log_alpha[std::min(last, best + 1)]);
+    if (best == last) hi = max_la;
+    const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+    auto value_at = [&](double x) {
+      SharpResponses(GgxPrefilterLegendre(std::exp(x)), p_mu, q);
+      return Criterion(luma, *q, &sy);
+    };
+    double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo);
+    double f1 = value_at(x1), f2 = value_at(x2);
+    for (int it = 0; it < 24; ++it) {
+      if (f1 < f2) {
+        hi = x2;
+        x2 = x1;
+        f2 = f1;
+        x1 = hi - g * (hi - lo);
+        f1 = value_at(x1);
+      } else {
+        lo = x1;
+        x1 = x2;
+        f1 = f2;
+        x2 = lo + g * (hi - lo);
+        f2 = value_at(x2);
+      }
+    }
+    const double mid = 0.5 * (lo + hi);
+    const double v = value_at(mid);
+    if (v <= best_value) {
+      la = mid;
+      best_value = v;
+    }
+  }
+  SharpResponses(GgxPrefilterLegendre(std::exp(la)), p_mu, q);
+  *value = best_value;
+  return std::exp(la);
+}
+
+// The material's broad lobe (α_b, s_b) and, per row, α_s, S and B; then B's quadratic and
+// S_i = E_i − B_fit(μ_i) (brdf/core/ibl_pack.h).
+void FitLobes(const std::vector<RowMoments>& rows, IblPack* pack) {
+  const KappaTable& table = Kappa();
+  const int n = static_cast<int>(rows.size());
+  std::vector<double> norm(n);
+  for (int i = 0; i < n; ++i) norm[i] = ResponseNorm(rows[i].luma);
+  const char* mode_env = std::getenv("BRDF_IBL_BROAD");
+  const std::string mode = mode_env != nullptr ? mode_env : "fit";
+  const char* shift_env = std::getenv("BRDF_IBL_BROAD_SHIFT");
+  const std::string shift_mode = shift_env != nullptr ? shift_env : "fit";
+  auto shift_of = [&](double ab) {
+    if (shift_mode == "alpha") return ab;
+    if (shift_mode == "frostbite") return 1.0 - (1.0 - ab) * (std::sqrt(1.0 - ab) + ab);
+    if (shift_mode == "one") return 1.0;
+    return -1.0;
+  };
+  // Total relative criterion of a candidate broad lobe (grid-only α_s).
+  auto total = [&](double ab, double sb) {
+    const Bands kb = GgxPrefilterLegendre(ab);
+    double sum = 0.0;
+    for (int i = 0; i < n; ++i) {
+      if (!(rows[i].luma.e > 0.0) || !(norm[i] > 0.0)) continue;
+      Responses q;
+      BroadResponses(kb, pack->mu[i], sb, &q);
+      double v = 0.0;
+      FitSharpAlpha(rows[i].luma, rows[i].p_mu, ab, false, &q, &v);
+      sum += v / norm[i];
+    }
+    return sum;
+  };
+  double alpha_b = 1.0, shift_b = 1.0;
+  if (mode != "off") {
+    double best = total(1.0, 1.0);
+    const double lo = std::log(0.02);
+    for (int a = kAlphaGrid - 1; a >= 0 && table.log_alpha[a] >= lo; a -= 2) {
+      const double ab = std::exp(table.log_alpha[a]);
+      const double fixed = shift_of(ab);
+      for (int k = 0; k <= 10; ++k) {
+        const double sb = fixed >= 0.0 ? fixed : 0.1 * k;
+        const double v = total(ab, sb);
+        if (v < best) {
+          best = v;
+          alpha_b = ab;
+          shift_b = sb;
+        }
+        if (fixed >= 0.0) break;
+      }
+    }
+  }
+  pack->broad_alpha = alpha_b;
+  pack->broad_shift = shift_b;
+  if (std::getenv("BRDF_IBL_DEBUG") != nullptr)
+    std::fprintf(stderr, "broad alpha %.3f shift %.2f\n", alpha_b, shift_b);
+  const Bands kb = GgxPrefilterLegendre(alpha_b);
+  for (int i = 0; i < n; ++i) {
+    const RowMoments& r = rows[i];
+    double alpha = 1.0, residual = 0.0;
+    Responses q;
+    BroadResponses(kb, pack->mu[i], shift_b, &q);
+    if (r.luma.e > 0.0) {
+      double value = 0.0;
+      alpha = FitSharpAlpha(r.luma, r.p_mu, alpha_b, true, &q, &value);
+      residual = norm[i] > 0.0 ? value / norm[i] : 0.0;
+    } else {
+      SharpResponses(GgxPrefilterLegendre(alpha), r.p_mu, &q);
+    }
+    for (int c = 0; c < 3; ++c) {
+      double sc = 0.0;
+      if (r.channel[c].e > 0.0) Criterion(r.channel[c], q, &sc);
+      pack->specular[i][c] = sc;
+      pack->diffuse[i][c] = std::max(0.0, r.channel[c].e - sc);
+    }
+    pack->alpha[i] = alpha;
+    pack->residual[i] = residual;
+  }
+  FitDiffuseQuadratic(pack);
+}
+
 }  // namespace
 
 IblPack ComputeIblPack(const BrdfSource& source) {
@@ -262,7 +454,6 @@ IblPack ComputeIblPack(const BrdfSource& source) {
   }
   std::vector<Rgb> hist(kBins);
   Bands p{};
-  const KappaTable& table = Kappa();
   std::vector<double> theta_x, theta_w, phi_x, phi_w, cos_phi(kPhi), sin_phi(kPhi);
   // A LUT is sampled by its own rule directly from the grid's angles (Lut::SampleAngles's rule
   // with the light at φ = 0 and the view at the relative azimuth, exactly what LutBrdf::Eval
@@ -270,6 +461,7 @@ IblPack ComputeIblPack(const BrdfSource& source) {
   const auto* lut = dynamic_cast<const LutBrdf*>(&source);
   std::vector<double> phi_out_deg(kPhi), cos_phi_out(kPhi), sin_phi_out(kPhi);
 
+  std::vector<RowMoments> rows(kRows);
   for (int row = 0; row < kRows; ++row) {
     const double mu = (row + 0.5) / kRows;
     const double s = std::sqrt(std::max(0.0, 1.0 - mu * mu));
@@ -366,69 +558,13 @@ IblPack ComputeIblPack(const BrdfSource& source) {
       luma.at_n[l] = Luma({m[0].at_n[l], m[1].at_n[l], m[2].at_n[l]});
       luma.at_r[l] = Luma({m[0].at_r[l], m[1].at_r[l], m[2].at_r[l]});
     }
-    Bands p_mu{};
-    Legendre(mu, &p_mu);
-
     pack.mu[row] = mu;
     pack.albedo[row] = e;
-    double alpha = 1.0, residual = 0.0, sy = 0.0;
-    if (luma.e > 0.0) {
-      // The grid of the κ table, then golden-section refinement between its neighbours.
-      int best = 0;
-      double best_value = 0.0;
-      for (int a = 0; a < kAlphaGrid; ++a) {
-        const double value = Criterion(luma, table.kappa[a], p_mu, &sy);
-        if (a == 0 || value < best_value) {
-          best = a;
-          best_value = value;
-        }
-      }
-      double lo = table.log_alpha[std::max(0, best - 1)];
-      double hi = table.log_alpha[std::min(kAlphaGrid - 1, best + 1)];
-      const double g = 0.5 * (std::sqrt(5.0) - 1.0);
-      auto value_at = [&](double la) {
-        return Criterion(luma, GgxPrefilterLegendre(std::exp(la)), p_mu, &sy);
-      };
-      double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo);
-      double f1 = value_at(x1), f2 = value_at(x2);
-      for (int it = 0; it < 24; ++it) {
-        if (f1 < f2) {
-          hi = x2;
-          x2 = x1;
-          f2 = f1;
-          x1 = hi - g * (hi - lo);
-          f1 = value_at(x1);
-        } else {
-          lo = x1;
-          x1 = x2;
-          f1 = f2;
-          x2 = lo + g * (hi - lo);
-          f2 = value_at(x2);
-        }
-      }
-      double la = 0.5 * (lo + hi);
-      double value = value_at(la);
-      if (best_value < value) {  // the grid's best was not bracketed (an end of the range)
-        la = table.log_alpha[best];
-        value = best_value;
-      }
-      alpha = std::exp(la);
-      double norm = 0.0;
-      for (int l = 1; l < kBands; ++l)
-        norm += (2.0 * l + 1.0) * (luma.at_n[l] * luma.at_n[l] + luma.at_r[l] * luma.at_r[l]);
-      residual = norm > 0.0 ? value / norm : 0.0;
-    }
-    const Bands kappa = GgxPrefilterLegendre(alpha);
-    for (int c = 0; c < 3; ++c) {
-      double sc = 0.0;
-      if (e[c] > 0.0) Criterion(m[c], kappa, p_mu, &sc);
-      pack.specular[row][c] = sc;
-      pack.diffuse[row][c] = std::max(0.0, e[c] - sc);
-    }
-    pack.alpha[row] = alpha;
-    pack.residual[row] = residual;
+    rows[row].channel = m;
+    rows[row].luma = luma;
+    Legendre(mu, &rows[row].p_mu);
   }
-  FitDiffuseQuadratic(&pack);
+  FitLobes(rows, &pack);
   return pack;
 }
 
@@ -471,6 +607,8 @@ std::string IblPackJson(const IblPack& pack) {
   out += "]";
   list("alpha_eq", [&](std::size_t i) { return number(pack.alpha[i]); });
   list("fit_residual", [&](std::size_t i) { return number(pack.residual[i]); });
+  out += ", \"broad_alpha\": " + number(pack.broad_alpha);
+  out += ", \"broad_shift\": " + number(pack.broad_shift);
   out += "}";
   return out;
 }
