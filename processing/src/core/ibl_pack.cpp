@@ -27,26 +27,6 @@ void Legendre(double x, Bands* p) {
     (*p)[l + 1] = ((2.0 * l + 1.0) * x * (*p)[l] - l * (*p)[l - 1]) / (l + 1.0);
 }
 
-// A_ℓ/π with A_ℓ = 2π∫₀¹ t P_ℓ(t) dt, the clamped cosine's Legendre coefficients in closed form
-// (Ramamoorthi & Hanrahan 2001): A_0 = π, A_1 = 2π/3, 0 for odd ℓ > 1, and for even ℓ ≥ 2
-// 2π·(−1)^(ℓ/2−1)/((ℓ+2)(ℓ−1)) · ℓ!/(2^ℓ·((ℓ/2)!)²).
-const Bands& CosineCoefficients() {
-  static const Bands table = [] {
-    Bands a{};
-    a[0] = 1.0;
-    a[1] = 2.0 / 3.0;
-    for (int l = 2; l < kBands; l += 2) {
-      // ℓ!/(2^ℓ (ℓ/2)!²) = C(ℓ, ℓ/2)/2^ℓ, by lgamma to stay finite.
-      const double central =
-          std::exp(std::lgamma(l + 1.0) - 2.0 * std::lgamma(l / 2 + 1.0) - l * std::log(2.0));
-      const double sign = (l / 2 - 1) % 2 == 0 ? 1.0 : -1.0;
-      a[l] = 2.0 * sign / ((l + 2.0) * (l - 1.0)) * central;
-    }
-    return a;
-  }();
-  return table;
-}
-
 // GGX D at half-vector polar angle θh (docs/design.md §9), without the 1/π (it cancels).
 double GgxD(double alpha, double theta_h) {
   const double c = std::cos(theta_h);
@@ -59,6 +39,7 @@ double GgxD(double alpha, double theta_h) {
 // κ_ℓ(α) on a log-spaced α grid, computed once: ∫ over γ ∈ [0, π/2] with γ = (π/2)·u² (nodes
 // dense near γ = 0, where narrow kernels live), kernel D(γ/2)·cosγ normalised by its integral.
 constexpr int kAlphaGrid = 64;
+constexpr double kMinBroadAlpha = 0.02;  // the broad lobe's α_b is searched in [0.02, 1]
 struct KappaTable {
   std::array<double, kAlphaGrid> log_alpha{};
   std::vector<Bands> kappa;
@@ -91,8 +72,7 @@ const KappaTable& Kappa() {
   return table;
 }
 
-// The fit criterion of one view for a given α (luminance or one channel): S by least squares
-// with D = E − S, clamped to [0, E]; returns the weighted squared residual, *s the S used.
+// One view's lobe (luminance or one channel): E and its responses to the Legendre rings.
 struct Moments {
   double e = 0.0;
   Bands at_n{}, at_r{};  // t_{n,ℓ}, t_{R,ℓ}
@@ -100,7 +80,7 @@ struct Moments {
 // The model's zonal responses about n and about R of the two lobes for one view: the broad
 // lobe (weight B) and the sharp lobe (weight S) per band ℓ.
 struct Responses {
-  Bands broad_n{}, broad_r{}, sharp_n{}, sharp_r{};
+  Bands broad_n{}, broad_r{};
 };
 // The broad lobe's responses: B·κ_ℓ(α_b)·P_ℓ(a·R_b), R_b = normalize(mix(R, n, s_b)); at α_b = 1,
 // s_b = 1 the clamped cosine about n (κ_ℓ(1) = A_ℓ/π).
@@ -119,38 +99,33 @@ void BroadResponses(const Bands& kappa_b, double mu, double shift, Responses* ou
     out->broad_r[l] = kappa_b[l] * pr[l];
   }
 }
-void SharpResponses(const Bands& kappa, const Bands& p_mu, Responses* out) {
-  for (int l = 0; l < kBands; ++l) {
-    out->sharp_n[l] = p_mu[l] * kappa[l];
-    out->sharp_r[l] = kappa[l];
-  }
-}
-// The fit criterion of one view (luminance or one channel): S by least squares with B = E − S,
-// clamped to [0, E] (or S given: *s_out ≥ 0 on entry with `fixed_s`); returns the weighted
-// squared residual, *s_out the S used.
-double Criterion(const Moments& m, const Responses& q, double* s_out, bool fixed_s = false) {
-  // Model response: (E − S)·b + S·c = E·b + S·(c − b).
-  double s = *s_out;
-  if (!fixed_s) {
-    double num = 0.0, den = 0.0;
-    for (int l = 1; l < kBands; ++l) {
-      const double weight = 2.0 * l + 1.0;
-      const double dn = q.sharp_n[l] - q.broad_n[l], dr = q.sharp_r[l] - q.broad_r[l];
-      num += weight * ((m.at_n[l] - m.e * q.broad_n[l]) * dn + (m.at_r[l] - m.e * q.broad_r[l]) * dr);
-      den += weight * (dn * dn + dr * dr);
-    }
-    s = den > 0.0 ? num / den : 0.0;
-    s = std::clamp(s, 0.0, std::max(0.0, m.e));
-  }
-  double residual = 0.0;
+// The fit criterion of one view (luminance or one channel): with u = t − E·b (the responses
+// less the broad lobe's at B = E) and d = c − b, S by least squares, S = ⟨u, d⟩/⟨d, d⟩ clamped
+// to [0, E] (B = E − S), and the weighted squared residual |u − S·d|² = ⟨u, u⟩ − 2S⟨u, d⟩ +
+// S²⟨d, d⟩ returned (⟨u, u⟩ given: it does not depend on the sharp lobe); *s_out the S used.
+// ⟨x, y⟩ = Σ_{ℓ≥1} (2ℓ+1)(x_{n,ℓ}y_{n,ℓ} + x_{R,ℓ}y_{R,ℓ}).
+double Criterion(const Moments& m, const Responses& q, const Bands& kappa_s, const Bands& p_mu,
+                 double uu, double* s_out) {
+  double ud = 0.0, dd = 0.0;
   for (int l = 1; l < kBands; ++l) {
     const double weight = 2.0 * l + 1.0;
-    const double rn = m.at_n[l] - (m.e * q.broad_n[l] + s * (q.sharp_n[l] - q.broad_n[l]));
-    const double rr = m.at_r[l] - (m.e * q.broad_r[l] + s * (q.sharp_r[l] - q.broad_r[l]));
-    residual += weight * (rn * rn + rr * rr);
+    const double dn = p_mu[l] * kappa_s[l] - q.broad_n[l], dr = kappa_s[l] - q.broad_r[l];
+    ud += weight * ((m.at_n[l] - m.e * q.broad_n[l]) * dn + (m.at_r[l] - m.e * q.broad_r[l]) * dr);
+    dd += weight * (dn * dn + dr * dr);
   }
+  double s = dd > 0.0 ? ud / dd : 0.0;
+  s = std::clamp(s, 0.0, std::max(0.0, m.e));
   *s_out = s;
-  return residual;
+  return std::max(0.0, uu - 2.0 * s * ud + s * s * dd);
+}
+// ⟨u, u⟩ of Criterion.
+double BroadResidual(const Moments& m, const Responses& q) {
+  double uu = 0.0;
+  for (int l = 1; l < kBands; ++l) {
+    const double un = m.at_n[l] - m.e * q.broad_n[l], ur = m.at_r[l] - m.e * q.broad_r[l];
+    uu += (2.0 * l + 1.0) * (un * un + ur * ur);
+  }
+  return uu;
 }
 
 double Luma(const Rgb& c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
@@ -187,10 +162,10 @@ Vec3 IblSpecularDirection(const Vec3& n, const Vec3& v, double alpha_eq) {
   return Normalize(r + (n - r) * s);
 }
 
-Vec3 IblBroadDirection(const Vec3& n, const Vec3& v, double broad_shift) {
+Vec3 IblBroadDirection(const Vec3& n, const Vec3& v, double broad_alpha) {
   const double mu = Dot(n, v);
   const Vec3 r = n * (2.0 * mu) - v;
-  const double s = std::clamp(broad_shift, 0.0, 1.0);
+  const double s = std::clamp(broad_alpha, 0.0, 1.0);
   return Normalize(r + (n - r) * s);
 }
 
@@ -290,20 +265,22 @@ double ResponseNorm(const Moments& m) {
   return norm;
 }
 
-// The sharp lobe's α_s of one view given the broad lobe's responses in *q: the κ table's grid
-// up to `max_alpha`, then (with `refine`) golden-section refinement between the best node's
-// neighbours. Fills q's sharp responses at the α returned; *value the criterion there.
-double FitSharpAlpha(const Moments& luma, const Bands& p_mu, double max_alpha, bool refine,
-                     Responses* q, double* value) {
+// The sharp lobe's α_s of one view given the broad lobe's responses q: the κ table's grid up
+// to `max_alpha` (the sharp lobe is the narrower one), then (with `refine`) golden-section
+// refinement in log α between the best node's neighbours. *value the criterion at the α
+// returned.
+double FitSharpAlpha(const Moments& luma, const Bands& p_mu, const Responses& q,
+                     double max_alpha, bool refine, double* value) {
+  const int stride = refine ? 1 : 2;
   const KappaTable& table = Kappa();
   const double max_la = std::log(std::clamp(max_alpha, IblPack::kMinAlpha, 1.0));
+  const double uu = BroadResidual(luma, q);
   double sy = 0.0;
   int best = 0;
   double best_value = 0.0;
   int last = 0;
-  for (int a = 0; a < kAlphaGrid && table.log_alpha[a] <= max_la + 1e-12; ++a) {
-    SharpResponses(table.kappa[a], p_mu, q);
-    const double v = Criterion(luma, *q, &sy);
+  for (int a = 0; a < kAlphaGrid && table.log_alpha[a] <= max_la + 1e-12; a += stride) {
+    const double v = Criterion(luma, q, table.kappa[a], p_mu, uu, &sy);
     if (a == 0 || v < best_value) {
       best = a;
       best_value = v;
@@ -313,12 +290,10 @@ double FitSharpAlpha(const Moments& luma, const Bands& p_mu, double max_alpha, b
   double la = table.log_alpha[best];
   if (refine) {
     double lo = table.log_alpha[std::max(0, best - 1)];
-    double hi = std::min(max_la, table.log_alpha[std::min(last, best + 1)]);
-    if (best == last) hi = max_la;
+    double hi = best == last ? max_la : table.log_alpha[best + 1];
     const double g = 0.5 * (std::sqrt(5.0) - 1.0);
     auto value_at = [&](double x) {
-      SharpResponses(GgxPrefilterLegendre(std::exp(x)), p_mu, q);
-      return Criterion(luma, *q, &sy);
+      return Criterion(luma, q, GgxPrefilterLegendre(std::exp(x)), p_mu, uu, &sy);
     };
     double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo);
     double f1 = value_at(x1), f2 = value_at(x2);
@@ -339,86 +314,74 @@ double FitSharpAlpha(const Moments& luma, const Bands& p_mu, double max_alpha, b
     }
     const double mid = 0.5 * (lo + hi);
     const double v = value_at(mid);
-    if (v <= best_value) {
+    if (v <= best_value) {  // else the grid's best was not bracketed (an end of the range)
       la = mid;
       best_value = v;
     }
   }
-  SharpResponses(GgxPrefilterLegendre(std::exp(la)), p_mu, q);
   *value = best_value;
   return std::exp(la);
 }
 
-// The material's broad lobe (α_b, s_b) and, per row, α_s, S and B; then B's quadratic and
-// S_i = E_i − B_fit(μ_i) (brdf/core/ibl_pack.h).
+// The material's broad lobe α_b (read about R_b = mix(R, n, α_b)) and, per row, α_s, S and B;
+// then B's quadratic and S_i = E_i − B_fit(μ_i) (brdf/core/ibl_pack.h).
 void FitLobes(const std::vector<RowMoments>& rows, IblPack* pack) {
   const KappaTable& table = Kappa();
   const int n = static_cast<int>(rows.size());
   std::vector<double> norm(n);
   for (int i = 0; i < n; ++i) norm[i] = ResponseNorm(rows[i].luma);
-  const char* mode_env = std::getenv("BRDF_IBL_BROAD");
-  const std::string mode = mode_env != nullptr ? mode_env : "fit";
-  const char* shift_env = std::getenv("BRDF_IBL_BROAD_SHIFT");
-  const std::string shift_mode = shift_env != nullptr ? shift_env : "fit";
-  auto shift_of = [&](double ab) {
-    if (shift_mode == "alpha") return ab;
-    if (shift_mode == "frostbite") return 1.0 - (1.0 - ab) * (std::sqrt(1.0 - ab) + ab);
-    if (shift_mode == "one") return 1.0;
-    return -1.0;
-  };
-  // Total relative criterion of a candidate broad lobe (grid-only α_s).
-  auto total = [&](double ab, double sb) {
+  // Σ over the rows of the relative criterion of a candidate α_b (α_s on the grid only).
+  auto total = [&](double ab) {
     const Bands kb = GgxPrefilterLegendre(ab);
     double sum = 0.0;
     for (int i = 0; i < n; ++i) {
       if (!(rows[i].luma.e > 0.0) || !(norm[i] > 0.0)) continue;
       Responses q;
-      BroadResponses(kb, pack->mu[i], sb, &q);
+      BroadResponses(kb, pack->mu[i], ab, &q);
       double v = 0.0;
-      FitSharpAlpha(rows[i].luma, rows[i].p_mu, ab, false, &q, &v);
+      FitSharpAlpha(rows[i].luma, rows[i].p_mu, q, ab, false, &v);
       sum += v / norm[i];
     }
     return sum;
   };
-  double alpha_b = 1.0, shift_b = 1.0;
-  if (mode != "off") {
-    double best = total(1.0, 1.0);
-    const double lo = std::log(0.02);
-    for (int a = kAlphaGrid - 1; a >= 0 && table.log_alpha[a] >= lo; a -= 2) {
-      const double ab = std::exp(table.log_alpha[a]);
-      const double fixed = shift_of(ab);
-      for (int k = 0; k <= 10; ++k) {
-        const double sb = fixed >= 0.0 ? fixed : 0.1 * k;
-        const double v = total(ab, sb);
-        if (v < best) {
-          best = v;
-          alpha_b = ab;
-          shift_b = sb;
-        }
-        if (fixed >= 0.0) break;
-      }
-    }
+  // α_b on every 2nd node of the κ table from 1 down to kMinBroadAlpha: every 6th first, then
+  // the nodes 2 and 4 either side of the best of those.
+  std::vector<int> nodes;
+  for (int a = kAlphaGrid - 1; a >= 0 && table.log_alpha[a] >= std::log(kMinBroadAlpha); a -= 2)
+    nodes.push_back(a);
+  std::vector<double> value(nodes.size(), -1.0);
+  auto value_of = [&](int k) {
+    if (value[k] < 0.0) value[k] = total(std::exp(table.log_alpha[nodes[k]]));
+    return value[k];
+  };
+  int best = 0;
+  const char* mode = std::getenv("BRDF_IBL_BROAD");
+  if (mode == nullptr || std::string(mode) != "off") {
+    for (int k = 0; k < static_cast<int>(nodes.size()); k += 3)
+      if (value_of(k) < value_of(best)) best = k;
+    const int coarse = best;
+    for (int k = std::max(0, coarse - 2); k <= std::min<int>(nodes.size() - 1, coarse + 2); ++k)
+      if (value_of(k) < value_of(best)) best = k;
   }
+  const double alpha_b = std::exp(table.log_alpha[nodes[best]]);
   pack->broad_alpha = alpha_b;
-  pack->broad_shift = shift_b;
   if (std::getenv("BRDF_IBL_DEBUG") != nullptr)
-    std::fprintf(stderr, "broad alpha %.3f shift %.2f\n", alpha_b, shift_b);
+    std::fprintf(stderr, "broad alpha %.3f\n", alpha_b);
   const Bands kb = GgxPrefilterLegendre(alpha_b);
   for (int i = 0; i < n; ++i) {
     const RowMoments& r = rows[i];
     double alpha = 1.0, residual = 0.0;
     Responses q;
-    BroadResponses(kb, pack->mu[i], shift_b, &q);
+    BroadResponses(kb, pack->mu[i], alpha_b, &q);
     if (r.luma.e > 0.0) {
       double value = 0.0;
-      alpha = FitSharpAlpha(r.luma, r.p_mu, alpha_b, true, &q, &value);
+      alpha = FitSharpAlpha(r.luma, r.p_mu, q, alpha_b, true, &value);
       residual = norm[i] > 0.0 ? value / norm[i] : 0.0;
-    } else {
-      SharpResponses(GgxPrefilterLegendre(alpha), r.p_mu, &q);
     }
+    const Bands ks = GgxPrefilterLegendre(alpha);
     for (int c = 0; c < 3; ++c) {
       double sc = 0.0;
-      if (r.channel[c].e > 0.0) Criterion(r.channel[c], q, &sc);
+      if (r.channel[c].e > 0.0) Criterion(r.channel[c], q, ks, r.p_mu, BroadResidual(r.channel[c], q), &sc);
       pack->specular[i][c] = sc;
       pack->diffuse[i][c] = std::max(0.0, r.channel[c].e - sc);
     }
@@ -608,7 +571,6 @@ std::string IblPackJson(const IblPack& pack) {
   list("alpha_eq", [&](std::size_t i) { return number(pack.alpha[i]); });
   list("fit_residual", [&](std::size_t i) { return number(pack.residual[i]); });
   out += ", \"broad_alpha\": " + number(pack.broad_alpha);
-  out += ", \"broad_shift\": " + number(pack.broad_shift);
   out += "}";
   return out;
 }

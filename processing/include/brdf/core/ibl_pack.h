@@ -87,7 +87,6 @@ struct IblPack {
   std::vector<double> alpha;               // α_eq(μ)
   std::vector<double> residual;            // relative residual of the fit per row (see above)
   double broad_alpha = 1.0;                // α_b of the broad lobe (1: the clamped cosine)
-  double broad_shift = 1.0;                // s_b: the broad lobe is read about mix(R, n, s_b)
 
   // D_fit at `mu` (the quadratic of diffuse_quadratic; `mu` as given, no clamping).
   Rgb DiffuseFit(double mu) const;
@@ -112,8 +111,8 @@ double IblSpecularShift(double alpha_eq, double mu);
 // R' for the unit normal n and unit view v (pointing away from the surface).
 Vec3 IblSpecularDirection(const Vec3& n, const Vec3& v, double alpha_eq);
 
-// The broad lobe's lookup direction R_b = normalize(mix(R, n, s_b)) (n at s_b = 1).
-Vec3 IblBroadDirection(const Vec3& n, const Vec3& v, double broad_shift);
+// The broad lobe's lookup direction R_b = normalize(mix(R, n, α_b)) (n at α_b = 1).
+Vec3 IblBroadDirection(const Vec3& n, const Vec3& v, double broad_alpha);
 
 // Computes the pack of `source`: 64 × 64 × 72 = 294,912 evaluations of the source and the fit,
 // on the calling thread (docs/benchmarks/ibl.md).
