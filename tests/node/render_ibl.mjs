@@ -151,7 +151,7 @@ try {
       const row = ibl.row, q = ibl.diffuse_quadratic_rgb;
       const material = (environment, iblPack) => mod.createMeasuredBrdfMaterial(lut, {
           lightColor: new THREE.Vector3(0, 0, 0), encodeSrgb: false, environment, iblPack,
-          iblPackRow: row, iblDiffuse: q, cell });
+          iblPackRow: row, iblDiffuse: q, iblBroadAlpha: ibl.broad_alpha, cell });
       // A copy of the pack (texels (specular_rgb, alpha_eq) at mu_i) changed by f(values, D_fit(mu_i)).
       const mutated = (f) => {
         const w = pack.image.width, src = pack.image.data, data = new Uint16Array(src.length);
@@ -202,7 +202,7 @@ try {
       const lut = await mod.loadMeasuredBrdfTexture('/web/' + name + '.ktx2', renderer);
       const pack = await mod.loadMeasuredBrdfIblPack('/web/' + manifest.ibl.texture.file);
       const measured = mod.createMeasuredBrdfMaterial(lut, { encodeSrgb: false, environment: env, iblPack: pack,
-          iblDiffuse: manifest.ibl.diffuse_quadratic_rgb,
+          iblDiffuse: manifest.ibl.diffuse_quadratic_rgb, iblBroadAlpha: manifest.ibl.broad_alpha,
           lightDirection: new THREE.Vector3(-0.5, 0.7, 0.5) });
       const standard = new THREE.MeshStandardMaterial({ metalness: 1, roughness: 0.39 });
       const sun = new THREE.DirectionalLight(0xffffff, 3);

@@ -374,9 +374,9 @@ void FitLobes(const std::vector<RowMoments>& rows, IblPack* pack) {
     Responses q;
     BroadResponses(kb, pack->mu[i], alpha_b, &q);
     if (r.luma.e > 0.0) {
-      double value = 0.0;
-      alpha = FitSharpAlpha(r.luma, r.p_mu, q, alpha_b, true, &value);
-      residual = norm[i] > 0.0 ? value / norm[i] : 0.0;
+      double row_value = 0.0;
+      alpha = FitSharpAlpha(r.luma, r.p_mu, q, alpha_b, true, &row_value);
+      residual = norm[i] > 0.0 ? row_value / norm[i] : 0.0;
     }
     const Bands ks = GgxPrefilterLegendre(alpha);
     for (int c = 0; c < 3; ++c) {
