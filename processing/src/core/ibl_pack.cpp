@@ -39,7 +39,11 @@ double GgxD(double alpha, double theta_h) {
 // κ_ℓ(α) on a log-spaced α grid, computed once: ∫ over γ ∈ [0, π/2] with γ = (π/2)·u² (nodes
 // dense near γ = 0, where narrow kernels live), kernel D(γ/2)·cosγ normalised by its integral.
 constexpr int kAlphaGrid = 64;
-constexpr double kMinBroadAlpha = 0.02;  // the broad lobe's α_b is searched in [0.02, 1]
+// The broad lobe's α_b is searched in [0.02, 0.75] and 1 (the cosine lobe): between 0.75 and 1
+// the GGX kernels differ little from the cosine, and the engines' roughest probe levels (and
+// the CPU preview's importance-sampled prefilter) differ from one another by more than that
+// (docs/benchmarks/ibl.md, "A broad lobe").
+constexpr double kMinBroadAlpha = 0.02, kMaxBroadAlpha = 0.75;
 struct KappaTable {
   std::array<double, kAlphaGrid> log_alpha{};
   std::vector<Bands> kappa;
@@ -348,7 +352,7 @@ void FitLobes(const std::vector<RowMoments>& rows, IblPack* pack) {
   // the nodes 2 and 4 either side of the best of those.
   std::vector<int> nodes;
   for (int a = kAlphaGrid - 1; a >= 0 && table.log_alpha[a] >= std::log(kMinBroadAlpha); a -= 2)
-    nodes.push_back(a);
+    if (a == kAlphaGrid - 1 || table.log_alpha[a] <= std::log(kMaxBroadAlpha)) nodes.push_back(a);
   std::vector<double> value(nodes.size(), -1.0);
   auto value_of = [&](int k) {
     if (value[k] < 0.0) value[k] = total(std::exp(table.log_alpha[nodes[k]]));
