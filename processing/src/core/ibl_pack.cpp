@@ -6,7 +6,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -359,18 +358,13 @@ void FitLobes(const std::vector<RowMoments>& rows, IblPack* pack) {
     return value[k];
   };
   int best = 0;
-  const char* mode = std::getenv("BRDF_IBL_BROAD");
-  if (mode == nullptr || std::string(mode) != "off") {
-    for (int k = 0; k < static_cast<int>(nodes.size()); k += 3)
-      if (value_of(k) < value_of(best)) best = k;
-    const int coarse = best;
-    for (int k = std::max(0, coarse - 2); k <= std::min<int>(nodes.size() - 1, coarse + 2); ++k)
-      if (value_of(k) < value_of(best)) best = k;
-  }
+  for (int k = 0; k < static_cast<int>(nodes.size()); k += 3)
+    if (value_of(k) < value_of(best)) best = k;
+  const int coarse = best;
+  for (int k = std::max(0, coarse - 2); k <= std::min<int>(nodes.size() - 1, coarse + 2); ++k)
+    if (value_of(k) < value_of(best)) best = k;
   const double alpha_b = std::exp(table.log_alpha[nodes[best]]);
   pack->broad_alpha = alpha_b;
-  if (std::getenv("BRDF_IBL_DEBUG") != nullptr)
-    std::fprintf(stderr, "broad alpha %.3f\n", alpha_b);
   const Bands kb = GgxPrefilterLegendre(alpha_b);
   for (int i = 0; i < n; ++i) {
     const RowMoments& r = rows[i];
@@ -538,10 +532,12 @@ IblPack ComputeIblPack(const BrdfSource& source) {
 std::string IblPackJson(const IblPack& pack) {
   std::string out =
       "{\"convention\": \"docs/engines.md, IBL pack: mu = cos(theta_view) at texel "
-      "centres (i + 0.5)/rows; radiance = D_fit(mu) * irradiance/pi + "
-      "specular_rgb * prefiltered(alpha_eq, reflect(-v, n)), D_fit(mu) = c0 + c1 t + c2 t^2, "
-      "t = 1 - mu, [c0, c1, c2] = diffuse_quadratic_rgb (least squares to diffuse_rgb, the "
-      "split's diffuse part); albedo_rgb = D_fit(mu) + specular_rgb at every mu\", \"rows\": ";
+      "centres (i + 0.5)/rows; radiance = D_fit(mu) * prefiltered(broad_alpha, R_b) + "
+      "specular_rgb * prefiltered(alpha_eq, R'), R = reflect(-v, n), R_b = normalize(mix(R, n, "
+      "broad_alpha)) (at broad_alpha = 1 the cosine lobe about n: irradiance/pi), R' = "
+      "normalize(mix(R, n, alpha_eq (1 - mu))), D_fit(mu) = c0 + c1 t + c2 t^2, t = 1 - mu, "
+      "[c0, c1, c2] = diffuse_quadratic_rgb (least squares to diffuse_rgb, the broad lobe's "
+      "part); albedo_rgb = D_fit(mu) + specular_rgb at every mu\", \"rows\": ";
   out += std::to_string(pack.mu.size());
   char buf[96];
   auto list = [&](const char* key, auto&& value) {
