@@ -138,20 +138,24 @@ FLOAT3 MeasuredBrdf(@LUT_PARAM@FLOAT3 n, FLOAT3 l, FLOAT3 v) {
   return MeasuredBrdfCell(@LUT_ARG@FLOAT2(0.0, 0.0), n, l, v);
 }
 
-// Image-based lighting (docs/engines.md, "ibl"): the split sum of the material's IBL pack,
-//   radiance = diffuse(mu) * irradiance(n)/pi + specular(mu) * prefiltered(alpha_eq(mu), R),
-// mu = dot(n, v), R = reflect(-v, n) moved toward n (MeasuredBrdfIblDirection); irradiance/pi is the probe's cosine-convolved radiance
-// (1 under a uniform radiance 1) and prefiltered the GGX-prefiltered probe about R at
-// alpha_eq (GGX alpha = perceptual roughness squared). Under a white furnace the material
-// reflects exactly its directional albedo diffuse + specular.
+// Image-based lighting (docs/engines.md, "ibl"): the split sum of the material's IBL pack with
+// two lobes,
+//   radiance = broad(mu) * probe(broad_alpha, R_b) + specular(mu) * probe(alpha_eq(mu), R'),
+// mu = dot(n, v), probe(alpha, d) the engine's GGX-prefiltered probe at GGX alpha (perceptual
+// roughness squared) read in direction d; R_b = R moved toward n by broad_alpha
+// (MeasuredBrdfIblBroadDirection) and R' = R moved toward n by alpha_eq (1 - mu)
+// (MeasuredBrdfIblDirection), R = reflect(-v, n). broad_alpha is a material constant
+// (manifest "broad_alpha"); at broad_alpha = 1 the broad lobe is the cosine lobe about n, the
+// probe's irradiance / pi (an engine may then read its SH or irradiance probe instead). Under a
+// white furnace the material reflects exactly its directional albedo broad + specular.
 CONST MEASURED_BRDF_IBL_ROWS = @IBL_ROWS@;
 
 // The material's row of the RGBA16F pack texture (NAME_ibl.dds: ROWS texels wide, texel i =
 // (specular_rgb, alpha_eq) at mu_i = (i + 0.5)/ROWS) read at mu, one fetch; pack_v = (row +
 // 0.5)/rows (0.5 for a single LUT). Sampler: linear, clamp-to-edge, no mipmaps, no sRGB
-// decode. The diffuse weight is the material's quadratic in t = 1 - mu (manifest
-// "diffuse_quadratic_rgb": diffuse0, diffuse1, diffuse2), at mu clamped to the texel centres
-// as the fetch is, so diffuse + specular is the albedo at every mu_i. Returns alpha_eq.
+// decode. The broad lobe's weight ("diffuse") is the material's quadratic in t = 1 - mu
+// (manifest "diffuse_quadratic_rgb": diffuse0, diffuse1, diffuse2), at mu clamped to the texel
+// centres as the fetch is, so diffuse + specular is the albedo at every mu_i. Returns alpha_eq.
 float MeasuredBrdfIblPack(@PACK_PARAM@float pack_v, float mu, FLOAT3 diffuse0, FLOAT3 diffuse1,
                           FLOAT3 diffuse2, out FLOAT3 diffuse, out FLOAT3 specular) {
   float mu_texel = clamp(mu * MEASURED_BRDF_IBL_ROWS, 0.5, MEASURED_BRDF_IBL_ROWS - 0.5) /
@@ -174,10 +178,18 @@ FLOAT3 MeasuredBrdfIblDirection(FLOAT3 n, FLOAT3 v, float alpha_eq) {
   return normalize(r + (n - r) * s);
 }
 
-// The probe term from the pack's weights and the engine's two probe values.
-FLOAT3 MeasuredBrdfIblRadiance(FLOAT3 diffuse, FLOAT3 specular, FLOAT3 irradiance_over_pi,
+// The direction the broad lobe's probe is read in: normalize(mix(R, n, broad_alpha)) (n at
+// broad_alpha = 1).
+FLOAT3 MeasuredBrdfIblBroadDirection(FLOAT3 n, FLOAT3 v, float broad_alpha) {
+  FLOAT3 r = n * (2.0 * dot(n, v)) - v;
+  return normalize(r + (n - r) * clamp(broad_alpha, 0.0, 1.0));
+}
+
+// The probe term from the pack's weights and the engine's two probe values (the broad lobe's
+// and the specular one's).
+FLOAT3 MeasuredBrdfIblRadiance(FLOAT3 diffuse, FLOAT3 specular, FLOAT3 broad_probe,
                                FLOAT3 prefiltered) {
-  return diffuse * irradiance_over_pi + specular * prefiltered;
+  return diffuse * broad_probe + specular * prefiltered;
 }
 )~~";
 

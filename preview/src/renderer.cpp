@@ -423,7 +423,11 @@ struct PreviewRenderer::Impl {
             const Vec3 wo = s.frame.ToWorld(s.wo);
             const IblPack::Row row = pack.At(mu);
             const Vec3 r = IblSpecularDirection(n, wo, row.alpha);
-            const Rgb irradiance = lighting.Irradiance(ToMap(n));
+            const Rgb irradiance =
+                pack.broad_alpha >= 1.0
+                    ? lighting.Irradiance(ToMap(n))
+                    : lighting.Prefiltered(pack.broad_alpha,
+                                           ToMap(IblBroadDirection(n, wo, pack.broad_alpha)));
             const Rgb prefiltered = lighting.Prefiltered(row.alpha, ToMap(r));
             for (int ch = 0; ch < 3; ++ch)
               sum[3 * k + ch] =

@@ -219,7 +219,7 @@ Texture2D g_pack; SamplerState g_pack_sampler;
 float4 main(float3 n : TEXCOORD0, float3 v : TEXCOORD1) : SV_Target {
   UnityTexture2D t; t.tex = g_pack; t.samplerstate = g_pack_sampler;
   float3 o; )" + function + R"((t, 0.5, float3(0.3, 0.2, 0.1), float3(0.01, 0.02, 0.03),
-                                  float3(-0.01, 0.0, 0.01), n, v, o);
+                                  float3(-0.01, 0.0, 0.01), 0.4, n, v, o);
   return float4(o, 1.0);
 }
 )";
@@ -324,13 +324,14 @@ float3 GetSkyLightReflection(float3 ReflectionVector, float Roughness, out float
 #include ")") +
         ush + "\"\n" +
         "float3 CustomExpression1(Texture2D IblPack, SamplerState IblPackSampler, float IblRow, "
-        "float3 IblDiffuse0, float3 IblDiffuse1, float3 IblDiffuse2, float3 N, float3 V) {\n  " +
+        "float3 IblDiffuse0, float3 IblDiffuse1, float3 IblDiffuse2, float IblBroadAlpha, float3 N, "
+        "float3 V) {\n  " +
         m[1].str() + "\n}\n" + R"(
 Texture2D Material_Texture2D_0; SamplerState Material_Texture2D_0Sampler;
 float4 main(float3 n : TEXCOORD0, float3 v : TEXCOORD1) : SV_Target {
   return float4(CustomExpression1(Material_Texture2D_0, Material_Texture2D_0Sampler, 0.5,
                                   float3(0.3, 0.2, 0.1), float3(0.01, 0.02, 0.03),
-                                  float3(-0.01, 0.0, 0.01), n, v), 1.0);
+                                  float3(-0.01, 0.0, 0.01), 0.4, n, v), 1.0);
 }
 )";
     const std::string file = (out / "unreal" / "ibl_harness.hlsl").string();

@@ -165,7 +165,7 @@ def es_harnesses(out, work):
                                  (r"render_mode [^;]+;", "", 1),
                                  (r"uniform (sampler3D|sampler2D|samplerCube) (\w+) : [^;]+;",
                                   r"uniform highp \1 \2;", 3),
-                                 (r"uniform float (\w+) = [^;]+;", r"uniform float \1;", 2),
+                                 (r"uniform float (\w+) = [^;]+;", r"uniform float \1;", 3),
                                  (r"uniform vec3 (\w+) = [^;]+;", r"uniform vec3 \1;", 3),
                                  (r"void fragment\(\)", "void godot_fragment()", 1),
                                  (r"void light\(\)", "void godot_light()", 1)):

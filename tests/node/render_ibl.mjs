@@ -15,7 +15,8 @@
 // Writes into --out, per material NAME (or ATLAS:CELL, written ATLAS.CELL; rows top first,
 // RGBA float32, not mirrored back):
 //   NAME.ibl.f32       the probe term alone (no direct light)
-//   NAME.alpha110.f32  the same with every alpha_eq of the pack 10 % larger (mutation)
+//   NAME.alpha110.f32  the same with every alpha_eq of the pack and broad_alpha 10 % larger
+//                      (broad_alpha at most 1; mutation)
 //   NAME.noE.f32       the same with the weights divided by E = D + S (mutation: E dropped)
 //                      (the two mutations only for the materials of --mutate, default all)
 //   NAME.furnace.f32   under a uniform radiance 1 (three's PMREM of a constant map)
@@ -149,9 +150,10 @@ try {
         ibl = manifest.ibl.cells[m];
       }
       const row = ibl.row, q = ibl.diffuse_quadratic_rgb;
-      const material = (environment, iblPack) => mod.createMeasuredBrdfMaterial(lut, {
+      // broadScale: the broad lobe's broad_alpha times this (at most 1), for the mutation.
+      const material = (environment, iblPack, broadScale = 1) => mod.createMeasuredBrdfMaterial(lut, {
           lightColor: new THREE.Vector3(0, 0, 0), encodeSrgb: false, environment, iblPack,
-          iblPackRow: row, iblDiffuse: q, cell });
+          iblPackRow: row, iblDiffuse: q, iblBroadAlpha: Math.min(1, (ibl.broad_alpha ?? 1) * broadScale), cell });
       // A copy of the pack (texels (specular_rgb, alpha_eq) at mu_i) changed by f(values, D_fit(mu_i)).
       const mutated = (f) => {
         const w = pack.image.width, src = pack.image.data, data = new Uint16Array(src.length);
@@ -171,7 +173,7 @@ try {
       const noE = mutated((v, d) => [1 - d[0], 1 - d[1], 1 - d[2], v[3]]);
       const out = { ibl: render(material(env, pack)), furnace: render(material(furnace, pack)) };
       if (${mutate === null || mutate.has(entry)})
-        Object.assign(out, { alpha110: render(material(env, alpha110)), noE: render(material(env, noE)) });
+        Object.assign(out, { alpha110: render(material(env, alpha110, 1.1)), noE: render(material(env, noE)) });
       for (const t of [lut, pack, alpha110, noE]) t.dispose();  // 37 materials in one page
       return out;
     })()`);
@@ -202,7 +204,7 @@ try {
       const lut = await mod.loadMeasuredBrdfTexture('/web/' + name + '.ktx2', renderer);
       const pack = await mod.loadMeasuredBrdfIblPack('/web/' + manifest.ibl.texture.file);
       const measured = mod.createMeasuredBrdfMaterial(lut, { encodeSrgb: false, environment: env, iblPack: pack,
-          iblDiffuse: manifest.ibl.diffuse_quadratic_rgb,
+          iblDiffuse: manifest.ibl.diffuse_quadratic_rgb, iblBroadAlpha: manifest.ibl.broad_alpha,
           lightDirection: new THREE.Vector3(-0.5, 0.7, 0.5) });
       const standard = new THREE.MeshStandardMaterial({ metalness: 1, roughness: 0.39 });
       const sun = new THREE.DirectionalLight(0xffffff, 3);

@@ -22,7 +22,8 @@ std::string GodotShader(const exporter::ShaderLutLayout& layout) {
 // disabled (they would light a white Lambertian); instead fragment() adds the material's probe
 // term as EMISSION from the IBL pack (measured_brdf_ibl_pack: <name>_ibl.dds, or its row of an
 // atlas's pack with measured_brdf_ibl_row = (row + 0.5) / rows; measured_brdf_ibl_diffuse0..2
-// = the manifest's "diffuse_quadratic_rgb" of the material or its cell) and a GGX-prefiltered radiance
+// = the manifest's "diffuse_quadratic_rgb" of the material or its cell,
+// measured_brdf_ibl_broad_alpha = its "broad_alpha") and a GGX-prefiltered radiance
 // cube map in the layout of Godot's own radiance maps (mip level = perceptual roughness x
 // max level, e.g. a baked ReflectionProbe's or the sky's exported radiance; Godot 4 spatial
 // shaders cannot read the scene's radiance map themselves). measured_brdf_radiance_max_lod = 0
@@ -37,6 +38,7 @@ uniform float measured_brdf_ibl_row = 0.5;
 uniform vec3 measured_brdf_ibl_diffuse0 = vec3(0.0);
 uniform vec3 measured_brdf_ibl_diffuse1 = vec3(0.0);
 uniform vec3 measured_brdf_ibl_diffuse2 = vec3(0.0);
+uniform float measured_brdf_ibl_broad_alpha = 1.0;
 uniform float measured_brdf_radiance_max_lod = 0.0;
 
 )~~" + exporter::MeasuredBrdfShaderCode(exporter::ShaderLanguage::kGodot, layout) +
@@ -55,11 +57,14 @@ void fragment() {
     float alpha_eq = MeasuredBrdfIblPack(measured_brdf_ibl_row, max(dot(n, v), 0.0),
                                          measured_brdf_ibl_diffuse0, measured_brdf_ibl_diffuse1,
                                          measured_brdf_ibl_diffuse2, ibl_diffuse, ibl_specular);
-    vec3 irradiance = textureLod(measured_brdf_radiance, n, measured_brdf_radiance_max_lod).rgb;
+    vec3 broad = textureLod(measured_brdf_radiance,
+                            MeasuredBrdfIblBroadDirection(n, v, measured_brdf_ibl_broad_alpha),
+                            sqrt(measured_brdf_ibl_broad_alpha) *
+                                measured_brdf_radiance_max_lod).rgb;
     vec3 prefiltered = textureLod(measured_brdf_radiance,
                                   MeasuredBrdfIblDirection(n, v, alpha_eq),
                                   sqrt(alpha_eq) * measured_brdf_radiance_max_lod).rgb;
-    EMISSION = MeasuredBrdfIblRadiance(ibl_diffuse, ibl_specular, irradiance, prefiltered);
+    EMISSION = MeasuredBrdfIblRadiance(ibl_diffuse, ibl_specular, broad, prefiltered);
   }
 }
 
@@ -260,6 +265,7 @@ uniform bool toneMapReinhard; // with encodeSrgb: x / (1 + x) per channel before
 uniform highp sampler2D iblPack;  // NAME_ibl.dds (loadMeasuredBrdfIblPack)
 uniform float iblPackRow;         // (row + 0.5) / rows of the material's pack row
 uniform vec3 iblDiffuse[3];       // the material's "diffuse_quadratic_rgb" (c0, c1, c2)
+uniform float iblBroadAlpha;      // the material's "broad_alpha"
 #endif
 in vec3 v_normal_world;
 in vec3 v_position_world;
@@ -281,15 +287,17 @@ void main() {{
     radiance = f * lightColor * max(dot(n, l), 0.0);
   }}
 #ifdef MEASURED_BRDF_IBL
-  // One pack fetch (one texel at mu) and two probe fetches: the PMREM's last level (GGX alpha 1
-  // = the cosine lobe: irradiance / pi) about n, and the level of alpha_eq about R.
+  // One pack fetch (one texel at mu) and two probe fetches: the PMREM's level of broad_alpha
+  // about R_b (at broad_alpha 1 its last level about n: GGX alpha 1 is the cosine lobe,
+  // irradiance / pi), and the level of alpha_eq about R'.
   vec3 ibl_diffuse, ibl_specular;
   float alpha_eq = MeasuredBrdfIblPack(iblPack, iblPackRow, max(dot(n, v), 0.0), iblDiffuse[0],
                                        iblDiffuse[1], iblDiffuse[2], ibl_diffuse, ibl_specular);
   vec3 r = MeasuredBrdfIblDirection(n, v, alpha_eq);
-  vec3 irradiance = textureLod(envMap, envMapRotation * n, ENVMAP_MAX_LOD).rgb;
+  vec3 broad = textureLod(envMap, envMapRotation * MeasuredBrdfIblBroadDirection(n, v, iblBroadAlpha),
+                          roughnessToMip(sqrt(iblBroadAlpha))).rgb;
   vec3 prefiltered = textureLod(envMap, envMapRotation * r, roughnessToMip(sqrt(alpha_eq))).rgb;
-  radiance += MeasuredBrdfIblRadiance(ibl_diffuse, ibl_specular, irradiance, prefiltered) *
+  radiance += MeasuredBrdfIblRadiance(ibl_diffuse, ibl_specular, broad, prefiltered) *
               envMapIntensity;
 #endif
   radiance *= exposure;
@@ -335,7 +343,8 @@ export async function loadMeasuredBrdfIblPack(url) {{
 // PMREMGenerator.fromEquirectangular/fromScene: its GGX-prefiltered cube map), iblPack (the
 // texture of loadMeasuredBrdfIblPack), iblPackRow (the material's row, 0 for a single LUT; the
 // manifest's "ibl" "row"), iblDiffuse (its "diffuse_quadratic_rgb": [[r, g, b] x 3], the
-// cell's for an atlas material), environmentIntensity.
+// cell's for an atlas material), iblBroadAlpha (its "broad_alpha", in (0, 1]; default 1, the
+// cosine lobe, which is what packs without the key were fitted with), environmentIntensity.
 export function createMeasuredBrdfMaterial(texture, options = {{}}) {{
   const color = options.lightColor ?? new THREE.Vector3(1, 1, 1);
   const uniforms = {{
@@ -355,6 +364,9 @@ export function createMeasuredBrdfMaterial(texture, options = {{}}) {{
     const q = options.iblDiffuse;
     if (!Array.isArray(q) || q.length !== 3 || !q.every((c) => Array.isArray(c) && c.length === 3))
       throw new Error(`measured BRDF: options.iblDiffuse: expected the manifest's diffuse_quadratic_rgb ([[r, g, b] x 3]), got ${{JSON.stringify(q)}}`);
+    const broadAlpha = options.iblBroadAlpha ?? 1.0;
+    if (typeof broadAlpha !== 'number' || !(broadAlpha > 0 && broadAlpha <= 1))
+      throw new Error(`measured BRDF: options.iblBroadAlpha: expected the manifest's broad_alpha (a number in (0, 1]), got ${{JSON.stringify(broadAlpha)}}`);
     const rows = options.iblPack.image.height;
     defines.MEASURED_BRDF_IBL = '';
     defines.ENVMAP_MAX_LOD = `${{environment.mipmaps.length - 1}}.0`;
@@ -364,6 +376,7 @@ export function createMeasuredBrdfMaterial(texture, options = {{}}) {{
     uniforms.iblPack = {{ value: options.iblPack }};
     uniforms.iblPackRow = {{ value: ((options.iblPackRow ?? 0) + 0.5) / rows }};
     uniforms.iblDiffuse = {{ value: q.map((c) => new THREE.Vector3(...c)) }};
+    uniforms.iblBroadAlpha = {{ value: broadAlpha }};
   }}
   return new THREE.ShaderMaterial({{
     glslVersion: THREE.GLSL3,
@@ -593,6 +606,7 @@ window.measuredBrdf.ready = (async () => {{
       const pack = manifest.atlas ? ibl.cells[cellIndex] : ibl;
       options.iblPackRow = pack.row;
       options.iblDiffuse = pack.diffuse_quadratic_rgb;
+      options.iblBroadAlpha = pack.broad_alpha;
     }}
   }}
   const shader = module.createMeasuredBrdfMaterial(texture, options);

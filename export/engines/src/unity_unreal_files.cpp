@@ -238,13 +238,16 @@ void MeasuredBrdfRadiance_half(UnityTexture3D Lut, half3 N, half3 L, half3 V,
 // Function Name MeasuredBrdfIbl; inputs IblPack (Texture 2D: the <name>_ibl.dds pack, linear,
 // clamp, no mips, sRGB off), IblRow (Float: (row + 0.5) / rows, 0.5 for one LUT), IblDiffuse0,
 // IblDiffuse1, IblDiffuse2 (Vector3: the manifest's "diffuse_quadratic_rgb", the material's or
-// its atlas cell's), N, V (world space); output Out = radiance). One pack fetch (one texel at
-// mu = N.V) and two probe fetches:
-//   URP (its Lighting.hlsl included, as in Lit and Unlit graphs): SampleSH(N) (irradiance / pi)
-//     and GlossyEnvironmentReflection(R, perceptual roughness sqrt(alpha_eq), 1) (the
-//     reflection probe, or the sky, at URP's mip for that roughness);
-//   HDRP (Core's AmbientProbe.hlsl included): EvaluateAmbientProbe(N) and the sky's
-//     GGX-prefiltered cube map SampleSkyTexture(R, PerceptualRoughnessToMipmapLevel(...), 0).
+// its atlas cell's), IblBroadAlpha (Float: its "broad_alpha"), N, V (world space); output Out =
+// radiance). One pack fetch (one texel at mu = N.V) and two probe fetches, the broad lobe's and
+// the specular one's:
+//   URP (its Lighting.hlsl included, as in Lit and Unlit graphs): GlossyEnvironmentReflection
+//     (direction, perceptual roughness sqrt(alpha), 1) (the reflection probe, or the sky, at
+//     URP's mip for that roughness), for the broad lobe at broad_alpha < 1; at broad_alpha = 1
+//     (the cosine lobe) SampleSH(N) (irradiance / pi);
+//   HDRP (Core's AmbientProbe.hlsl included): the sky's GGX-prefiltered cube map
+//     SampleSkyTexture(direction, PerceptualRoughnessToMipmapLevel(...), 0), and at
+//     broad_alpha = 1 EvaluateAmbientProbe(N) for the broad lobe.
 #if defined(UNIVERSAL_LIGHTING_INCLUDED)
 #define MEASURED_BRDF_IRRADIANCE(n) SampleSH(n)
 #define MEASURED_BRDF_PREFILTERED(r, roughness) GlossyEnvironmentReflection(r, roughness, 1.0)
@@ -255,16 +258,21 @@ void MeasuredBrdfRadiance_half(UnityTexture3D Lut, half3 N, half3 L, half3 V,
 #endif
 #ifdef MEASURED_BRDF_IRRADIANCE
 void MeasuredBrdfIbl_float(UnityTexture2D IblPack, float IblRow, float3 IblDiffuse0,
-                           float3 IblDiffuse1, float3 IblDiffuse2, float3 N, float3 V,
-                           out float3 Out)
+                           float3 IblDiffuse1, float3 IblDiffuse2, float IblBroadAlpha,
+                           float3 N, float3 V, out float3 Out)
 {
     float3 n = normalize(N), v = normalize(V), d, s;
     float alpha_eq = MeasuredBrdfIblPack(IblPack.tex, IblPack.samplerstate, IblRow,
                                          saturate(dot(n, v)), IblDiffuse0, IblDiffuse1,
                                          IblDiffuse2, d, s);
     float3 r = MeasuredBrdfIblDirection(n, v, alpha_eq);
-    Out = MeasuredBrdfIblRadiance(d, s, MEASURED_BRDF_IRRADIANCE(n),
-                                  MEASURED_BRDF_PREFILTERED(r, sqrt(alpha_eq)));
+    float3 broad;
+    [branch] if (IblBroadAlpha >= 1.0)
+        broad = MEASURED_BRDF_IRRADIANCE(n);
+    else
+        broad = MEASURED_BRDF_PREFILTERED(MeasuredBrdfIblBroadDirection(n, v, IblBroadAlpha),
+                                          sqrt(IblBroadAlpha));
+    Out = MeasuredBrdfIblRadiance(d, s, broad, MEASURED_BRDF_PREFILTERED(r, sqrt(alpha_eq)));
 }
 #endif
 #ifdef MEASURED_BRDF_BUILTIN_LIGHTING
@@ -316,12 +324,14 @@ std::string UnrealUsh(const exporter::ShaderLutLayout& layout) {
 // Defines MEASURED_BRDF_UNREAL_SKY = 1, inputs IblPack (TextureObject of <name>_ibl.dds: sRGB
 // off, TC_HDR, no mips, clamp; Unreal passes IblPack and IblPackSampler), IblRow ((row + 0.5) /
 // rows, 0.5 for one LUT), IblDiffuse0, IblDiffuse1, IblDiffuse2 (float3 constants: the
-// manifest's "diffuse_quadratic_rgb", the material's or its atlas cell's), N, V, Output Type
-// CMOT Float 3, added to the direct term (Emissive of an Unlit material, or the lit sum):
-// Code:   return MeasuredBrdfIblUnreal(IblPack, IblPackSampler, IblRow, IblDiffuse0, IblDiffuse1, IblDiffuse2, normalize(N), normalize(V));
-// It reads the Sky Light, Unreal's own probe: GetSkySHDiffuse (irradiance / pi) and
-// GetSkyLightReflection at roughness sqrt(alpha_eq) (the captured sky cube map at Unreal's mip
-// for that roughness), each times the light's colour; one pack fetch, two probe fetches.
+// manifest's "diffuse_quadratic_rgb", the material's or its atlas cell's), IblBroadAlpha (a
+// scalar constant: its "broad_alpha"), N, V, Output Type CMOT Float 3, added to the direct term
+// (Emissive of an Unlit material, or the lit sum):
+// Code:   return MeasuredBrdfIblUnreal(IblPack, IblPackSampler, IblRow, IblDiffuse0, IblDiffuse1, IblDiffuse2, IblBroadAlpha, normalize(N), normalize(V));
+// It reads the Sky Light, Unreal's own probe: GetSkyLightReflection at roughness sqrt(alpha_eq)
+// (the captured sky cube map at Unreal's mip for that roughness) for the specular lobe, and at
+// sqrt(broad_alpha) for the broad lobe (GetSkySHDiffuse, irradiance / pi, at broad_alpha = 1),
+// each times the light's colour; one pack fetch, two probe fetches.
 #pragma once
 
 )~~" + exporter::MeasuredBrdfShaderCode(exporter::ShaderLanguage::kHlsl, layout) +
@@ -329,7 +339,7 @@ std::string UnrealUsh(const exporter::ShaderLutLayout& layout) {
 #if MEASURED_BRDF_UNREAL_SKY
 float3 MeasuredBrdfIblUnreal(Texture2D IblPack, SamplerState IblPackSampler, float IblRow,
                              float3 IblDiffuse0, float3 IblDiffuse1, float3 IblDiffuse2,
-                             float3 N, float3 V)
+                             float IblBroadAlpha, float3 N, float3 V)
 {
     float3 diffuse, specular;
     float alpha_eq = MeasuredBrdfIblPack(IblPack, IblPackSampler, IblRow, saturate(dot(N, V)),
@@ -339,8 +349,13 @@ float3 MeasuredBrdfIblUnreal(Texture2D IblPack, SamplerState IblPackSampler, flo
     float3 prefiltered = GetSkyLightReflection(MeasuredBrdfIblDirection(N, V, alpha_eq),
                                                sqrt(alpha_eq),
                                                sky_brightness);
-    return MeasuredBrdfIblRadiance(diffuse, specular, GetSkySHDiffuse(N) * View.SkyLightColor.rgb,
-                                   prefiltered);
+    float3 broad;
+    [branch] if (IblBroadAlpha >= 1.0)
+        broad = GetSkySHDiffuse(N) * View.SkyLightColor.rgb;
+    else
+        broad = GetSkyLightReflection(MeasuredBrdfIblBroadDirection(N, V, IblBroadAlpha),
+                                      sqrt(IblBroadAlpha), sky_brightness);
+    return MeasuredBrdfIblRadiance(diffuse, specular, broad, prefiltered);
 }
 #endif
 )~~";

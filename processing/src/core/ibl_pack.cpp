@@ -26,26 +26,6 @@ void Legendre(double x, Bands* p) {
     (*p)[l + 1] = ((2.0 * l + 1.0) * x * (*p)[l] - l * (*p)[l - 1]) / (l + 1.0);
 }
 
-// A_ℓ/π with A_ℓ = 2π∫₀¹ t P_ℓ(t) dt, the clamped cosine's Legendre coefficients in closed form
-// (Ramamoorthi & Hanrahan 2001): A_0 = π, A_1 = 2π/3, 0 for odd ℓ > 1, and for even ℓ ≥ 2
-// 2π·(−1)^(ℓ/2−1)/((ℓ+2)(ℓ−1)) · ℓ!/(2^ℓ·((ℓ/2)!)²).
-const Bands& CosineCoefficients() {
-  static const Bands table = [] {
-    Bands a{};
-    a[0] = 1.0;
-    a[1] = 2.0 / 3.0;
-    for (int l = 2; l < kBands; l += 2) {
-      // ℓ!/(2^ℓ (ℓ/2)!²) = C(ℓ, ℓ/2)/2^ℓ, by lgamma to stay finite.
-      const double central =
-          std::exp(std::lgamma(l + 1.0) - 2.0 * std::lgamma(l / 2 + 1.0) - l * std::log(2.0));
-      const double sign = (l / 2 - 1) % 2 == 0 ? 1.0 : -1.0;
-      a[l] = 2.0 * sign / ((l + 2.0) * (l - 1.0)) * central;
-    }
-    return a;
-  }();
-  return table;
-}
-
 // GGX D at half-vector polar angle θh (docs/design.md §9), without the 1/π (it cancels).
 double GgxD(double alpha, double theta_h) {
   const double c = std::cos(theta_h);
@@ -58,6 +38,11 @@ double GgxD(double alpha, double theta_h) {
 // κ_ℓ(α) on a log-spaced α grid, computed once: ∫ over γ ∈ [0, π/2] with γ = (π/2)·u² (nodes
 // dense near γ = 0, where narrow kernels live), kernel D(γ/2)·cosγ normalised by its integral.
 constexpr int kAlphaGrid = 64;
+// The broad lobe's α_b is searched in [0.02, 0.75] and 1 (the cosine lobe): between 0.75 and 1
+// the GGX kernels differ little from the cosine, and the engines' roughest probe levels (and
+// the CPU preview's importance-sampled prefilter) differ from one another by more than that
+// (docs/benchmarks/ibl.md, "A broad lobe").
+constexpr double kMinBroadAlpha = 0.02, kMaxBroadAlpha = 0.75;
 struct KappaTable {
   std::array<double, kAlphaGrid> log_alpha{};
   std::vector<Bands> kappa;
@@ -90,35 +75,60 @@ const KappaTable& Kappa() {
   return table;
 }
 
-// The fit criterion of one view for a given α (luminance or one channel): S by least squares
-// with D = E − S, clamped to [0, E]; returns the weighted squared residual, *s the S used.
+// One view's lobe (luminance or one channel): E and its responses to the Legendre rings.
 struct Moments {
   double e = 0.0;
   Bands at_n{}, at_r{};  // t_{n,ℓ}, t_{R,ℓ}
 };
-double Criterion(const Moments& m, const Bands& kappa, const Bands& p_mu, double* s_out) {
-  const Bands& cosine = CosineCoefficients();
-  // Model response: (E − S)·a + S·b = E·a + S·(b − a).
-  double num = 0.0, den = 0.0;
+// The model's zonal responses about n and about R of the two lobes for one view: the broad
+// lobe (weight B) and the sharp lobe (weight S) per band ℓ.
+struct Responses {
+  Bands broad_n{}, broad_r{};
+};
+// The broad lobe's responses: B·κ_ℓ(α_b)·P_ℓ(a·R_b), R_b = normalize(mix(R, n, s_b)); at α_b = 1,
+// s_b = 1 the clamped cosine about n (κ_ℓ(1) = A_ℓ/π).
+void BroadResponses(const Bands& kappa_b, double mu, double shift, Responses* out) {
+  const double sv = std::sqrt(std::max(0.0, 1.0 - mu * mu));
+  // R = (−sv, μ), n = (0, 1) in the plane of incidence.
+  double x = (1.0 - shift) * -sv, z = (1.0 - shift) * mu + shift;
+  const double len = std::sqrt(x * x + z * z);
+  x /= len;
+  z /= len;
+  Bands pn{}, pr{};
+  Legendre(z, &pn);                 // n·R_b
+  Legendre(-sv * x + mu * z, &pr);  // R·R_b
+  for (int l = 0; l < kBands; ++l) {
+    out->broad_n[l] = kappa_b[l] * pn[l];
+    out->broad_r[l] = kappa_b[l] * pr[l];
+  }
+}
+// The fit criterion of one view (luminance or one channel): with u = t − E·b (the responses
+// less the broad lobe's at B = E) and d = c − b, S by least squares, S = ⟨u, d⟩/⟨d, d⟩ clamped
+// to [0, E] (B = E − S), and the weighted squared residual |u − S·d|² = ⟨u, u⟩ − 2S⟨u, d⟩ +
+// S²⟨d, d⟩ returned (⟨u, u⟩ given: it does not depend on the sharp lobe); *s_out the S used.
+// ⟨x, y⟩ = Σ_{ℓ≥1} (2ℓ+1)(x_{n,ℓ}y_{n,ℓ} + x_{R,ℓ}y_{R,ℓ}).
+double Criterion(const Moments& m, const Responses& q, const Bands& kappa_s, const Bands& p_mu,
+                 double uu, double* s_out) {
+  double ud = 0.0, dd = 0.0;
   for (int l = 1; l < kBands; ++l) {
     const double weight = 2.0 * l + 1.0;
-    const double a_n = cosine[l], b_n = p_mu[l] * kappa[l];
-    const double a_r = p_mu[l] * cosine[l], b_r = kappa[l];
-    num += weight * ((m.at_n[l] - m.e * a_n) * (b_n - a_n) + (m.at_r[l] - m.e * a_r) * (b_r - a_r));
-    den += weight * ((b_n - a_n) * (b_n - a_n) + (b_r - a_r) * (b_r - a_r));
+    const double dn = p_mu[l] * kappa_s[l] - q.broad_n[l], dr = kappa_s[l] - q.broad_r[l];
+    ud += weight * ((m.at_n[l] - m.e * q.broad_n[l]) * dn + (m.at_r[l] - m.e * q.broad_r[l]) * dr);
+    dd += weight * (dn * dn + dr * dr);
   }
-  double s = den > 0.0 ? num / den : 0.0;
+  double s = dd > 0.0 ? ud / dd : 0.0;
   s = std::clamp(s, 0.0, std::max(0.0, m.e));
-  double residual = 0.0;
-  for (int l = 1; l < kBands; ++l) {
-    const double weight = 2.0 * l + 1.0;
-    const double rn = m.at_n[l] - (m.e * cosine[l] + s * (p_mu[l] * kappa[l] - cosine[l]));
-    const double rr =
-        m.at_r[l] - (m.e * p_mu[l] * cosine[l] + s * (kappa[l] - p_mu[l] * cosine[l]));
-    residual += weight * (rn * rn + rr * rr);
-  }
   *s_out = s;
-  return residual;
+  return std::max(0.0, uu - 2.0 * s * ud + s * s * dd);
+}
+// ⟨u, u⟩ of Criterion.
+double BroadResidual(const Moments& m, const Responses& q) {
+  double uu = 0.0;
+  for (int l = 1; l < kBands; ++l) {
+    const double un = m.at_n[l] - m.e * q.broad_n[l], ur = m.at_r[l] - m.e * q.broad_r[l];
+    uu += (2.0 * l + 1.0) * (un * un + ur * ur);
+  }
+  return uu;
 }
 
 double Luma(const Rgb& c) { return 0.2126 * c[0] + 0.7152 * c[1] + 0.0722 * c[2]; }
@@ -152,6 +162,13 @@ Vec3 IblSpecularDirection(const Vec3& n, const Vec3& v, double alpha_eq) {
   const double mu = Dot(n, v);
   const Vec3 r = n * (2.0 * mu) - v;
   const double s = IblSpecularShift(alpha_eq, mu);
+  return Normalize(r + (n - r) * s);
+}
+
+Vec3 IblBroadDirection(const Vec3& n, const Vec3& v, double broad_alpha) {
+  const double mu = Dot(n, v);
+  const Vec3 r = n * (2.0 * mu) - v;
+  const double s = std::clamp(broad_alpha, 0.0, 1.0);
   return Normalize(r + (n - r) * s);
 }
 
@@ -236,6 +253,142 @@ void FitDiffuseQuadratic(IblPack* pack) {
   }
 }
 
+// The lobes' moments of one view: per channel and of the luminance, and P_ℓ(μ).
+struct RowMoments {
+  std::array<Moments, 3> channel{};
+  Moments luma;
+  Bands p_mu{};
+};
+
+// Σ (2ℓ+1)(t_{n,ℓ}² + t_{R,ℓ}²) over ℓ ≥ 1: what a row's residual is relative to.
+double ResponseNorm(const Moments& m) {
+  double norm = 0.0;
+  for (int l = 1; l < kBands; ++l)
+    norm += (2.0 * l + 1.0) * (m.at_n[l] * m.at_n[l] + m.at_r[l] * m.at_r[l]);
+  return norm;
+}
+
+// The sharp lobe's α_s of one view given the broad lobe's responses q: the κ table's grid up
+// to `max_alpha` (the sharp lobe is the narrower one), then (with `refine`) golden-section
+// refinement in log α between the best node's neighbours. *value the criterion at the α
+// returned.
+double FitSharpAlpha(const Moments& luma, const Bands& p_mu, const Responses& q,
+                     double max_alpha, bool refine, double* value) {
+  const int stride = refine ? 1 : 2;
+  const KappaTable& table = Kappa();
+  const double max_la = std::log(std::clamp(max_alpha, IblPack::kMinAlpha, 1.0));
+  const double uu = BroadResidual(luma, q);
+  double sy = 0.0;
+  int best = 0;
+  double best_value = 0.0;
+  int last = 0;
+  for (int a = 0; a < kAlphaGrid && table.log_alpha[a] <= max_la + 1e-12; a += stride) {
+    const double v = Criterion(luma, q, table.kappa[a], p_mu, uu, &sy);
+    if (a == 0 || v < best_value) {
+      best = a;
+      best_value = v;
+    }
+    last = a;
+  }
+  double la = table.log_alpha[best];
+  if (refine) {
+    double lo = table.log_alpha[std::max(0, best - 1)];
+    double hi = best == last ? max_la : table.log_alpha[best + 1];
+    const double g = 0.5 * (std::sqrt(5.0) - 1.0);
+    auto value_at = [&](double x) {
+      return Criterion(luma, q, GgxPrefilterLegendre(std::exp(x)), p_mu, uu, &sy);
+    };
+    double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo);
+    double f1 = value_at(x1), f2 = value_at(x2);
+    for (int it = 0; it < 24; ++it) {
+      if (f1 < f2) {
+        hi = x2;
+        x2 = x1;
+        f2 = f1;
+        x1 = hi - g * (hi - lo);
+        f1 = value_at(x1);
+      } else {
+        lo = x1;
+        x1 = x2;
+        f1 = f2;
+        x2 = lo + g * (hi - lo);
+        f2 = value_at(x2);
+      }
+    }
+    const double mid = 0.5 * (lo + hi);
+    const double v = value_at(mid);
+    if (v <= best_value) {  // else the grid's best was not bracketed (an end of the range)
+      la = mid;
+      best_value = v;
+    }
+  }
+  *value = best_value;
+  return std::exp(la);
+}
+
+// The material's broad lobe α_b (read about R_b = mix(R, n, α_b)) and, per row, α_s, S and B;
+// then B's quadratic and S_i = E_i − B_fit(μ_i) (brdf/core/ibl_pack.h).
+void FitLobes(const std::vector<RowMoments>& rows, IblPack* pack) {
+  const KappaTable& table = Kappa();
+  const int n = static_cast<int>(rows.size());
+  std::vector<double> norm(n);
+  for (int i = 0; i < n; ++i) norm[i] = ResponseNorm(rows[i].luma);
+  // Σ over the rows of the relative criterion of a candidate α_b (α_s on the grid only).
+  auto total = [&](double ab) {
+    const Bands kb = GgxPrefilterLegendre(ab);
+    double sum = 0.0;
+    for (int i = 0; i < n; ++i) {
+      if (!(rows[i].luma.e > 0.0) || !(norm[i] > 0.0)) continue;
+      Responses q;
+      BroadResponses(kb, pack->mu[i], ab, &q);
+      double v = 0.0;
+      FitSharpAlpha(rows[i].luma, rows[i].p_mu, q, ab, false, &v);
+      sum += v / norm[i];
+    }
+    return sum;
+  };
+  // α_b on every 2nd node of the κ table from 1 down to kMinBroadAlpha: every 6th first, then
+  // the nodes 2 and 4 either side of the best of those.
+  std::vector<int> nodes;
+  for (int a = kAlphaGrid - 1; a >= 0 && table.log_alpha[a] >= std::log(kMinBroadAlpha); a -= 2)
+    if (a == kAlphaGrid - 1 || table.log_alpha[a] <= std::log(kMaxBroadAlpha)) nodes.push_back(a);
+  std::vector<double> value(nodes.size(), -1.0);
+  auto value_of = [&](int k) {
+    if (value[k] < 0.0) value[k] = total(std::exp(table.log_alpha[nodes[k]]));
+    return value[k];
+  };
+  int best = 0;
+  for (int k = 0; k < static_cast<int>(nodes.size()); k += 3)
+    if (value_of(k) < value_of(best)) best = k;
+  const int coarse = best;
+  for (int k = std::max(0, coarse - 2); k <= std::min<int>(nodes.size() - 1, coarse + 2); ++k)
+    if (value_of(k) < value_of(best)) best = k;
+  const double alpha_b = std::exp(table.log_alpha[nodes[best]]);
+  pack->broad_alpha = alpha_b;
+  const Bands kb = GgxPrefilterLegendre(alpha_b);
+  for (int i = 0; i < n; ++i) {
+    const RowMoments& r = rows[i];
+    double alpha = 1.0, residual = 0.0;
+    Responses q;
+    BroadResponses(kb, pack->mu[i], alpha_b, &q);
+    if (r.luma.e > 0.0) {
+      double row_value = 0.0;
+      alpha = FitSharpAlpha(r.luma, r.p_mu, q, alpha_b, true, &row_value);
+      residual = norm[i] > 0.0 ? row_value / norm[i] : 0.0;
+    }
+    const Bands ks = GgxPrefilterLegendre(alpha);
+    for (int c = 0; c < 3; ++c) {
+      double sc = 0.0;
+      if (r.channel[c].e > 0.0) Criterion(r.channel[c], q, ks, r.p_mu, BroadResidual(r.channel[c], q), &sc);
+      pack->specular[i][c] = sc;
+      pack->diffuse[i][c] = std::max(0.0, r.channel[c].e - sc);
+    }
+    pack->alpha[i] = alpha;
+    pack->residual[i] = residual;
+  }
+  FitDiffuseQuadratic(pack);
+}
+
 }  // namespace
 
 IblPack ComputeIblPack(const BrdfSource& source) {
@@ -262,7 +415,6 @@ IblPack ComputeIblPack(const BrdfSource& source) {
   }
   std::vector<Rgb> hist(kBins);
   Bands p{};
-  const KappaTable& table = Kappa();
   std::vector<double> theta_x, theta_w, phi_x, phi_w, cos_phi(kPhi), sin_phi(kPhi);
   // A LUT is sampled by its own rule directly from the grid's angles (Lut::SampleAngles's rule
   // with the light at φ = 0 and the view at the relative azimuth, exactly what LutBrdf::Eval
@@ -270,6 +422,7 @@ IblPack ComputeIblPack(const BrdfSource& source) {
   const auto* lut = dynamic_cast<const LutBrdf*>(&source);
   std::vector<double> phi_out_deg(kPhi), cos_phi_out(kPhi), sin_phi_out(kPhi);
 
+  std::vector<RowMoments> rows(kRows);
   for (int row = 0; row < kRows; ++row) {
     const double mu = (row + 0.5) / kRows;
     const double s = std::sqrt(std::max(0.0, 1.0 - mu * mu));
@@ -366,79 +519,25 @@ IblPack ComputeIblPack(const BrdfSource& source) {
       luma.at_n[l] = Luma({m[0].at_n[l], m[1].at_n[l], m[2].at_n[l]});
       luma.at_r[l] = Luma({m[0].at_r[l], m[1].at_r[l], m[2].at_r[l]});
     }
-    Bands p_mu{};
-    Legendre(mu, &p_mu);
-
     pack.mu[row] = mu;
     pack.albedo[row] = e;
-    double alpha = 1.0, residual = 0.0, sy = 0.0;
-    if (luma.e > 0.0) {
-      // The grid of the κ table, then golden-section refinement between its neighbours.
-      int best = 0;
-      double best_value = 0.0;
-      for (int a = 0; a < kAlphaGrid; ++a) {
-        const double value = Criterion(luma, table.kappa[a], p_mu, &sy);
-        if (a == 0 || value < best_value) {
-          best = a;
-          best_value = value;
-        }
-      }
-      double lo = table.log_alpha[std::max(0, best - 1)];
-      double hi = table.log_alpha[std::min(kAlphaGrid - 1, best + 1)];
-      const double g = 0.5 * (std::sqrt(5.0) - 1.0);
-      auto value_at = [&](double la) {
-        return Criterion(luma, GgxPrefilterLegendre(std::exp(la)), p_mu, &sy);
-      };
-      double x1 = hi - g * (hi - lo), x2 = lo + g * (hi - lo);
-      double f1 = value_at(x1), f2 = value_at(x2);
-      for (int it = 0; it < 24; ++it) {
-        if (f1 < f2) {
-          hi = x2;
-          x2 = x1;
-          f2 = f1;
-          x1 = hi - g * (hi - lo);
-          f1 = value_at(x1);
-        } else {
-          lo = x1;
-          x1 = x2;
-          f1 = f2;
-          x2 = lo + g * (hi - lo);
-          f2 = value_at(x2);
-        }
-      }
-      double la = 0.5 * (lo + hi);
-      double value = value_at(la);
-      if (best_value < value) {  // the grid's best was not bracketed (an end of the range)
-        la = table.log_alpha[best];
-        value = best_value;
-      }
-      alpha = std::exp(la);
-      double norm = 0.0;
-      for (int l = 1; l < kBands; ++l)
-        norm += (2.0 * l + 1.0) * (luma.at_n[l] * luma.at_n[l] + luma.at_r[l] * luma.at_r[l]);
-      residual = norm > 0.0 ? value / norm : 0.0;
-    }
-    const Bands kappa = GgxPrefilterLegendre(alpha);
-    for (int c = 0; c < 3; ++c) {
-      double sc = 0.0;
-      if (e[c] > 0.0) Criterion(m[c], kappa, p_mu, &sc);
-      pack.specular[row][c] = sc;
-      pack.diffuse[row][c] = std::max(0.0, e[c] - sc);
-    }
-    pack.alpha[row] = alpha;
-    pack.residual[row] = residual;
+    rows[row].channel = m;
+    rows[row].luma = luma;
+    Legendre(mu, &rows[row].p_mu);
   }
-  FitDiffuseQuadratic(&pack);
+  FitLobes(rows, &pack);
   return pack;
 }
 
 std::string IblPackJson(const IblPack& pack) {
   std::string out =
       "{\"convention\": \"docs/engines.md, IBL pack: mu = cos(theta_view) at texel "
-      "centres (i + 0.5)/rows; radiance = D_fit(mu) * irradiance/pi + "
-      "specular_rgb * prefiltered(alpha_eq, reflect(-v, n)), D_fit(mu) = c0 + c1 t + c2 t^2, "
-      "t = 1 - mu, [c0, c1, c2] = diffuse_quadratic_rgb (least squares to diffuse_rgb, the "
-      "split's diffuse part); albedo_rgb = D_fit(mu) + specular_rgb at every mu\", \"rows\": ";
+      "centres (i + 0.5)/rows; radiance = D_fit(mu) * prefiltered(broad_alpha, R_b) + "
+      "specular_rgb * prefiltered(alpha_eq, R'), R = reflect(-v, n), R_b = normalize(mix(R, n, "
+      "broad_alpha)) (at broad_alpha = 1 the cosine lobe about n: irradiance/pi), R' = "
+      "normalize(mix(R, n, alpha_eq (1 - mu))), D_fit(mu) = c0 + c1 t + c2 t^2, t = 1 - mu, "
+      "[c0, c1, c2] = diffuse_quadratic_rgb (least squares to diffuse_rgb, the broad lobe's "
+      "part); albedo_rgb = D_fit(mu) + specular_rgb at every mu\", \"rows\": ";
   out += std::to_string(pack.mu.size());
   char buf[96];
   auto list = [&](const char* key, auto&& value) {
@@ -471,6 +570,7 @@ std::string IblPackJson(const IblPack& pack) {
   out += "]";
   list("alpha_eq", [&](std::size_t i) { return number(pack.alpha[i]); });
   list("fit_residual", [&](std::size_t i) { return number(pack.residual[i]); });
+  out += ", \"broad_alpha\": " + number(pack.broad_alpha);
   out += "}";
   return out;
 }

@@ -8,17 +8,22 @@
 // a linearly filtered 1D texture of kRows texels returns row i at u = μ_i):
 //
 //   E(μ)   = ∫_{H²} f_r(l, v) cosθl dω_l              directional albedo, RGB
-//   E(μ)   = D(μ) + S(μ)                              diffuse-like and specular-like parts
-//   L_o(v) ≈ D(μ)·Ē(n) + S(μ)·P(α_eq(μ), R)           the split sum an engine evaluates
+//   E(μ)   = D(μ) + S(μ)                              broad and sharp parts
+//   L_o(v) ≈ D(μ)·P(α_b, R_b) + S(μ)·P(α_eq(μ), R)    the split sum an engine evaluates
 //
-// with Ē(n) = (1/π)∫ L(l) max(n·l, 0) dω (the irradiance over π: 1 under a uniform radiance 1),
-// R = 2(n·v)n − v, and P(α, R) = ∫ L(l) K_α(R·l) dω the GGX-prefiltered radiance, the kernel
-// every engine's probe filter applies (the split-sum prefilter with n = v = R, Karis 2013):
+// with P(α, d) = ∫ L(l) K_α(d·l) dω the GGX-prefiltered radiance, the kernel every engine's
+// probe filter applies (the split-sum prefilter with n = v = R, Karis 2013):
 //
 //   K_α(cosγ) = D_α(θh = γ/2) · max(cosγ, 0) / N_α,    N_α such that ∫ K_α dω = 1,
 //
-// D_α the GGX distribution of docs/design.md §9 and γ the angle between R and l. Under a
-// uniform radiance 1 both Ē and P are 1, so the split sum gives E(μ) exactly (white furnace).
+// R = 2(n·v)n − v, α_b (`broad_alpha`) one roughness per material and R_b = normalize(mix(R, n,
+// α_b)). At α_b = 1, D_1 is constant and K_1 the normalised clamped cosine, so P(1, n) = Ē(n) =
+// (1/π)∫ L(l) max(n·l, 0) dω, the irradiance over π: the broad lobe is then the diffuse-like
+// part lit by the engine's irradiance probe or SH (what Lambert-like materials get), and below 1
+// it is a clear coat's base lobe or a metal's broad skirt. Under a uniform radiance 1 every P is
+// 1, so the split sum gives E(μ) exactly (white furnace).
+//
+// D_α the GGX distribution of docs/design.md §9 and γ the angle between d and l.
 //
 // How the numbers are found:
 //  - Quadrature: for each view, a product grid over the light hemisphere in the normal frame
@@ -37,23 +42,26 @@
 //    tests/core/ibl_pack_test.cpp). The largest errors are at grazing views (μ < 0.1), where
 //    the lobe meets the horizon and a LUT's value jumps at its last slice (docs/design.md §5);
 //    elsewhere they are below 0.15 %.
-//  - The split and α_eq: the lobe w(l) = f_r(l, v)·cosθl is lit by the environments
+//  - The split, α_eq and α_b: the lobe w(l) = f_r(l, v)·cosθl is lit by the environments
 //    P_ℓ(l·a), Legendre polynomials of degree ℓ = 0…kMaxBand centred on the normal (a = n) and
 //    on the mirror direction (a = R): rings of every angular frequency around the two
-//    directions the engine's two probes are looked up at. Its responses t_{a,ℓ} = ∫ w P_ℓ(l·a)dω
-//    are compared with the model's, which are closed-form (Funk–Hecke): D·P_ℓ(a·n)·A_ℓ/π +
-//    S·P_ℓ(a·R)·κ_ℓ(α), A_ℓ = 2π∫₀¹ t P_ℓ(t) dt (the cosine's Legendre coefficients) and
-//    κ_ℓ(α) = 2π∫ K_α(t) P_ℓ(t) dt. ℓ = 0 is matched exactly (D + S = E); α_eq minimises
-//    Σ_{a,ℓ≥1} (2ℓ+1)·(t_{a,ℓ} − model)² (the squared L² distance of the two lobes' zonal parts
-//    about a), with S by least squares for each α (clamped to 0 ≤ S ≤ E), over α in
-//    [kMinAlpha, 1] on the luminance; then S and D per channel at that α. The relative
-//    residual (the criterion at α_eq over Σ (2ℓ+1) t²) is kept per row: a lobe that no GGX
-//    kernel plus Lambert fits (off-specular, retro-reflective) says so there.
+//    directions the engine's probes are looked up at. Its responses t_{a,ℓ} = ∫ w P_ℓ(l·a)dω
+//    are compared with the model's, which are closed-form (Funk–Hecke): D·κ_ℓ(α_b)·P_ℓ(a·R_b)
+//    + S·κ_ℓ(α)·P_ℓ(a·R), κ_ℓ(α) = 2π∫ K_α(t) P_ℓ(t) dt (κ_ℓ(1) = A_ℓ/π, the clamped cosine's
+//    Legendre coefficients). ℓ = 0 is matched exactly (D + S = E). For a given α_b, α_eq per
+//    row minimises Σ_{a,ℓ≥1} (2ℓ+1)·(t_{a,ℓ} − model)² (the squared L² distance of the two
+//    lobes' zonal parts about a), with S by least squares for each α (clamped to 0 ≤ S ≤ E),
+//    over α in [kMinAlpha, α_b] on the luminance; α_b minimises the sum over the rows of that
+//    criterion relative to Σ (2ℓ+1) t² (each view counts alike), searched on the κ table's
+//    grid in [0.02, 0.75] and 1 (every 6th node, then the 2 either side of the best; grid-only
+//    α_eq during the search); then α_eq refined and S and D per channel at it. The relative
+//    residual at α_eq is kept per row: a lobe that two GGX kernels do not fit
+//    (off-specular, retro-reflective) says so there.
 // Rows with E = 0 (a black material, or a view where the source is zero) get S = D = 0 and
-// α_eq = 1.
+// α_eq = 1 (with any α_b).
 //
-// What an engine reads (one pack fetch per pixel): the diffuse part as a quadratic in
-// t = 1 − μ, D_fit(μ) = c0 + c1·t + c2·t², three RGB constants per material fitted by least
+// What an engine reads (one pack fetch per pixel, two probe fetches): the broad part D as a
+// quadratic in t = 1 − μ, D_fit(μ) = c0 + c1·t + c2·t², three RGB constants per material fitted by least
 // squares, per channel, to the split's D rows (`diffuse`); and per row S_i = E_i − D_fit(μ_i)
 // (`specular`, stored with α_eq in one texel), so that D_fit + S = E exactly at every texel
 // centre and the white furnace holds whatever the quadratic's error. S_i may then be slightly
@@ -86,6 +94,8 @@ struct IblPack {
   std::array<Rgb, 3> diffuse_quadratic{};  // c0, c1, c2 of D_fit(μ) = c0 + c1·t + c2·t², t = 1 − μ
   std::vector<double> alpha;               // α_eq(μ)
   std::vector<double> residual;            // relative residual of the fit per row (see above)
+  double broad_alpha = 1.0;                // α_b of the broad lobe (1: the clamped cosine), D's
+                                           // kernel, read about mix(R, n, α_b)
 
   // D_fit at `mu` (the quadratic of diffuse_quadratic; `mu` as given, no clamping).
   Rgb DiffuseFit(double mu) const;
@@ -109,6 +119,9 @@ struct IblPack {
 double IblSpecularShift(double alpha_eq, double mu);
 // R' for the unit normal n and unit view v (pointing away from the surface).
 Vec3 IblSpecularDirection(const Vec3& n, const Vec3& v, double alpha_eq);
+
+// The broad lobe's lookup direction R_b = normalize(mix(R, n, α_b)) (n at α_b = 1).
+Vec3 IblBroadDirection(const Vec3& n, const Vec3& v, double broad_alpha);
 
 // Computes the pack of `source`: 64 × 64 × 72 = 294,912 evaluations of the source and the fit,
 // on the calling thread (docs/benchmarks/ibl.md).
