@@ -156,10 +156,26 @@ constexpr int kVarMode = 0, kVarPartition = 13, kVarCount = 14;
 struct BitSource {
   std::uint8_t var, bit;
 };
+// `count` bits of a variable from bit `first` up, in block order (a run of BitSources).
+struct BitRun {
+  std::uint8_t var, first, count;
+};
 struct Mode {
   ModeInfo info;
   std::vector<BitSource> bits;  // one entry per header bit, in block order
+  std::vector<BitRun> runs;     // the same bits, consecutive ones of a variable merged
 };
+
+std::vector<BitRun> MergeRuns(const std::vector<BitSource>& bits) {
+  std::vector<BitRun> runs;
+  for (const BitSource& b : bits) {
+    if (!runs.empty() && runs.back().var == b.var && runs.back().first + runs.back().count == b.bit)
+      ++runs.back().count;
+    else
+      runs.push_back({b.var, b.bit, 1});
+  }
+  return runs;
+}
 
 int VariableOf(std::string_view name) {
   if (name == "m") return kVarMode;
@@ -198,6 +214,7 @@ struct Tables {
     for (std::size_t i = 0; i < kModes.size(); ++i) {
       modes[i].info = kModes[i];
       modes[i].bits = ParseLayout(kModes[i].layout);
+      modes[i].runs = MergeRuns(modes[i].bits);
       index_of_number[kModes[i].number] = static_cast<int>(i);
     }
   }
@@ -319,9 +336,14 @@ struct Encoded {
   std::array<int, 16> indices{};
 };
 
-void WriteBits(Bc6hBlock& block, int& pos, std::uint32_t value, int count) {
-  for (int i = 0; i < count; ++i, ++pos)
-    if ((value >> i) & 1u) block[pos >> 3] |= static_cast<std::uint8_t>(1u << (pos & 7));
+// Appends the low `count` (≤ 32) bits of `value` at bit `pos` of the block held as two 64-bit
+// words (bit i of the block is bit i % 64 of word i / 64).
+void PutBits(std::uint64_t (&words)[2], int& pos, std::uint32_t value, int count) {
+  const std::uint64_t v = value & ((std::uint64_t{1} << count) - 1);
+  const int shift = pos & 63;
+  words[pos >> 6] |= v << shift;
+  if (shift + count > 64) words[1] |= v >> (64 - shift);
+  pos += count;
 }
 
 Bc6hBlock Pack(const Mode& mode, int partition, const int (&fields)[4][3],
@@ -331,16 +353,16 @@ Bc6hBlock Pack(const Mode& mode, int partition, const int (&fields)[4][3],
   vars[kVarPartition] = partition;
   for (int e = 0; e < 2 * mode.info.subsets; ++e)
     for (int c = 0; c < 3; ++c) vars[1 + 3 * e + c] = fields[e][c];
-  Bc6hBlock block{};
+  std::uint64_t words[2] = {};
   int pos = 0;
-  for (const BitSource& s : mode.bits) {
-    if ((vars[s.var] >> s.bit) & 1) block[pos >> 3] |= static_cast<std::uint8_t>(1u << (pos & 7));
-    ++pos;
-  }
+  for (const BitRun& r : mode.runs)
+    PutBits(words, pos, static_cast<std::uint32_t>(vars[r.var]) >> r.first, r.count);
   const int index_bits = mode.info.subsets == 2 ? 3 : 4;
   for (int t = 0; t < 16; ++t)
-    WriteBits(block, pos, static_cast<std::uint32_t>(indices[t]),
-              index_bits - (IsAnchor(t, mode.info.subsets, partition) ? 1 : 0));
+    PutBits(words, pos, static_cast<std::uint32_t>(indices[t]),
+            index_bits - (IsAnchor(t, mode.info.subsets, partition) ? 1 : 0));
+  Bc6hBlock block{};
+  for (int i = 0; i < 16; ++i) block[i] = static_cast<std::uint8_t>(words[i >> 3] >> (8 * (i & 7)));
   return block;
 }
 
