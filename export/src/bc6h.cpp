@@ -156,10 +156,26 @@ constexpr int kVarMode = 0, kVarPartition = 13, kVarCount = 14;
 struct BitSource {
   std::uint8_t var, bit;
 };
+// `count` bits of a variable from bit `first` up, in block order (a run of BitSources).
+struct BitRun {
+  std::uint8_t var, first, count;
+};
 struct Mode {
   ModeInfo info;
   std::vector<BitSource> bits;  // one entry per header bit, in block order
+  std::vector<BitRun> runs;     // the same bits, consecutive ones of a variable merged
 };
+
+std::vector<BitRun> MergeRuns(const std::vector<BitSource>& bits) {
+  std::vector<BitRun> runs;
+  for (const BitSource& b : bits) {
+    if (!runs.empty() && runs.back().var == b.var && runs.back().first + runs.back().count == b.bit)
+      ++runs.back().count;
+    else
+      runs.push_back({b.var, b.bit, 1});
+  }
+  return runs;
+}
 
 int VariableOf(std::string_view name) {
   if (name == "m") return kVarMode;
@@ -198,6 +214,7 @@ struct Tables {
     for (std::size_t i = 0; i < kModes.size(); ++i) {
       modes[i].info = kModes[i];
       modes[i].bits = ParseLayout(kModes[i].layout);
+      modes[i].runs = MergeRuns(modes[i].bits);
       index_of_number[kModes[i].number] = static_cast<int>(i);
     }
   }
@@ -247,7 +264,15 @@ struct BlockInput {
   float t[16][3];
   float w[16][3];
   float r[16][3];  // √w: a channel's half steps in half steps of the texel's largest channel
+  float hs[3][16];  // h by channel
+  double wd[16][4], td[16][4];  // w and t as doubles (exact), lane 3 zero: the refit's inputs
 };
+
+// Four floats, four int32 and four doubles as one value (GCC/Clang vector extensions: the
+// lanes are computed one by one as scalars would be, on SSE2 two or four at a time).
+using F4 = float __attribute__((vector_size(16)));
+using I4 = std::int32_t __attribute__((vector_size(16)));
+using D4 = double __attribute__((vector_size(32)));
 
 float ContinuousHalf(float x) {
   if (!(x > 0.0f)) return 0.0f;
@@ -311,9 +336,14 @@ struct Encoded {
   std::array<int, 16> indices{};
 };
 
-void WriteBits(Bc6hBlock& block, int& pos, std::uint32_t value, int count) {
-  for (int i = 0; i < count; ++i, ++pos)
-    if ((value >> i) & 1u) block[pos >> 3] |= static_cast<std::uint8_t>(1u << (pos & 7));
+// Appends the low `count` (≤ 32) bits of `value` at bit `pos` of the block held as two 64-bit
+// words (bit i of the block is bit i % 64 of word i / 64).
+void PutBits(std::uint64_t (&words)[2], int& pos, std::uint32_t value, int count) {
+  const std::uint64_t v = value & ((std::uint64_t{1} << count) - 1);
+  const int shift = pos & 63;
+  words[pos >> 6] |= v << shift;
+  if (shift + count > 64) words[1] |= v >> (64 - shift);
+  pos += count;
 }
 
 Bc6hBlock Pack(const Mode& mode, int partition, const int (&fields)[4][3],
@@ -323,16 +353,16 @@ Bc6hBlock Pack(const Mode& mode, int partition, const int (&fields)[4][3],
   vars[kVarPartition] = partition;
   for (int e = 0; e < 2 * mode.info.subsets; ++e)
     for (int c = 0; c < 3; ++c) vars[1 + 3 * e + c] = fields[e][c];
-  Bc6hBlock block{};
+  std::uint64_t words[2] = {};
   int pos = 0;
-  for (const BitSource& s : mode.bits) {
-    if ((vars[s.var] >> s.bit) & 1) block[pos >> 3] |= static_cast<std::uint8_t>(1u << (pos & 7));
-    ++pos;
-  }
+  for (const BitRun& r : mode.runs)
+    PutBits(words, pos, static_cast<std::uint32_t>(vars[r.var]) >> r.first, r.count);
   const int index_bits = mode.info.subsets == 2 ? 3 : 4;
   for (int t = 0; t < 16; ++t)
-    WriteBits(block, pos, static_cast<std::uint32_t>(indices[t]),
-              index_bits - (IsAnchor(t, mode.info.subsets, partition) ? 1 : 0));
+    PutBits(words, pos, static_cast<std::uint32_t>(indices[t]),
+            index_bits - (IsAnchor(t, mode.info.subsets, partition) ? 1 : 0));
+  Bc6hBlock block{};
+  for (int i = 0; i < 16; ++i) block[i] = static_cast<std::uint8_t>(words[i >> 3] >> (8 * (i & 7)));
   return block;
 }
 
@@ -340,12 +370,18 @@ Bc6hBlock Pack(const Mode& mode, int partition, const int (&fields)[4][3],
 // to the indices by least squares, `refinements` times; the best candidate seen goes into
 // `best`. A refit whose quantized endpoints equal the previous pass's would repeat that pass
 // exactly (same palette, indices and error, so never strictly better): the loop stops there.
+// kSubsets is the mode's subset count (a template argument, so the one-subset search has no
+// partition lookups). Lanes of F4 and D4 hold independent numbers, each formed by the same
+// operations in the same order as a scalar loop would (no sums across lanes).
+template <int kSubsets>
 void TryMode(const Mode& mode, int partition, Endpoints ends, QuantizedEnds& first,
              const BlockInput& in, int refinements, Encoded& best) {
   const ModeInfo& info = mode.info;
-  const int subsets = info.subsets;
+  constexpr int subsets = kSubsets;
   const std::uint16_t mask = subsets == 2 ? kPartitions[partition] : 0;
-  const int levels = subsets == 2 ? 8 : 16;
+  // Texel 0 is always an anchor; the second subset's anchor (none for one subset).
+  const int anchor1 = subsets == 2 ? kAnchor2[partition] : 0;
+  constexpr int levels = subsets == 2 ? 8 : 16;
   const int* weights = subsets == 2 ? kWeights3.data() : kWeights4.data();
   const int wrap = (1 << info.epb) - 1;
   int previous_q[4][3];
@@ -378,7 +414,7 @@ void TryMode(const Mode& mode, int partition, Endpoints ends, QuantizedEnds& fir
     // Decoded palettes, exactly as the decoder computes them, as floats by channel: entry k of
     // subset s, channel c is pal[s][c][k + 1] (one slot of padding before entry 0 and two
     // after the last, so a texel's three neighbouring entries are one load of four lanes).
-    float pal[2][3][kPaletteSlots];
+    float pal[subsets][3][kPaletteSlots];
     for (int s = 0; s < subsets; ++s)
       for (int c = 0; c < 3; ++c) {
         const int a = Unquantize(q[2 * s][c], info.epb), b = Unquantize(q[2 * s + 1][c], info.epb);
@@ -404,25 +440,51 @@ void TryMode(const Mode& mode, int partition, Endpoints ends, QuantizedEnds& fir
       }
       inv_len2[s] = len2 > 0.0f ? 64.0f / len2 : 0.0f;
     }
+    // The weights of all 16 texels, four texels a vector: lane i of group g is texel 4g + i,
+    // its subset's origin, direction and 1/length² chosen per lane (by bits, exactly).
+    alignas(16) std::int32_t nearest_weight[16];
+    for (int g = 0; g < 4; ++g) {
+      I4 lane_subset = {};
+      if constexpr (subsets == 2)
+        lane_subset = I4{(mask >> (4 * g)) & 1, (mask >> (4 * g + 1)) & 1,
+                         (mask >> (4 * g + 2)) & 1, (mask >> (4 * g + 3)) & 1};
+      const I4 second = -lane_subset;  // all bits set in the lanes of subset 1
+      const auto pick = [&](float v0, float v1) {
+        const I4 a = std::bit_cast<I4>(F4{v0, v0, v0, v0}), b = std::bit_cast<I4>(F4{v1, v1, v1, v1});
+        return std::bit_cast<F4>((a & ~second) | (b & second));
+      };
+      F4 p = {};
+      for (int c = 0; c < 3; ++c) {
+        F4 h;
+        std::memcpy(&h, &in.hs[c][4 * g], sizeof(h));
+        const F4 origin = pick(pal[0][c][1], pal[subsets - 1][c][1]);
+        const F4 direction = pick(dir[0][c], dir[subsets - 1][c]);
+        p += (h - origin) * direction;
+      }
+      const F4 scale = pick(inv_len2[0], inv_len2[subsets - 1]);
+      I4 w = __builtin_convertvector(p * scale + 0.5f, I4);
+      w = w < 0 ? 0 : w;
+      w = w > 64 ? 64 : w;
+      std::memcpy(&nearest_weight[4 * g], &w, sizeof(w));
+    }
     for (int t = 0; t < 16; ++t) {
-      const int s = (mask >> t) & 1;
-      const int allowed = IsAnchor(t, subsets, partition) ? levels / 2 : levels;
+      const int s = subsets == 2 ? (mask >> t) & 1 : 0;
+      const int allowed = t == 0 || (subsets == 2 && t == anchor1) ? levels / 2 : levels;
       const float* h = in.h[t];
       const float* w3 = in.w[t];
-      float p = 0.0f;
-      for (int c = 0; c < 3; ++c) p += (h[c] - pal[s][c][1]) * dir[s][c];
-      const int w = std::clamp(static_cast<int>(p * inv_len2[s] + 0.5f), 0, 64);
-      const int centre = std::min<int>(nearest[w], allowed - 1);
+      const int centre = std::min<int>(nearest[nearest_weight[t]], allowed - 1);
       // Lane j holds entry centre − 1 + j (lane 3 and out-of-range lanes are not compared); each
       // lane's sums are formed in the order of one entry's: channel 0, 1, 2.
-      float e2[4] = {}, plain[4] = {};
+      F4 e2v = {}, plainv = {};
       for (int c = 0; c < 3; ++c) {
-        const float* entry = &pal[s][c][centre];
-        for (int j = 0; j < 4; ++j) {
-          const float d = entry[j] - h[c];
-          e2[j] += w3[c] * d * d, plain[j] += d * d;
-        }
+        F4 entry;
+        std::memcpy(&entry, &pal[s][c][centre], sizeof(entry));
+        const F4 d = entry - h[c];
+        e2v += w3[c] * d * d, plainv += d * d;
       }
+      float e2[4], plain[4];
+      std::memcpy(e2, &e2v, sizeof(e2));
+      std::memcpy(plain, &plainv, sizeof(plain));
       // Entries centre − 1, centre, centre + 1 in turn, a later one only when strictly better;
       // the centre is always in range, so a missing neighbour simply loses.
       constexpr float kMissing = std::numeric_limits<float>::infinity();
@@ -446,9 +508,10 @@ void TryMode(const Mode& mode, int partition, Endpoints ends, QuantizedEnds& fir
       // Only the one-subset search's early exit reads it; two-subset candidates leave it at
       // infinity (not computed).
       float worst = subsets == 1 ? 0.0f : std::numeric_limits<float>::infinity();
-      for (int t = 0; subsets == 1 && t < 16; ++t)
-        for (int c = 0; c < 3; ++c)
-          worst = std::max(worst, in.r[t][c] * std::abs(pal[0][c][indices[t] + 1] - in.h[t][c]));
+      if constexpr (subsets == 1)
+        for (int t = 0; t < 16; ++t)
+          for (int c = 0; c < 3; ++c)
+            worst = std::max(worst, in.r[t][c] * std::abs(pal[0][c][indices[t] + 1] - in.h[t][c]));
       best.worst = worst;
     }
     // No refit can beat an exact candidate.
@@ -456,17 +519,18 @@ void TryMode(const Mode& mode, int partition, Endpoints ends, QuantizedEnds& fir
     // Weighted least squares per subset and channel: min Σ w·((1 − α)a + αb − t)² over the
     // texels (the weights differ per channel, so each channel has its own 2 × 2 system).
     // One pass over the texels; each subset's sums still take its texels in ascending order.
-    double aa[2][3] = {}, ab[2][3] = {}, bb[2][3] = {}, at[2][3] = {}, bt[2][3] = {},
-           wsum[2][3] = {}, wt[2][3] = {};
+    // Lane c of the D4 sums is channel c (lane 3 is padding).
+    D4 aa[2] = {}, ab[2] = {}, bb[2] = {}, at[2] = {}, bt[2] = {}, wsum[2] = {}, wt[2] = {};
     for (int t = 0; t < 16; ++t) {
-      const int s = (mask >> t) & 1;
+      const int s = subsets == 2 ? (mask >> t) & 1 : 0;
       const double alpha = weights[indices[t]] / 64.0, beta = 1.0 - alpha;
-      for (int c = 0; c < 3; ++c) {
-        const double w = in.w[t][c], x = in.t[t][c];
-        aa[s][c] += w * beta * beta, ab[s][c] += w * alpha * beta, bb[s][c] += w * alpha * alpha;
-        at[s][c] += w * beta * x, bt[s][c] += w * alpha * x;
-        wsum[s][c] += w, wt[s][c] += w * x;
-      }
+      D4 w, x;
+      std::memcpy(&w, in.wd[t], sizeof(w));
+      std::memcpy(&x, in.td[t], sizeof(x));
+      const D4 wa = w * alpha, wb = w * beta;
+      aa[s] += wb * beta, ab[s] += wa * beta, bb[s] += wa * alpha;
+      at[s] += wb * x, bt[s] += wa * x;
+      wsum[s] += w, wt[s] += w * x;
     }
     for (int s = 0; s < subsets; ++s)
       for (int c = 0; c < 3; ++c) {
@@ -652,8 +716,8 @@ bool DeltasFit(const ModeInfo& info, QuantizedEnds& quantized) {
 
 // Tries the kModesTried most precise modes of `subsets` subsets whose deltas hold the
 // endpoints (modes are listed by endpoint precision within each kind, the raw ones last).
-void TryBestModes(int subsets, int partition, const Endpoints& ends, const BlockInput& in,
-                  Encoded& best) {
+template <int subsets>
+void TryBestModes(int partition, const Endpoints& ends, const BlockInput& in, Encoded& best) {
   static const std::array<int, 14> order = [] {
     std::array<int, 14> o{};
     for (int i = 0; i < 14; ++i) o[i] = i;
@@ -667,7 +731,7 @@ void TryBestModes(int subsets, int partition, const Endpoints& ends, const Block
   for (int i : order) {
     const Mode& mode = tables.modes[i];
     if (mode.info.subsets != subsets || !DeltasFit(mode.info, quantized)) continue;
-    TryMode(mode, partition, ends, quantized, in, kRefinements, best);
+    TryMode<subsets>(mode, partition, ends, quantized, in, kRefinements, best);
     if (++tried == kModesTried) break;
   }
 }
@@ -748,13 +812,16 @@ Bc6hBlock EncodeBc6hBlock(const float* rgb48, float reference_max) {
       const float ratio = std::min(std::max(x[c], kDenormalValue) / scale, 1.0f);
       in.w[t][c] = ratio * ratio;
       in.r[t][c] = ratio;
+      in.hs[c][t] = in.h[t][c];
+      in.wd[t][c] = in.w[t][c], in.td[t][c] = in.t[t][c];
     }
+    in.wd[t][3] = in.td[t][3] = 0.0;
   }
   Encoded best;
   {
     Endpoints ends{};
     FitLine(in, 0, 0, 0, ends.e[0]);
-    TryBestModes(1, 0, ends, in, best);
+    TryBestModes<1>(0, ends, in, best);
   }
   if (!kReferenceSearch && static_cast<int>(std::ceil(best.worst)) <= kBc6hGoodEnoughHalfSteps)
     return PackBest(best);
@@ -771,7 +838,7 @@ Bc6hBlock EncodeBc6hBlock(const float* rgb48, float reference_max) {
     Endpoints ends{};
     FitLine(in, kPartitions[part], 0, 0, ends.e[0]);
     FitLine(in, kPartitions[part], 1, kAnchor2[part], ends.e[1]);
-    TryBestModes(2, part, ends, in, best);
+    TryBestModes<2>(part, ends, in, best);
   }
   return PackBest(best);
 }
