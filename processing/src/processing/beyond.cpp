@@ -61,15 +61,65 @@ View TexelView(double theta_in_deg, int j, int i) {
 struct Parts {
   double y = 0, offset = 0;
 };
-Parts PartsOf(Model family, const ShadingGeometry& g, double shape) {
+
+// The terms of models::Ggx, Ward and Lafortune at one geometry that do not depend on the shape
+// (the cosines' squares and tangents, the Fresnel weight, the denominators), each computed with
+// the operations the model does, so PartsOf below gives the doubles of the models themselves.
+// A fit tries 30 shapes at the same points; these are computed once per point.
+struct ShapeFreeTerms {
+  double tan2_l = 0, tan2_v = 0, cos2_h = 0, fresnel_weight = 0, ggx_denom = 0;  // ggx
+  double tan2_h = 0, sqrt_lv = 0;                                               // ward
+  double v_dot_r = 0;                                                           // lafortune
+};
+double TanSquared(double cos_theta) {  // models::GgxG1's and Ward's tan²
+  const double cos2 = cos_theta * cos_theta;
+  return (1.0 - cos2) / cos2;
+}
+ShapeFreeTerms ShapeFreeTermsOf(Model family, const ShadingGeometry& g) {
+  ShapeFreeTerms t;
   switch (family) {
     case Model::kWard:
-      return {models::Ward(g, 0.0, 1.0, shape), 0.0};
+      t.tan2_h = TanSquared(g.n_dot_h);
+      t.sqrt_lv = std::sqrt(g.n_dot_l * g.n_dot_v);
+      break;
     case Model::kLafortune:
-      return {models::Lafortune(g, 0.0, 1.0, shape), 0.0};
+      t.v_dot_r = g.v_dot_r;
+      break;
+    default:
+      t.tan2_l = TanSquared(g.n_dot_l);
+      t.tan2_v = TanSquared(g.n_dot_v);
+      t.cos2_h = g.n_dot_h * g.n_dot_h;
+      t.fresnel_weight = models::Pow5(1.0 - g.v_dot_h);
+      t.ggx_denom = 4.0 * g.n_dot_l * g.n_dot_v;
+      break;
+  }
+  return t;
+}
+
+// {models::Ward(g, 0, 1, shape), 0}, {models::Lafortune(g, 0, 1, shape), 0} and for ggx
+// {Ggx(g, 0, 1, shape) − Ggx(g, 0, 0, shape), Ggx(g, 0, 0, shape)}, the two GGX evaluations
+// sharing their shadowing and distribution; every operation as in brdf/core/models.h.
+Parts PartsOf(Model family, const ShapeFreeTerms& t, double shape) {
+  switch (family) {
+    case Model::kWard: {
+      const double a2 = shape * shape;
+      return {0.0 * kInvPi + 1.0 * std::exp(-t.tan2_h / a2) / (4 * kPi * a2 * t.sqrt_lv), 0.0};
+    }
+    case Model::kLafortune: {
+      const double lobe = t.v_dot_r > 0 ? std::pow(t.v_dot_r, shape) : 0.0;
+      return {0.0 * kInvPi + 1.0 * (shape + 2.0) * (0.5 * kInvPi) * lobe, 0.0};
+    }
     default: {
-      const double off = models::Ggx(g, 0.0, 0.0, shape);
-      return {models::Ggx(g, 0.0, 1.0, shape) - off, off};
+      const double a2 = shape * shape;
+      const double shadowing = 2.0 / (1.0 + std::sqrt(1.0 + a2 * t.tan2_l)) *
+                               (2.0 / (1.0 + std::sqrt(1.0 + a2 * t.tan2_v)));
+      const double dd = t.cos2_h * (a2 - 1.0) + 1.0;
+      const double d = a2 / (kPi * dd * dd);
+      const double fresnel_0 = 0.0 + (1.0 - 0.0) * t.fresnel_weight;
+      const double fresnel_1 = 1.0 + (1.0 - 1.0) * t.fresnel_weight;
+      const double off = 0.0 * kInvPi + fresnel_0 * shadowing * d / t.ggx_denom;
+      const double one = 0.0 * kInvPi + fresnel_1 * shadowing * d / t.ggx_denom;
+      return {one - off, off};
     }
   }
 }
@@ -84,6 +134,40 @@ struct FitPoint {
   ShadingGeometry g;
   std::array<double, 3> f;
 };
+
+// What FitAtShape needs of the points besides the model's parts: each point's relative weight
+// w = 1/(f + ε)² per channel and w·(1/π), and the sums that do not involve the parts (Σ w/π²
+// always, and Σ w·f/π and Σ w·f² for the families without an offset), each summed in the
+// points' order as FitAtShape summed it.
+struct FitData {
+  const std::vector<FitPoint>* pts = nullptr;
+  std::vector<std::array<double, 3>> w, wx;
+  std::array<double, 3> saa{}, sa{}, s{};
+  bool offset_free = false;
+};
+FitData FitDataOf(const std::vector<FitPoint>& pts, const std::array<double, 3>& eps,
+                  Model family) {
+  FitData d;
+  d.pts = &pts;
+  d.offset_free = family == Model::kWard || family == Model::kLafortune;
+  d.w.resize(pts.size());
+  d.wx.resize(pts.size());
+  const double x = kInvPi;
+  for (std::size_t k = 0; k < pts.size(); ++k) {
+    const FitPoint& p = pts[k];
+    for (int c = 0; c < 3; ++c) {
+      const double w = 1.0 / ((p.f[c] + eps[c]) * (p.f[c] + eps[c]));
+      d.w[k][c] = w;
+      d.wx[k][c] = w * x;
+      d.saa[c] += w * x * x;
+      if (d.offset_free) {
+        const double y = p.f[c] - 0.0;
+        d.sa[c] += w * x * y, d.s[c] += w * y * y;
+      }
+    }
+  }
+  return d;
+}
 
 // Weighted least squares of kd, f0 ∈ [0, 1] for one channel: Σ w (kd/π + f0·a + b − f)².
 struct Normal {
@@ -114,26 +198,44 @@ struct Candidate {
   double shape = 0;
 };
 
-// PartsOf(family, p.g, shape) of every point: what a fit at one shape needs from the model,
+// PartsOf(family, point, shape) of every point: what a fit at one shape needs from the model,
 // independent of the values fitted.
-std::vector<Parts> PartsAtShape(Model family, const std::vector<FitPoint>& pts, double shape) {
-  std::vector<Parts> parts(pts.size());
-  for (std::size_t k = 0; k < pts.size(); ++k) parts[k] = PartsOf(family, pts[k].g, shape);
+std::vector<Parts> PartsAtShape(Model family, const std::vector<ShapeFreeTerms>& terms,
+                                double shape) {
+  std::vector<Parts> parts(terms.size());
+  for (std::size_t k = 0; k < terms.size(); ++k) parts[k] = PartsOf(family, terms[k], shape);
   return parts;
 }
 
-double FitAtShape(const std::vector<FitPoint>& pts, const std::vector<Parts>& parts,
-                  const std::array<double, 3>& eps, double shape, Candidate* out) {
+// The weighted normal equations Σ w (a/π + b·y + offset − f)² per channel at one shape, and
+// their bounded solution.
+double FitAtShape(const FitData& d, const std::vector<Parts>& parts, double shape,
+                  Candidate* out) {
+  const std::vector<FitPoint>& pts = *d.pts;
   std::array<Normal, 3> n{};
-  for (std::size_t k = 0; k < pts.size(); ++k) {
-    const FitPoint& p = pts[k];
-    const Parts& q = parts[k];
-    const double x = kInvPi;
-    for (int c = 0; c < 3; ++c) {
-      const double w = 1.0 / ((p.f[c] + eps[c]) * (p.f[c] + eps[c]));
-      const double y = p.f[c] - q.offset;
-      n[c].saa += w * x * x, n[c].sab += w * x * q.y, n[c].sbb += w * q.y * q.y;
-      n[c].sa += w * x * y, n[c].sb += w * q.y * y, n[c].s += w * y * y;
+  for (int c = 0; c < 3; ++c) n[c].saa = d.saa[c];
+  if (d.offset_free) {
+    for (int c = 0; c < 3; ++c) n[c].sa = d.sa[c], n[c].s = d.s[c];
+    for (std::size_t k = 0; k < pts.size(); ++k) {
+      const FitPoint& p = pts[k];
+      const double qy = parts[k].y;
+      for (int c = 0; c < 3; ++c) {
+        const double wq = d.w[k][c] * qy;
+        const double y = p.f[c] - 0.0;
+        n[c].sab += d.wx[k][c] * qy, n[c].sbb += wq * qy, n[c].sb += wq * y;
+      }
+    }
+  } else {
+    for (std::size_t k = 0; k < pts.size(); ++k) {
+      const FitPoint& p = pts[k];
+      const Parts& q = parts[k];
+      for (int c = 0; c < 3; ++c) {
+        const double w = d.w[k][c];
+        const double wq = w * q.y;
+        const double y = p.f[c] - q.offset;
+        n[c].sab += d.wx[k][c] * q.y, n[c].sbb += wq * q.y;
+        n[c].sa += d.wx[k][c] * y, n[c].sb += wq * y, n[c].s += w * y * y;
+      }
     }
   }
   double total = 0;
@@ -277,13 +379,13 @@ using PointsKey = std::tuple<int, std::vector<std::uint64_t>, std::uint64_t, std
 std::shared_ptr<const std::vector<Parts>> SharedPartsAtShape(Model family,
                                                              const std::vector<double>& theta_in,
                                                              double theta_b,
-                                                             const std::vector<FitPoint>& pts,
+                                                             const std::vector<ShapeFreeTerms>& terms,
                                                              double shape) {
   static SharedMap<PointsKey, std::vector<Parts>> parts(128);
   std::vector<std::uint64_t> slices(theta_in.size());
   std::transform(theta_in.begin(), theta_in.end(), slices.begin(), Bits);
   return parts.Get({static_cast<int>(family), std::move(slices), Bits(theta_b), Bits(shape)}, [&] {
-    return std::make_shared<const std::vector<Parts>>(PartsAtShape(family, pts, shape));
+    return std::make_shared<const std::vector<Parts>>(PartsAtShape(family, terms, shape));
   });
 }
 
@@ -803,11 +905,14 @@ FillModel FitFillModel(const Lut& lut, double theta_b, Model family) {
   std::array<double, 3> eps{};
   const double all = (mean[0] + mean[1] + mean[2]) / (3.0 * std::max<std::size_t>(pts.size(), 1));
   for (int c = 0; c < 3; ++c) eps[c] = 0.02 * all + 1e-6;
+  const FitData data = FitDataOf(pts, eps, family);
+  std::vector<ShapeFreeTerms> terms(pts.size());
+  for (std::size_t k = 0; k < pts.size(); ++k) terms[k] = ShapeFreeTermsOf(family, pts[k].g);
   // The grid's shapes and the golden section's first two (set by the best grid shape alone) are
   // shared; the later ones depend on the values fitted and are computed here.
   const auto fit_at = [&](double shape, Candidate* out, bool shared = true) {
-    if (!shared) return FitAtShape(pts, PartsAtShape(family, pts, shape), eps, shape, out);
-    return FitAtShape(pts, *SharedPartsAtShape(family, lut.theta_in_deg, theta_b, pts, shape), eps,
+    if (!shared) return FitAtShape(data, PartsAtShape(family, terms, shape), shape, out);
+    return FitAtShape(data, *SharedPartsAtShape(family, lut.theta_in_deg, theta_b, terms, shape),
                       shape, out);
   };
   const bool lafortune = family == Model::kLafortune;
