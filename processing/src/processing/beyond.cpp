@@ -38,6 +38,12 @@ FillModel Widened(FillModel m) {
   return m;
 }
 
+// A new slice's blend weight at θout' = min(θout, 90°): 0 below θL − 5° (reciprocity alone), 1
+// above θL + 5° (the continuation of the slice below alone), linear in between.
+double BlendWeight(double to, double last) {
+  return std::clamp((to - (last - kBlendDeg)) / (2 * kBlendDeg), 0.0, 1.0);
+}
+
 // Runs body(j) for every texel row j, on TBB's workers (within any enclosing arena's limit).
 template <class Body>
 void ForRows(const Body& body) {
@@ -327,6 +333,28 @@ class SharedTables {
                     });
   }
 
+  // Where Fill's reciprocity reads the banded LUT (the measured slices with their band and the
+  // inserted ones, θin list `banded`) for the new slice at θin `t` whose views are `views`:
+  // Lut::TextureCoordinates(min(θout, θL), min(t, 90°), −φout) at every texel whose blend weight
+  // is below 1 (the others are left 0). They depend on the θin lists and the views alone; the
+  // trigonometry was most of a reciprocity read.
+  using Coordinates = std::array<double, 3>;
+  static std::shared_ptr<const std::vector<Coordinates>> ReciprocityAt(const Lut& banded, double t,
+                                                                       double last,
+                                                                       const ViewsPtr& views) {
+    using Key = std::tuple<std::vector<std::uint64_t>, std::uint64_t, std::uint64_t, const Views*>;
+    static SharedMap<Key, Derived<Coordinates>> coordinates(kMaxSlices);
+    std::vector<std::uint64_t> list(banded.theta_in_deg.size());
+    std::transform(banded.theta_in_deg.begin(), banded.theta_in_deg.end(), list.begin(), Bits);
+    return PerTexel(coordinates, Key{std::move(list), Bits(t), Bits(last), views.get()}, views,
+                    true, [&](const View& v, Coordinates& c) {
+                      const double to = std::min(v.theta_deg, 90.0);
+                      if (BlendWeight(to, last) < 1.0)
+                        c = banded.TextureCoordinates(std::min(to, last), std::min(t, 90.0),
+                                                      -v.phi_deg);
+                    });
+  }
+
   // cos θout of every texel of `views` (the albedo's weights, std::cos as Albedo computed it).
   static std::shared_ptr<const std::vector<double>> CosinesAt(const ViewsPtr& views) {
     static SharedMap<const Views*, Derived<double>> cosines(kMaxSlices);
@@ -606,16 +634,19 @@ Lut Fill(const Lut& measured_in, double theta_b, double max_theta_in, double ste
     const SliceGrid& g = ratio.Prepare(t);
     const SliceGrid& g_below = ratio.Prepare(t - delta);
     const Mask* only = MaskAt(ratio.needs ? &ratio.needs->texels : nullptr, t);
+    const auto reciprocity = SharedTables::ReciprocityAt(banded, t, last, g.views);
     ForRows([&](int j) {
       for (int i = 0; i < Lut::kWidth; ++i) {
         const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
         if (only && !(*only)[n]) continue;  // never read (left 0)
         const View v = g.view()[n];
         const double to = std::min(v.theta_deg, 90.0);
-        const double w = std::clamp((to - (last - kBlendDeg)) / (2 * kBlendDeg), 0.0, 1.0);
+        const double w = BlendWeight(to, last);
         std::array<double, 3> value{};
         if (w < 1.0) {
-          const auto f = banded.SampleTexture(std::min(to, last), std::min(t, 90.0), -v.phi_deg);
+          // banded.SampleTexture(min(θout, θL), min(t, 90°), −φout) at the shared coordinates.
+          const auto& at = (*reciprocity)[n];
+          const auto f = banded.SampleTrilinear(at[0], at[1], at[2]);
           for (int c = 0; c < 3; ++c) value[c] = (1.0 - w) * f[c];
         }
         if (w > 0.0) {
