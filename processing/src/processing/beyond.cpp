@@ -464,12 +464,11 @@ struct Ratio {
       const Mask* only = MaskAt(needs ? &needs->model : nullptr, theta_in_deg);
       g.m.resize(at.size());
       ForRows([&](int j) {
-        for (int i = 0; i < Lut::kWidth; ++i) {
-          const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
-          if (only && !(*only)[n]) continue;  // never read (left 0)
-          // FillModel::Eval at the cached geometry (the same numbers).
-          g.m[n] = detail::EvaluateFillModel(model->material, at[n]);
-        }
+        const std::size_t row = static_cast<std::size_t>(j) * Lut::kWidth;
+        // FillModel::Eval at the cached geometry (the same numbers); texels never read are
+        // left 0.
+        detail::EvaluateFillModelAt(model->material, &at[row], Lut::kWidth, &g.m[row],
+                                    [&](int i) { return only && !(*only)[row + i]; });
       });
     }
     return grids->emplace(key, std::move(g)).first->second;
@@ -596,14 +595,20 @@ Lut Fill(const Lut& measured_in, double theta_b, double max_theta_in, double ste
     const Material& model = ratio.model->material;
     const Mask* only = MaskAt(ratio.needs ? &ratio.needs->texels : nullptr, t);
     ForRows([&](int j) {
+      const std::size_t row = static_cast<std::size_t>(j) * Lut::kWidth;
+      const auto skip = [&](int i) {
+        const View& v = g.view()[row + i];
+        // Not in the band, or neither read nor in the slice's albedo (θout < 90°), which
+        // scales the band below.
+        return v.theta_deg <= theta_b || (only && !(*only)[row + i] && v.theta_deg >= 90.0);
+      };
+      // FillModel::Eval(t, θb, φout) at the shared geometry (the same numbers).
+      std::array<std::array<double, 3>, Lut::kWidth> at_band;
+      detail::EvaluateFillModelAt(model, &(*band)[row], Lut::kWidth, at_band.data(), skip);
       for (int i = 0; i < Lut::kWidth; ++i) {
-        const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
-        const View v = g.view()[n];
-        if (v.theta_deg <= theta_b) continue;
-        // Neither read nor in the slice's albedo (θout < 90°), which scales the band below.
-        if (only && !(*only)[n] && v.theta_deg >= 90.0) continue;
-        // FillModel::Eval(t, θb, φout) at the shared geometry (the same numbers).
-        const auto r = RatioOf(g.m[n], detail::EvaluateFillModel(model, (*band)[n]));
+        if (skip(i)) continue;
+        const std::size_t n = row + static_cast<std::size_t>(i);
+        const auto r = RatioOf(g.m[n], at_band[static_cast<std::size_t>(i)]);
         float* f = out.Texel(k, j, i);
         for (int c = 0; c < 3; ++c) f[c] = static_cast<float>(f[c] * r[c]);
       }
