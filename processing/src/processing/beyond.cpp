@@ -38,6 +38,8 @@ FillModel Widened(FillModel m) {
   return m;
 }
 
+std::uint64_t Bits(double x) { return std::bit_cast<std::uint64_t>(x); }
+
 // A new slice's blend weight at θout' = min(θout, 90°): 0 below θL − 5° (reciprocity alone), 1
 // above θL + 5° (the continuation of the slice below alone), linear in between.
 double BlendWeight(double to, double last) {
@@ -104,8 +106,9 @@ ShapeFreeTerms ShapeFreeTermsOf(Model family, const ShadingGeometry& g) {
 
 // {models::Ward(g, 0, 1, shape), 0}, {models::Lafortune(g, 0, 1, shape), 0} and for ggx
 // {Ggx(g, 0, 1, shape) − Ggx(g, 0, 0, shape), Ggx(g, 0, 0, shape)}, the two GGX evaluations
-// sharing their shadowing and distribution; every operation as in brdf/core/models.h.
-Parts PartsOf(Model family, const ShapeFreeTerms& t, double shape) {
+// sharing their shadowing and distribution; every operation as in brdf/core/models.h. g1_l is
+// GGX's light-side masking models::GgxG1(n·l, shape²) (one per slice: the caller keeps it).
+Parts PartsOf(Model family, const ShapeFreeTerms& t, double shape, double g1_l) {
   switch (family) {
     case Model::kWard: {
       const double a2 = shape * shape;
@@ -117,8 +120,7 @@ Parts PartsOf(Model family, const ShapeFreeTerms& t, double shape) {
     }
     default: {
       const double a2 = shape * shape;
-      const double shadowing = 2.0 / (1.0 + std::sqrt(1.0 + a2 * t.tan2_l)) *
-                               (2.0 / (1.0 + std::sqrt(1.0 + a2 * t.tan2_v)));
+      const double shadowing = g1_l * (2.0 / (1.0 + std::sqrt(1.0 + a2 * t.tan2_v)));
       const double dd = t.cos2_h * (a2 - 1.0) + 1.0;
       const double d = a2 / (kPi * dd * dd);
       const double fresnel_0 = 0.0 + (1.0 - 0.0) * t.fresnel_weight;
@@ -215,7 +217,18 @@ struct Candidate {
 std::vector<Parts> PartsAtShape(Model family, const std::vector<ShapeFreeTerms>& terms,
                                 double shape) {
   std::vector<Parts> parts(terms.size());
-  for (std::size_t k = 0; k < terms.size(); ++k) parts[k] = PartsOf(family, terms[k], shape);
+  // models::GgxG1(n·l) = 2/(1 + √(1 + α² tan²θl)) again only when tan²θl changes (its bits).
+  const double a2 = shape * shape;
+  std::uint64_t l_bits = 0;
+  double g1_l = 0;
+  for (std::size_t k = 0; k < terms.size(); ++k) {
+    if (family == Model::kGgx) {
+      const std::uint64_t bits = Bits(terms[k].tan2_l);
+      if (k == 0 || bits != l_bits)
+        g1_l = 2.0 / (1.0 + std::sqrt(1.0 + a2 * terms[k].tan2_l)), l_bits = bits;
+    }
+    parts[k] = PartsOf(family, terms[k], shape, g1_l);
+  }
   return parts;
 }
 
@@ -298,7 +311,6 @@ class SharedMap {
   std::map<Key, std::shared_ptr<const Table>> map_;
 };
 
-std::uint64_t Bits(double x) { return std::bit_cast<std::uint64_t>(x); }
 
 class SharedTables {
  public:

@@ -11,7 +11,9 @@
 #pragma once
 
 #include <array>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 
 #include "brdf/core/models.h"
 
@@ -26,12 +28,14 @@ inline bool IsOneShapeFillModel(const Material& material) {
 }
 
 // The three families at one geometry above the horizon, p = the material's values (shape p[6]).
-inline std::array<double, 3> GgxFill(const double* p, const ShadingGeometry& g) {
+// GGX with its light-side masking g1_l = models::GgxG1(g.n_dot_l, α²) given: a slice's light is
+// one direction, so a row of texels shares it (EvaluateFillModelAt computes it once per value).
+inline std::array<double, 3> GgxFill(const double* p, const ShadingGeometry& g, double g1_l) {
   // models::Ggx: kd/π + F·G·D / (4 n·l n·v), F = f0 + (1 − f0)(1 − v·h)⁵.
   std::array<double, 3> out;
   const double a2 = p[6] * p[6];
   const double fresnel_weight = models::Pow5(1.0 - g.v_dot_h);
-  const double shadowing = models::GgxG1(g.n_dot_l, a2) * models::GgxG1(g.n_dot_v, a2);
+  const double shadowing = g1_l * models::GgxG1(g.n_dot_v, a2);
   const double d = models::GgxD(g.n_dot_h, a2);
   const double denom = 4.0 * g.n_dot_l * g.n_dot_v;
   for (int c = 0; c < 3; ++c) {
@@ -67,7 +71,7 @@ inline std::array<double, 3> EvaluateFillModel(const Material& material, const S
   if (!g.AboveHorizon()) return {0.0, 0.0, 0.0};
   switch (material.model) {
     case Model::kGgx:
-      return GgxFill(p, g);
+      return GgxFill(p, g, models::GgxG1(g.n_dot_l, p[6] * p[6]));
     case Model::kWard:
       return WardFill(p, g);
     default:
@@ -94,9 +98,19 @@ void EvaluateFillModelAt(const Material& material, const ShadingGeometry* g, int
     return;
   }
   switch (material.model) {
-    case Model::kGgx:
-      each(GgxFill);
+    case Model::kGgx: {
+      // GgxG1(n·l) again only when n·l changes (its bits: the same input, the same double).
+      const double a2 = p[6] * p[6];
+      std::uint64_t l_bits = 0;
+      double g1_l = 0;
+      bool have = false;
+      each([&](const double* q, const ShadingGeometry& at) {
+        const std::uint64_t bits = std::bit_cast<std::uint64_t>(at.n_dot_l);
+        if (!have || bits != l_bits) g1_l = models::GgxG1(at.n_dot_l, a2), l_bits = bits, have = true;
+        return GgxFill(q, at, g1_l);
+      });
       break;
+    }
     case Model::kWard:
       each(WardFill);
       break;
