@@ -143,10 +143,24 @@ struct FitPoint {
   std::array<double, 3> f;
 };
 
-// Four doubles operated on lane by lane (GCC/Clang vector extension; two SSE2 operations each
-// on x86-64): the three channels of a fit point, lane 3 unused (0). Each lane does exactly the
-// scalar operations, so a channel's sums are the doubles the scalar loop gave.
-using Lanes = double __attribute__((vector_size(32)));
+// The three channels of a fit point as two pairs of doubles operated on lane by lane (GCC/Clang
+// vector extension, one SSE2 register each on x86-64): channels 0 and 1, then channel 2 and an
+// unused 0. Each lane does exactly the scalar operations, so a channel's sums are the doubles
+// the scalar loop gave. (A four-lane type is split by the compiler through the stack, which
+// made the accumulation wait on memory.)
+using Pair = double __attribute__((vector_size(16)));
+struct Lanes {
+  Pair lo{}, hi{};
+  double operator[](int c) const { return c < 2 ? lo[c] : hi[c - 2]; }
+  double& operator[](int c) { return c < 2 ? lo[c] : hi[c - 2]; }
+};
+inline Lanes operator*(const Lanes& a, double x) { return {a.lo * x, a.hi * x}; }
+inline Lanes operator*(const Lanes& a, const Lanes& b) { return {a.lo * b.lo, a.hi * b.hi}; }
+inline Lanes operator-(const Lanes& a, double x) { return {a.lo - x, a.hi - x}; }
+inline Lanes& operator+=(Lanes& a, const Lanes& b) {
+  a.lo += b.lo, a.hi += b.hi;
+  return a;
+}
 
 // What FitAtShape needs of the points besides the model's parts: each point's value f and
 // relative weight w = 1/(f + ε)² per channel and w·(1/π), and the sums that do not involve the
