@@ -519,11 +519,13 @@ struct Ratio {
 //   (1 − t)·f(θa)·M(θ)/M(θa) + t·f(θb)·M(θ)/M(θb)
 // with M at each slice's own view of that texel: linear in θin at equal (θd, φd) for M ≡ 1,
 // and following the model's change with θin otherwise.
-Lut Densify(const Lut& measured, double step, const Ratio& ratio) {
+// The result has room for `capacity_slices` slices (Fill appends its new slices).
+Lut Densify(Lut measured, double step, const Ratio& ratio, std::size_t capacity_slices) {
   const double delta = measured.DeltaInDeg();
   const int per = static_cast<int>(std::lround(delta / step));
   if (per <= 1) return measured;
   Lut out;
+  out.texels.reserve(capacity_slices * Lut::kHeight * Lut::kWidth * 3);
   out.Resize(static_cast<std::size_t>((measured.slices() - 1) * per + 1));
   for (int k = 0; k < out.slices(); ++k) {
     const double theta = k * step;
@@ -609,9 +611,20 @@ void LimitAlbedo(Lut* lut, int k, const SliceGrid& g, Filled filled, BeyondRepor
 // The fill of `measured` by `ratio` (no validation, no method choice).
 Lut Fill(const Lut& measured_in, double theta_b, double max_theta_in, double step,
          const Ratio& ratio, BeyondReport* report) {
-  Lut out = measured_in;
   const int k_meas = measured_in.slices();
   const double last = measured_in.theta_in_deg.back();
+  // Room for every slice of the result (a bound: the step of steps 2 and 3 below), so that
+  // appending the new slices copies nothing else.
+  const double step_out = step > 0 && std::lround(measured_in.DeltaInDeg() / step) > 1
+                              ? step
+                              : measured_in.DeltaInDeg();
+  const std::size_t capacity = static_cast<std::size_t>(std::max(
+      k_meas * std::max(1L, step > 0 ? std::lround(measured_in.DeltaInDeg() / step) : 1L),
+      step_out > 0 ? static_cast<long>(std::floor(max_theta_in / step_out + 1e-9)) + 1 : 0L));
+  Lut out;
+  out.theta_in_deg = measured_in.theta_in_deg;
+  out.texels.reserve(capacity * Lut::kHeight * Lut::kWidth * 3);
+  out.texels = measured_in.texels;
   // 1. The θout band of the measured slices.
   for (int k = 0; k < k_meas; ++k) {
     const double t = measured_in.theta_in_deg[k];
@@ -644,7 +657,7 @@ Lut Fill(const Lut& measured_in, double theta_b, double max_theta_in, double ste
   }
   // 2. Slices between the measured ones, when the step is finer.
   if (step > 0) {
-    out = Densify(out, step, ratio);
+    out = Densify(std::move(out), step, ratio, capacity);
     for (double t : out.theta_in_deg)
       if (std::none_of(measured_in.theta_in_deg.begin(), measured_in.theta_in_deg.end(),
                        [&](double m) { return std::fabs(m - t) < 1e-6; }))
@@ -652,16 +665,17 @@ Lut Fill(const Lut& measured_in, double theta_b, double max_theta_in, double ste
   }
   const int k_meas_step = out.slices();
   const double delta = out.DeltaInDeg();
-  const Lut banded = out;  // measured slices with their band: what reciprocity reads
-  // 3. New slices beyond the last measured one.
+  // 3. New slices beyond the last measured one, made in `added` (slice q is slice
+  // k_meas_step + q of the result) while `out` is the banded LUT (the measured slices with their
+  // band, and the inserted ones) that reciprocity reads; appended to it at the end.
+  const Lut& banded = out;
   const int k_total = static_cast<int>(std::floor(max_theta_in / delta + 1e-9)) + 1;
-  // One allocation for the new slices (growing slice by slice copied the LUT each time).
-  out.texels.reserve(static_cast<std::size_t>(std::max(k_total, k_meas_step)) * Lut::kHeight *
-                     Lut::kWidth * 3);
+  Lut added;
+  added.Resize(static_cast<std::size_t>(std::max(0, k_total - k_meas_step)));
   for (int k = k_meas_step; k < k_total; ++k) {
     const double t = k * delta;
-    out.theta_in_deg.push_back(t);
-    out.texels.resize(static_cast<std::size_t>(k + 1) * Lut::kHeight * Lut::kWidth * 3);
+    const int q = k - k_meas_step;
+    added.theta_in_deg[static_cast<std::size_t>(q)] = t;
     const SliceGrid& g = ratio.Prepare(t);
     const SliceGrid& g_below = ratio.Prepare(t - delta);
     const Mask* only = MaskAt(ratio.needs ? &ratio.needs->texels : nullptr, t);
@@ -682,20 +696,23 @@ Lut Fill(const Lut& measured_in, double theta_b, double max_theta_in, double ste
         }
         if (w > 0.0) {
           const auto r = ratio.Between(g, g_below, n);
-          const float* f = out.Texel(k - 1, j, i);
+          const float* f = q == 0 ? out.Texel(k - 1, j, i) : added.Texel(q - 1, j, i);
           for (int c = 0; c < 3; ++c) value[c] += w * f[c] * r[c];
         }
-        float* dst = out.Texel(k, j, i);
+        float* dst = added.Texel(q, j, i);
         for (int c = 0; c < 3; ++c) dst[c] = static_cast<float>(value[c]);
       }
     });
     // Column 360 repeats column 0 (docs/design.md §5).
     for (int j = 0; j < Lut::kHeight; ++j)
-      std::copy_n(out.Texel(k, j, 0), 3, out.Texel(k, j, Lut::kWidth - 1));
+      std::copy_n(added.Texel(q, j, 0), 3, added.Texel(q, j, Lut::kWidth - 1));
     LimitAlbedo(
-        &out, k, g, [](int, int, const View&) { return true; }, report);
+        &added, q, g, [](int, int, const View&) { return true; }, report);
     report->extrapolated_theta_in_deg.push_back(t);
   }
+  out.theta_in_deg.insert(out.theta_in_deg.end(), added.theta_in_deg.begin(),
+                          added.theta_in_deg.end());
+  out.texels.insert(out.texels.end(), added.texels.begin(), added.texels.end());
   return out;
 }
 
