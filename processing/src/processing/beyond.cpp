@@ -1034,7 +1034,8 @@ FillModel FitFillModel(const Lut& lut, double theta_b, Model family) {
   std::vector<double> rel;
   rel.reserve(pts.size() * 3);
   for (const FitPoint& p : pts) {
-    const Rgb m = models::EvaluateRgb(family, p.g, out.material.values.data());
+    // models::EvaluateRgb(family, p.g, …), its shape terms once for the three channels.
+    const std::array<double, 3> m = detail::EvaluateFillModel(out.material, p.g);
     for (int c = 0; c < 3; ++c) rel.push_back(std::fabs(m[c] - p.f[c]) / std::max(p.f[c], 1e-3));
   }
   if (!rel.empty()) {
