@@ -237,8 +237,10 @@ CaptureAssessment AssessCapture(const std::string& path, BpcReadResult read) {
   }
   if (!a.refusals.empty()) a.refusal = a.refusals.front();
   if (a.refusals.empty()) {
-    // The exported slices' own requirement, by the rule BuildLut applies for them.
-    for (const processing::LutInputProblem& p : processing::FindLutInputProblems(r.measurement))
+    // The exported slices' own requirement, by the rule BuildLut applies for them. No refusal
+    // means CheckValues found no problem with the samples (the same checks for any θin rule),
+    // so the θin list's are all that is left to find.
+    for (const processing::LutInputProblem& p : processing::FindThetaInProblems(r.measurement))
       if (p.kind == processing::LutInputProblem::Kind::kThetaInNotUniform)
         a.export_refusals.push_back(
             {"slices (θin " + DegList(a.present_theta_in_deg) + "°)",

@@ -92,21 +92,33 @@ std::array<float, 3> Lut::SampleAngles(double theta_in, double theta_out_deg,
 
 std::array<float, 3> Lut::SampleTexture(double theta_in, double theta_out_deg,
                                         double phi_out_deg) const {
+  const std::array<double, 3> c = TextureCoordinates(theta_in, theta_out_deg, phi_out_deg);
+  return SampleTrilinear(c[0], c[1], c[2]);
+}
+
+std::array<double, 3> Lut::TextureCoordinates(double theta_in, double theta_out_deg,
+                                              double phi_out_deg) const {
   const Vec3 w_out = SphericalDirectionDeg(theta_out_deg, phi_out_deg);
   const SpecularFrame frame = SpecularFrame::FromThetaInDeg(theta_in);
-  return SampleTextureFrame(frame.cos_m, frame.sin_m, SliceCoordinate(theta_in), w_out.x, w_out.y,
-                            w_out.z);
+  return TextureCoordinatesFrame(frame.cos_m, frame.sin_m, SliceCoordinate(theta_in), w_out.x,
+                                 w_out.y, w_out.z);
 }
 
 std::array<float, 3> Lut::SampleTextureFrame(double cos_in, double sin_in, double k, double x,
                                              double y, double z) const {
+  const std::array<double, 3> c = TextureCoordinatesFrame(cos_in, sin_in, k, x, y, z);
+  return SampleTrilinear(c[0], c[1], c[2]);
+}
+
+std::array<double, 3> Lut::TextureCoordinatesFrame(double cos_in, double sin_in, double k,
+                                                   double x, double y, double z) const {
   const Vec3 w_d = SpecularFrame{cos_in, sin_in}.ToSpecular({x, y, z});
   const double theta_d = RadToDeg(ThetaOf(w_d));
   const double phi_d = RadToDeg(PhiOf(w_d));
   const double u = (phi_d / kTexelDeg + 0.5) / kWidth;
   const double v = (theta_d / kTexelDeg + 0.5) / kHeight;
   const double w = (k + 0.5) / slices();
-  return SampleTrilinear(u, v, w);
+  return {u, v, w};
 }
 
 Rgb LutBrdf::Eval(const Vec3& wi, const Vec3& wo) const {

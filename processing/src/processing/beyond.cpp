@@ -38,6 +38,14 @@ FillModel Widened(FillModel m) {
   return m;
 }
 
+std::uint64_t Bits(double x) { return std::bit_cast<std::uint64_t>(x); }
+
+// A new slice's blend weight at θout' = min(θout, 90°): 0 below θL − 5° (reciprocity alone), 1
+// above θL + 5° (the continuation of the slice below alone), linear in between.
+double BlendWeight(double to, double last) {
+  return std::clamp((to - (last - kBlendDeg)) / (2 * kBlendDeg), 0.0, 1.0);
+}
+
 // Runs body(j) for every texel row j, on TBB's workers (within any enclosing arena's limit).
 template <class Body>
 void ForRows(const Body& body) {
@@ -61,15 +69,65 @@ View TexelView(double theta_in_deg, int j, int i) {
 struct Parts {
   double y = 0, offset = 0;
 };
-Parts PartsOf(Model family, const ShadingGeometry& g, double shape) {
+
+// The terms of models::Ggx, Ward and Lafortune at one geometry that do not depend on the shape
+// (the cosines' squares and tangents, the Fresnel weight, the denominators), each computed with
+// the operations the model does, so PartsOf below gives the doubles of the models themselves.
+// A fit tries 30 shapes at the same points; these are computed once per point.
+struct ShapeFreeTerms {
+  double tan2_l = 0, tan2_v = 0, cos2_h = 0, fresnel_weight = 0, ggx_denom = 0;  // ggx
+  double tan2_h = 0, sqrt_lv = 0;                                               // ward
+  double v_dot_r = 0;                                                           // lafortune
+};
+double TanSquared(double cos_theta) {  // models::GgxG1's and Ward's tan²
+  const double cos2 = cos_theta * cos_theta;
+  return (1.0 - cos2) / cos2;
+}
+ShapeFreeTerms ShapeFreeTermsOf(Model family, const ShadingGeometry& g) {
+  ShapeFreeTerms t;
   switch (family) {
     case Model::kWard:
-      return {models::Ward(g, 0.0, 1.0, shape), 0.0};
+      t.tan2_h = TanSquared(g.n_dot_h);
+      t.sqrt_lv = std::sqrt(g.n_dot_l * g.n_dot_v);
+      break;
     case Model::kLafortune:
-      return {models::Lafortune(g, 0.0, 1.0, shape), 0.0};
+      t.v_dot_r = g.v_dot_r;
+      break;
+    default:
+      t.tan2_l = TanSquared(g.n_dot_l);
+      t.tan2_v = TanSquared(g.n_dot_v);
+      t.cos2_h = g.n_dot_h * g.n_dot_h;
+      t.fresnel_weight = models::Pow5(1.0 - g.v_dot_h);
+      t.ggx_denom = 4.0 * g.n_dot_l * g.n_dot_v;
+      break;
+  }
+  return t;
+}
+
+// {models::Ward(g, 0, 1, shape), 0}, {models::Lafortune(g, 0, 1, shape), 0} and for ggx
+// {Ggx(g, 0, 1, shape) − Ggx(g, 0, 0, shape), Ggx(g, 0, 0, shape)}, the two GGX evaluations
+// sharing their shadowing and distribution; every operation as in brdf/core/models.h. g1_l is
+// GGX's light-side masking models::GgxG1(n·l, shape²) (one per slice: the caller keeps it).
+Parts PartsOf(Model family, const ShapeFreeTerms& t, double shape, double g1_l) {
+  switch (family) {
+    case Model::kWard: {
+      const double a2 = shape * shape;
+      return {0.0 * kInvPi + 1.0 * std::exp(-t.tan2_h / a2) / (4 * kPi * a2 * t.sqrt_lv), 0.0};
+    }
+    case Model::kLafortune: {
+      const double lobe = t.v_dot_r > 0 ? std::pow(t.v_dot_r, shape) : 0.0;
+      return {0.0 * kInvPi + 1.0 * (shape + 2.0) * (0.5 * kInvPi) * lobe, 0.0};
+    }
     default: {
-      const double off = models::Ggx(g, 0.0, 0.0, shape);
-      return {models::Ggx(g, 0.0, 1.0, shape) - off, off};
+      const double a2 = shape * shape;
+      const double shadowing = g1_l * (2.0 / (1.0 + std::sqrt(1.0 + a2 * t.tan2_v)));
+      const double dd = t.cos2_h * (a2 - 1.0) + 1.0;
+      const double d = a2 / (kPi * dd * dd);
+      const double fresnel_0 = 0.0 + (1.0 - 0.0) * t.fresnel_weight;
+      const double fresnel_1 = 1.0 + (1.0 - 1.0) * t.fresnel_weight;
+      const double off = 0.0 * kInvPi + fresnel_0 * shadowing * d / t.ggx_denom;
+      const double one = 0.0 * kInvPi + fresnel_1 * shadowing * d / t.ggx_denom;
+      return {one - off, off};
     }
   }
 }
@@ -84,6 +142,60 @@ struct FitPoint {
   ShadingGeometry g;
   std::array<double, 3> f;
 };
+
+// The three channels of a fit point as two pairs of doubles operated on lane by lane (GCC/Clang
+// vector extension, one SSE2 register each on x86-64): channels 0 and 1, then channel 2 and an
+// unused 0. Each lane does exactly the scalar operations, so a channel's sums are the doubles
+// the scalar loop gave. (A four-lane type is split by the compiler through the stack, which
+// made the accumulation wait on memory.)
+using Pair = double __attribute__((vector_size(16)));
+struct Lanes {
+  Pair lo{}, hi{};
+  double operator[](int c) const { return c < 2 ? lo[c] : hi[c - 2]; }
+  double& operator[](int c) { return c < 2 ? lo[c] : hi[c - 2]; }
+};
+inline Lanes operator*(const Lanes& a, double x) { return {a.lo * x, a.hi * x}; }
+inline Lanes operator*(const Lanes& a, const Lanes& b) { return {a.lo * b.lo, a.hi * b.hi}; }
+inline Lanes operator-(const Lanes& a, double x) { return {a.lo - x, a.hi - x}; }
+inline Lanes& operator+=(Lanes& a, const Lanes& b) {
+  a.lo += b.lo, a.hi += b.hi;
+  return a;
+}
+
+// What FitAtShape needs of the points besides the model's parts: each point's value f and
+// relative weight w = 1/(f + ε)² per channel and w·(1/π), and the sums that do not involve the
+// parts (Σ w/π² always, and Σ w·f/π and Σ w·f² for the families without an offset), each summed
+// in the points' order as FitAtShape summed it.
+struct FitData {
+  std::vector<Lanes> f, w, wx;
+  Lanes saa{}, sa{}, s{};
+  bool offset_free = false;
+};
+FitData FitDataOf(const std::vector<FitPoint>& pts, const std::array<double, 3>& eps,
+                  Model family) {
+  FitData d;
+  d.offset_free = family == Model::kWard || family == Model::kLafortune;
+  d.f.resize(pts.size());
+  d.w.resize(pts.size());
+  d.wx.resize(pts.size());
+  const double x = kInvPi;
+  for (std::size_t k = 0; k < pts.size(); ++k) {
+    const FitPoint& p = pts[k];
+    Lanes f{}, w{};
+    for (int c = 0; c < 3; ++c) {
+      f[c] = p.f[c];
+      w[c] = 1.0 / ((p.f[c] + eps[c]) * (p.f[c] + eps[c]));
+    }
+    const Lanes wx = w * x;
+    d.f[k] = f, d.w[k] = w, d.wx[k] = wx;
+    d.saa += wx * x;
+    if (d.offset_free) {
+      const Lanes y = f - 0.0;
+      d.sa += wx * y, d.s += w * y * y;
+    }
+  }
+  return d;
+}
 
 // Weighted least squares of kd, f0 ∈ [0, 1] for one channel: Σ w (kd/π + f0·a + b − f)².
 struct Normal {
@@ -114,28 +226,51 @@ struct Candidate {
   double shape = 0;
 };
 
-// PartsOf(family, p.g, shape) of every point: what a fit at one shape needs from the model,
+// PartsOf(family, point, shape) of every point: what a fit at one shape needs from the model,
 // independent of the values fitted.
-std::vector<Parts> PartsAtShape(Model family, const std::vector<FitPoint>& pts, double shape) {
-  std::vector<Parts> parts(pts.size());
-  for (std::size_t k = 0; k < pts.size(); ++k) parts[k] = PartsOf(family, pts[k].g, shape);
+std::vector<Parts> PartsAtShape(Model family, const std::vector<ShapeFreeTerms>& terms,
+                                double shape) {
+  std::vector<Parts> parts(terms.size());
+  // models::GgxG1(n·l) = 2/(1 + √(1 + α² tan²θl)) again only when tan²θl changes (its bits).
+  const double a2 = shape * shape;
+  std::uint64_t l_bits = 0;
+  double g1_l = 0;
+  for (std::size_t k = 0; k < terms.size(); ++k) {
+    if (family == Model::kGgx) {
+      const std::uint64_t bits = Bits(terms[k].tan2_l);
+      if (k == 0 || bits != l_bits)
+        g1_l = 2.0 / (1.0 + std::sqrt(1.0 + a2 * terms[k].tan2_l)), l_bits = bits;
+    }
+    parts[k] = PartsOf(family, terms[k], shape, g1_l);
+  }
   return parts;
 }
 
-double FitAtShape(const std::vector<FitPoint>& pts, const std::vector<Parts>& parts,
-                  const std::array<double, 3>& eps, double shape, Candidate* out) {
-  std::array<Normal, 3> n{};
-  for (std::size_t k = 0; k < pts.size(); ++k) {
-    const FitPoint& p = pts[k];
-    const Parts& q = parts[k];
-    const double x = kInvPi;
-    for (int c = 0; c < 3; ++c) {
-      const double w = 1.0 / ((p.f[c] + eps[c]) * (p.f[c] + eps[c]));
-      const double y = p.f[c] - q.offset;
-      n[c].saa += w * x * x, n[c].sab += w * x * q.y, n[c].sbb += w * q.y * q.y;
-      n[c].sa += w * x * y, n[c].sb += w * q.y * y, n[c].s += w * y * y;
+// The weighted normal equations Σ w (a/π + b·y + offset − f)² per channel at one shape, and
+// their bounded solution.
+double FitAtShape(const FitData& d, const std::vector<Parts>& parts, double shape,
+                  Candidate* out) {
+  const std::size_t count = d.f.size();
+  Lanes sab{}, sbb{}, sb{}, sa = d.sa, s = d.s;
+  if (d.offset_free) {
+    for (std::size_t k = 0; k < count; ++k) {
+      const double qy = parts[k].y;
+      const Lanes wq = d.w[k] * qy;
+      const Lanes y = d.f[k] - 0.0;
+      sab += d.wx[k] * qy, sbb += wq * qy, sb += wq * y;
+    }
+  } else {
+    for (std::size_t k = 0; k < count; ++k) {
+      const Parts& q = parts[k];
+      const Lanes wq = d.w[k] * q.y;
+      const Lanes y = d.f[k] - q.offset;
+      sab += d.wx[k] * q.y, sbb += wq * q.y;
+      sa += d.wx[k] * y, sb += wq * y, s += d.w[k] * y * y;
     }
   }
+  std::array<Normal, 3> n{};
+  for (int c = 0; c < 3; ++c)
+    n[c] = {d.saa[c], sab[c], sbb[c], sa[c], sb[c], s[c]};
   double total = 0;
   for (int c = 0; c < 3; ++c) total += SolveBounded(n[c], &out->a[c], &out->b[c]);
   out->shape = shape;
@@ -190,7 +325,6 @@ class SharedMap {
   std::map<Key, std::shared_ptr<const Table>> map_;
 };
 
-std::uint64_t Bits(double x) { return std::bit_cast<std::uint64_t>(x); }
 
 class SharedTables {
  public:
@@ -222,6 +356,28 @@ class SharedTables {
                     [&](const View& v, ShadingGeometry& g) {
                       if (v.theta_deg > theta_b_deg)
                         g = GeometryAt(theta_in_deg, theta_b_deg, v.phi_deg);
+                    });
+  }
+
+  // Where Fill's reciprocity reads the banded LUT (the measured slices with their band and the
+  // inserted ones, θin list `banded`) for the new slice at θin `t` whose views are `views`:
+  // Lut::TextureCoordinates(min(θout, θL), min(t, 90°), −φout) at every texel whose blend weight
+  // is below 1 (the others are left 0). They depend on the θin lists and the views alone; the
+  // trigonometry was most of a reciprocity read.
+  using Coordinates = std::array<double, 3>;
+  static std::shared_ptr<const std::vector<Coordinates>> ReciprocityAt(const Lut& banded, double t,
+                                                                       double last,
+                                                                       const ViewsPtr& views) {
+    using Key = std::tuple<std::vector<std::uint64_t>, std::uint64_t, std::uint64_t, const Views*>;
+    static SharedMap<Key, Derived<Coordinates>> coordinates(kMaxSlices);
+    std::vector<std::uint64_t> list(banded.theta_in_deg.size());
+    std::transform(banded.theta_in_deg.begin(), banded.theta_in_deg.end(), list.begin(), Bits);
+    return PerTexel(coordinates, Key{std::move(list), Bits(t), Bits(last), views.get()}, views,
+                    true, [&](const View& v, Coordinates& c) {
+                      const double to = std::min(v.theta_deg, 90.0);
+                      if (BlendWeight(to, last) < 1.0)
+                        c = banded.TextureCoordinates(std::min(to, last), std::min(t, 90.0),
+                                                      -v.phi_deg);
                     });
   }
 
@@ -277,13 +433,13 @@ using PointsKey = std::tuple<int, std::vector<std::uint64_t>, std::uint64_t, std
 std::shared_ptr<const std::vector<Parts>> SharedPartsAtShape(Model family,
                                                              const std::vector<double>& theta_in,
                                                              double theta_b,
-                                                             const std::vector<FitPoint>& pts,
+                                                             const std::vector<ShapeFreeTerms>& terms,
                                                              double shape) {
   static SharedMap<PointsKey, std::vector<Parts>> parts(128);
   std::vector<std::uint64_t> slices(theta_in.size());
   std::transform(theta_in.begin(), theta_in.end(), slices.begin(), Bits);
   return parts.Get({static_cast<int>(family), std::move(slices), Bits(theta_b), Bits(shape)}, [&] {
-    return std::make_shared<const std::vector<Parts>>(PartsAtShape(family, pts, shape));
+    return std::make_shared<const std::vector<Parts>>(PartsAtShape(family, terms, shape));
   });
 }
 
@@ -334,12 +490,11 @@ struct Ratio {
       const Mask* only = MaskAt(needs ? &needs->model : nullptr, theta_in_deg);
       g.m.resize(at.size());
       ForRows([&](int j) {
-        for (int i = 0; i < Lut::kWidth; ++i) {
-          const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
-          if (only && !(*only)[n]) continue;  // never read (left 0)
-          // FillModel::Eval at the cached geometry (the same numbers).
-          g.m[n] = detail::EvaluateFillModel(model->material, at[n]);
-        }
+        const std::size_t row = static_cast<std::size_t>(j) * Lut::kWidth;
+        // FillModel::Eval at the cached geometry (the same numbers); texels never read are
+        // left 0.
+        detail::EvaluateFillModelAt(model->material, &at[row], Lut::kWidth, &g.m[row],
+                                    [&](int i) { return only && !(*only)[row + i]; });
       });
     }
     return grids->emplace(key, std::move(g)).first->second;
@@ -364,11 +519,13 @@ struct Ratio {
 //   (1 − t)·f(θa)·M(θ)/M(θa) + t·f(θb)·M(θ)/M(θb)
 // with M at each slice's own view of that texel: linear in θin at equal (θd, φd) for M ≡ 1,
 // and following the model's change with θin otherwise.
-Lut Densify(const Lut& measured, double step, const Ratio& ratio) {
+// The result has room for `capacity_slices` slices (Fill appends its new slices).
+Lut Densify(Lut measured, double step, const Ratio& ratio, std::size_t capacity_slices) {
   const double delta = measured.DeltaInDeg();
   const int per = static_cast<int>(std::lround(delta / step));
   if (per <= 1) return measured;
   Lut out;
+  out.texels.reserve(capacity_slices * Lut::kHeight * Lut::kWidth * 3);
   out.Resize(static_cast<std::size_t>((measured.slices() - 1) * per + 1));
   for (int k = 0; k < out.slices(); ++k) {
     const double theta = k * step;
@@ -454,9 +611,20 @@ void LimitAlbedo(Lut* lut, int k, const SliceGrid& g, Filled filled, BeyondRepor
 // The fill of `measured` by `ratio` (no validation, no method choice).
 Lut Fill(const Lut& measured_in, double theta_b, double max_theta_in, double step,
          const Ratio& ratio, BeyondReport* report) {
-  Lut out = measured_in;
   const int k_meas = measured_in.slices();
   const double last = measured_in.theta_in_deg.back();
+  // Room for every slice of the result (a bound: the step of steps 2 and 3 below), so that
+  // appending the new slices copies nothing else.
+  const double step_out = step > 0 && std::lround(measured_in.DeltaInDeg() / step) > 1
+                              ? step
+                              : measured_in.DeltaInDeg();
+  const std::size_t capacity = static_cast<std::size_t>(std::max(
+      k_meas * std::max(1L, step > 0 ? std::lround(measured_in.DeltaInDeg() / step) : 1L),
+      step_out > 0 ? static_cast<long>(std::floor(max_theta_in / step_out + 1e-9)) + 1 : 0L));
+  Lut out;
+  out.theta_in_deg = measured_in.theta_in_deg;
+  out.texels.reserve(capacity * Lut::kHeight * Lut::kWidth * 3);
+  out.texels = measured_in.texels;
   // 1. The θout band of the measured slices.
   for (int k = 0; k < k_meas; ++k) {
     const double t = measured_in.theta_in_deg[k];
@@ -466,14 +634,20 @@ Lut Fill(const Lut& measured_in, double theta_b, double max_theta_in, double ste
     const Material& model = ratio.model->material;
     const Mask* only = MaskAt(ratio.needs ? &ratio.needs->texels : nullptr, t);
     ForRows([&](int j) {
+      const std::size_t row = static_cast<std::size_t>(j) * Lut::kWidth;
+      const auto skip = [&](int i) {
+        const View& v = g.view()[row + i];
+        // Not in the band, or neither read nor in the slice's albedo (θout < 90°), which
+        // scales the band below.
+        return v.theta_deg <= theta_b || (only && !(*only)[row + i] && v.theta_deg >= 90.0);
+      };
+      // FillModel::Eval(t, θb, φout) at the shared geometry (the same numbers).
+      std::array<std::array<double, 3>, Lut::kWidth> at_band;
+      detail::EvaluateFillModelAt(model, &(*band)[row], Lut::kWidth, at_band.data(), skip);
       for (int i = 0; i < Lut::kWidth; ++i) {
-        const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
-        const View v = g.view()[n];
-        if (v.theta_deg <= theta_b) continue;
-        // Neither read nor in the slice's albedo (θout < 90°), which scales the band below.
-        if (only && !(*only)[n] && v.theta_deg >= 90.0) continue;
-        // FillModel::Eval(t, θb, φout) at the shared geometry (the same numbers).
-        const auto r = RatioOf(g.m[n], detail::EvaluateFillModel(model, (*band)[n]));
+        if (skip(i)) continue;
+        const std::size_t n = row + static_cast<std::size_t>(i);
+        const auto r = RatioOf(g.m[n], at_band[static_cast<std::size_t>(i)]);
         float* f = out.Texel(k, j, i);
         for (int c = 0; c < 3; ++c) f[c] = static_cast<float>(f[c] * r[c]);
       }
@@ -483,7 +657,7 @@ Lut Fill(const Lut& measured_in, double theta_b, double max_theta_in, double ste
   }
   // 2. Slices between the measured ones, when the step is finer.
   if (step > 0) {
-    out = Densify(out, step, ratio);
+    out = Densify(std::move(out), step, ratio, capacity);
     for (double t : out.theta_in_deg)
       if (std::none_of(measured_in.theta_in_deg.begin(), measured_in.theta_in_deg.end(),
                        [&](double m) { return std::fabs(m - t) < 1e-6; }))
@@ -491,47 +665,54 @@ Lut Fill(const Lut& measured_in, double theta_b, double max_theta_in, double ste
   }
   const int k_meas_step = out.slices();
   const double delta = out.DeltaInDeg();
-  const Lut banded = out;  // measured slices with their band: what reciprocity reads
-  // 3. New slices beyond the last measured one.
+  // 3. New slices beyond the last measured one, made in `added` (slice q is slice
+  // k_meas_step + q of the result) while `out` is the banded LUT (the measured slices with their
+  // band, and the inserted ones) that reciprocity reads; appended to it at the end.
+  const Lut& banded = out;
   const int k_total = static_cast<int>(std::floor(max_theta_in / delta + 1e-9)) + 1;
-  // One allocation for the new slices (growing slice by slice copied the LUT each time).
-  out.texels.reserve(static_cast<std::size_t>(std::max(k_total, k_meas_step)) * Lut::kHeight *
-                     Lut::kWidth * 3);
+  Lut added;
+  added.Resize(static_cast<std::size_t>(std::max(0, k_total - k_meas_step)));
   for (int k = k_meas_step; k < k_total; ++k) {
     const double t = k * delta;
-    out.theta_in_deg.push_back(t);
-    out.texels.resize(static_cast<std::size_t>(k + 1) * Lut::kHeight * Lut::kWidth * 3);
+    const int q = k - k_meas_step;
+    added.theta_in_deg[static_cast<std::size_t>(q)] = t;
     const SliceGrid& g = ratio.Prepare(t);
     const SliceGrid& g_below = ratio.Prepare(t - delta);
     const Mask* only = MaskAt(ratio.needs ? &ratio.needs->texels : nullptr, t);
+    const auto reciprocity = SharedTables::ReciprocityAt(banded, t, last, g.views);
     ForRows([&](int j) {
       for (int i = 0; i < Lut::kWidth; ++i) {
         const std::size_t n = static_cast<std::size_t>(j) * Lut::kWidth + i;
         if (only && !(*only)[n]) continue;  // never read (left 0)
         const View v = g.view()[n];
         const double to = std::min(v.theta_deg, 90.0);
-        const double w = std::clamp((to - (last - kBlendDeg)) / (2 * kBlendDeg), 0.0, 1.0);
+        const double w = BlendWeight(to, last);
         std::array<double, 3> value{};
         if (w < 1.0) {
-          const auto f = banded.SampleTexture(std::min(to, last), std::min(t, 90.0), -v.phi_deg);
+          // banded.SampleTexture(min(θout, θL), min(t, 90°), −φout) at the shared coordinates.
+          const auto& at = (*reciprocity)[n];
+          const auto f = banded.SampleTrilinear(at[0], at[1], at[2]);
           for (int c = 0; c < 3; ++c) value[c] = (1.0 - w) * f[c];
         }
         if (w > 0.0) {
           const auto r = ratio.Between(g, g_below, n);
-          const float* f = out.Texel(k - 1, j, i);
+          const float* f = q == 0 ? out.Texel(k - 1, j, i) : added.Texel(q - 1, j, i);
           for (int c = 0; c < 3; ++c) value[c] += w * f[c] * r[c];
         }
-        float* dst = out.Texel(k, j, i);
+        float* dst = added.Texel(q, j, i);
         for (int c = 0; c < 3; ++c) dst[c] = static_cast<float>(value[c]);
       }
     });
     // Column 360 repeats column 0 (docs/design.md §5).
     for (int j = 0; j < Lut::kHeight; ++j)
-      std::copy_n(out.Texel(k, j, 0), 3, out.Texel(k, j, Lut::kWidth - 1));
+      std::copy_n(added.Texel(q, j, 0), 3, added.Texel(q, j, Lut::kWidth - 1));
     LimitAlbedo(
-        &out, k, g, [](int, int, const View&) { return true; }, report);
+        &added, q, g, [](int, int, const View&) { return true; }, report);
     report->extrapolated_theta_in_deg.push_back(t);
   }
+  out.theta_in_deg.insert(out.theta_in_deg.end(), added.theta_in_deg.begin(),
+                          added.theta_in_deg.end());
+  out.texels.insert(out.texels.end(), added.texels.begin(), added.texels.end());
   return out;
 }
 
@@ -803,11 +984,14 @@ FillModel FitFillModel(const Lut& lut, double theta_b, Model family) {
   std::array<double, 3> eps{};
   const double all = (mean[0] + mean[1] + mean[2]) / (3.0 * std::max<std::size_t>(pts.size(), 1));
   for (int c = 0; c < 3; ++c) eps[c] = 0.02 * all + 1e-6;
+  const FitData data = FitDataOf(pts, eps, family);
+  std::vector<ShapeFreeTerms> terms(pts.size());
+  for (std::size_t k = 0; k < pts.size(); ++k) terms[k] = ShapeFreeTermsOf(family, pts[k].g);
   // The grid's shapes and the golden section's first two (set by the best grid shape alone) are
   // shared; the later ones depend on the values fitted and are computed here.
   const auto fit_at = [&](double shape, Candidate* out, bool shared = true) {
-    if (!shared) return FitAtShape(pts, PartsAtShape(family, pts, shape), eps, shape, out);
-    return FitAtShape(pts, *SharedPartsAtShape(family, lut.theta_in_deg, theta_b, pts, shape), eps,
+    if (!shared) return FitAtShape(data, PartsAtShape(family, terms, shape), shape, out);
+    return FitAtShape(data, *SharedPartsAtShape(family, lut.theta_in_deg, theta_b, terms, shape),
                       shape, out);
   };
   const bool lafortune = family == Model::kLafortune;
@@ -850,7 +1034,8 @@ FillModel FitFillModel(const Lut& lut, double theta_b, Model family) {
   std::vector<double> rel;
   rel.reserve(pts.size() * 3);
   for (const FitPoint& p : pts) {
-    const Rgb m = models::EvaluateRgb(family, p.g, out.material.values.data());
+    // models::EvaluateRgb(family, p.g, …), its shape terms once for the three channels.
+    const std::array<double, 3> m = detail::EvaluateFillModel(out.material, p.g);
     for (int c = 0; c < 3; ++c) rel.push_back(std::fabs(m[c] - p.f[c]) / std::max(p.f[c], 1e-3));
   }
   if (!rel.empty()) {

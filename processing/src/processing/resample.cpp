@@ -85,8 +85,11 @@ void ResampleOptions::Validate() const {
                           std::to_string(neighbours));
 }
 
-std::vector<LutInputProblem> FindLutInputProblems(const Measurement& m,
-                                                  const ResampleOptions& options) {
+namespace {
+
+// FindLutInputProblems's checks: the θin list's, then (when `samples`) the samples'.
+std::vector<LutInputProblem> FindProblems(const Measurement& m, const ResampleOptions& options,
+                                          bool samples) {
   using Kind = LutInputProblem::Kind;
   std::vector<LutInputProblem> out;
   const auto add = [&](Kind kind, int slice, std::string message) {
@@ -129,6 +132,7 @@ std::vector<LutInputProblem> FindLutInputProblems(const Measurement& m,
           -1, text.compare(0, prefix.size(), prefix) == 0 ? text.substr(prefix.size()) : text);
     }
   }
+  if (!samples) return out;
   float theta_b = 0;
   for (std::size_t i = 0; i < m.slices.size(); ++i) {
     const Slice& s = m.slices[i];
@@ -182,6 +186,18 @@ std::vector<LutInputProblem> FindLutInputProblems(const Measurement& m,
         "every valid sample is at θout = 0° (measured range θout 0°–0°): there is nothing to "
         "interpolate or extrapolate from");
   return out;
+}
+
+}  // namespace
+
+std::vector<LutInputProblem> FindLutInputProblems(const Measurement& m,
+                                                  const ResampleOptions& options) {
+  return FindProblems(m, options, true);
+}
+
+std::vector<LutInputProblem> FindThetaInProblems(const Measurement& m,
+                                                 const ResampleOptions& options) {
+  return FindProblems(m, options, false);
 }
 
 Lut BuildLut(const Measurement& measurement, const ExtrapolationParams& params,

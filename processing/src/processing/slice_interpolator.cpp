@@ -98,13 +98,16 @@ double BoundCos(const Sample& s) {
 
 }  // namespace
 
+// Both checks below read the bound v·cosθout > kMaxFrCosPerSr only for v above it: cosθout
+// (BoundCos) is in (0, 1], so v·cosθout ≤ v exactly (rounding is monotone) and a value at
+// most kMaxFrCosPerSr never exceeds the bound. The cosine, most of a sample's check, is then
+// computed only for values above 10⁵ 1/sr; the outcome is the same for every sample.
 double NegativeAllowance(const Slice& slice) {
   double peak = 0;
   for (const Sample& s : slice.samples) {
     if (s.flags & kFlagInvalid) continue;
-    const double c = BoundCos(s);
     for (float v : s.rgb)
-      if (std::isfinite(v) && v * c <= kMaxFrCosPerSr)
+      if (std::isfinite(v) && (v <= kMaxFrCosPerSr || v * BoundCos(s) <= kMaxFrCosPerSr))
         peak = std::max(peak, static_cast<double>(v));
   }
   return std::max(kNegativeFloorPerSr, kNegativeFractionOfPeak * peak);
@@ -118,13 +121,12 @@ const char* SampleDefect(const Sample& s, std::optional<double> negative_allowan
   for (int c = 0; c < 3; ++c)
     if (!std::isfinite(s.rgb[c])) return kNotFinite[c];
   if (!negative_allowance) return nullptr;
-  const double cos_out = BoundCos(s);
   for (int c = 0; c < 3; ++c) {
     const double v = s.rgb[c];
     // σ widens the allowance only when it is a finite, non-negative number.
     const double sigma = s.sigma[c] >= 0.0f && std::isfinite(s.sigma[c]) ? s.sigma[c] : 0.0;
     if (v < -std::max(*negative_allowance, kNegativeSigmas * sigma)) return kTooNegative[c];
-    if (v * cos_out > kMaxFrCosPerSr) return kTooLarge[c];
+    if (v > kMaxFrCosPerSr && v * BoundCos(s) > kMaxFrCosPerSr) return kTooLarge[c];
   }
   return nullptr;
 }

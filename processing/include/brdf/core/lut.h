@@ -70,6 +70,13 @@ struct Lut {
   // SampleTexture from there on, so equal inputs give the same bits.
   std::array<float, 3> SampleTextureFrame(double cos_in, double sin_in, double slice, double x,
                                           double y, double z) const;
+  // The normalised coordinates (u, v, w) SampleTexture and SampleTextureFrame pass to
+  // SampleTrilinear: they depend on the θin list alone, not on the texels, so a loop that reads
+  // the same places of many LUTs (the blind-spot fill of a batch) computes them once.
+  std::array<double, 3> TextureCoordinates(double theta_in_deg, double theta_out_deg,
+                                           double phi_out_deg) const;
+  std::array<double, 3> TextureCoordinatesFrame(double cos_in, double sin_in, double slice,
+                                                double x, double y, double z) const;
   // The fractional slice coordinate of `theta_in_deg` (k + t), before clamping: θin/Δin for a
   // k·Δin list, piecewise linear between entries otherwise.
   double SliceCoordinate(double theta_in_deg) const;

@@ -144,6 +144,12 @@ struct LutInputProblem {
 // measurement.
 std::vector<LutInputProblem> FindLutInputProblems(const Measurement& measurement,
                                                   const ResampleOptions& options = {});
+// The θin-list part of FindLutInputProblems alone (kThetaInOutOfRange, kDuplicateThetaIn,
+// kThetaInNotUniform; kNoSlices for no slice), without the samples' checks: for a caller that
+// has checked the samples already with other θin rules (sources::AssessCapture asks whether the
+// slices it accepted are k·Δin).
+std::vector<LutInputProblem> FindThetaInProblems(const Measurement& measurement,
+                                                 const ResampleOptions& options = {});
 
 // Builds the LUT of docs/design.md §5 from `measurement` with the §6 extrapolation `params`.
 // Requirements (InvalidArgument otherwise, naming the sample and what is wrong):
