@@ -85,10 +85,13 @@ TEST(PreviewIbl, WhiteFurnaceEngineAndTrueImagesEqualTheAlbedoOfACaptureLut) {
   ExpectFurnaceEqualsAlbedo(*capture.brdf, 0.005);
 }
 
-TEST(PreviewIbl, EngineImageOfAGgxMaterialNearTheNormalIsWithin5PercentOfTheTruth) {
-  // Near the normal the split sum's assumption n = v = R holds and α_eq ≈ α: the engine's image
-  // must be close to the environment-lit truth there. Measured 3.4 % RMS over μ ≥ 0.9 (gold,
-  // studio, 96²); α_eq scaled by 1.1 gives 9.4 %, by 0.9 8.1 % (docs/preview.md).
+TEST(PreviewIbl, EngineImageOfAGgxMaterialNearTheNormalIsWithin10PercentOfTheTruth) {
+  // Near the normal the split sum's assumption n = v = R holds: the engine's image must be close
+  // to the environment-lit truth there. With the one-lobe pack this was 3.4 % RMS over μ ≥ 0.9
+  // (gold, studio, 96²); the two-lobe pack describes one GGX lobe as a sharp core plus a broad
+  // skirt (α = 0.2: α_eq 0.17, broad_alpha 0.31; tests/core/ibl_pack_test.cpp), which costs this
+  // case 8.2 % while the measured materials gain (ibl_browser: pooled p95 17.1 → 7.9 %);
+  // docs/benchmarks/ibl.md.
   const AnalyticBrdf gold(Material::Make(
       Model::kGgx, {{0, 0, 0}, {0.962585, 0.786916, 0.40822}, {0.15, 0.15, 0.15}}, "gold"));
   const EnvironmentMap studio = EnvironmentMap::Studio();
@@ -113,7 +116,7 @@ TEST(PreviewIbl, EngineImageOfAGgxMaterialNearTheNormalIsWithin5PercentOfTheTrut
     }
   ASSERT_GT(n, 500);
   const double relative_rms = std::sqrt(sum_sq / n) / (sum / n);
-  EXPECT_LT(relative_rms, 0.05);
+  EXPECT_LT(relative_rms, 0.10);
 }
 
 }  // namespace
