@@ -21,18 +21,22 @@ ShadingGeometry RandomGeometry(std::mt19937_64& rng) {
                              SphericalDirectionDeg(theta(rng), phi(rng)));
 }
 
+// A material of `family` with random diffuse and specular colours in [0, 1) and `shape`.
+Material RandomMaterial(Model family, double shape, std::mt19937_64& rng) {
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  return Material::Make(family,
+                        {Rgb{unit(rng), unit(rng), unit(rng)}, Rgb{unit(rng), unit(rng), unit(rng)},
+                         Rgb{shape, shape, shape}},
+                        "fill");
+}
+
 void ExpectSameBits(Model family, double shape_lo, double shape_hi) {
   std::mt19937_64 rng(20261202);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
   std::uniform_real_distribution<double> log_shape(std::log(shape_lo), std::log(shape_hi));
   int compared = 0;
   for (int trial = 0; trial < 20000; ++trial) {
     const double shape = std::exp(log_shape(rng));
-    const Material m =
-        Material::Make(family,
-                       {Rgb{unit(rng), unit(rng), unit(rng)}, Rgb{unit(rng), unit(rng), unit(rng)},
-                        Rgb{shape, shape, shape}},
-                       "fill");
+    const Material m = RandomMaterial(family, shape, rng);
     const ShadingGeometry g = RandomGeometry(rng);
     const Rgb want = models::EvaluateRgb(family, g, m.values.data());
     const std::array<double, 3> got = EvaluateFillModel(m, g);
@@ -64,11 +68,7 @@ void ExpectRowsSameBits(Model family, double shape_lo, double shape_hi) {
   int compared = 0;
   for (int trial = 0; trial < 300; ++trial) {
     const double shape = std::exp(log_shape(rng));
-    const Material m =
-        Material::Make(family,
-                       {Rgb{unit(rng), unit(rng), unit(rng)}, Rgb{unit(rng), unit(rng), unit(rng)},
-                        Rgb{shape, shape, shape}},
-                       "fill");
+    const Material m = RandomMaterial(family, shape, rng);
     std::vector<ShadingGeometry> g(kRow);
     std::vector<bool> skip(kRow);
     double theta_in = theta(rng);
@@ -86,8 +86,8 @@ void ExpectRowsSameBits(Model family, double shape_lo, double shape_hi) {
                                : models::EvaluateRgb(family, g[k], m.values.data());
       for (int c = 0; c < 3; ++c) {
         ASSERT_EQ(std::bit_cast<std::uint64_t>(got[k][c]), std::bit_cast<std::uint64_t>(want[c]))
-            << ModelName(family) << " shape " << shape << " entry " << k << " channel " << c
-            << ": " << got[k][c] << " against " << want[c];
+            << ModelName(family) << " shape " << shape << " entry " << k << " channel " << c << ": "
+            << got[k][c] << " against " << want[c];
         compared += !skip[k] && want[c] > 0;
       }
     }

@@ -158,18 +158,22 @@ double IblSpecularShift(double alpha_eq, double mu) {
   return std::clamp(alpha_eq, 0.0, 1.0) * (1.0 - std::clamp(mu, 0.0, 1.0));
 }
 
-Vec3 IblSpecularDirection(const Vec3& n, const Vec3& v, double alpha_eq) {
+namespace {
+// normalize(mix(R, n, s)) with R = 2(n·v)n − v and s = shift(n·v): both lobes' lookup.
+template <typename Shift>
+Vec3 MixedReflection(const Vec3& n, const Vec3& v, Shift shift) {
   const double mu = Dot(n, v);
   const Vec3 r = n * (2.0 * mu) - v;
-  const double s = IblSpecularShift(alpha_eq, mu);
-  return Normalize(r + (n - r) * s);
+  return Normalize(r + (n - r) * shift(mu));
+}
+}  // namespace
+
+Vec3 IblSpecularDirection(const Vec3& n, const Vec3& v, double alpha_eq) {
+  return MixedReflection(n, v, [&](double mu) { return IblSpecularShift(alpha_eq, mu); });
 }
 
 Vec3 IblBroadDirection(const Vec3& n, const Vec3& v, double broad_alpha) {
-  const double mu = Dot(n, v);
-  const Vec3 r = n * (2.0 * mu) - v;
-  const double s = std::clamp(broad_alpha, 0.0, 1.0);
-  return Normalize(r + (n - r) * s);
+  return MixedReflection(n, v, [&](double) { return std::clamp(broad_alpha, 0.0, 1.0); });
 }
 
 IblPack::Row IblPack::At(double m) const {
@@ -272,8 +276,8 @@ double ResponseNorm(const Moments& m) {
 // to `max_alpha` (the sharp lobe is the narrower one), then (with `refine`) golden-section
 // refinement in log α between the best node's neighbours. *value the criterion at the α
 // returned.
-double FitSharpAlpha(const Moments& luma, const Bands& p_mu, const Responses& q,
-                     double max_alpha, bool refine, double* value) {
+double FitSharpAlpha(const Moments& luma, const Bands& p_mu, const Responses& q, double max_alpha,
+                     bool refine, double* value) {
   const int stride = refine ? 1 : 2;
   const KappaTable& table = Kappa();
   const double max_la = std::log(std::clamp(max_alpha, IblPack::kMinAlpha, 1.0));
@@ -379,7 +383,8 @@ void FitLobes(const std::vector<RowMoments>& rows, IblPack* pack) {
     const Bands ks = GgxPrefilterLegendre(alpha);
     for (int c = 0; c < 3; ++c) {
       double sc = 0.0;
-      if (r.channel[c].e > 0.0) Criterion(r.channel[c], q, ks, r.p_mu, BroadResidual(r.channel[c], q), &sc);
+      if (r.channel[c].e > 0.0)
+        Criterion(r.channel[c], q, ks, r.p_mu, BroadResidual(r.channel[c], q), &sc);
       pack->specular[i][c] = sc;
       pack->diffuse[i][c] = std::max(0.0, r.channel[c].e - sc);
     }
