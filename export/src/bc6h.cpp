@@ -263,7 +263,7 @@ struct BlockInput {
   float h[16][3];
   float t[16][3];
   float w[16][3];
-  float r[16][3];  // √w: a channel's half steps in half steps of the texel's largest channel
+  float r[16][3];   // √w: a channel's half steps in half steps of the texel's largest channel
   float hs[3][16];  // h by channel
   double wd[16][4], td[16][4];  // w and t as doubles (exact), lane 3 zero: the refit's inputs
 };
@@ -450,7 +450,8 @@ void TryMode(const Mode& mode, int partition, Endpoints ends, QuantizedEnds& fir
                          (mask >> (4 * g + 2)) & 1, (mask >> (4 * g + 3)) & 1};
       const I4 second = -lane_subset;  // all bits set in the lanes of subset 1
       const auto pick = [&](float v0, float v1) {
-        const I4 a = std::bit_cast<I4>(F4{v0, v0, v0, v0}), b = std::bit_cast<I4>(F4{v1, v1, v1, v1});
+        const I4 a = std::bit_cast<I4>(F4{v0, v0, v0, v0}),
+                 b = std::bit_cast<I4>(F4{v1, v1, v1, v1});
         return std::bit_cast<F4>((a & ~second) | (b & second));
       };
       F4 p = {};

@@ -2,8 +2,8 @@
 // every view and has no specular part; a GGX material's albedo against a brute-force quadrature
 // in the normal frame (tests/brute_force_albedo.h, a different grid from the pack's); at views near
 // the normal, where the split sum's assumption n = v = R holds, the two lobes fitted to a GGX lobe
-// bracket its α and keep its kernel's spectrum; the kernel's Legendre coefficients against the closed form of the limit α → 0 and a direct
-// sum.
+// bracket its α and keep its kernel's spectrum; the kernel's Legendre coefficients against the
+// closed form of the limit α → 0 and a direct sum.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -122,9 +122,9 @@ TEST(IblPack, TwoLobesOfAGgxLobeBracketItsAlphaAndKeepItsSpectrumNearTheNormal) 
   // with two GGX kernels, the broad lobe's α_b (one per material, fitted over all views, where
   // the horizon clips and shifts the lobe) and the sharp one's α_s per row: near the normal they
   // must bracket α (α_s ≤ α ≤ α_b, 5 % allowed for the table's interpolation in log α), and
-  // their mix about R, B·κ_ℓ(α_b)·P_ℓ(R·R_b) + S·κ_ℓ(α_s), must have the spectrum of E·κ_ℓ(α), the kernel's
-  // own coefficients by a direct sum, within 0.06 for ℓ = 1…4 (the G factor, and α_b: one per
-  // material, fitted over every view, it makes the mix up to 0.053 broader than the kernel at
+  // their mix about R, B·κ_ℓ(α_b)·P_ℓ(R·R_b) + S·κ_ℓ(α_s), must have the spectrum of E·κ_ℓ(α), the
+  // kernel's own coefficients by a direct sum, within 0.06 for ℓ = 1…4 (the G factor, and α_b: one
+  // per material, fitted over every view, it makes the mix up to 0.053 broader than the kernel at
   // α = 0.2 near the normal); most of the energy goes to the sharp lobe.
   for (double alpha : {0.05, 0.1, 0.2}) {
     const IblPack pack = ComputeIblPack(Ggx(0.0, 1.0, alpha));
@@ -133,7 +133,7 @@ TEST(IblPack, TwoLobesOfAGgxLobeBracketItsAlphaAndKeepItsSpectrumNearTheNormal) 
     EXPECT_GE(pack.broad_alpha, 0.95 * alpha);
     for (int i = IblPack::kRows - 4; i < IblPack::kRows; ++i) {
       SCOPED_TRACE(::testing::Message() << "alpha " << alpha << " mu " << pack.mu[i] << " alpha_b "
-                                      << pack.broad_alpha << " alpha_s " << pack.alpha[i]);
+                                        << pack.broad_alpha << " alpha_s " << pack.alpha[i]);
       EXPECT_LE(pack.alpha[i], 1.05 * alpha);
       const double mu = pack.mu[i], e = pack.albedo[i][0];
       const Vec3 n = {0, 0, 1}, v = {std::sqrt(1 - mu * mu), 0, mu};
@@ -244,7 +244,8 @@ TEST(IblPack, BroadDirectionMovesTheMirrorDirectionTowardTheNormalByAlpha) {
       const double t = theta_deg * kPi / 180.0;
       const Vec3 v = {std::sin(t), 0.0, std::cos(t)};
       const Vec3 r = IblBroadDirection(n, v, alpha);
-      const double want = std::atan2((1.0 - alpha) * std::sin(t), (1.0 - alpha) * std::cos(t) + alpha);
+      const double want =
+          std::atan2((1.0 - alpha) * std::sin(t), (1.0 - alpha) * std::cos(t) + alpha);
       EXPECT_NEAR(std::atan2(-r.x, r.z), want, 1e-12) << alpha << " " << theta_deg;
       EXPECT_NEAR(r.x * r.x + r.y * r.y + r.z * r.z, 1.0, 1e-12);
     }

@@ -324,7 +324,8 @@ float3 GetSkyLightReflection(float3 ReflectionVector, float Roughness, out float
 #include ")") +
         ush + "\"\n" +
         "float3 CustomExpression1(Texture2D IblPack, SamplerState IblPackSampler, float IblRow, "
-        "float3 IblDiffuse0, float3 IblDiffuse1, float3 IblDiffuse2, float IblBroadAlpha, float3 N, "
+        "float3 IblDiffuse0, float3 IblDiffuse1, float3 IblDiffuse2, float IblBroadAlpha, float3 "
+        "N, "
         "float3 V) {\n  " +
         m[1].str() + "\n}\n" + R"(
 Texture2D Material_Texture2D_0; SamplerState Material_Texture2D_0Sampler;

@@ -110,8 +110,8 @@ std::array<float, 3> Lut::SampleTextureFrame(double cos_in, double sin_in, doubl
   return SampleTrilinear(c[0], c[1], c[2]);
 }
 
-std::array<double, 3> Lut::TextureCoordinatesFrame(double cos_in, double sin_in, double k,
-                                                   double x, double y, double z) const {
+std::array<double, 3> Lut::TextureCoordinatesFrame(double cos_in, double sin_in, double k, double x,
+                                                   double y, double z) const {
   const Vec3 w_d = SpecularFrame{cos_in, sin_in}.ToSpecular({x, y, z});
   const double theta_d = RadToDeg(ThetaOf(w_d));
   const double phi_d = RadToDeg(PhiOf(w_d));

@@ -76,8 +76,8 @@ struct Parts {
 // A fit tries 30 shapes at the same points; these are computed once per point.
 struct ShapeFreeTerms {
   double tan2_l = 0, tan2_v = 0, cos2_h = 0, fresnel_weight = 0, ggx_denom = 0;  // ggx
-  double tan2_h = 0, sqrt_lv = 0;                                               // ward
-  double v_dot_r = 0;                                                           // lafortune
+  double tan2_h = 0, sqrt_lv = 0;                                                // ward
+  double v_dot_r = 0;                                                            // lafortune
 };
 double TanSquared(double cos_theta) {  // models::GgxG1's and Ward's tan²
   const double cos2 = cos_theta * cos_theta;
@@ -248,8 +248,7 @@ std::vector<Parts> PartsAtShape(Model family, const std::vector<ShapeFreeTerms>&
 
 // The weighted normal equations Σ w (a/π + b·y + offset − f)² per channel at one shape, and
 // their bounded solution.
-double FitAtShape(const FitData& d, const std::vector<Parts>& parts, double shape,
-                  Candidate* out) {
+double FitAtShape(const FitData& d, const std::vector<Parts>& parts, double shape, Candidate* out) {
   const std::size_t count = d.f.size();
   Lanes sab{}, sbb{}, sb{}, sa = d.sa, s = d.s;
   if (d.offset_free) {
@@ -269,8 +268,7 @@ double FitAtShape(const FitData& d, const std::vector<Parts>& parts, double shap
     }
   }
   std::array<Normal, 3> n{};
-  for (int c = 0; c < 3; ++c)
-    n[c] = {d.saa[c], sab[c], sbb[c], sa[c], sb[c], s[c]};
+  for (int c = 0; c < 3; ++c) n[c] = {d.saa[c], sab[c], sbb[c], sa[c], sb[c], s[c]};
   double total = 0;
   for (int c = 0; c < 3; ++c) total += SolveBounded(n[c], &out->a[c], &out->b[c]);
   out->shape = shape;
@@ -324,7 +322,6 @@ class SharedMap {
   std::mutex mutex_;
   std::map<Key, std::shared_ptr<const Table>> map_;
 };
-
 
 class SharedTables {
  public:
@@ -430,11 +427,9 @@ class SharedTables {
 // the batch. The shape grid is fixed, so its parts are shared like the tables above (about
 // 200 KB per shape for a capture; 18 shapes per family and point set).
 using PointsKey = std::tuple<int, std::vector<std::uint64_t>, std::uint64_t, std::uint64_t>;
-std::shared_ptr<const std::vector<Parts>> SharedPartsAtShape(Model family,
-                                                             const std::vector<double>& theta_in,
-                                                             double theta_b,
-                                                             const std::vector<ShapeFreeTerms>& terms,
-                                                             double shape) {
+std::shared_ptr<const std::vector<Parts>> SharedPartsAtShape(
+    Model family, const std::vector<double>& theta_in, double theta_b,
+    const std::vector<ShapeFreeTerms>& terms, double shape) {
   static SharedMap<PointsKey, std::vector<Parts>> parts(128);
   std::vector<std::uint64_t> slices(theta_in.size());
   std::transform(theta_in.begin(), theta_in.end(), slices.begin(), Bits);

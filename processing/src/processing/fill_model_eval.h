@@ -106,7 +106,8 @@ void EvaluateFillModelAt(const Material& material, const ShadingGeometry* g, int
       bool have = false;
       each([&](const double* q, const ShadingGeometry& at) {
         const std::uint64_t bits = std::bit_cast<std::uint64_t>(at.n_dot_l);
-        if (!have || bits != l_bits) g1_l = models::GgxG1(at.n_dot_l, a2), l_bits = bits, have = true;
+        if (!have || bits != l_bits)
+          g1_l = models::GgxG1(at.n_dot_l, a2), l_bits = bits, have = true;
         return GgxFill(q, at, g1_l);
       });
       break;

@@ -61,8 +61,8 @@
 // α_eq = 1 (with any α_b).
 //
 // What an engine reads (one pack fetch per pixel, two probe fetches): the broad part D as a
-// quadratic in t = 1 − μ, D_fit(μ) = c0 + c1·t + c2·t², three RGB constants per material fitted by least
-// squares, per channel, to the split's D rows (`diffuse`); and per row S_i = E_i − D_fit(μ_i)
+// quadratic in t = 1 − μ, D_fit(μ) = c0 + c1·t + c2·t², three RGB constants per material fitted by
+// least squares, per channel, to the split's D rows (`diffuse`); and per row S_i = E_i − D_fit(μ_i)
 // (`specular`, stored with α_eq in one texel), so that D_fit + S = E exactly at every texel
 // centre and the white furnace holds whatever the quadratic's error. S_i may then be slightly
 // negative where D_fit lies above E (a Lambertian's S is D_i − D_fit(μ_i), rounding-small);
